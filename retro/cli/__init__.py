@@ -1,0 +1,47 @@
+"""The `retro` command line: parse, call one function, print.
+
+Each subcommand lives in its own module in this package and exposes
+`register(subparsers)`, which adds its parser and sets `func(args) -> int`.
+Every RetroError becomes one line on stderr and its exit code; argparse usage errors exit 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from retro.errors import RetroError
+
+# Module names inside retro.cli, in the order `retro --help` lists them.
+COMMAND_MODULES = ["asm", "run", "demo"]
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # one line, exit 2, no usage dump
+        print(f"{self.prog}: {message}", file=sys.stderr)
+        raise SystemExit(2)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="retro", description="Collision detection on retro hardware (C64, NES).")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+    for name in COMMAND_MODULES:
+        importlib.import_module(f"retro.cli.{name}").register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except RetroError as exc:
+        print(f"retro {args.command}: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print(f"retro {args.command}: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return 1

@@ -1,0 +1,35 @@
+"""`retro asm FILE.s [-o OUT.prg] [--labels OUT.lbl] [--list OUT.lst]`"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from retro.assembler import assemble_file
+from retro.fileio import write_atomic
+from retro.program import format_vice_labels, prg_bytes
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("asm", help="assemble a 6502 source (Ophis syntax) into a PRG and a VICE label file")
+    p.add_argument("source", metavar="FILE.s")
+    p.add_argument("-o", "--output", metavar="OUT.prg", help="PRG to write (default: FILE.prg)")
+    p.add_argument("--labels", metavar="OUT.lbl", help="VICE label file to write")
+    p.add_argument("--list", dest="listing", metavar="OUT.lst", help="listing to write")
+    p.set_defaults(func=run_asm)
+
+
+def run_asm(args: argparse.Namespace) -> int:
+    program = assemble_file(args.source)
+    output = Path(args.output) if args.output else Path(args.source).with_suffix(".prg")
+    write_atomic(output, prg_bytes(program))
+    written = [str(output)]
+    if args.labels:
+        write_atomic(args.labels, format_vice_labels(program.symbols))
+        written.append(args.labels)
+    if args.listing:
+        write_atomic(args.listing, program.listing)
+        written.append(args.listing)
+    print(f"{len(program.code)} bytes at ${program.origin:04X}-${program.end - 1:04X}, "
+          f"{len(program.symbols)} labels -> {', '.join(written)}")
+    return 0

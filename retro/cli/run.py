@@ -1,0 +1,55 @@
+"""`retro run FILE.s|FILE.prg --entry LABEL|ADDR [...] [--json]`"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from retro.cpu.machine import DEFAULT_BUDGET, JSR_CYCLES
+from retro.numbers import parse_int
+from retro.runner import run_routine
+
+
+def _byte(text: str) -> int:
+    return parse_int(text, field="register value", lo=0, hi=0xFF)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("run", help="call a 6502 routine in the emulator and report registers, cycles and memory")
+    p.add_argument("program", metavar="FILE.s|FILE.prg")
+    p.add_argument("--labels", metavar="F.lbl", help="VICE label file for a .prg")
+    p.add_argument("--entry", required=True, metavar="LABEL|ADDR")
+    p.add_argument("--a", default="0", metavar="V")
+    p.add_argument("--x", default="0", metavar="V")
+    p.add_argument("--y", default="0", metavar="V")
+    p.add_argument("--set", dest="sets", action="append", default=[], metavar="TARGET=V")
+    p.add_argument("--peek", dest="peeks", action="append", default=[], metavar="TARGET[:N]")
+    p.add_argument("--budget", default=str(DEFAULT_BUDGET), metavar="CYCLES")
+    p.add_argument("--scene", metavar="SCENE.toml", help="attach a VIC-II or NES PPU scene to the machine")
+    p.add_argument("--trace", action="store_true", help="print every instruction executed")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=cmd_run)
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    report = run_routine(
+        args.program, args.entry, labels=args.labels,
+        a=parse_int(args.a, field="--a", lo=0, hi=0xFF), x=parse_int(args.x, field="--x", lo=0, hi=0xFF),
+        y=parse_int(args.y, field="--y", lo=0, hi=0xFF), sets=args.sets, peeks=args.peeks,
+        budget=parse_int(args.budget, field="--budget", lo=1), scene=args.scene, trace=args.trace)
+    r = report.result
+    if args.json:
+        print(json.dumps({"cycles": r.cycles, "instructions": r.instructions, "a": r.a, "x": r.x, "y": r.y,
+                          "s": r.s, "p": r.p, "peek": report.peeks}))
+        return 0
+    if r.trace:
+        for e in r.trace:
+            notes = " ".join(n for n, on in (("taken", e.branch_taken), ("page+1", e.page_crossed)) if on)
+            print(f"${e.address:04X}  {report.machine.disassemble_at(e.address):<14} {e.cycles}  {notes}".rstrip())
+    flags = "".join(name if on else "." for name, on in r.flags.items())
+    print(f"A=${r.a:02X} X=${r.x:02X} Y=${r.y:02X} S=${r.s:02X} P=${r.p:02X} [{flags}]")
+    print(f"{r.cycles} cycles, {r.instructions} instructions "
+          f"(from the entry ${report.entry:04X} through its RTS; the caller's JSR, {JSR_CYCLES} cycles, is not included)")
+    for target, values in report.peeks.items():
+        print(f"{target}: " + " ".join(f"${v:02X}" for v in values))
+    return 0

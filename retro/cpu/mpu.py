@@ -1,0 +1,425 @@
+"""The 6502 cores: py65's MPU made cycle-exact, bus-aware, and complete for C64 code.
+
+Two variants:
+- `MPU6510` (Commodore 64): NMOS 6502 with decimal mode.
+- `MPU2A03` (NES): the same core with decimal mode removed: ADC, SBC and the undocumented
+  opcodes built on them (RRA, ISC, ARR) ignore the D flag.
+
+What this adds to py65 1.2.0:
+- DEC abs ($CE) costs 6 cycles (py65 charges 3).
+- The stable undocumented NMOS opcodes that C64 code uses: LAX, SAX, DCP, ISC, SLO, RLA, SRE, RRA,
+  ANC, ALR, ARR, SBX, SBC #imm ($EB) and the undocumented NOPs, with their page-crossing penalties.
+  Sources: "NMOS 6510 Unintended Opcodes - No More Secrets" (groepaz, 2024) and 64doc
+  (J. Ahola et al.) for the operations, decimal-mode ARR/ADC/SBC and the cycle counts.
+- The unstable opcodes (SHA, SHX, SHY, TAS, LAS, ANE, LXA) and the twelve JAM opcodes raise
+  `CpuHalt`, naming the opcode and its address: their results depend on the chip and temperature.
+- Device access timing: when a read or write lands on a page that a device owns, the device is told
+  the CPU cycle of that bus access (cycle count at the start of the instruction plus the offset of
+  that bus cycle within it), so chips can be timed against the beam. Plain RAM stays a Python list.
+- BRK optionally stops the run (`stop_on_brk`), which `Machine.call` uses.
+"""
+
+from __future__ import annotations
+
+from py65.devices.mpu6502 import MPU as _Py65MPU
+from py65.utils.devices import make_instruction_decorator
+
+ADDRESS_MASK = 0xFFFF
+PAGE_SHIFT = 8
+
+FLAG_N = 0x80
+FLAG_V = 0x40
+FLAG_U = 0x20
+FLAG_B = 0x10
+FLAG_D = 0x08
+FLAG_I = 0x04
+FLAG_Z = 0x02
+FLAG_C = 0x01
+
+OPCODE_BRK = 0x00
+# 64doc / No More Secrets: these lock the NMOS CPU until reset.
+JAM_OPCODES = frozenset({0x02, 0x12, 0x22, 0x32, 0x42, 0x52, 0x62, 0x72, 0x92, 0xB2, 0xD2, 0xF2})
+# Results depend on the chip revision, temperature or bus state ("unstable" in No More Secrets).
+UNSTABLE_OPCODES = {
+    0x93: "SHA", 0x9F: "SHA", 0x9E: "SHX", 0x9C: "SHY", 0x9B: "TAS",
+    0xBB: "LAS", 0x8B: "ANE", 0xAB: "LXA",
+}
+
+
+class CpuHalt(Exception):
+    """The CPU met an instruction it will not execute (JAM, unstable opcode, or BRK when stopping)."""
+
+    def __init__(self, kind: str, opcode: int, address: int):
+        self.kind = kind
+        self.opcode = opcode
+        self.address = address
+        super().__init__(f"{kind} (opcode ${opcode:02X}) at ${address:04X}")
+
+
+def _copy_tables(base):
+    return list(base.instruct), list(base.cycletime), list(base.extracycles), list(base.disassemble)
+
+
+class MPU6510(_Py65MPU):
+    """NMOS 6502 as in the C64's 6510 (the I/O port at $00/$01 is not modelled: it is plain RAM)."""
+
+    instruct, cycletime, extracycles, disassemble = _copy_tables(_Py65MPU)
+    instruction = make_instruction_decorator(instruct, disassemble, cycletime, extracycles)
+    has_decimal = True
+
+    # Opcodes whose memory operand is read, modified and written back (read at n-3, the unmodified
+    # value written at n-2, the result at n-1, where n is the instruction's cycle count).
+    RMW_OPCODES: frozenset[int] = frozenset()
+
+    def __init__(self, memory=None, pc: int = 0x0000, page_devices=None):
+        self.page_devices = page_devices if page_devices is not None else [None] * 256
+        self.stop_on_brk = False
+        self.current_op = 0
+        self.instruction_start = 0
+        super().__init__(memory=memory, pc=pc)
+        self.name = type(self).__name__[3:]
+
+    # ---- execution -------------------------------------------------------------------------
+
+    def step(self):
+        pc = self.pc
+        op = self.memory[pc]
+        self.instruction_start = pc
+        self.current_op = op
+        self.pc = (pc + 1) & ADDRESS_MASK
+        self.excycles = 0
+        self.addcycles = self.extracycles[op]
+        self.instruct[op](self)
+        self.pc &= ADDRESS_MASK
+        self.processorCycles += self.cycletime[op] + self.excycles
+        return self
+
+    def stall(self, cycles: int) -> None:
+        """Add cycles to the current instruction (the CPU halted by DMA)."""
+        self.excycles += cycles
+
+    # ---- bus -------------------------------------------------------------------------------
+
+    def _access_cycle(self, from_end: int) -> int:
+        op = self.current_op
+        return self.processorCycles + self.cycletime[op] + self.excycles - from_end
+
+    def ByteAt(self, addr):
+        device = self.page_devices[addr >> PAGE_SHIFT]
+        if device is None:
+            return self.memory[addr]
+        from_end = 3 if self.current_op in self.RMW_OPCODES else 1
+        return device.read(addr, self._access_cycle(from_end))
+
+    def WriteByte(self, addr: int, value: int) -> None:
+        device = self.page_devices[addr >> PAGE_SHIFT]
+        if device is None:
+            self.memory[addr] = value
+        else:
+            device.write(addr, value, self._access_cycle(1))
+
+    def _write_back(self, addr: int, old: int, new: int) -> None:
+        """The RMW double write: the unmodified value one cycle before the result."""
+        device = self.page_devices[addr >> PAGE_SHIFT]
+        if device is None:
+            self.memory[addr] = new
+        else:
+            device.write(addr, old, self._access_cycle(2))
+            device.write(addr, new, self._access_cycle(1))
+
+    # ---- py65 operations that write memory, rerouted through the bus ------------------------
+
+    def opSTA(self, x):
+        self.WriteByte(x(), self.a)
+
+    def opSTX(self, y):
+        self.WriteByte(y(), self.x)
+
+    def opSTY(self, x):
+        self.WriteByte(x(), self.y)
+
+    def _rmw(self, x, operation):
+        if x is None:
+            self.a = operation(self.a)
+            return
+        addr = x()
+        old = self.ByteAt(addr)
+        self._write_back(addr, old, operation(old))
+
+    def opASL(self, x):
+        self._rmw(x, self._asl)
+
+    def opLSR(self, x):
+        self._rmw(x, self._lsr)
+
+    def opROL(self, x):
+        self._rmw(x, self._rol)
+
+    def opROR(self, x):
+        self._rmw(x, self._ror)
+
+    def opINCR(self, x):
+        self._rmw(x, self._inc)
+
+    def opDECR(self, x):
+        self._rmw(x, self._dec)
+
+    # ---- ALU helpers (value in, value out, flags set) -----------------------------------------
+
+    def _nz(self, value: int) -> int:
+        self.p = (self.p & ~(FLAG_N | FLAG_Z)) | (value & FLAG_N) | (0 if value else FLAG_Z)
+        return value
+
+    def _asl(self, v: int) -> int:
+        self.p = (self.p & ~FLAG_C) | (v >> 7)
+        return self._nz((v << 1) & 0xFF)
+
+    def _lsr(self, v: int) -> int:
+        self.p = (self.p & ~FLAG_C) | (v & 1)
+        return self._nz(v >> 1)
+
+    def _rol(self, v: int) -> int:
+        carry_in = self.p & FLAG_C
+        self.p = (self.p & ~FLAG_C) | (v >> 7)
+        return self._nz(((v << 1) | carry_in) & 0xFF)
+
+    def _ror(self, v: int) -> int:
+        carry_in = self.p & FLAG_C
+        self.p = (self.p & ~FLAG_C) | (v & 1)
+        return self._nz((v >> 1) | (carry_in << 7))
+
+    def _inc(self, v: int) -> int:
+        return self._nz((v + 1) & 0xFF)
+
+    def _dec(self, v: int) -> int:
+        return self._nz((v - 1) & 0xFF)
+
+    def _compare(self, register: int, v: int) -> None:
+        diff = register - v
+        self.p = (self.p & ~FLAG_C) | (FLAG_C if diff >= 0 else 0)
+        self._nz(diff & 0xFF)
+
+    def _decimal_on(self) -> bool:
+        return self.has_decimal and bool(self.p & FLAG_D)
+
+    def _adc(self, v: int) -> None:
+        a = self.a
+        carry = self.p & FLAG_C
+        binary = a + v + carry
+        if not self._decimal_on():
+            overflow = (~(a ^ v) & (a ^ binary) & 0x80) != 0
+            self.p = (self.p & ~(FLAG_C | FLAG_V)) | (FLAG_C if binary > 0xFF else 0) | (FLAG_V if overflow else 0)
+            self.a = self._nz(binary & 0xFF)
+            return
+        # NMOS decimal ADC (64doc): Z from the binary sum, N and V from the half-adjusted result.
+        low = (a & 0x0F) + (v & 0x0F) + carry
+        if low > 9:
+            low += 6
+        if low <= 0x0F:
+            t = (low & 0x0F) + (a & 0xF0) + (v & 0xF0)
+        else:
+            t = (low & 0x0F) + (a & 0xF0) + (v & 0xF0) + 0x10
+        overflow = ((a ^ t) & 0x80) != 0 and ((a ^ v) & 0x80) == 0
+        negative = t & 0x80
+        if (t & 0x1F0) > 0x90:
+            t += 0x60
+        self.p = (self.p & ~(FLAG_N | FLAG_V | FLAG_Z | FLAG_C)) | negative \
+            | (FLAG_V if overflow else 0) | (0 if binary & 0xFF else FLAG_Z) \
+            | (FLAG_C if (t & 0xFF0) > 0xF0 else 0)
+        self.a = t & 0xFF
+
+    def _sbc(self, v: int) -> None:
+        a = self.a
+        borrow = 1 - (self.p & FLAG_C)
+        binary = a - v - borrow
+        overflow = ((a ^ v) & (a ^ binary) & 0x80) != 0
+        self.p = (self.p & ~(FLAG_C | FLAG_V)) | (FLAG_C if binary >= 0 else 0) | (FLAG_V if overflow else 0)
+        self._nz(binary & 0xFF)
+        if not self._decimal_on():
+            self.a = binary & 0xFF
+            return
+        # NMOS decimal SBC (64doc): flags as in binary, the accumulator adjusted per nybble.
+        low = (a & 0x0F) - (v & 0x0F) - borrow
+        high = (a >> 4) - (v >> 4)
+        if low & 0x10:
+            low -= 6
+            high -= 1
+        if high & 0x10:
+            high -= 6
+        self.a = ((high << 4) | (low & 0x0F)) & 0xFF
+
+    def _arr(self, imm: int) -> None:
+        t = self.a & imm
+        carry_in = self.p & FLAG_C
+        result = (t >> 1) | (carry_in << 7)
+        if not self._decimal_on():
+            self.a = self._nz(result)
+            bit6 = (result >> 6) & 1
+            bit5 = (result >> 5) & 1
+            self.p = (self.p & ~(FLAG_C | FLAG_V)) | (FLAG_C if bit6 else 0) | (FLAG_V if bit6 ^ bit5 else 0)
+            return
+        # No More Secrets, ARR in decimal mode: N from the carry in, Z and V from the binary result,
+        # then a BCD fix-up of each nybble of the AND result that also decides the carry.
+        self.p = (self.p & ~(FLAG_N | FLAG_Z | FLAG_V | FLAG_C)) | (FLAG_N if carry_in else 0) \
+            | (0 if result else FLAG_Z) | (FLAG_V if (t ^ result) & 0x40 else 0)
+        if (t & 0x0F) + (t & 0x01) > 5:
+            result = (result & 0xF0) | ((result + 6) & 0x0F)
+        if (t & 0xF0) + (t & 0x10) > 0x50:
+            result = (result + 0x60) & 0xFF
+            self.p |= FLAG_C
+        self.a = result
+
+    # Documented ADC/SBC go through the same helpers so the 2A03 variant drops decimal in one place.
+    def opADC(self, x):
+        self._adc(self.ByteAt(x()))
+
+    def opSBC(self, x):
+        self._sbc(self.ByteAt(x()))
+
+    # ---- undocumented operations -------------------------------------------------------------
+
+    def _rmw_then(self, x, modify, then) -> None:
+        addr = x()
+        old = self.ByteAt(addr)
+        new = modify(old)
+        self._write_back(addr, old, new)
+        then(new)
+
+    def opSLO(self, x):
+        self._rmw_then(x, self._asl, lambda v: setattr(self, "a", self._nz(self.a | v)))
+
+    def opRLA(self, x):
+        self._rmw_then(x, self._rol, lambda v: setattr(self, "a", self._nz(self.a & v)))
+
+    def opSRE(self, x):
+        self._rmw_then(x, self._lsr, lambda v: setattr(self, "a", self._nz(self.a ^ v)))
+
+    def opRRA(self, x):
+        self._rmw_then(x, self._ror, self._adc)
+
+    def opDCP(self, x):
+        self._rmw_then(x, lambda v: (v - 1) & 0xFF, lambda v: self._compare(self.a, v))
+
+    def opISC(self, x):
+        self._rmw_then(x, lambda v: (v + 1) & 0xFF, self._sbc)
+
+    def opLAX(self, x):
+        self.a = self.x = self._nz(self.ByteAt(x()))
+
+    def opSAX(self, x):
+        self.WriteByte(x(), self.a & self.x)
+
+    def opNOPRead(self, x):
+        self.ByteAt(x())  # the read happens on the bus (it can clear a latch)
+
+    def halt_on(self, kind: str) -> None:
+        raise CpuHalt(kind, self.current_op, self.instruction_start)
+
+
+def _register_undocumented(cls) -> None:
+    """Fill the undocumented opcodes into cls's tables (cycle counts from 64doc)."""
+    ins = cls.instruction
+
+    def op(opcode, name, mode, cycles, extra, body, length):
+        def handler(self):
+            body(self)
+            self.pc += length - 1
+        handler.__name__ = f"inst_0x{opcode:02x}"
+        ins(name=name, mode=mode, cycles=cycles, extracycles=extra)(handler)
+
+    modes = {
+        "zpg": (lambda s: s.ZeroPageAddr, 2),
+        "zpx": (lambda s: s.ZeroPageXAddr, 2),
+        "zpy": (lambda s: s.ZeroPageYAddr, 2),
+        "abs": (lambda s: s.AbsoluteAddr, 3),
+        "abx": (lambda s: s.AbsoluteXAddr, 3),
+        "aby": (lambda s: s.AbsoluteYAddr, 3),
+        "inx": (lambda s: s.IndirectXAddr, 2),
+        "iny": (lambda s: s.IndirectYAddr, 2),
+        "imm": (lambda s: s.ProgramCounter, 2),
+    }
+
+    def with_mode(opcode, name, mode, cycles, extra, method):
+        address_of, length = modes[mode]
+        op(opcode, name, mode, cycles, extra, lambda s: getattr(s, method)(address_of(s)), length)
+
+    # Read-modify-write families: same opcode layout and cycle counts for all six.
+    rmw_layout = [("zpg", 0x07, 5), ("zpx", 0x17, 6), ("inx", 0x03, 8), ("iny", 0x13, 8),
+                  ("abs", 0x0F, 6), ("abx", 0x1F, 7), ("aby", 0x1B, 7)]
+    rmw = set()
+    for base, name in [(0x00, "SLO"), (0x20, "RLA"), (0x40, "SRE"), (0x60, "RRA"), (0xC0, "DCP"), (0xE0, "ISC")]:
+        for mode, low, cycles in rmw_layout:
+            with_mode(base + low, name, mode, cycles, 0, f"op{name}")
+            rmw.add(base + low)
+
+    for opcode, mode, cycles, extra in [(0xA7, "zpg", 3, 0), (0xB7, "zpy", 4, 0), (0xA3, "inx", 6, 0),
+                                        (0xB3, "iny", 5, 1), (0xAF, "abs", 4, 0), (0xBF, "aby", 4, 1)]:
+        with_mode(opcode, "LAX", mode, cycles, extra, "opLAX")
+    for opcode, mode, cycles in [(0x87, "zpg", 3), (0x97, "zpy", 4), (0x83, "inx", 6), (0x8F, "abs", 4)]:
+        with_mode(opcode, "SAX", mode, cycles, 0, "opSAX")
+
+    # Undocumented NOPs: implied, immediate, and ones that really read memory.
+    for opcode in (0x1A, 0x3A, 0x5A, 0x7A, 0xDA, 0xFA):
+        op(opcode, "NOP", "imp", 2, 0, lambda s: None, 1)
+    for opcode in (0x80, 0x82, 0x89, 0xC2, 0xE2):
+        op(opcode, "NOP", "imm", 2, 0, lambda s: None, 2)
+    for opcode in (0x04, 0x44, 0x64):
+        with_mode(opcode, "NOP", "zpg", 3, 0, "opNOPRead")
+    for opcode in (0x14, 0x34, 0x54, 0x74, 0xD4, 0xF4):
+        with_mode(opcode, "NOP", "zpx", 4, 0, "opNOPRead")
+    with_mode(0x0C, "NOP", "abs", 4, 0, "opNOPRead")
+    for opcode in (0x1C, 0x3C, 0x5C, 0x7C, 0xDC, 0xFC):
+        with_mode(opcode, "NOP", "abx", 4, 1, "opNOPRead")
+
+    def immediate(opcode, name, body):
+        op(opcode, name, "imm", 2, 0, lambda s: body(s, s.ByteAt(s.pc)), 2)
+
+    def anc(s, v):
+        s.a = s._nz(s.a & v)
+        s.p = (s.p & ~FLAG_C) | (FLAG_C if s.a & 0x80 else 0)
+
+    def sbx(s, v):
+        diff = (s.a & s.x) - v
+        s.p = (s.p & ~FLAG_C) | (FLAG_C if diff >= 0 else 0)
+        s.x = s._nz(diff & 0xFF)
+
+    immediate(0x0B, "ANC", anc)
+    immediate(0x2B, "ANC", anc)
+    immediate(0x4B, "ALR", lambda s, v: setattr(s, "a", s._lsr(s.a & v)))
+    immediate(0x6B, "ARR", lambda s, v: s._arr(v))
+    immediate(0xCB, "SBX", sbx)
+    immediate(0xEB, "SBC", lambda s, v: s._sbc(v))
+
+    for opcode in JAM_OPCODES:
+        op(opcode, "JAM", "imp", 2, 0, lambda s: s.halt_on("JAM"), 1)
+    for opcode, name in UNSTABLE_OPCODES.items():
+        op(opcode, name, "imp", 2, 0, lambda s, n=name: s.halt_on(f"unstable opcode {n}"), 1)
+
+    documented_rmw = {0x06, 0x16, 0x0E, 0x1E, 0x26, 0x36, 0x2E, 0x3E, 0x46, 0x56, 0x4E, 0x5E,
+                      0x66, 0x76, 0x6E, 0x7E, 0xC6, 0xD6, 0xCE, 0xDE, 0xE6, 0xF6, 0xEE, 0xFE}
+    cls.RMW_OPCODES = frozenset(rmw | documented_rmw)
+
+
+_register_undocumented(MPU6510)
+MPU6510.cycletime[0xCE] = 6  # DEC abs: py65 1.2.0 charges 3; the datasheet says 6.
+
+_py65_brk = MPU6510.instruct[OPCODE_BRK]
+
+
+def _brk(self):
+    if self.stop_on_brk:
+        self.halt_on("BRK")
+    _py65_brk(self)
+
+
+MPU6510.instruct[OPCODE_BRK] = _brk
+
+
+class MPU2A03(MPU6510):
+    """The NES CPU (Ricoh 2A03/2A07): a 6502 whose decimal mode was removed; D is still a flag."""
+
+    instruct, cycletime, extracycles, disassemble = _copy_tables(MPU6510)
+    has_decimal = False
+
+
+VARIANTS = {"6510": MPU6510, "2a03": MPU2A03}

@@ -1,0 +1,29 @@
+"""`retro demo`: the toolkit's main job on built-in examples, each capability one step.
+
+A step is a function `step(out_dir: Path) -> list[str]` returning the lines to print; any files it
+writes go into out_dir. Steps are listed in DEMO_STEPS by dotted path so a step's module is only
+imported when the demo runs.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+from pathlib import Path
+
+# (title, "module:function")
+DEMO_STEPS: list[tuple[str, str]] = [
+    ("Assemble and run a 6502 routine", "retro.demo_steps:assemble_and_run"),
+]
+
+
+def run_demo(out_dir: Path, emit: Callable[[str], None] = print) -> Path:
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for title, target in DEMO_STEPS:
+        module_name, func_name = target.split(":")
+        step = getattr(importlib.import_module(module_name), func_name)
+        emit(f"== {title}")
+        for line in step(out_dir):
+            emit(f"   {line}")
+    emit(f"Output files are in {out_dir.resolve()}")
+    return out_dir

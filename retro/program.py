@@ -1,0 +1,77 @@
+"""A loaded 6502 program (bytes at an origin, with symbols), and the PRG / VICE label formats.
+
+PRG: a 2-byte little-endian load address followed by the bytes (the C64 disk/tape file format).
+VICE label file: one label a line, `al C:1000 .name` (the monitor's `ll`/`sl` format); ACME, 64tass
+and ca65 (via ld65 -Ln) all write it.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from retro.errors import InputError
+from retro.fileio import read_bytes, read_text
+
+PRG_HEADER_SIZE = 2
+
+
+@dataclass(frozen=True)
+class Program:
+    code: bytes
+    origin: int
+    symbols: dict[str, int] = field(default_factory=dict)
+    listing: str = ""
+    source: str = ""
+
+    @property
+    def end(self) -> int:
+        """One past the last byte."""
+        return self.origin + len(self.code)
+
+    def address_of(self, label: str) -> int:
+        try:
+            return self.symbols[label]
+        except KeyError:
+            raise InputError(f"{self.source or 'program'}: unknown label {label!r}") from None
+
+
+def prg_bytes(program: Program) -> bytes:
+    return program.origin.to_bytes(PRG_HEADER_SIZE, "little") + program.code
+
+
+def parse_prg(data: bytes, source: str = "PRG") -> Program:
+    if len(data) < PRG_HEADER_SIZE:
+        raise InputError(f"{source}: a PRG needs a 2-byte load address, file has {len(data)} byte(s)")
+    origin = int.from_bytes(data[:PRG_HEADER_SIZE], "little")
+    code = bytes(data[PRG_HEADER_SIZE:])
+    if origin + len(code) > 0x10000:
+        raise InputError(f"{source}: {len(code)} bytes at ${origin:04X} run past $FFFF")
+    return Program(code=code, origin=origin, source=source)
+
+
+_LABEL_LINE = re.compile(r"^al\s+(?:C:)?([0-9A-Fa-f]{1,4})\s+\.?(\S+)\s*$")
+
+
+def parse_vice_labels(text: str, source: str = "labels") -> dict[str, int]:
+    symbols: dict[str, int] = {}
+    for number, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped or stripped.startswith(("#", ";")):
+            continue
+        match = _LABEL_LINE.match(stripped)
+        if not match:
+            raise InputError(f"{source}:{number}: expected 'al C:ADDR .name', got {stripped[:60]!r}")
+        symbols[match.group(2)] = int(match.group(1), 16)
+    return symbols
+
+
+def format_vice_labels(symbols: dict[str, int]) -> str:
+    return "".join(f"al C:{address:04x} .{name}\n" for name, address in sorted(symbols.items(), key=lambda kv: (kv[1], kv[0])))
+
+
+def load_prg_file(path: str | Path, labels: str | Path | None = None) -> Program:
+    program = parse_prg(read_bytes(path, "PRG file"), source=str(path))
+    symbols = parse_vice_labels(read_text(labels, "label file"), source=str(labels)) if labels else {}
+    return Program(code=program.code, origin=program.origin, symbols=symbols, source=str(path))

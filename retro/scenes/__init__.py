@@ -1,0 +1,40 @@
+"""Scene files (TOML): the state one frame of a chip needs, and nothing more.
+
+`load_scene(path)` reads the TOML, looks at its `chip` key and hands the document to the module for
+that chip (`retro.scenes.vic` for "vic-ii", `retro.scenes.nes` for "nes"), which validates it into
+plain dataclasses. Every scene object has `cpu_variant` ("6510" or "2a03") and
+`attach(machine) -> device`, which maps the chip onto the machine's bus.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from pathlib import Path
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+from retro.errors import InputError
+from retro.fileio import read_text
+
+CHIP_MODULES = {"vic-ii": "retro.scenes.vic", "nes": "retro.scenes.nes"}
+
+
+def read_toml(path: str | Path) -> dict:
+    text = read_text(path, "scene file")
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: not valid TOML: {exc}") from None
+
+
+def load_scene(path: str | Path):
+    doc = read_toml(path)
+    chip = doc.get("chip")
+    if chip not in CHIP_MODULES:
+        raise InputError(f"{path}: chip: expected one of {', '.join(repr(c) for c in CHIP_MODULES)}, got {chip!r}")
+    module = importlib.import_module(CHIP_MODULES[chip])
+    return module.parse(doc, source=str(path))
