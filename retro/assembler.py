@@ -30,14 +30,32 @@ _OPHIS_DRIVER = "import sys; from Ophis.Main import run_ophis; sys.exit(run_ophi
 _ERROR_LINE = re.compile(r"^(?P<file>.+?):(?P<line>\d+): (?P<message>.+)$")
 _MAP_LINE = re.compile(r"^\$(?P<address>[0-9A-Fa-f]+)\s*\|\s*(?P<name>\S+)\s*\|")
 _LISTING_ADDRESS = re.compile(r"^\s*(?P<address>[0-9A-Fa-f]{4})\s")
-_TABLES_REQUEST = re.compile(r"^\s*;\s*retro-tables:\s*(?P<names>.*)$", re.MULTILINE)
+_TABLES_REQUEST = re.compile(r"^[ \t]*;[ \t]*retro-tables:(?P<names>.*)$", re.MULTILINE)
 ASSEMBLER_TIMEOUT_SECONDS = 60
+_STDIN = "-"  # Ophis's name for standard input
+ANONYMOUS_LABEL = "*"  # Ophis's `*` labels, reached by +/- references only
 
 
 def requested_tables(source_text: str) -> list[str]:
-    names: list[str] = []
+    return [name for name, _ in _table_requests(source_text)]
+
+
+def _table_requests(source_text: str) -> list[tuple[str, int]]:
+    """(table name, line number) for each name on a `; retro-tables:` line."""
+    requests = []
     for match in _TABLES_REQUEST.finditer(source_text):
-        names.extend(match.group("names").split())
+        line = source_text.count("\n", 0, match.start()) + 1
+        requests.extend((name, line) for name in match.group("names").split())
+    return requests
+
+
+def _check_tables(source_text: str, shown: str, known: dict) -> list[str]:
+    names = []
+    for name, line in _table_requests(source_text):
+        if name not in known:
+            listed = ", ".join(sorted(known)) or "none"
+            raise InputError(f"{shown}:{line}: unknown table {name!r} in '; retro-tables:' (known: {listed})")
+        names.append(name)
     return names
 
 
@@ -49,12 +67,11 @@ def assemble_file(path: str | Path) -> Program:
 
 
 def assemble_text(text: str, name: str = "<source>") -> Program:
-    """Assemble source given as a string (includes resolve against the current directory)."""
-    with tempfile.TemporaryDirectory(prefix="retro-src-") as tmp:
-        path = Path(tmp) / "source.s"
-        path.write_text(text)
-        program = _assemble(str(path), name, text)
-    return program
+    """Assemble source given as a string; its includes resolve against the current directory.
+
+    The text goes to Ophis on standard input (its name "-"), which is what makes Ophis resolve
+    includes against the working directory; errors name the text `name`."""
+    return _assemble(_STDIN, name, text)
 
 
 def _fingerprint(path: Path, text: str) -> str:
@@ -78,7 +95,7 @@ def _assemble(resolved: str, shown: str, text: str) -> Program:
     with tempfile.TemporaryDirectory(prefix="retro-asm-") as tmp:
         out = Path(tmp)
         infiles = [resolved]
-        table_names = requested_tables(text)
+        table_names = _check_tables(text, shown, tables.GENERATORS)
         if table_names:
             generated = out / "retro-tables.s"
             generated.write_text(tables.ophis_source(table_names, source=shown))
@@ -86,7 +103,8 @@ def _assemble(resolved: str, shown: str, text: str) -> Program:
         command = [sys.executable, "-c", _OPHIS_DRIVER, "--no-branch-extend", "-u", "-q",
                    "-o", str(out / "out.bin"), "-l", str(out / "out.lst"), "-m", str(out / "out.map"), *infiles]
         try:
-            done = subprocess.run(command, capture_output=True, text=True, timeout=ASSEMBLER_TIMEOUT_SECONDS)
+            done = subprocess.run(command, capture_output=True, text=True, timeout=ASSEMBLER_TIMEOUT_SECONDS,
+                                  input=text if resolved == _STDIN else None)
         except subprocess.TimeoutExpired:
             raise InputError(f"{shown}: the assembler did not finish in {ASSEMBLER_TIMEOUT_SECONDS} s") from None
         if done.returncode != 0:
@@ -110,12 +128,14 @@ def _first_error(output: str, resolved: str, shown: str) -> str:
 
 
 def _parse_map(text: str) -> dict[str, int]:
-    symbols = {}
+    """Ophis's map file -> {label: address}, leaving out the labels a name cannot pick out:
+    anonymous `*` labels and `.scope`-local names defined more than once."""
+    seen: dict[str, set[int]] = {}
     for line in text.splitlines():
         match = _MAP_LINE.match(line)
-        if match:
-            symbols[match.group("name")] = int(match.group("address"), 16)
-    return symbols
+        if match and match.group("name") != ANONYMOUS_LABEL:
+            seen.setdefault(match.group("name"), set()).add(int(match.group("address"), 16))
+    return {name: next(iter(addresses)) for name, addresses in seen.items() if len(addresses) == 1}
 
 
 def _origin(listing: str) -> int:

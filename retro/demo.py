@@ -14,6 +14,10 @@ from pathlib import Path
 # (title, "module:function")
 DEMO_STEPS: list[tuple[str, str]] = [
     ("Assemble and run a 6502 routine", "retro.demo_steps:assemble_and_run"),
+    ("VIC-II collision scene: $D01E/$D01F/$D019 and the overlap image", "retro.vic_report:demo_step"),
+    ("Parry pipeline: padded AABB window, SAT contact, MTV knock-back", "retro.render.parry:demo_step"),
+    ("NES sprite-zero hit: model, picture, polling loop", "retro.demo_nes:sprite_zero"),
+    ("Speed against accuracy: cycles and error rates of every collision method", "retro.analysis.study.demo_step:chart_step"),
 ]
 
 

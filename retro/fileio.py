@@ -22,6 +22,7 @@ def write_atomic(path: str | os.PathLike, data: bytes | str) -> Path:
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(payload)
+        os.chmod(tmp, _mode_for(target))  # mkstemp makes the file private (0600); a plain write would not
         os.replace(tmp, target)
     except OSError as exc:
         try:
@@ -30,6 +31,16 @@ def write_atomic(path: str | os.PathLike, data: bytes | str) -> Path:
             pass
         raise InputError(f"{target}: cannot write: {exc.strerror or exc}") from None
     return target
+
+
+def _mode_for(target: Path) -> int:
+    """The permissions open() would give: the existing file's, else 0666 less the umask."""
+    try:
+        return target.stat().st_mode & 0o7777
+    except OSError:
+        umask = os.umask(0)
+        os.umask(umask)
+        return 0o666 & ~umask
 
 
 def read_bytes(path: str | os.PathLike, what: str = "file") -> bytes:

@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
+import re
+
 from retro.errors import InputError
+
+_NUMBER = re.compile(r"^(?P<sign>-)?(?:\$(?P<hex>[0-9a-fA-F]+)|0[xX](?P<hex0x>[0-9a-fA-F]+)"
+                     r"|%(?P<binary>[01]+)|0[bB](?P<binary0b>[01]+)|(?P<decimal>[0-9]+))$")
+_BASES = {"hex": 16, "hex0x": 16, "binary": 2, "binary0b": 2, "decimal": 10}
 
 
 def parse_int(text: str | int, *, field: str = "value", lo: int | None = None, hi: int | None = None) -> int:
@@ -12,24 +18,12 @@ def parse_int(text: str | int, *, field: str = "value", lo: int | None = None, h
     if isinstance(text, int):
         value = text
     else:
-        s = str(text).strip().replace("_", "")
-        negative = s.startswith("-")
-        body = s[1:] if negative else s
-        try:
-            if body.startswith("$"):
-                value = int(body[1:], 16)
-            elif body.lower().startswith("0x"):
-                value = int(body[2:], 16)
-            elif body.startswith("%"):
-                value = int(body[1:], 2)
-            elif body.lower().startswith("0b"):
-                value = int(body[2:], 2)
-            else:
-                value = int(body, 10)
-        except ValueError:
-            raise InputError(f"{field}: not a number: {text!r} (use $C000, 0xc000, %1010 or 49152)") from None
-        if negative:
-            value = -value
+        match = _NUMBER.match(str(text).strip().replace("_", ""))
+        if not match:
+            raise InputError(f"{field}: not a number: {text!r} (use $C000, 0xc000, %1010 or 49152)")
+        base, digits = next((_BASES[name], digits) for name, digits in match.groupdict().items()
+                            if digits is not None and name != "sign")
+        value = int(digits, base) * (-1 if match.group("sign") else 1)
     if lo is not None and value < lo or hi is not None and value > hi:
         raise InputError(f"{field}: {text!r} is out of range {fmt_range(lo, hi)}")
     return value

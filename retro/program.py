@@ -15,6 +15,7 @@ from retro.errors import InputError
 from retro.fileio import read_bytes, read_text
 
 PRG_HEADER_SIZE = 2
+ADDRESS_LIMIT = 0xFFFF  # the 6502's 16-bit address space
 
 
 @dataclass(frozen=True)
@@ -46,15 +47,17 @@ def parse_prg(data: bytes, source: str = "PRG") -> Program:
         raise InputError(f"{source}: a PRG needs a 2-byte load address, file has {len(data)} byte(s)")
     origin = int.from_bytes(data[:PRG_HEADER_SIZE], "little")
     code = bytes(data[PRG_HEADER_SIZE:])
-    if origin + len(code) > 0x10000:
+    if origin + len(code) > ADDRESS_LIMIT + 1:
         raise InputError(f"{source}: {len(code)} bytes at ${origin:04X} run past $FFFF")
     return Program(code=code, origin=origin, source=source)
 
 
-_LABEL_LINE = re.compile(r"^al\s+(?:C:)?([0-9A-Fa-f]{1,4})\s+\.?(\S+)\s*$")
+# ACME writes `al C:c000 .name`, 64tass `al c000 .name`, ld65 (-Ln) `al 00C000 .name`.
+_LABEL_LINE = re.compile(r"^al\s+(?:C:)?(?P<address>[0-9A-Fa-f]{1,6})\s+\.?(?P<name>\S+)\s*$")
 
 
 def parse_vice_labels(text: str, source: str = "labels") -> dict[str, int]:
+    """VICE label lines -> {name: address}; a name given twice keeps its last address."""
     symbols: dict[str, int] = {}
     for number, line in enumerate(text.splitlines(), start=1):
         stripped = line.strip()
@@ -63,7 +66,10 @@ def parse_vice_labels(text: str, source: str = "labels") -> dict[str, int]:
         match = _LABEL_LINE.match(stripped)
         if not match:
             raise InputError(f"{source}:{number}: expected 'al C:ADDR .name', got {stripped[:60]!r}")
-        symbols[match.group(2)] = int(match.group(1), 16)
+        address = int(match.group("address"), 16)
+        if address > ADDRESS_LIMIT:
+            raise InputError(f"{source}:{number}: address ${address:X} of {match.group('name')!r} is above $FFFF")
+        symbols[match.group("name")] = address
     return symbols
 
 

@@ -20,7 +20,7 @@ class RunReport:
     program: Program
     entry: int
     result: CallResult
-    peeks: dict[str, list[int]]
+    peeks: dict[str, list[int]]  # TARGET as the user gave it (without :N) -> byte values
     machine: Machine
 
 
@@ -48,6 +48,17 @@ def parse_peek(text: str) -> tuple[str, int]:
     return target.strip(), parse_int(count, field=f"--peek {text} count", lo=1, hi=0x10000)
 
 
+def _peek_counts(peeks: list[str]) -> dict[str, int]:
+    """--peek arguments -> {TARGET as given: byte count}; one count per target."""
+    counts: dict[str, int] = {}
+    for given in peeks:
+        target, count = parse_peek(given)
+        if counts.get(target, count) != count:
+            raise InputError(f"--peek {given!r}: {target} is already peeked with count {counts[target]}")
+        counts[target] = count
+    return counts
+
+
 def run_routine(path: str | Path, entry: str, *, labels: str | Path | None = None, a: int = 0, x: int = 0,
                 y: int = 0, sets: list[str] = (), peeks: list[str] = (), budget: int = DEFAULT_BUDGET,
                 scene: str | Path | None = None, trace: bool = False) -> RunReport:
@@ -65,10 +76,10 @@ def run_routine(path: str | Path, entry: str, *, labels: str | Path | None = Non
     memory = dict(parse_assignment(s) for s in sets)
     for target in memory:
         machine.resolve(target, f"--set {target}")
-    peek_targets = {given: parse_peek(given) for given in peeks}
-    for target, _ in peek_targets.values():
+    peek_counts = _peek_counts(peeks)
+    for target in peek_counts:
         machine.resolve(target, f"--peek {target}")
     entry_address = machine.resolve(entry, "--entry")
     result = machine.call(entry_address, a=a, x=x, y=y, memory=memory, budget=budget, trace=trace)
-    values = {given: machine.peek(t, n) for given, (t, n) in peek_targets.items()}
+    values = {target: machine.peek(target, count) for target, count in peek_counts.items()}
     return RunReport(program=program, entry=entry_address, result=result, peeks=values, machine=machine)

@@ -36,3 +36,126 @@ def ophis_source(names: list[str], source: str = "source") -> str:
         for start in range(0, len(values), 16):
             lines.append("    .byte " + ", ".join(f"${v:02x}" for v in values[start:start + 16]))
     return "\n".join(lines) + "\n"
+
+
+# ---- tables of the collision routines in asm/ (issue 5) -------------------------------------
+# Square and quarter-square tables (mul8, circle) and the C64 screen lookups (tile, tile_box,
+# pixel). Each entry is written from its definition; docs/routines.md explains how each is used.
+
+def _lo(values: list[int]) -> list[int]:
+    return [v & 0xFF for v in values]
+
+
+def _hi(values: list[int]) -> list[int]:
+    return [(v >> 8) & 0xFF for v in values]
+
+
+def _quarter_squares() -> list[int]:
+    """f(n) = floor(n^2 / 4) for n = 0..511 (mul8 uses 0..510)."""
+    return [n * n // 4 for n in range(512)]
+
+
+def _quarter_squares_of_difference() -> list[int]:
+    """g(i) = f(i - 255) for i = 0..511: read at (255 - a) + b it gives f(b - a) for either sign."""
+    return [(i - 255) ** 2 // 4 for i in range(512)]
+
+
+table("qsq_lo")(lambda: _lo(_quarter_squares()))
+table("qsq_hi")(lambda: _hi(_quarter_squares()))
+table("qsqd_lo")(lambda: _lo(_quarter_squares_of_difference()))
+table("qsqd_hi")(lambda: _hi(_quarter_squares_of_difference()))
+
+_SQUARES = [i * i for i in range(256)]
+# circle: x1 - x2 - 1 with x1 <= x2 is 255 - |dx|; with x1 > x2 it is |dx| - 1 and the table holds
+# dx^2 + 1 (the routine subtracts R^2 - 1 - dx^2 with the carry set); y1 - y2 with y1 < y2 is
+# 256 - |dy| and the table holds dy^2 - 1 (subtracted with the carry clear). Index 0 of the last
+# is never read.
+_CIRCLE_DXN = [(255 - i) ** 2 for i in range(256)]
+_CIRCLE_DXP = [(i + 1) ** 2 + 1 for i in range(256)]
+_CIRCLE_DYN = [0] + [(256 - i) ** 2 - 1 for i in range(1, 256)]
+table("sq_lo")(lambda: _lo(_SQUARES))
+table("sq_hi")(lambda: _hi(_SQUARES))
+table("circle_dxn_lo")(lambda: _lo(_CIRCLE_DXN))
+table("circle_dxn_hi")(lambda: _hi(_CIRCLE_DXN))
+table("circle_dxp_lo")(lambda: _lo(_CIRCLE_DXP))
+table("circle_dxp_hi")(lambda: _hi(_CIRCLE_DXP))
+table("circle_dyn_lo")(lambda: _lo(_CIRCLE_DYN))
+table("circle_dyn_hi")(lambda: _hi(_CIRCLE_DYN))
+
+
+def _screen():
+    from retro.routines import screen  # plain constants; imported here to keep this module light
+    return screen
+
+
+def _cell_row_address_by_y() -> list[int]:
+    """For sprite Y 0..255: address of the screen row under it, 0 off screen."""
+    s = _screen()
+    out = []
+    for y in range(256):
+        cell = s.cell_of(s.SPRITE_X_AT_COLUMN_0, y)
+        out.append(s.row_address(cell[1]) if cell else 0)
+    return out
+
+
+def _column_by_x(high: int) -> list[int]:
+    """For sprite X = high * 256 + 0..255: the screen column under it, $FF off screen."""
+    s = _screen()
+    out = []
+    for low in range(256):
+        cell = s.cell_of(high * 256 + low, s.SPRITE_Y_AT_ROW_0)
+        out.append(cell[0] if cell else 0xFF)
+    return out
+
+
+table("tile_rowlo")(lambda: _lo(_cell_row_address_by_y()))
+table("tile_rowhi")(lambda: _hi(_cell_row_address_by_y()))
+table("tile_col0")(lambda: _column_by_x(0))
+table("tile_col1")(lambda: _column_by_x(1))
+# Storage, not a lookup table: the game's property byte per screen code (zeros until filled).
+table("tile_props")(lambda: [0] * 256)
+
+
+def _first_cell(coordinate: int, origin: int, cells: int) -> int:
+    """Index of the first cell whose pixels reach coordinate or beyond, clamped to 0..cells."""
+    s = _screen()
+    return min(max((coordinate - origin) // s.CELL_PIXELS, 0), cells)
+
+
+def _end_cell(end: int, origin: int, cells: int) -> int:
+    """One past the last cell that starts before `end` (exclusive pixel end), clamped to 0..cells."""
+    s = _screen()
+    return min(max(-((origin - end) // s.CELL_PIXELS), 0), cells)
+
+
+def _tbox_columns(high: int, end: bool) -> list[int]:
+    s = _screen()
+    f = _end_cell if end else _first_cell
+    return [f(high * 256 + low, s.SPRITE_X_AT_COLUMN_0, s.COLUMNS) for low in range(256)]
+
+
+def _tbox_rows(high: int, end: bool) -> list[int]:
+    s = _screen()
+    f = _end_cell if end else _first_cell
+    return [f(high * 256 + low, s.SPRITE_Y_AT_ROW_0, s.ROWS) for low in range(256)]
+
+
+table("tbox_cfirst0")(lambda: _tbox_columns(0, end=False))
+table("tbox_cfirst1")(lambda: _tbox_columns(1, end=False))
+table("tbox_cend0")(lambda: _tbox_columns(0, end=True))
+table("tbox_cend1")(lambda: _tbox_columns(1, end=True))
+table("tbox_rfirst")(lambda: _tbox_rows(0, end=False))
+table("tbox_rend0")(lambda: _tbox_rows(0, end=True))
+table("tbox_rend1")(lambda: _tbox_rows(1, end=True))
+table("tbox_rowlo")(lambda: _lo([_screen().row_address(r) for r in range(_screen().ROWS)]))
+table("tbox_rowhi")(lambda: _hi([_screen().row_address(r) for r in range(_screen().ROWS)]))
+
+# pixel: page s (s = 0..7) of pixel_shr holds b >> s, of pixel_shl holds (b << (8 - s)) & $FF.
+table("pixel_shr")(lambda: [b >> s for s in range(8) for b in range(256)])
+table("pixel_shl")(lambda: [(b << (8 - s)) & 0xFF for s in range(8) for b in range(256)])
+# Storage: the two sprite masks (63 bytes used each).
+table("pixel_mask_a")(lambda: [0] * 64)
+table("pixel_mask_b")(lambda: [0] * 64)
+
+# Tables that are storage the caller fills, not lookup tables (reported apart from table bytes).
+STORAGE_TABLES = frozenset({"tile_props", "pixel_mask_a", "pixel_mask_b"})

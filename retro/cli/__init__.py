@@ -14,7 +14,7 @@ import sys
 from retro.errors import RetroError
 
 # Module names inside retro.cli, in the order `retro --help` lists them.
-COMMAND_MODULES = ["asm", "run", "demo"]
+COMMAND_MODULES = ["asm", "run", "demo", "parry", "nes", "vic", "chart", "stability", "advise"]
 
 
 class _Parser(argparse.ArgumentParser):

@@ -30,6 +30,6 @@ def run_asm(args: argparse.Namespace) -> int:
     if args.listing:
         write_atomic(args.listing, program.listing)
         written.append(args.listing)
-    print(f"{len(program.code)} bytes at ${program.origin:04X}-${program.end - 1:04X}, "
-          f"{len(program.symbols)} labels -> {', '.join(written)}")
+    span = f"${program.origin:04X}-${program.end - 1:04X}" if program.code else f"${program.origin:04X}"
+    print(f"{len(program.code)} bytes at {span}, {len(program.symbols)} labels -> {', '.join(written)}")
     return 0

@@ -11,7 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from retro.cpu.bus import Bus, Device
-from retro.cpu.mpu import FLAG_I, FLAG_U, VARIANTS, CpuHalt
+from retro.cpu.mpu import (FLAG_B, FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_U, FLAG_V, FLAG_Z, RECENT_MASK,
+                           VARIANTS, CpuHalt)
 from retro.errors import InputError, RunError
 from retro.numbers import parse_int
 from retro.program import Program
@@ -20,7 +21,9 @@ DEFAULT_BUDGET = 5_000_000  # cycles; about five seconds of C64 time, a few seco
 RETURN_TRAP = 0x0000  # the routine "returns" here: RTS to $0000 with the stack back where it started
 CALL_STACK_TOP = 0xFF
 DEFAULT_FLAGS = FLAG_U | FLAG_I
-RECENT_INSTRUCTIONS = 16
+RECENT_SHOWN = 8  # instructions listed in a failure message
+NO_ADDRESS = -1  # a stop address the PC never equals
+ANY_STACK = -1  # stop at the address whatever the stack pointer
 JSR_CYCLES = 6  # the caller's JSR, excluded from every reported count
 
 
@@ -48,9 +51,14 @@ class CallResult:
     flags: dict[str, bool] = field(default_factory=dict)
 
 
+def _status(p: int) -> int:
+    """P as the register holds it: bit 5 reads as 1, and bit 4 (B) exists only in pushed copies."""
+    return (p | FLAG_U) & ~FLAG_B
+
+
 def _flags(p: int) -> dict[str, bool]:
     return {name: bool(p & bit) for name, bit in
-            (("N", 0x80), ("V", 0x40), ("D", 0x08), ("I", 0x04), ("Z", 0x02), ("C", 0x01))}
+            (("N", FLAG_N), ("V", FLAG_V), ("D", FLAG_D), ("I", FLAG_I), ("Z", FLAG_Z), ("C", FLAG_C))}
 
 
 class Machine:
@@ -111,48 +119,65 @@ class Machine:
 
     def call(self, entry: str | int, *, a: int = 0, x: int = 0, y: int = 0, p: int = DEFAULT_FLAGS,
              memory: dict | None = None, budget: int = DEFAULT_BUDGET, trace: bool = False) -> CallResult:
-        """Run the routine at entry as if called by JSR; stop at its RTS."""
+        """Run the routine at entry as if called by JSR; stop at its RTS.
+
+        Fails (RunError) on BRK, JAM or an unstable opcode, and when the routine needs more than
+        `budget` cycles (a runaway routine is stopped as soon as it has used them).
+        """
         address = self.resolve(entry, "entry")
         for name, value in (("a", a), ("x", x), ("y", y), ("p", p)):
             if not 0 <= value <= 0xFF:
                 raise InputError(f"{name}: {value} is not a byte (0-255)")
+        if budget < 1:
+            raise InputError(f"budget: {budget} is not a positive number of cycles")
         for target, values in (memory or {}).items():
             self.poke(target, values)
         mpu = self.mpu
-        mpu.a, mpu.x, mpu.y, mpu.p = a, x, y, p | FLAG_U
+        mpu.a, mpu.x, mpu.y, mpu.p = a, x, y, _status(p)
         mpu.sp = CALL_STACK_TOP
         mpu.stPushWord((RETURN_TRAP - 1) & 0xFFFF)
         mpu.pc = address
         start = mpu.processorCycles
+        limit = start + budget
         entries: list[TraceEntry] | None = [] if trace else None
-        count = self._run_until_return(start + budget, entries)
-        return CallResult(a=mpu.a, x=mpu.x, y=mpu.y, s=mpu.sp, p=mpu.p, cycles=mpu.processorCycles - start,
-                          instructions=count, trace=entries, flags=_flags(mpu.p))
+        count = self._execute(RETURN_TRAP, CALL_STACK_TOP, limit, entries)
+        if mpu.pc != RETURN_TRAP or mpu.sp != CALL_STACK_TOP:
+            self._over_budget(budget, count)
+        if mpu.processorCycles - start > budget:  # returned, but its last instruction ran past the budget
+            raise RunError(f"cycle budget of {budget} cycles exceeded: the routine returned after "
+                           f"{mpu.processorCycles - start} cycles")
+        status = _status(mpu.p)
+        return CallResult(a=mpu.a, x=mpu.x, y=mpu.y, s=mpu.sp, p=status, cycles=mpu.processorCycles - start,
+                          instructions=count, trace=entries, flags=_flags(status))
 
-    def _run_until_return(self, limit: int, entries: list[TraceEntry] | None) -> int:
+    def run(self, entry: str | int, *, until: str | int | None = None, cycles: int = DEFAULT_BUDGET) -> int:
+        """Run from entry for a number of cycles, or until the PC reaches `until` (error if it never does).
+
+        Returns the number of instructions executed. For programs that never return (main loops).
+        """
         mpu = self.mpu
-        step = mpu.step
-        recent = [0] * RECENT_INSTRUCTIONS
-        count = 0
+        mpu.pc = self.resolve(entry, "entry")
+        stop = self.resolve(until, "until") if until is not None else NO_ADDRESS
+        count = self._execute(stop, ANY_STACK, mpu.processorCycles + cycles, None)
+        if until is not None and mpu.pc != stop:
+            self._over_budget(cycles, count)
+        return count
+
+    def _execute(self, stop_pc: int, stop_sp: int, limit: int, entries: list[TraceEntry] | None) -> int:
+        """Run to stop_pc (and stop_sp) or the limit; a CpuHalt becomes a RunError saying where."""
+        mpu = self.mpu
         try:
             if entries is None:
-                while mpu.pc != RETURN_TRAP or mpu.sp != CALL_STACK_TOP:
-                    recent[count % RECENT_INSTRUCTIONS] = mpu.pc
-                    step()
-                    count += 1
-                    if mpu.processorCycles >= limit:
-                        self._over_budget(limit, recent, count)
-            else:
-                while mpu.pc != RETURN_TRAP or mpu.sp != CALL_STACK_TOP:
-                    recent[count % RECENT_INSTRUCTIONS] = mpu.pc
-                    entries.append(self._traced_step())
-                    count += 1
-                    if mpu.processorCycles >= limit:
-                        self._over_budget(limit, recent, count)
+                return mpu.run_until(stop_pc, stop_sp, limit)
+            count = 0
+            while not (mpu.pc == stop_pc and (stop_sp < 0 or mpu.sp == stop_sp)) and mpu.processorCycles < limit:
+                mpu.recent[count & RECENT_MASK] = mpu.pc
+                count += 1
+                mpu.executed = count
+                entries.append(self._traced_step())
+            return count
         except CpuHalt as halt:
-            recent[count % RECENT_INSTRUCTIONS] = halt.address
-            raise RunError(f"{halt}; last instructions: {self._describe_recent(recent, count + 1)}") from None
-        return count
+            raise RunError(f"{halt}; last instructions: {self._describe_recent(mpu.executed)}") from None
 
     def _traced_step(self) -> TraceEntry:
         mpu = self.mpu
@@ -168,41 +193,12 @@ class Machine:
                           page_crossed=(extra == 2) if is_branch else extra == 1,
                           branch_taken=is_branch and extra >= 1)
 
-    def run(self, entry: str | int, *, until: str | int | None = None, cycles: int = DEFAULT_BUDGET) -> int:
-        """Run from entry for a number of cycles, or until the PC reaches `until` (error if it never does).
+    def _over_budget(self, budget: int, count: int) -> None:
+        raise RunError(f"cycle budget of {budget} cycles used up at PC ${self.mpu.pc:04X} after {count} "
+                       f"instructions; last instructions: {self._describe_recent(count)}")
 
-        Returns the number of instructions executed. For programs that never return (main loops).
-        """
-        mpu = self.mpu
-        mpu.pc = self.resolve(entry, "entry")
-        stop = self.resolve(until, "until") if until is not None else None
-        limit = mpu.processorCycles + cycles
-        step = mpu.step
-        recent = [0] * RECENT_INSTRUCTIONS
-        count = 0
-        try:
-            while mpu.processorCycles < limit:
-                if mpu.pc == stop:
-                    return count
-                recent[count % RECENT_INSTRUCTIONS] = mpu.pc
-                step()
-                count += 1
-        except CpuHalt as halt:
-            recent[count % RECENT_INSTRUCTIONS] = halt.address
-            raise RunError(f"{halt}; last instructions: {self._describe_recent(recent, count + 1)}") from None
-        if stop is not None and mpu.pc != stop:
-            self._over_budget(limit, recent, count)
-        return count
-
-    def _over_budget(self, limit: int, recent: list[int], count: int) -> None:
-        raise RunError(f"cycle budget exhausted (clock {self.mpu.processorCycles}, limit {limit}) "
-                       f"at PC ${self.mpu.pc:04X} after {count} instructions; "
-                       f"last instructions: {self._describe_recent(recent, count)}")
-
-    def _describe_recent(self, recent: list[int], count: int) -> str:
-        n = min(count, RECENT_INSTRUCTIONS)
-        addresses = [recent[(count - n + i) % RECENT_INSTRUCTIONS] for i in range(n)]
-        shown = addresses[-8:]
+    def _describe_recent(self, count: int) -> str:
+        shown = self.mpu.recent_addresses(count)[-RECENT_SHOWN:]
         return ", ".join(f"${a:04X} {self.disassemble_at(a)}" for a in shown)
 
     def disassemble_at(self, address: int) -> str:

@@ -13,10 +13,14 @@ What this adds to py65 1.2.0:
   (J. Ahola et al.) for the operations, decimal-mode ARR/ADC/SBC and the cycle counts.
 - The unstable opcodes (SHA, SHX, SHY, TAS, LAS, ANE, LXA) and the twelve JAM opcodes raise
   `CpuHalt`, naming the opcode and its address: their results depend on the chip and temperature.
-- Device access timing: when a read or write lands on a page that a device owns, the device is told
-  the CPU cycle of that bus access (cycle count at the start of the instruction plus the offset of
-  that bus cycle within it), so chips can be timed against the beam. Plain RAM stays a Python list.
+- Device access timing: when a data read or write lands on a page that a device owns, the device is
+  told the CPU cycle of that bus access (cycle count at the start of the instruction plus the offset
+  of that bus cycle within it), so chips can be timed against the beam. Plain RAM stays a Python
+  list; opcodes and operands are always fetched from it. Dummy reads are not put on the bus.
+  docs/cpu.md has the model and what it leaves out.
 - BRK optionally stops the run (`stop_on_brk`), which `Machine.call` uses.
+- `run_until`, the loop `Machine` runs: `step` inlined, with a ring of recent instruction addresses
+  for error messages. It and the cheaper operand fetches make it faster than bare py65.
 """
 
 from __future__ import annotations
@@ -37,6 +41,9 @@ FLAG_Z = 0x02
 FLAG_C = 0x01
 
 OPCODE_BRK = 0x00
+RECENT_SIZE = 16  # a power of two: run_until keeps the addresses of this many recent instructions
+RECENT_MASK = RECENT_SIZE - 1
+_KEEP_ALL_BUT_NVZC = 0xFF & ~(FLAG_N | FLAG_V | FLAG_Z | FLAG_C)
 # 64doc / No More Secrets: these lock the NMOS CPU until reset.
 JAM_OPCODES = frozenset({0x02, 0x12, 0x22, 0x32, 0x42, 0x52, 0x62, 0x72, 0x92, 0xB2, 0xD2, 0xF2})
 # Results depend on the chip revision, temperature or bus state ("unstable" in No More Secrets).
@@ -75,16 +82,18 @@ class MPU6510(_Py65MPU):
         self.page_devices = page_devices if page_devices is not None else [None] * 256
         self.stop_on_brk = False
         self.current_op = 0
-        self.instruction_start = 0
+        # Addresses of the last RECENT_SIZE instructions started by run_until (a ring, indexed by count).
+        self.recent = [0] * RECENT_SIZE
+        self.executed = 0  # instructions started by the last run_until, including one that halted
         super().__init__(memory=memory, pc=pc)
         self.name = type(self).__name__[3:]
 
     # ---- execution -------------------------------------------------------------------------
 
     def step(self):
+        """Execute one instruction (run_until is the same cycle, inlined for speed)."""
         pc = self.pc
         op = self.memory[pc]
-        self.instruction_start = pc
         self.current_op = op
         self.pc = (pc + 1) & ADDRESS_MASK
         self.excycles = 0
@@ -94,9 +103,94 @@ class MPU6510(_Py65MPU):
         self.processorCycles += self.cycletime[op] + self.excycles
         return self
 
+    def run_until(self, stop_pc: int, stop_sp: int, limit: int) -> int:
+        """Execute until PC == stop_pc (and SP == stop_sp, unless stop_sp < 0) or the clock reaches limit.
+
+        Returns the number of instructions executed; records their addresses in `recent`. The body of
+        `step` is inlined here: a method call per instruction would cost over 10% of the speed.
+        CpuHalt propagates with `executed` counting the halting instruction.
+        """
+        memory = self.memory
+        instruct = self.instruct
+        cycletime = self.cycletime
+        extracycles = self.extracycles
+        recent = self.recent
+        count = 0
+        try:
+            while True:
+                pc = self.pc
+                if pc == stop_pc and (stop_sp < 0 or self.sp == stop_sp):
+                    return count
+                if self.processorCycles >= limit:
+                    return count
+                recent[count & RECENT_MASK] = pc
+                count += 1
+                op = memory[pc]
+                self.current_op = op
+                self.pc = (pc + 1) & ADDRESS_MASK
+                self.excycles = 0
+                self.addcycles = extracycles[op]
+                instruct[op](self)
+                self.pc &= ADDRESS_MASK
+                self.processorCycles += cycletime[op] + self.excycles
+        finally:
+            self.executed = count
+
+    def recent_addresses(self, count: int) -> list[int]:
+        """The addresses of the last min(count, RECENT_SIZE) instructions, oldest first."""
+        n = min(count, RECENT_SIZE)
+        return [self.recent[i & RECENT_MASK] for i in range(count - n, count)]
+
     def stall(self, cycles: int) -> None:
         """Add cycles to the current instruction (the CPU halted by DMA)."""
         self.excycles += cycles
+
+    # ---- instruction stream ------------------------------------------------------------------
+    # Opcodes and operands are fetched from RAM (the bus's memory list), never from a device:
+    # devices see data accesses only. This also makes operand fetches cheaper than py65's.
+
+    def ImmediateByte(self):
+        return self.memory[self.pc]
+
+    def ZeroPageAddr(self):
+        return self.memory[self.pc]
+
+    def ZeroPageXAddr(self):
+        return (self.x + self.memory[self.pc]) & 0xFF
+
+    def ZeroPageYAddr(self):
+        return (self.y + self.memory[self.pc]) & 0xFF
+
+    def AbsoluteAddr(self):
+        memory = self.memory
+        pc = self.pc
+        return memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8
+
+    def _indexed(self, base: int, index: int) -> int:
+        address = (base + index) & ADDRESS_MASK
+        if self.addcycles and (base ^ address) & 0xFF00:
+            self.excycles += 1  # the page-crossing penalty of reads
+        return address
+
+    def AbsoluteXAddr(self):
+        memory = self.memory
+        pc = self.pc
+        return self._indexed(memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8, self.x)
+
+    def AbsoluteYAddr(self):
+        memory = self.memory
+        pc = self.pc
+        return self._indexed(memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8, self.y)
+
+    # The zero-page pointer of (zp,X) and (zp),Y is data: read through the bus, wrapping in page 0.
+    def IndirectXAddr(self):
+        pointer = (self.memory[self.pc] + self.x) & 0xFF
+        return self.ByteAt(pointer) | self.ByteAt((pointer + 1) & 0xFF) << 8
+
+    def IndirectYAddr(self):
+        pointer = self.memory[self.pc]
+        base = self.ByteAt(pointer) | self.ByteAt((pointer + 1) & 0xFF) << 8
+        return self._indexed(base, self.y)
 
     # ---- bus -------------------------------------------------------------------------------
 
@@ -204,12 +298,18 @@ class MPU6510(_Py65MPU):
 
     def _adc(self, v: int) -> None:
         a = self.a
-        carry = self.p & FLAG_C
+        p = self.p
+        carry = p & FLAG_C
         binary = a + v + carry
-        if not self._decimal_on():
-            overflow = (~(a ^ v) & (a ^ binary) & 0x80) != 0
-            self.p = (self.p & ~(FLAG_C | FLAG_V)) | (FLAG_C if binary > 0xFF else 0) | (FLAG_V if overflow else 0)
-            self.a = self._nz(binary & 0xFF)
+        if not (p & FLAG_D and self.has_decimal):
+            result = binary & 0xFF
+            p = (p & _KEEP_ALL_BUT_NVZC) | (result & FLAG_N) | (0 if result else FLAG_Z)
+            if binary > 0xFF:
+                p |= FLAG_C
+            if ~(a ^ v) & (a ^ binary) & 0x80:
+                p |= FLAG_V
+            self.p = p
+            self.a = result
             return
         # NMOS decimal ADC (64doc): Z from the binary sum, N and V from the half-adjusted result.
         low = (a & 0x0F) + (v & 0x0F) + carry
@@ -230,13 +330,19 @@ class MPU6510(_Py65MPU):
 
     def _sbc(self, v: int) -> None:
         a = self.a
-        borrow = 1 - (self.p & FLAG_C)
+        p = self.p
+        borrow = 1 - (p & FLAG_C)
         binary = a - v - borrow
-        overflow = ((a ^ v) & (a ^ binary) & 0x80) != 0
-        self.p = (self.p & ~(FLAG_C | FLAG_V)) | (FLAG_C if binary >= 0 else 0) | (FLAG_V if overflow else 0)
-        self._nz(binary & 0xFF)
-        if not self._decimal_on():
-            self.a = binary & 0xFF
+        result = binary & 0xFF
+        # Flags come from the binary difference in both modes (64doc).
+        p = (p & _KEEP_ALL_BUT_NVZC) | (result & FLAG_N) | (0 if result else FLAG_Z)
+        if binary >= 0:
+            p |= FLAG_C
+        if (a ^ v) & (a ^ binary) & 0x80:
+            p |= FLAG_V
+        self.p = p
+        if not (p & FLAG_D and self.has_decimal):
+            self.a = result
             return
         # NMOS decimal SBC (64doc): flags as in binary, the accumulator adjusted per nybble.
         low = (a & 0x0F) - (v & 0x0F) - borrow
@@ -313,7 +419,8 @@ class MPU6510(_Py65MPU):
         self.ByteAt(x())  # the read happens on the bus (it can clear a latch)
 
     def halt_on(self, kind: str) -> None:
-        raise CpuHalt(kind, self.current_op, self.instruction_start)
+        # Called while executing the opcode byte, before any operand is consumed: PC is one past it.
+        raise CpuHalt(kind, self.current_op, (self.pc - 1) & ADDRESS_MASK)
 
 
 def _register_undocumented(cls) -> None:

@@ -1,0 +1,162 @@
+"""Speed against accuracy as pictures: the overall chart and the per-pair grid (matplotlib, PNG bytes).
+
+x: 6502 cycles per test (mean, log scale, bar from min to max); y: accuracy. Methods on the Pareto
+front are drawn in colour and joined by a step line; dominated methods are grey. A method without a
+6502 routine (SAT) has no x position: it is drawn as a dashed horizontal line at its accuracy.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
+
+from retro.analysis.study.report import ALL, HARDWARE, FigureRow  # noqa: E402
+
+COLOURS = {"box": "#1f77b4", "tight": "#2ca02c", "circle": "#ff7f0e", "tile": "#8c564b",
+           "pixel": "#d62728", "latch": "#17becf", "sat": "#9467bd"}
+MARKERS = {"box": "s", "tight": "D", "circle": "o", "tile": "P", "pixel": "*", "latch": "^", "sat": "X"}
+GREY = "#b0b0b0"
+
+
+def _png(fig) -> bytes:
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=110)
+    plt.close(fig)
+    return buffer.getvalue()
+
+
+def _x_limits(rows: list[FigureRow]) -> tuple[float, float]:
+    lows = [r.cycles_min for r in rows if r.cycles_min]
+    highs = [r.cycles_max for r in rows if r.cycles_max]
+    if not lows:
+        return 1, 1000
+    return min(lows) / 1.5, max(highs) * 1.5
+
+
+def _draw_panel(ax, rows: list[FigureRow], xlim: tuple[float, float], labels: bool, title: str) -> None:
+    measured = [r for r in rows if not math.isnan(r.cycles_mean)]
+    accuracies = [r.accuracy for r in rows if not math.isnan(r.accuracy)]
+    y_low = max(0.0, min(accuracies) - 0.06) if accuracies else 0.0
+    for r in measured:
+        hardware = r.method in HARDWARE
+        lit = r.pareto_software or hardware
+        colour = COLOURS.get(r.method, "black") if lit else GREY
+        ax.errorbar([r.cycles_mean], [r.accuracy],
+                    xerr=[[r.cycles_mean - r.cycles_min], [r.cycles_max - r.cycles_mean]],
+                    fmt=MARKERS.get(r.method, "o"), color=colour, ecolor=colour, elinewidth=1.2, capsize=3,
+                    markersize=9 if labels else 6, markeredgecolor="black" if lit else GREY,
+                    markerfacecolor="none" if hardware else colour, markeredgewidth=1.6 if hardware else 1.0,
+                    zorder=3 if lit else 2)
+    front = sorted((r for r in measured if r.pareto_software), key=lambda r: r.cycles_mean)
+    if len(front) > 1:
+        xs = [r.cycles_mean for r in front] + [xlim[1]]
+        ys = [r.accuracy for r in front] + [front[-1].accuracy]
+        ax.step(xs, ys, where="post", color="black", linewidth=0.8, alpha=0.5, zorder=1)
+    for r in rows:
+        if math.isnan(r.cycles_mean) and not math.isnan(r.accuracy):
+            ax.axhline(r.accuracy, color=COLOURS.get(r.method, "black"), linestyle="--", linewidth=1.2)
+            text = f"{r.label}: {100 * r.accuracy:.1f}% (host only, no 6502 routine)" if labels else f"{r.method} (host)"
+            ax.text(xlim[1] / 1.08, r.accuracy, text, fontsize=8.5 if labels else 6.5,
+                    color=COLOURS.get(r.method, "black"), va="top", ha="right")
+    ax.set_xscale("log")
+    ax.set_xlim(*xlim)
+    ax.set_ylim(y_low, 1.0 + (1.0 - y_low) * 0.06)
+    ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0) if labels else (1.0,)))
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{100 * v:.0f}%"))
+    ax.grid(True, which="major", alpha=0.3)
+    ax.set_title(title, fontsize=11 if labels else 8.5)
+    ax.tick_params(labelsize=9 if labels else 7)
+    if labels:
+        _place_labels(ax, measured)
+
+
+# Label positions tried in turn (offset in points, horizontal alignment) until one overlaps nothing.
+_LABEL_SLOTS = ((9, -16, "left"), (9, 5, "left"), (-9, 5, "right"), (-9, -16, "right"), (9, -30, "left"), (9, 18, "left"))
+
+
+def _place_labels(ax, rows: list[FigureRow]) -> None:
+    """Label each point with its name and figures, avoiding the labels already placed."""
+    fig = ax.figure
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    from matplotlib.transforms import Bbox
+
+    taken = []
+    for r in rows:  # keep labels off every marker
+        px, py = ax.transData.transform((r.cycles_mean, r.accuracy))
+        taken.append(Bbox.from_extents(px - 8, py - 8, px + 8, py + 8))
+    for r in sorted(rows, key=lambda r: (-r.pareto_software, r.cycles_mean)):
+        text = f"{r.label}\n{r.cycles_mean:.0f} cycles, {100 * r.accuracy:.1f}%"
+        if r.method in HARDWARE:
+            text += "\n(hardware: not which pair, not when)"
+        lit = r.pareto_software or r.method in HARDWARE
+        for dx, dy, align in _LABEL_SLOTS:
+            note = ax.annotate(text, (r.cycles_mean, r.accuracy), textcoords="offset points", xytext=(dx, dy),
+                               ha=align, fontsize=8.5, color="black" if lit else "#707070",
+                               bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8), zorder=4)
+            box = note.get_window_extent(renderer)
+            if not any(box.overlaps(other) for other in taken):
+                break
+            note.remove()
+        else:
+            note = ax.annotate(text, (r.cycles_mean, r.accuracy), textcoords="offset points", xytext=_LABEL_SLOTS[0][:2],
+                               fontsize=8.5, color="black" if lit else "#707070", zorder=4)
+            box = note.get_window_extent(renderer)
+        taken.append(box)
+
+
+def overall_chart(rows: list[FigureRow], note: str = "") -> bytes:
+    """One large panel for the pooled corpus, every point labelled. The front is that of the software
+    methods; the hardware latch (hollow marker) is drawn in colour beside it for reference."""
+    chosen = [r for r in rows if r.scope == ALL]
+    fig, ax = plt.subplots(figsize=(10, 6.5))
+    fig.subplots_adjust(left=0.08, right=0.82, bottom=0.12, top=0.94)  # fixed before labels are placed
+    _draw_panel(ax, chosen, _x_limits(chosen), labels=True,
+                title=f"Speed against accuracy, all pairs pooled ({chosen[0].cases if chosen else 0} cases)")
+    ax.set_xlabel("6502 cycles per test (mean; bar = min to max over the corpus inputs), log scale")
+    ax.set_ylabel("accuracy (share of cases decided correctly)")
+    _legend(fig)
+    if note:
+        fig.text(0.01, 0.01, note, fontsize=8, color="#555555")
+    return _png(fig)
+
+
+def _legend(fig, below: bool = False) -> None:
+    from matplotlib.lines import Line2D
+
+    handles = [Line2D([], [], marker=MARKERS[k], color=COLOURS[k], linestyle="", markersize=8, markeredgecolor="black",
+                      label=k) for k in COLOURS]
+    handles.append(Line2D([], [], marker="o", color=GREY, linestyle="", markersize=8, label="dominated (grey)"))
+    handles.append(Line2D([], [], color="black", alpha=0.5, label="Pareto front\n(software methods)"))
+    if below:
+        fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=9, frameon=False)
+    else:
+        fig.legend(handles=handles, loc="upper right", fontsize=8.5, frameon=True, title="method", title_fontsize=9)
+
+
+def pairs_chart(rows: list[FigureRow], columns: int = 6) -> bytes:
+    """A faceted grid, one small panel per shape pair, sharing the x range."""
+    scopes = [s for s in dict.fromkeys(r.scope for r in rows) if s != ALL]
+    count = max(1, len(scopes))
+    columns = min(columns, count)
+    lines = math.ceil(count / columns)
+    fig, axes = plt.subplots(lines, columns, figsize=(2.5 * columns + 0.6, 2.2 * lines + 1.2), squeeze=False)
+    xlim = _x_limits([r for r in rows if r.scope != ALL])
+    for i, scope in enumerate(scopes):
+        ax = axes[i // columns][i % columns]
+        _draw_panel(ax, [r for r in rows if r.scope == scope], xlim, labels=False, title=scope)
+    for j in range(len(scopes), lines * columns):
+        axes[j // columns][j % columns].axis("off")
+    fig.supxlabel("6502 cycles per test (mean, bar = min-max; log scale)", fontsize=10, y=0.035)
+    fig.supylabel("accuracy", fontsize=10)
+    _legend(fig, below=True)
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    return _png(fig)

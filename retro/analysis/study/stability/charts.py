@@ -1,0 +1,70 @@
+"""Pictures of the stability study (matplotlib, PNG bytes)."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from retro.analysis.study.chart import COLOURS, MARKERS, _png  # noqa: E402
+from retro.analysis.study.stability.tunnelling import SWEPT, TunnelRow  # noqa: E402
+
+LABELS = {"box": "sprite box AABB", "tight": "tight hitbox AABB", "circle": "fitted circle",
+          "pixel": "pixel-perfect / latch", SWEPT: "swept tight box (retro.geometry)"}
+
+
+def tunnelling_chart(rows: list[TunnelRow], mover: str) -> bytes:
+    thicknesses = sorted({r.thickness for r in rows})
+    methods = list(dict.fromkeys(r.method for r in rows))
+    fig, axes = plt.subplots(1, len(thicknesses), figsize=(3.6 * len(thicknesses) + 1.5, 3.9), sharey=True, squeeze=False)
+    for ax, t in zip(axes[0], thicknesses):
+        for key in methods:
+            chosen = sorted((r for r in rows if r.method == key and r.thickness == t), key=lambda r: r.speed)
+            ax.plot([r.speed for r in chosen], [100 * r.miss_rate for r in chosen],
+                    color="black" if key == SWEPT else COLOURS.get(key, "black"),
+                    linestyle="--" if key == SWEPT else "-", marker=MARKERS.get(key, None), markevery=4,
+                    markersize=5, linewidth=2.4 if key == SWEPT else 1.5, label=LABELS.get(key, key))
+        ax.set_title(f"obstacle {t} px thick", fontsize=10)
+        ax.set_xlabel("speed (pixels per frame)")
+        ax.grid(True, alpha=0.3)
+        ax.set_ylim(-3, 100)
+    axes[0][0].set_ylabel("crossings missed (% of start phases)")
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(methods), fontsize=8.5, frameon=False)
+    fig.suptitle(f"Tunnelling: a {mover} crossing a wall at v px/frame, tested once per frame", fontsize=11)
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
+    return _png(fig)
+
+
+def wrap_chart(maps: dict, rows: list) -> bytes:
+    """One map per (video, software test): for every pair of X registers, whether the software box
+    test and the VIC-II agree."""
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    from retro.analysis.study.stability.wrap import X_RANGE
+
+    colours = ["#ffffff", "#c8c8c8", "#ff7f0e", "#1f77b4"]
+    names = ["both: no collision", "both: collision", "software only (chip shows none)",
+             "chip only (software misses)"]
+    keys = list(maps)
+    fig, axes = plt.subplots(1, len(keys), figsize=(3.9 * len(keys), 4.9), squeeze=False)
+    counts = {(r.video, r.test): r for r in rows}
+    for ax, key in zip(axes[0], keys):
+        ax.imshow(maps[key], cmap=ListedColormap(colours), vmin=0, vmax=3, origin="lower",
+                  interpolation="nearest", extent=(0, X_RANGE, 0, X_RANGE))
+        r = counts[key]
+        ax.set_title(f"{key[0].upper()}: {key[1]}\nsoftware only {r.software_only}, chip only {r.hardware_only}",
+                     fontsize=8.5)
+        ax.set_xlabel("X of sprite b", fontsize=8.5)
+        ax.set_xticks([0, 128, 256, 384, 504])
+        ax.set_yticks([0, 128, 256, 384, 504])
+        ax.tick_params(labelsize=7.5)
+    axes[0][0].set_ylabel("X of sprite a", fontsize=8.5)
+    fig.legend(handles=[Patch(color=c, label=n, ec="black", lw=0.5) for c, n in zip(colours, names)],
+               loc="lower center", ncol=4, fontsize=8.5, frameon=False)
+    fig.suptitle("Coordinate wrap: box test on sprite X registers against the VIC-II (two full 24x21 sprites)",
+                 fontsize=10.5)
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    return _png(fig)

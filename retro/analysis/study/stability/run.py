@@ -1,0 +1,133 @@
+"""`retro stability`: every part of the stability study, written as charts, CSVs and one Markdown report."""
+
+from __future__ import annotations
+
+import csv
+import io
+import time
+from dataclasses import astuple, dataclass, fields
+from pathlib import Path
+
+from retro.analysis.study.corpus import load_shapes
+from retro.analysis.study.evaluate import Progress, quiet
+from retro.fileio import write_atomic
+
+REDUCED_SPEEDS = tuple(range(1, 25))
+FULL_SPEEDS = tuple(range(1, 65))
+
+
+@dataclass(frozen=True)
+class StabilityOutput:
+    files: list[Path]
+    lines: list[str]
+    seconds: float
+
+
+def _csv(rows: list) -> str:
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    if rows:
+        writer.writerow([f.name for f in fields(rows[0])])
+        for r in rows:
+            writer.writerow(["" if v is None else v for v in astuple(r)])
+    return out.getvalue()
+
+
+def _md_table(header: list[str], body: list[list[object]]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in body]
+    return "\n".join(lines) + "\n"
+
+
+def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = quiet) -> StabilityOutput:
+    from retro.analysis.study.stability import charts, edges, latch_pitfalls, ranges, tunnelling, wrap
+
+    start = time.perf_counter()
+    files: list[Path] = []
+    md = ["# Stability: where each method breaks\n"]
+    summary: list[str] = []
+
+    # Tunnelling
+    mover = load_shapes(["bullet"])[0]
+    speeds = REDUCED_SPEEDS if reduced else FULL_SPEEDS
+    progress("stability: tunnelling")
+    tunnel = tunnelling.tunnelling_table(mover, speeds=speeds)
+    files.append(write_atomic(out_dir / "tunnelling.csv", _csv(tunnel)))
+    files.append(write_atomic(out_dir / "tunnelling.png", charts.tunnelling_chart(tunnel, "4x4 bullet sprite")))
+    methods = list(dict.fromkeys(r.method for r in tunnel))
+    body = [[charts.LABELS.get(m, m)] + [tunnelling.safe_speed(tunnel, m, t) for t in tunnelling.THICKNESSES]
+            for m in methods]
+    md.append("## Tunnelling\n\nHighest speed (px/frame, tested up to "
+              f"{max(speeds)}) at which a 4x4 bullet never passes through a wall of the given thickness "
+              "unseen (every start phase tried):\n\n")
+    md.append(_md_table(["method"] + [f"wall {t} px" for t in tunnelling.THICKNESSES], body))
+    md.append("\n![tunnelling](tunnelling.png)\n\n")
+    pixel_safe = tunnelling.safe_speed(tunnel, "pixel", 1)
+    summary.append(f"tunnelling: pixel-exact static tests miss a 1 px wall above {pixel_safe} px/frame; "
+                   f"the swept test never misses (up to {max(speeds)})")
+
+    # Coordinate wrap
+    progress("stability: coordinate wrap")
+    wrap_rows, maps = wrap.wrap_table()
+    files.append(write_atomic(out_dir / "wrap.csv", _csv(wrap_rows)))
+    files.append(write_atomic(out_dir / "wrap.png", charts.wrap_chart(maps, wrap_rows)))
+    md.append("## Coordinate wrap\n\nTwo full sprites at every pair of X register values (0-511, "
+              "262,144 cases per row); the chip's answer from the VIC-II model:\n\n")
+    md.append(_md_table(["video", "software test", "software says hit, chip shows none", "chip latches, software misses",
+                         "first example (xa, xb)"],
+                        [[r.video.upper(), r.test, r.software_only, r.hardware_only,
+                          r.example_software_only or r.example_hardware_only] for r in wrap_rows]))
+    routine_wrap = ranges.wrap_routine_rows()
+    if routine_wrap:
+        md.append("\nThe 6502 routines across the boundary, run in the emulator:\n\n")
+        md.append(_md_table(["routine", "inputs", "cases", "mismatches against the 9-bit truth", "example"],
+                            [[r.routine, r.inputs, r.cases, r.mismatches, r.example or ""] for r in routine_wrap]))
+    md.append("\n![wrap](wrap.png)\n\n")
+    pal9 = next(r for r in wrap_rows if r.video == "pal" and r.test.startswith("9-bit"))
+    summary.append(f"wrap: on PAL a 9-bit box test disagrees with the chip in {pal9.software_only + pal9.hardware_only} "
+                   "of 262,144 X pairs (X $1F8-$1FF and the wrap to 0)")
+
+    # Arithmetic range
+    progress("stability: arithmetic range")
+    range_rows = ranges.range_rows(reduced=reduced)
+    files.append(write_atomic(out_dir / "ranges.csv", _csv(range_rows)))
+    md.append("## Arithmetic range\n\n")
+    if range_rows:
+        md.append("Found by running the assembly over the input space (exhaustively where stated):\n\n")
+        md.append(_md_table(["routine", "input space searched", "cases", "wrong answers", "correct exactly when"],
+                            [[r.routine, r.searched, r.cases, r.wrong, r.domain] for r in range_rows]))
+    else:
+        md.append("No 6502 routines found in asm/ (issue 5): nothing to search.\n")
+    md.append("\n")
+
+    # Edge conventions
+    progress("stability: edge conventions")
+    edge_rows = edges.edge_table()
+    files.append(write_atomic(out_dir / "edges.csv", _csv(edge_rows)))
+    tests = list(dict.fromkeys(r.test for r in edge_rows))
+    cases = list(dict.fromkeys(r.case for r in edge_rows))
+    by = {(r.case, r.test): r.hit for r in edge_rows}
+    md.append("## Edge conventions\n\n")
+    md.append(_md_table(["case"] + tests, [[c] + [{True: "hit", False: "no", None: ""}[by.get((c, t))]
+                                                  for t in tests] for c in cases]))
+    md.append("\n")
+
+    # Latch pitfalls
+    progress("stability: latch pitfalls")
+    ship, ball = load_shapes(["ship", "ball"])
+    found = latch_pitfalls.pitfalls(ship, ball)
+    flat = [(p.scenario, p.kind, p.truth, "; ".join(f"frame {r.frame} line {r.line}: ${r.value:02X}" for r in p.reads),
+             p.conclusion) for p in found]
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(["scenario", "kind", "truth", "reads", "conclusion"])
+    writer.writerows(flat)
+    files.append(write_atomic(out_dir / "latch_pitfalls.csv", out.getvalue()))
+    md.append("## Latch pitfalls\n\nA ship (sprite 0) and balls, driven through the VIC-II device; reads of "
+              "$D01E at the raster lines shown:\n\n")
+    md.append(_md_table(["scenario", "what happened", "reads of $D01E", "what the program concludes", "error"],
+                        [[s, t, r, c, k] for s, k, t, r, c in flat]))
+    summary.append("latch: " + ", ".join(f"{p.scenario} -> {p.kind}" for p in found))
+
+    files.append(write_atomic(out_dir / "stability.md", "".join(md)))
+    return StabilityOutput(files=files, lines=summary, seconds=time.perf_counter() - start)

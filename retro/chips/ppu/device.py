@@ -1,0 +1,316 @@
+"""The PPU as a bus device of the 2A03 machine: registers at $2000-$3FFF and OAM DMA at $4014.
+
+What a program sees (nesdev wiki "PPU registers", "PPU scrolling", "PPU frame timing"):
+- $2000-$2007 repeat every 8 bytes up to $3FFF.
+- $2002 returns vblank (bit 7), sprite-zero hit (bit 6), overflow (bit 5, not modelled: 0) and the
+  I/O latch in bits 0-4. Reading it clears bit 7 and the $2005/$2006 write toggle, never bit 6.
+  The vblank flag is set at line 241 dot 1; vblank and hit are cleared at dot 1 of the pre-render
+  line. The hit flag is set at the dot the hit model (`retro.chips.ppu.hit`) gives.
+- $2000/$2005/$2006 load the internal t/x/w registers; $2006's second write copies t to v; $2007
+  reads (buffered, except the palette) and writes VRAM at v, then adds 1 or 32 ($2000 bit 2).
+- VRAM: $0000-$1FFF pattern tables (the scene's CHR, writable like CHR RAM), $2000-$2FFF the
+  four nametables folded onto 2 KiB by the mirroring, $3000-$3EFF a mirror, $3F00-$3F1F palette
+  ($3F10/$14/$18/$1C mirror $3F00/$04/$08/$0C).
+- $4014: OAM DMA copies the 256 bytes of page N to OAM starting at OAMADDR and stalls the CPU
+  513 cycles, 514 when the write lands on an odd CPU cycle.
+The PPU clock follows `retro.chips.ppu.clock`. The frame's scroll is taken from t and x, which the
+real PPU copies into v during the pre-render line (vertical) and at dot 257 of each line
+(horizontal); writes during lines 0-239 take effect for the pixels after the write, as if the new
+state held for the whole frame (the real PPU's mid-frame v/t details are not modelled), nor are
+NMI, sprite overflow, the $2002 read/vblank race, or the power-up write lock-out.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from retro.chips.ppu.clock import dots_at_cycle, frame_dots, line_and_dot
+from retro.chips.ppu.constants import (
+    CHR_SIZE, COARSE_SHIFT, CTRL_INCREMENT_32, CTRL_NAMETABLE, DOTS_PER_LINE, FINE_SCROLL,
+    FLAG_CLEAR_DOT, MASK_RENDERING, MIRRORING, NAMETABLE_SIZE, NAMETABLE_SPACE_MASK,
+    OAM_DMA_CYCLES, OAM_DMA_ODD_EXTRA, OAM_SIZE, OAMADDR, OAMDATA, OAMDMA, ODD_FRAME_SKIP_DOT,
+    PALETTE_BASE, PALETTE_SHADOW_OFFSET, PALETTE_SIZE, PPUADDR_HIGH_BITS, PPU_REGISTER_BASE, PPU_REGISTER_END, PPU_REGISTER_MASK, PPUADDR,
+    PPUCTRL, PPUDATA, PPUMASK, PPUSCROLL, PPUSTATUS, SCREEN_HEIGHT, STATUS_OPEN_BUS,
+    STATUS_SPRITE0_HIT, STATUS_VBLANK, V_COARSE_X, V_COARSE_Y, V_COARSE_Y_SHIFT, V_FINE_Y,
+    V_BITS, V_FINE_Y_SHIFT, V_NAMETABLE, V_NAMETABLE_SHIFT, VBLANK_DOT, VBLANK_LINE, VRAM_ADDRESS_MASK,
+    VideoStandard,
+)
+from retro.chips.ppu.hit import hit_dot, hit_pixels, rendering_enabled_for_hits
+from retro.chips.ppu.state import PpuState
+
+PAGE_SIZE = 0x100
+INCREMENT_ACROSS = 1
+INCREMENT_DOWN = 32
+PALETTE_MIRROR_MASK = 0x13          # $3F10/$14/$18/$1C -> $3F00/$04/$08/$0C
+PALETTE_MIRRORED = 0x10
+
+
+class PpuDevice:
+    """The PPU on the bus. Create it from a PpuState (the scene), then `attach_ppu(machine, device)`."""
+
+    def __init__(self, state: PpuState | None = None, *, origin: int = 0,
+                 read_memory: Callable[[int], int] | None = None,
+                 stall: Callable[[int], None] | None = None) -> None:
+        state = state or PpuState()
+        self.video: VideoStandard = state.video
+        self.mirroring = state.mirroring
+        self.ctrl = state.ctrl
+        self.mask = state.mask
+        self.oam = bytearray(state.oam)
+        self.chr = bytearray(state.chr)
+        self.ciram = bytearray(state.ciram)
+        self.palette = bytearray(PALETTE_SIZE)
+        self.t = ((state.ctrl & CTRL_NAMETABLE) << V_NAMETABLE_SHIFT) | self._scroll_bits(state.scroll_x, state.scroll_y)
+        self.fine_x = state.scroll_x & FINE_SCROLL
+        self.v = self.t
+        self.w = 0
+        self.oam_addr = 0
+        self.read_buffer = 0
+        self.latch = 0
+        self.vblank = False
+        self.sprite0_hit = False
+        self.read_memory = read_memory or (lambda address: 0)
+        self.stall = stall or (lambda cycles: None)
+        # clock
+        self.origin = origin
+        self.frame = 0
+        self.frame_start = 0            # absolute dot of (line 0, dot 0) of the current frame
+        self.position = 0               # absolute dot up to which events have been applied
+        self.frame_length = self.video.dots_per_frame
+        self._event = 0                 # index into _fixed_events of the next one
+        self._state_from = -1           # absolute dot of the last change that can move the hit
+        self._candidates: np.ndarray | None = None
+        self.hits: list[tuple[int, int, int]] = []   # (frame, line, dot) of each hit, for inspection
+        pre = self.video.pre_render_line
+        self._fixed_events = [
+            (VBLANK_LINE * DOTS_PER_LINE + VBLANK_DOT, self._set_vblank),
+            (pre * DOTS_PER_LINE + FLAG_CLEAR_DOT, self._clear_flags),
+            (pre * DOTS_PER_LINE + ODD_FRAME_SKIP_DOT, self._decide_frame_length),
+            (None, self._next_frame),   # at frame_length
+        ]
+
+    # ---- state as the hit model sees it ------------------------------------------------------
+
+    @staticmethod
+    def _scroll_bits(scroll_x: int, scroll_y: int) -> int:
+        return ((scroll_x >> COARSE_SHIFT) | ((scroll_y >> COARSE_SHIFT) << V_COARSE_Y_SHIFT)
+                | ((scroll_y & FINE_SCROLL) << V_FINE_Y_SHIFT))
+
+    def state(self) -> PpuState:
+        """The PPU state the current frame renders with (scroll from t and fine x)."""
+        t = self.t
+        scroll_x = ((t & V_COARSE_X) << COARSE_SHIFT) | self.fine_x
+        scroll_y = (((t & V_COARSE_Y) >> V_COARSE_Y_SHIFT) << COARSE_SHIFT) | ((t & V_FINE_Y) >> V_FINE_Y_SHIFT)
+        ctrl = (self.ctrl & ~CTRL_NAMETABLE) | ((t & V_NAMETABLE) >> V_NAMETABLE_SHIFT)
+        return PpuState(ctrl=ctrl, mask=self.mask, scroll_x=scroll_x, scroll_y=scroll_y, mirroring=self.mirroring,
+                        video=self.video, oam=bytes(self.oam), chr=bytes(self.chr), ciram=bytes(self.ciram))
+
+    def _changed(self, dot: int) -> None:
+        self._state_from = dot
+        self._candidates = None
+
+    # ---- clock -------------------------------------------------------------------------------
+
+    def dot_of(self, cycle: int) -> int:
+        return dots_at_cycle(cycle, self.origin, self.video)
+
+    def where(self) -> tuple[int, int, int]:
+        """(frame, line, dot) of the last access."""
+        line, dot = line_and_dot(self.position - self.frame_start)
+        return self.frame, line, dot
+
+    def _next_hit(self) -> int | None:
+        if self.sprite0_hit or self._event > 0:
+            return None                  # already hit, or past the vblank line (no visible line left)
+        if not rendering_enabled_for_hits(self.mask):
+            return None
+        if self.position - self.frame_start >= SCREEN_HEIGHT * DOTS_PER_LINE:
+            return None                  # no visible line left in this frame
+        if self._candidates is None:
+            lines, xs = hit_pixels(self.state())
+            self._candidates = lines * DOTS_PER_LINE + hit_dot(xs)
+        later = self._candidates[self._candidates > self._state_from - self.frame_start]
+        return int(later[0]) + self.frame_start if later.size else None
+
+    def advance(self, target: int) -> None:
+        """Apply every PPU event at absolute dots <= target."""
+        while True:
+            offset, action = self._fixed_events[self._event]
+            fixed_at = self.frame_start + (self.frame_length if offset is None else offset)
+            hit_at = self._next_hit()
+            if hit_at is not None and hit_at <= fixed_at:
+                if hit_at > target:
+                    break
+                self.sprite0_hit = True
+                self.hits.append((self.frame, *line_and_dot(hit_at - self.frame_start)))
+                continue
+            if fixed_at > target:
+                break
+            self._event += 1
+            action(fixed_at)
+        self.position = max(self.position, target)
+
+    def _set_vblank(self, dot: int) -> None:
+        self.vblank = True
+
+    def _clear_flags(self, dot: int) -> None:
+        self.vblank = False
+        self.sprite0_hit = False
+
+    def _decide_frame_length(self, dot: int) -> None:
+        self.frame_length = frame_dots(self.frame, bool(self.mask & MASK_RENDERING), self.video)
+
+    def _next_frame(self, dot: int) -> None:
+        self.frame += 1
+        self.frame_start = dot
+        self.frame_length = self.video.dots_per_frame
+        self._event = 0
+
+    # ---- bus interface -----------------------------------------------------------------------
+
+    def read(self, address: int, cycle: int) -> int:
+        if address == OAMDMA:
+            return self.latch
+        self.advance(self.dot_of(cycle))
+        register = PPU_REGISTER_BASE | (address & PPU_REGISTER_MASK)
+        if register == PPUSTATUS:
+            value = self._status()
+            self.vblank = False
+            self.w = 0
+        elif register == OAMDATA:
+            value = self.oam[self.oam_addr]
+        elif register == PPUDATA:
+            value = self._read_data()
+        else:
+            return self.latch            # write-only registers read back the latch
+        self.latch = value
+        return value
+
+    def peek(self, address: int) -> int:
+        if address == OAMDMA:
+            return self.latch
+        register = PPU_REGISTER_BASE | (address & PPU_REGISTER_MASK)
+        if register == PPUSTATUS:
+            return self._status()
+        if register == OAMDATA:
+            return self.oam[self.oam_addr]
+        if register == PPUDATA:
+            return self._vram_read(self.v) if self._is_palette(self.v) else self.read_buffer
+        return self.latch
+
+    def write(self, address: int, value: int, cycle: int) -> None:
+        dot = self.dot_of(cycle)
+        self.advance(dot)
+        self.latch = value
+        if address == OAMDMA:
+            self._oam_dma(value, cycle)
+            self._changed(dot)
+            return
+        register = PPU_REGISTER_BASE | (address & PPU_REGISTER_MASK)
+        if register == PPUCTRL:
+            self.ctrl = value
+            self.t = (self.t & ~V_NAMETABLE) | ((value & CTRL_NAMETABLE) << V_NAMETABLE_SHIFT)
+        elif register == PPUMASK:
+            self.mask = value
+        elif register == OAMADDR:
+            self.oam_addr = value
+            return
+        elif register == OAMDATA:
+            self.oam[self.oam_addr] = value
+            self.oam_addr = (self.oam_addr + 1) & 0xFF
+        elif register == PPUSCROLL:
+            self._write_scroll(value)
+        elif register == PPUADDR:
+            self._write_address(value)
+        elif register == PPUDATA:
+            self._vram_write(self.v, value)
+            self._step_v()
+        else:
+            return                        # $2002 is read-only
+        self._changed(dot)
+
+    # ---- registers ---------------------------------------------------------------------------
+
+    def _status(self) -> int:
+        return ((STATUS_VBLANK if self.vblank else 0) | (STATUS_SPRITE0_HIT if self.sprite0_hit else 0)
+                | (self.latch & STATUS_OPEN_BUS))
+
+    def _write_scroll(self, value: int) -> None:
+        if self.w == 0:
+            self.t = (self.t & ~V_COARSE_X) | (value >> COARSE_SHIFT)
+            self.fine_x = value & FINE_SCROLL
+        else:
+            self.t = (self.t & ~(V_COARSE_Y | V_FINE_Y)) | self._scroll_bits(0, value)
+        self.w ^= 1
+
+    def _write_address(self, value: int) -> None:
+        if self.w == 0:
+            self.t = (self.t & 0x00FF) | ((value & PPUADDR_HIGH_BITS) << 8)
+        else:
+            self.t = (self.t & 0xFF00) | value
+            self.v = self.t
+        self.w ^= 1
+
+    def _step_v(self) -> None:
+        step = INCREMENT_DOWN if self.ctrl & CTRL_INCREMENT_32 else INCREMENT_ACROSS
+        self.v = (self.v + step) & V_BITS
+
+    def _read_data(self) -> int:
+        address = self.v & VRAM_ADDRESS_MASK
+        if self._is_palette(address):
+            value = self._vram_read(address)
+            self.read_buffer = self._vram_read(address - PALETTE_SHADOW_OFFSET)
+        else:
+            value, self.read_buffer = self.read_buffer, self._vram_read(address)
+        self._step_v()
+        return value
+
+    @staticmethod
+    def _is_palette(address: int) -> bool:
+        return (address & VRAM_ADDRESS_MASK) >= PALETTE_BASE
+
+    def _ciram_index(self, address: int) -> int:
+        offset = address & NAMETABLE_SPACE_MASK
+        page = MIRRORING[self.mirroring][offset // NAMETABLE_SIZE]
+        return page * NAMETABLE_SIZE + offset % NAMETABLE_SIZE
+
+    @staticmethod
+    def _palette_index(address: int) -> int:
+        index = address % PALETTE_SIZE
+        return index & ~PALETTE_MIRRORED if index & PALETTE_MIRROR_MASK == PALETTE_MIRRORED else index
+
+    def _vram_read(self, address: int) -> int:
+        address &= VRAM_ADDRESS_MASK
+        if address < CHR_SIZE:
+            return self.chr[address]
+        if address < PALETTE_BASE:
+            return self.ciram[self._ciram_index(address)]
+        return self.palette[self._palette_index(address)]
+
+    def _vram_write(self, address: int, value: int) -> None:
+        address &= VRAM_ADDRESS_MASK
+        if address < CHR_SIZE:
+            self.chr[address] = value
+        elif address < PALETTE_BASE:
+            self.ciram[self._ciram_index(address)] = value
+        else:
+            self.palette[self._palette_index(address)] = value
+
+    def _oam_dma(self, page: int, cycle: int) -> None:
+        base = page * PAGE_SIZE
+        for i in range(OAM_SIZE):
+            self.oam[(self.oam_addr + i) & 0xFF] = self.read_memory(base + i)
+        self.stall(OAM_DMA_CYCLES + (OAM_DMA_ODD_EXTRA if cycle % 2 else 0))
+
+
+def attach_ppu(machine, device: PpuDevice) -> PpuDevice:
+    """Map the PPU onto a 2A03 machine ($2000-$3FFF and $4014); its clock starts at the machine's now."""
+    device.origin = machine.cycle
+    device.read_memory = machine.bus.peek
+    device.stall = machine.mpu.stall
+    machine.attach(device, PPU_REGISTER_BASE, PPU_REGISTER_END)
+    machine.attach(device, OAMDMA, OAMDMA)
+    return device
+

@@ -1,0 +1,133 @@
+"""VIC-II hardware numbers, each named once (6569 PAL and 6567R8 NTSC).
+
+Sources:
+- [Bauer] Christian Bauer, "The MOS 6567/6569 video controller (VIC-II) and its application in the
+  Commodore 64" (1996): 3.2 registers and unused bits, 3.4 frame and display window dimensions,
+  3.6.1 X coordinates, 3.7 graphics modes and idle state, 3.8 sprites, 3.9 border, 3.12 interrupts.
+- [PRG] Commodore 64 Programmer's Reference Guide, p.145 (sprite-sprite / sprite-data collisions).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+# ---- address space [Bauer 3.2] ------------------------------------------------------------------
+VIC_BASE = 0xD000
+VIC_LAST = 0xD3FF  # the 47 registers repeat every 64 bytes through $D000-$D3FF
+REGISTER_COUNT = 47  # $D000-$D02E
+MIRROR_SIZE = 64  # address & (MIRROR_SIZE - 1) selects the register
+UNUSED_READ = 0xFF  # $D02F-$D03F
+
+# register offsets from $D000
+REG_SPRITE_X0 = 0x00  # X of sprite n at 2n, Y at 2n+1
+REG_SPRITE_Y0 = 0x01
+REG_SPRITE_X_MSB = 0x10  # bit n: bit 8 of sprite n's X
+REG_CONTROL1 = 0x11  # $D011: YSCROLL, RSEL, DEN, BMM, ECM, RST8
+REG_RASTER = 0x12  # $D012
+REG_LIGHTPEN_X = 0x13
+REG_LIGHTPEN_Y = 0x14
+REG_SPRITE_ENABLE = 0x15  # $D015
+REG_CONTROL2 = 0x16  # $D016: XSCROLL, CSEL, MCM
+REG_SPRITE_EXPAND_Y = 0x17  # $D017
+REG_MEMORY_POINTERS = 0x18  # $D018
+REG_IRQ_LATCH = 0x19  # $D019
+REG_IRQ_ENABLE = 0x1A  # $D01A
+REG_SPRITE_PRIORITY = 0x1B  # $D01B: 1 = behind foreground graphics
+REG_SPRITE_MULTICOLOR = 0x1C  # $D01C
+REG_SPRITE_EXPAND_X = 0x1D  # $D01D
+REG_SPRITE_SPRITE = 0x1E  # $D01E: sprite-sprite collision latch
+REG_SPRITE_BACKGROUND = 0x1F  # $D01F: sprite-background collision latch
+REG_BORDER_COLOR = 0x20
+REG_BACKGROUND0 = 0x21  # $D021-$D024
+REG_SPRITE_MC0 = 0x25  # sprite multicolor 0 (pair 01)
+REG_SPRITE_MC1 = 0x26  # sprite multicolor 1 (pair 11)
+REG_SPRITE_COLOR0 = 0x27  # $D027-$D02E
+
+# Bits that do not exist read as 1 [Bauer 3.2, register table]
+UNUSED_BITS = {REG_CONTROL2: 0xC0, REG_MEMORY_POINTERS: 0x01, REG_IRQ_LATCH: 0x70, REG_IRQ_ENABLE: 0xF0,
+               **{reg: 0xF0 for reg in range(REG_BORDER_COLOR, REG_SPRITE_COLOR0 + 8)}}
+READ_ONLY_LATCHES = (REG_SPRITE_SPRITE, REG_SPRITE_BACKGROUND)
+
+# $D011
+CONTROL1_YSCROLL = 0x07
+CONTROL1_RSEL = 0x08
+CONTROL1_DEN = 0x10
+CONTROL1_BMM = 0x20
+CONTROL1_ECM = 0x40
+CONTROL1_RST8 = 0x80
+# $D016
+CONTROL2_XSCROLL = 0x07
+CONTROL2_CSEL = 0x08
+CONTROL2_MCM = 0x10
+
+# $D019 / $D01A [Bauer 3.12]
+IRQ_RASTER = 0x01
+IRQ_SPRITE_BACKGROUND = 0x02  # IMBC
+IRQ_SPRITE_SPRITE = 0x04  # IMMC
+IRQ_LIGHTPEN = 0x08
+IRQ_SOURCES = 0x0F
+IRQ_ANY = 0x80  # reads 1 while a latched source is enabled in $D01A
+
+SPRITE_COUNT = 8
+COLOR_MASK = 0x0F
+
+# ---- sprites [Bauer 3.8, PRG p.145] --------------------------------------------------------------
+SPRITE_WIDTH = 24
+SPRITE_HEIGHT = 21
+SPRITE_BYTES = 63
+SPRITE_BLOCK = 64  # sprite data sits in 64-byte blocks; the last byte is unused
+SPRITE_BYTES_PER_ROW = 3
+SPRITE_MC_WIDTH = SPRITE_WIDTH // 2  # multicolor: 12 pairs of bits per row
+Y_COMPARE_MASK = 0xFF  # the sprite Y compare sees only the low 8 bits of the raster line
+X_BITS_MASK = 0x1FF
+
+# ---- screen geometry [Bauer 3.4, 3.7] -------------------------------------------------------------
+TEXT_COLUMNS = 40
+TEXT_ROWS = 25
+CHAR_HEIGHT = 8
+CELL_WIDTH = 8
+SCREEN_CELLS = TEXT_COLUMNS * TEXT_ROWS  # 1000
+CHARSET_BYTES = 256 * CHAR_HEIGHT  # 2048
+BITMAP_BYTES = SCREEN_CELLS * CHAR_HEIGHT  # 8000
+ECM_CODE_MASK = 0x3F  # ECM: the character shape comes from code & $3F; bits 6-7 pick the background
+ECM_BITMAP_ADDRESS_MASK = 0x19FF  # ECM+BMM: the g-access loses address bits 9 and 10 [Bauer 3.7.3.7]
+MULTICOLOR_TEXT_FLAG = 0x08  # colour RAM bit 3 makes a character multicolor [Bauer 3.7.3.2]
+GRAPHICS_FIRST_X = 24  # column 0 pixel 0 with XSCROLL = 0: X = 24 + 8c + k + XSCROLL
+GRAPHICS_FIRST_LINE = 48  # text row r starts on line 48 + YSCROLL + 8r ($30: first bad line possible)
+BAD_LINE_LAST = 0xF7
+# Display window [Bauer 3.9]: (first line, last line) by RSEL, (first X, last X) by CSEL
+WINDOW_LINES = {1: (51, 250), 0: (55, 246)}
+WINDOW_X = {1: (24, 343), 0: (31, 334)}
+
+
+@dataclass(frozen=True, eq=False)  # two instances only: identity hashing keeps the caches cheap
+class Video:
+    """One chip's raster: lines, cycles and the X coordinates that exist [Bauer 3.4, 3.6.1]."""
+
+    name: str
+    chip: str
+    lines: int
+    cycles_per_line: int
+    x_positions: int  # X runs 0 .. x_positions-1 (the 6569 has no $1F8-$1FF)
+    first_x: int  # X coordinate drawn first in a raster line (cycle 1, where the raster IRQ fires)
+    first_visible_line: int  # after the vertical blank
+    visible_lines: int
+    first_visible_x: int
+    visible_pixels: int  # per line, in drawing order from first_visible_x (through the X wrap)
+
+    @property
+    def frame_cycles(self) -> int:
+        return self.lines * self.cycles_per_line
+
+
+PIXELS_PER_CYCLE = 8
+PAL = Video("pal", "6569", lines=312, cycles_per_line=63, x_positions=0x1F8, first_x=0x194,
+            first_visible_line=16, visible_lines=284, first_visible_x=0x1E0, visible_pixels=403)
+# 65 cycles draw 520 pixels but only 512 X coordinates exist: the model gives the 65th cycle no
+# X coordinate (see docs/vic.md, timing model).
+NTSC = Video("ntsc", "6567R8", lines=263, cycles_per_line=65, x_positions=0x200, first_x=0x19C,
+             first_visible_line=41, visible_lines=235, first_visible_x=0x1E9, visible_pixels=418)
+VIDEOS = {"pal": PAL, "ntsc": NTSC}
+
+# Raster compare [Bauer 3.12]: the IRQ for line 0 comes one cycle later than for the other lines.
+RASTER_IRQ_LINE0_DELAY = 1

@@ -1,0 +1,164 @@
+"""The VIC-II as a bus device at $D000-$D3FF, driven lazily by the CPU's cycle clock.
+
+Nothing runs per cycle. When the CPU touches a register at cycle m, the device first catches up:
+it applies every collision event drawn since its last access (from the frame schedule of the
+register state that held meanwhile, model.frame_collisions, cached per state), then serves the
+access. A write to a register that changes what collides switches to the new state's schedule from
+the next cycle on, so programs can move sprites between frames or between raster bands.
+
+Register behaviour [Bauer 3.2, 3.8.2, 3.12]:
+- the 47 registers repeat every 64 bytes; $D02F-$D03F read $FF; unused bits read 1;
+- $D011 bit 7 and $D012 read the current raster line; writes set the raster compare line;
+- $D01E/$D01F accumulate until read; a read (of any mirror) returns them and clears them; writes
+  are ignored;
+- $D019 bit 2 / bit 1 latch when $D01E / $D01F goes from zero to non-zero, bit 0 when the raster
+  compare line begins; bit 7 reads 1 while a latched bit is enabled in $D01A; writing 1s
+  acknowledges; reading $D01E/$D01F does not touch $D019.
+Timing model: retro.chips.vic.beam.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from retro.chips.vic.beam import position
+from retro.chips.vic.constants import (CONTROL1_RST8, IRQ_RASTER, IRQ_SOURCES, IRQ_SPRITE_BACKGROUND,
+                                       IRQ_SPRITE_SPRITE, MIRROR_SIZE, REG_CONTROL1, REG_IRQ_ENABLE,
+                                       REG_IRQ_LATCH, REG_LIGHTPEN_X, REG_LIGHTPEN_Y, REG_RASTER,
+                                       REG_SPRITE_BACKGROUND, REG_SPRITE_SPRITE, REGISTER_COUNT, UNUSED_BITS,
+                                       UNUSED_READ, Y_COMPARE_MASK)
+from retro.chips.vic.model import (COLLISION_REGISTERS, FrameCollisions, VicState, frame_collisions,
+                                   irq_register, raster_irq_time)
+
+SCHEDULE_CACHE_SIZE = 256
+_COLLISION_SET = frozenset(COLLISION_REGISTERS)
+_READ_ONLY = frozenset({REG_SPRITE_SPRITE, REG_SPRITE_BACKGROUND, REG_LIGHTPEN_X, REG_LIGHTPEN_Y})
+
+
+def _bits_between(times: np.ndarray, bits: np.ndarray, lo: int, hi: int, frame_cycles: int) -> int:
+    """OR of the event bits with device time in [lo, hi), events repeating every frame."""
+    if hi <= lo or times.size == 0:
+        return 0
+    if hi - lo >= frame_cycles:
+        return int(np.bitwise_or.reduce(bits))
+    a = lo % frame_cycles
+    b = a + (hi - lo)
+    windows = [(a, b)] if b <= frame_cycles else [(a, frame_cycles), (0, b - frame_cycles)]
+    found = 0
+    for start, end in windows:
+        i, j = np.searchsorted(times, [start, end])
+        if j > i:
+            found |= int(np.bitwise_or.reduce(bits[i:j]))
+    return found
+
+
+def _time_between(t: int | None, lo: int, hi: int, frame_cycles: int) -> bool:
+    """Whether a once-per-frame event at frame time t happens in device time [lo, hi)."""
+    if t is None or hi <= lo:
+        return False
+    if hi - lo >= frame_cycles:
+        return True
+    return (t - lo) % frame_cycles < hi - lo
+
+
+class VicDevice:
+    """A VIC-II whose frame starts (line 0, cycle 1) at machine cycle `start_cycle`."""
+
+    def __init__(self, state: VicState, start_cycle: int = 0) -> None:
+        self.state = state
+        self.video = state.video
+        self.start_cycle = start_cycle
+        self.registers = bytearray(state.registers)
+        self.sprite_sprite = 0  # $D01E as accumulated since the last read
+        self.sprite_background = 0  # $D01F
+        self.irq_latch = 0  # $D019 bits 0-3
+        self.synced = 0  # device time up to which (exclusive) events have been applied
+        self._schedules: dict[bytes, FrameCollisions] = {}
+        self._schedule = self._schedule_for(state)
+
+    # ---- catching up -------------------------------------------------------------------------
+
+    def _schedule_for(self, state: VicState) -> FrameCollisions:
+        key = state.collision_key()
+        schedule = self._schedules.get(key)
+        if schedule is None:
+            if len(self._schedules) >= SCHEDULE_CACHE_SIZE:
+                self._schedules.clear()
+            schedule = self._schedules[key] = frame_collisions(state)
+        return schedule
+
+    def _advance(self, until: int) -> None:
+        """Apply everything the beam draws in device time [synced, until)."""
+        lo = self.synced
+        if until <= lo:
+            return
+        frame_cycles = self.video.frame_cycles
+        events = self._schedule
+        new_ss = _bits_between(events.ss_times, events.ss_bits, lo, until, frame_cycles)
+        new_sb = _bits_between(events.sb_times, events.sb_bits, lo, until, frame_cycles)
+        if new_ss and not self.sprite_sprite:
+            self.irq_latch |= IRQ_SPRITE_SPRITE
+        if new_sb and not self.sprite_background:
+            self.irq_latch |= IRQ_SPRITE_BACKGROUND
+        self.sprite_sprite |= new_ss
+        self.sprite_background |= new_sb
+        if _time_between(raster_irq_time(self.video, self.registers), lo, until, frame_cycles):
+            self.irq_latch |= IRQ_RASTER
+        self.synced = until
+
+    def time(self, cycle: int) -> int:
+        return cycle - self.start_cycle
+
+    def beam(self, cycle: int) -> tuple[int, int, int]:
+        """(frame, line, cycle in line) at a machine cycle."""
+        return position(self.video, self.time(cycle))
+
+    # ---- the bus -----------------------------------------------------------------------------
+
+    def read(self, address: int, cycle: int) -> int:
+        t = self.time(cycle)
+        self._advance(t)
+        register = address % MIRROR_SIZE
+        if register == REG_SPRITE_SPRITE:
+            value, self.sprite_sprite = self.sprite_sprite, 0
+            return value
+        if register == REG_SPRITE_BACKGROUND:
+            value, self.sprite_background = self.sprite_background, 0
+            return value
+        return self._value(register, t)
+
+    def _value(self, register: int, t: int) -> int:
+        if register >= REGISTER_COUNT:
+            return UNUSED_READ
+        if register in (REG_CONTROL1, REG_RASTER):
+            _, line, _ = position(self.video, max(t, 0))
+            if register == REG_RASTER:
+                return line & Y_COMPARE_MASK
+            return (self.registers[REG_CONTROL1] & ~CONTROL1_RST8) | (CONTROL1_RST8 if line > Y_COMPARE_MASK else 0)
+        if register == REG_IRQ_LATCH:
+            return irq_register(self.irq_latch, self.registers[REG_IRQ_ENABLE])
+        return self.registers[register] | UNUSED_BITS.get(register, 0)
+
+    def write(self, address: int, value: int, cycle: int) -> None:
+        t = self.time(cycle)
+        self._advance(t + 1)  # what is drawn up to and including this cycle used the old value
+        register = address % MIRROR_SIZE
+        if register >= REGISTER_COUNT or register in _READ_ONLY:
+            return
+        if register == REG_IRQ_LATCH:
+            self.irq_latch &= ~value & IRQ_SOURCES
+            return
+        old = self.registers[register]
+        self.registers[register] = value & 0xFF
+        if register in _COLLISION_SET and old != value:
+            self.state = self.state.with_registers(self.registers)
+            self._schedule = self._schedule_for(self.state)
+
+    def peek(self, address: int) -> int:
+        """The value a read would return at the last synchronised cycle, without clearing anything."""
+        register = address % MIRROR_SIZE
+        if register == REG_SPRITE_SPRITE:
+            return self.sprite_sprite
+        if register == REG_SPRITE_BACKGROUND:
+            return self.sprite_background
+        return self._value(register, self.synced)

@@ -1,0 +1,41 @@
+"""`retro advise SCENE [--accuracy 0.99]`: the cheapest collision method good enough for a scene's shapes."""
+
+from __future__ import annotations
+
+import argparse
+
+from retro.analysis.study.advisor import advice_lines, advise
+from retro.analysis.study.evaluate import quiet, stderr_progress
+from retro.errors import InputError
+from retro.numbers import parse_int
+
+DEFAULT_ACCURACY = 0.99
+
+
+def _accuracy(text: str) -> float:
+    try:
+        value = float(text.rstrip("%")) / (100 if text.endswith("%") else 1)
+    except ValueError:
+        raise InputError(f"--accuracy: not a number: {text!r} (use 0.99 or 99%)") from None
+    if not 0 < value <= 1:
+        raise InputError(f"--accuracy: {text!r} is outside (0, 1] (use 0.99 or 99%)")
+    return value
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("advise", help="the cheapest collision method (6502 cycles) that meets an accuracy target "
+                                      "on a VIC-II scene's sprites")
+    p.add_argument("scene", metavar="SCENE.toml")
+    p.add_argument("--accuracy", default=str(DEFAULT_ACCURACY), metavar="A",
+                   help=f"required share of cases decided correctly, 0-1 or a percentage (default: {DEFAULT_ACCURACY})")
+    p.add_argument("--workers", default="2", metavar="N", help="processes to use (default: 2)")
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+    p.set_defaults(func=cmd_advise)
+
+
+def cmd_advise(args: argparse.Namespace) -> int:
+    advice = advise(args.scene, _accuracy(args.accuracy), workers=parse_int(args.workers, field="--workers", lo=1, hi=64),
+                    progress=quiet if args.quiet else stderr_progress)
+    for line in advice_lines(advice):
+        print(line)
+    return 0

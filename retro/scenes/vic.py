@@ -1,0 +1,281 @@
+"""VIC-II scene files: the TOML format of docs/vic.md -> VicScene (validated dataclasses).
+
+Every error is one line naming the file and the field: `FILE: sprite[2].x: ...`. Sprite `file`
+paths, and charset/bitmap files, resolve relative to the scene file.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from retro.chips.vic.constants import (BITMAP_BYTES, CHAR_HEIGHT, CHARSET_BYTES, COLOR_MASK, REG_IRQ_LATCH,
+                                       REG_SPRITE_COLOR0, REG_SPRITE_ENABLE, REG_SPRITE_EXPAND_X,
+                                       REG_SPRITE_EXPAND_Y, REG_SPRITE_MULTICOLOR, REG_SPRITE_PRIORITY,
+                                       REG_SPRITE_X0, REG_SPRITE_X_MSB, REG_SPRITE_Y0, READ_ONLY_LATCHES,
+                                       REGISTER_COUNT, SCREEN_CELLS, SPRITE_BYTES, SPRITE_COUNT, TEXT_COLUMNS,
+                                       TEXT_ROWS, VIC_BASE, VIDEOS, X_BITS_MASK, Y_COMPARE_MASK)
+from retro.chips.vic.graphics import VicMemory
+from retro.chips.vic.model import VicState
+from retro.errors import InputError
+from retro.fileio import read_bytes
+from retro.numbers import parse_int
+from retro.sprites import parse_hex, parse_rows, read_png, read_spr
+
+TOP_KEYS = {"chip", "video", "registers", "sprite", "memory"}
+SPRITE_KEYS = {"index", "x", "y", "enabled", "multicolor", "expand_x", "expand_y", "behind", "color", "data",
+               "rows", "file", "frame"}
+MEMORY_KEYS = {"screen", "color", "charset", "bitmap", "idle"}
+FILL_KEYS = {"fill", "cells"}
+SCREEN_CELL_KEYS = {"col", "row", "value"}
+BITMAP_KEYS = {"cells", "file"}
+BITMAP_CELL_KEYS = {"col", "row", "bytes"}
+SPRITE_FLAGS = {"enabled": REG_SPRITE_ENABLE, "multicolor": REG_SPRITE_MULTICOLOR, "expand_x": REG_SPRITE_EXPAND_X,
+                "expand_y": REG_SPRITE_EXPAND_Y, "behind": REG_SPRITE_PRIORITY}
+
+
+@dataclass(frozen=True)
+class SpriteSpec:
+    index: int
+    data: bytes  # 63 bytes
+    source: str  # "data", "rows", "file NAME"
+
+
+@dataclass(frozen=True, eq=False)
+class VicScene:
+    """A validated VIC-II scene: initial registers, sprite data, what the VIC sees in memory."""
+
+    source: str
+    video: str
+    registers: bytes
+    sprites: tuple[SpriteSpec, ...]
+    memory: VicMemory
+    state: VicState = field(repr=False)
+    cpu_variant: str = "6510"
+
+    def attach(self, machine):
+        """Map a VIC-II device for this scene at $D000-$D3FF; its frame starts now (line 0, cycle 1)."""
+        from retro.chips.vic.constants import VIC_LAST
+        from retro.chips.vic.device import VicDevice
+
+        return machine.attach(VicDevice(self.state, start_cycle=machine.cycle), VIC_BASE, VIC_LAST)
+
+
+class _Where:
+    def __init__(self, source: str):
+        self.source = source
+
+    def error(self, field_name: str, message: str) -> InputError:
+        return InputError(f"{self.source}: {field_name}: {message}")
+
+    def table(self, value, field_name: str, allowed: set[str]) -> dict:
+        if not isinstance(value, dict):
+            raise self.error(field_name, f"expected a table, got {type(value).__name__}")
+        unknown = sorted(set(value) - allowed)
+        if unknown:
+            raise self.error(f"{field_name}.{unknown[0]}" if field_name else unknown[0],
+                             f"unknown key (known: {', '.join(sorted(allowed))})")
+        return value
+
+    def number(self, value, field_name: str, lo: int, hi: int) -> int:
+        if isinstance(value, float) or isinstance(value, (list, dict)):
+            raise self.error(field_name, f"expected an integer, got {value!r}")
+        try:
+            return parse_int(value, field=field_name, lo=lo, hi=hi)
+        except InputError as exc:
+            raise InputError(f"{self.source}: {exc}") from None
+
+    def flag(self, value, field_name: str) -> bool:
+        if not isinstance(value, bool):
+            raise self.error(field_name, f"expected true or false, got {value!r}")
+        return value
+
+    def byte_list(self, value, field_name: str, length: int) -> list[int]:
+        if not isinstance(value, list) or len(value) != length:
+            got = len(value) if isinstance(value, list) else type(value).__name__
+            raise self.error(field_name, f"expected a list of {length} bytes, got {got}")
+        return [self.number(v, f"{field_name}[{i}]", 0, 0xFF) for i, v in enumerate(value)]
+
+    def file(self, value, field_name: str, what: str) -> Path:
+        if not isinstance(value, str) or not value:
+            raise self.error(field_name, f"expected a file name, got {value!r}")
+        path = Path(value)
+        if not path.is_absolute():
+            path = Path(self.source).parent / path
+        if not path.is_file():
+            raise self.error(field_name, f"{what} {value!r} not found (looked for {path})")
+        return path
+
+
+def register_offset(key: str, where: _Where) -> int:
+    text = str(key).strip().lower()
+    digits = text[1:] if text.startswith("$") else text[2:] if text.startswith("0x") else text
+    try:
+        address = int(digits, 16)
+    except ValueError:
+        raise where.error(f"registers.{key}", "not a register address (write \"$d011\", \"0xd011\" or \"d011\")") from None
+    offset = address - VIC_BASE
+    if not 0 <= offset < REGISTER_COUNT:
+        raise where.error(f"registers.{key}", f"not a VIC-II register (${VIC_BASE:04x}-${VIC_BASE + REGISTER_COUNT - 1:04x})")
+    if offset in READ_ONLY_LATCHES or offset == REG_IRQ_LATCH:
+        raise where.error(f"registers.{key}", "a latch the chip sets; a scene starts with it clear")
+    return offset
+
+
+def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: _Where) -> SpriteSpec:
+    name = f"sprite[{i}]"
+    entry = where.table(entry, name, SPRITE_KEYS)
+    if "index" not in entry:
+        raise where.error(f"{name}.index", "missing (0-7)")
+    n = where.number(entry["index"], f"{name}.index", 0, SPRITE_COUNT - 1)
+    if n in seen:
+        raise where.error(f"{name}.index", f"sprite {n} is declared twice")
+    seen.add(n)
+    bit = 1 << n
+    if "x" in entry:
+        x = where.number(entry["x"], f"{name}.x", 0, X_BITS_MASK)
+        registers[REG_SPRITE_X0 + 2 * n] = x & 0xFF
+        registers[REG_SPRITE_X_MSB] = (registers[REG_SPRITE_X_MSB] & ~bit) | (bit if x >> 8 else 0)
+    if "y" in entry:
+        registers[REG_SPRITE_Y0 + 2 * n] = where.number(entry["y"], f"{name}.y", 0, Y_COMPARE_MASK)
+    flags = {"enabled": True, **{k: entry[k] for k in SPRITE_FLAGS if k in entry}}
+    for key, value in flags.items():
+        on = where.flag(value, f"{name}.{key}")
+        register = SPRITE_FLAGS[key]
+        registers[register] = (registers[register] & ~bit) | (bit if on else 0)
+    if "color" in entry:
+        registers[REG_SPRITE_COLOR0 + n] = where.number(entry["color"], f"{name}.color", 0, COLOR_MASK)
+    multicolor = bool(registers[REG_SPRITE_MULTICOLOR] & bit)
+    given = [k for k in ("data", "rows", "file") if k in entry]
+    if len(given) != 1:
+        raise where.error(name, f"give exactly one of data, rows, file (got {', '.join(given) or 'none'})")
+    if "frame" in entry and given[0] != "file":
+        raise where.error(f"{name}.frame", "goes with file")
+    kind = given[0]
+    try:
+        if kind == "data":
+            data = parse_hex(entry["data"], field="data")
+            source = "data"
+        elif kind == "rows":
+            data = parse_rows(entry["rows"], multicolor, field="rows")
+            source = "rows"
+        else:
+            path = where.file(entry["file"], f"{name}.file", "sprite file")
+            if path.suffix.lower() == ".png":
+                if "frame" in entry:
+                    raise where.error(f"{name}.frame", "a PNG holds one sprite")
+                data = read_png(path, multicolor)
+            else:
+                frame = where.number(entry.get("frame", 0), f"{name}.frame", 0, 1 << 16)
+                data = read_spr(path, frame)
+            source = f"file {entry['file']}"
+    except InputError as exc:
+        message = str(exc)
+        if message.startswith(kind) or message.startswith("rows["):
+            raise InputError(f"{where.source}: {name}.{message}") from None
+        raise InputError(f"{where.source}: {name}: {message}") from None
+    return SpriteSpec(n, data[:SPRITE_BYTES], source)
+
+
+def _fill_cells(spec, name: str, where: _Where, hi: int) -> np.ndarray:
+    spec = where.table(spec, f"memory.{name}", FILL_KEYS)
+    values = np.full(SCREEN_CELLS, where.number(spec.get("fill", 0), f"memory.{name}.fill", 0, hi), np.uint8)
+    cells = spec.get("cells", [])
+    if not isinstance(cells, list):
+        raise where.error(f"memory.{name}.cells", "expected a list of {col, row, value} tables")
+    for i, cell in enumerate(cells):
+        field_name = f"memory.{name}.cells[{i}]"
+        cell = where.table(cell, field_name, SCREEN_CELL_KEYS)
+        for key in SCREEN_CELL_KEYS:
+            if key not in cell:
+                raise where.error(f"{field_name}.{key}", "missing")
+        col = where.number(cell["col"], f"{field_name}.col", 0, TEXT_COLUMNS - 1)
+        row = where.number(cell["row"], f"{field_name}.row", 0, TEXT_ROWS - 1)
+        values[row * TEXT_COLUMNS + col] = where.number(cell["value"], f"{field_name}.value", 0, hi)
+    return values
+
+
+def _file_bytes(value, field_name: str, size: int, where: _Where) -> np.ndarray:
+    path = where.file(value, field_name, "file")
+    raw = read_bytes(path)
+    if len(raw) != size:
+        raise where.error(field_name, f"{value!r} must hold {size} bytes, got {len(raw)}")
+    return np.frombuffer(raw, dtype=np.uint8).copy()
+
+
+def _memory(doc, where: _Where) -> VicMemory:
+    spec = where.table(doc, "memory", MEMORY_KEYS)
+    memory = VicMemory.blank()
+    screen = _fill_cells(spec["screen"], "screen", where, 0xFF) if "screen" in spec else memory.screen
+    color = _fill_cells(spec["color"], "color", where, COLOR_MASK) if "color" in spec else memory.color
+    charset = memory.charset
+    if "charset" in spec:
+        table = spec["charset"]
+        if not isinstance(table, dict):
+            raise where.error("memory.charset", "expected a table of glyphs by code (\"1\" = [8 bytes]) or file =")
+        if "file" in table:
+            charset = _file_bytes(table["file"], "memory.charset.file", CHARSET_BYTES, where)
+        for key, glyph in table.items():
+            if key == "file":
+                continue
+            code = where.number(key, f"memory.charset.{key}", 0, 0xFF)
+            charset[code * CHAR_HEIGHT:(code + 1) * CHAR_HEIGHT] = where.byte_list(glyph, f"memory.charset.{key}",
+                                                                                   CHAR_HEIGHT)
+    bitmap = memory.bitmap
+    if "bitmap" in spec:
+        table = where.table(spec["bitmap"], "memory.bitmap", BITMAP_KEYS)
+        if "file" in table:
+            bitmap = _file_bytes(table["file"], "memory.bitmap.file", BITMAP_BYTES, where)
+        cells = table.get("cells", [])
+        if not isinstance(cells, list):
+            raise where.error("memory.bitmap.cells", "expected a list of {col, row, bytes} tables")
+        for i, cell in enumerate(cells):
+            field_name = f"memory.bitmap.cells[{i}]"
+            cell = where.table(cell, field_name, BITMAP_CELL_KEYS)
+            for key in BITMAP_CELL_KEYS:
+                if key not in cell:
+                    raise where.error(f"{field_name}.{key}", "missing")
+            col = where.number(cell["col"], f"{field_name}.col", 0, TEXT_COLUMNS - 1)
+            row = where.number(cell["row"], f"{field_name}.row", 0, TEXT_ROWS - 1)
+            start = (row * TEXT_COLUMNS + col) * CHAR_HEIGHT
+            bitmap[start:start + CHAR_HEIGHT] = where.byte_list(cell["bytes"], f"{field_name}.bytes", CHAR_HEIGHT)
+    idle = where.number(spec.get("idle", 0), "memory.idle", 0, 0xFF)
+    return VicMemory(screen, color, charset, bitmap, idle)
+
+
+def parse(doc: dict, source: str) -> VicScene:
+    where = _Where(source)
+    where.table(doc, "", TOP_KEYS)
+    video = doc.get("video", "pal")
+    if video not in VIDEOS:
+        raise where.error("video", f"expected \"pal\" (6569) or \"ntsc\" (6567R8), got {video!r}")
+    registers = bytearray(REGISTER_COUNT)
+    table = doc.get("registers", {})
+    if not isinstance(table, dict):
+        raise where.error("registers", "expected a table of \"$d0xx\" = value")
+    for key, value in table.items():
+        offset = register_offset(key, where)
+        registers[offset] = where.number(value, f"registers.{key}", 0, 0xFF)
+    entries = doc.get("sprite", [])
+    if not isinstance(entries, list):
+        raise where.error("sprite", "expected [[sprite]] tables")
+    seen: set[int] = set()
+    specs = [_sprite(entry, i, registers, seen, where) for i, entry in enumerate(entries)]
+    data = [bytes(SPRITE_BYTES)] * SPRITE_COUNT
+    for spec in specs:
+        data[spec.index] = spec.data
+    memory = _memory(doc.get("memory", {}), where)
+    state = VicState(VIDEOS[video], bytes(registers), tuple(data), memory)
+    return VicScene(source, video, bytes(registers), tuple(specs), memory, state)
+
+
+def load(path: str | Path) -> VicScene:
+    """Read and validate a VIC-II scene file (the chip key must say "vic-ii")."""
+    from retro.scenes import load_scene
+
+    scene = load_scene(path)
+    if not isinstance(scene, VicScene):
+        raise InputError(f"{path}: chip: expected \"vic-ii\"")
+    return scene

@@ -1,0 +1,278 @@
+"""Machine: call semantics, trace, budget, halts, main loops, devices and the clock.
+
+Programs are hand-assembled bytes (opcode comments alongside) so these tests do not depend on the
+assembler; expected cycle counts are added up by hand from the 6502 datasheet timings.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from retro.cpu import Machine
+from retro.cpu.mpu import FLAG_D
+from retro.errors import InputError, RunError
+
+ORIGIN = 0xC000
+
+
+def machine_with(code: dict[int, list[int]], variant: str = "6510") -> Machine:
+    machine = Machine(variant)
+    for address, data in code.items():
+        machine.poke(address, data)
+    return machine
+
+
+COUNT_DOWN = {ORIGIN: [
+    0xA9, 0x01,  # C000 LDA #$01    2
+    0xA2, 0x03,  # C002 LDX #$03    2
+    0xCA,        # C004 DEX         2 x3
+    0xD0, 0xFD,  # C005 BNE $C004   3 + 3 + 2 (taken, taken, not taken)
+    0x60,        # C007 RTS         6
+]}
+
+
+def test_call_counts_from_the_first_instruction_through_rts_without_the_jsr():
+    result = machine_with(COUNT_DOWN).call(ORIGIN)
+    assert result.cycles == 2 + 2 + 3 * 2 + (3 + 3 + 2) + 6  # 24: no 6 for the caller's JSR
+    assert result.instructions == 9
+    assert (result.a, result.x, result.s) == (1, 0, 0xFF)
+    assert result.flags["Z"] and not result.flags["N"]
+
+
+def test_nested_jsr_does_not_end_the_call():
+    machine = machine_with({
+        ORIGIN: [0x20, 0x10, 0xC0,  # C000 JSR $C010  6
+                 0xE8,              # C003 INX        2
+                 0x60],             # C004 RTS        6
+        0xC010: [0xA0, 0x05,        # C010 LDY #5     2
+                 0x60],             # C012 RTS        6
+    })
+    result = machine.call(ORIGIN)
+    assert (result.cycles, result.instructions) == (6 + 2 + 6 + 2 + 6, 5)
+    assert (result.x, result.y) == (1, 5)
+
+
+PAGE_AND_BRANCH = {0xC0F0: [
+    0xA2, 0x01,        # C0F0 LDX #1          2
+    0xBD, 0xFF, 0xC0,  # C0F2 LDA $C0FF,X     4 + 1: $C100 is on the next page
+    0xBD, 0x00, 0xC1,  # C0F5 LDA $C100,X     4: $C101, same page
+    0xA0, 0x00,        # C0F8 LDY #0          2 (Z set)
+    0xD0, 0x10,        # C0FA BNE             2: not taken
+    0xF0, 0x04,        # C0FC BEQ $C102       2 + 1 taken + 1 into the next page
+    0x42, 0x00,        # C0FE (skipped)
+], 0xC100: [
+    0x42, 0x00,        # C100 data read by the LDAs
+    0xF0, 0x00,        # C102 BEQ $C104       2 + 1 taken, same page
+    0x60,              # C104 RTS             6
+]}
+
+
+def test_trace_records_cycles_page_crossings_and_taken_branches():
+    result = machine_with(PAGE_AND_BRANCH).call(0xC0F0, trace=True)
+    rows = [(e.address, e.mnemonic, e.cycles, e.page_crossed, e.branch_taken) for e in result.trace]
+    assert rows == [
+        (0xC0F0, "LDX", 2, False, False),
+        (0xC0F2, "LDA", 5, True, False),
+        (0xC0F5, "LDA", 4, False, False),
+        (0xC0F8, "LDY", 2, False, False),
+        (0xC0FA, "BNE", 2, False, False),
+        (0xC0FC, "BEQ", 4, True, True),
+        (0xC102, "BEQ", 3, False, True),
+        (0xC104, "RTS", 6, False, False),
+    ]
+    assert result.cycles == sum(row[2] for row in rows) == 28
+    assert result.instructions == len(rows)
+
+
+def test_traced_and_fast_runs_agree():
+    fast = machine_with(PAGE_AND_BRANCH).call(0xC0F0, x=9, y=3)
+    traced = machine_with(PAGE_AND_BRANCH).call(0xC0F0, x=9, y=3, trace=True)
+    assert (fast.a, fast.x, fast.y, fast.p, fast.s, fast.cycles, fast.instructions) == \
+        (traced.a, traced.x, traced.y, traced.p, traced.s, traced.cycles, traced.instructions)
+    assert fast.trace is None
+
+
+INFINITE = {ORIGIN: [0x4C, 0x00, 0xC0]}  # C000 JMP $C000 (3 cycles, forever)
+
+
+def test_budget_stops_a_runaway_routine_naming_pc_and_last_instructions():
+    with pytest.raises(RunError) as error:
+        machine_with(INFINITE).call(ORIGIN, budget=1000)
+    message = str(error.value)
+    assert "1000 cycles" in message and "PC $C000" in message
+    assert "after 334 instructions" in message  # the clock first reaches 1000 after ceil(1000 / 3) JMPs
+    assert "$C000 JMP $C000" in message
+    assert "\n" not in message
+
+
+def test_budget_is_inclusive():
+    assert machine_with(COUNT_DOWN).call(ORIGIN, budget=24).cycles == 24
+    with pytest.raises(RunError):
+        machine_with(COUNT_DOWN).call(ORIGIN, budget=23)
+
+
+def test_budget_also_stops_a_traced_run():
+    with pytest.raises(RunError, match="budget"):
+        machine_with(INFINITE).call(ORIGIN, budget=300, trace=True)
+
+
+@pytest.mark.parametrize("opcode, kind", [(0x00, "BRK"), (0x02, "JAM"), (0xF2, "JAM"), (0x8B, "ANE"), (0x9E, "SHX")])
+@pytest.mark.parametrize("trace", [False, True])
+def test_brk_jam_and_unstable_opcodes_stop_with_an_error(opcode, kind, trace):
+    machine = machine_with({ORIGIN: [0xEA,  # C000 NOP
+                                     0xE8,  # C001 INX
+                                     opcode]})
+    with pytest.raises(RunError) as error:
+        machine.call(ORIGIN, trace=trace)
+    message = str(error.value)
+    assert kind in message and f"${opcode:02X}" in message and "at $C002" in message
+    assert message.endswith("$C000 NOP, $C001 INX, $C002 " + machine.disassemble_at(0xC002))
+
+
+def test_run_stops_at_an_address_or_after_a_number_of_cycles():
+    machine = machine_with({ORIGIN: [0xE8,              # C000 INX       2
+                                     0x4C, 0x00, 0xC0]})  # C001 JMP $C000 3
+    start = machine.cycle
+    assert machine.run(ORIGIN, cycles=50) == 20  # 10 rounds of 5 cycles
+    assert machine.cycle - start == 50
+    assert machine.mpu.x == 10
+    assert machine.run(ORIGIN, until=0xC001) == 1
+    with pytest.raises(RunError, match="budget"):
+        machine.run(ORIGIN, until=0xC004, cycles=100)
+
+
+def test_the_clock_keeps_running_across_calls_and_devices_see_the_bus_cycle():
+    class Recorder:
+        def __init__(self):
+            self.events = []
+
+        def read(self, address, cycle):
+            self.events.append(("read", address, cycle))
+            return 0x80
+
+        def write(self, address, value, cycle):
+            self.events.append(("write", address, value, cycle))
+
+        def peek(self, address):
+            return 0x80
+
+    machine = machine_with({ORIGIN: [
+        0xAD, 0x12, 0xD0,  # C000 LDA $D012  4: operand read in cycle 3
+        0x2C, 0x12, 0xD0,  # C003 BIT $D012  4: read in cycle 3
+        0x8D, 0x20, 0xD0,  # C006 STA $D020  4: write in cycle 3
+        0xEE, 0x20, 0xD0,  # C009 INC $D020  6: read in 3, old value written in 4, new in 5
+        0x60,              # C00C RTS        6
+    ]})
+    device = machine.attach(Recorder(), 0xD000, 0xD3FF)
+    machine.call(ORIGIN, trace=True)  # the clock moves on; the second call starts later
+    device.events.clear()
+    start = machine.cycle
+    result = machine.call(ORIGIN)
+    assert result.cycles == 4 + 4 + 4 + 6 + 6
+    assert machine.cycle == start + result.cycles
+    assert device.events == [
+        ("read", 0xD012, start + 3),
+        ("read", 0xD012, start + 4 + 3),
+        ("write", 0xD020, 0x80, start + 8 + 3),
+        ("read", 0xD020, start + 12 + 3),
+        ("write", 0xD020, 0x80, start + 12 + 4),
+        ("write", 0xD020, 0x81, start + 12 + 5),
+    ]
+    assert machine.peek(0xD012) == [0x80]
+
+
+def test_a_device_on_part_of_a_page_leaves_the_rest_to_ram_and_can_stall_the_cpu():
+    class Dma:
+        def __init__(self):
+            self.writes = []
+
+        def read(self, address, cycle):
+            raise AssertionError("not read")
+
+        def write(self, address, value, cycle):
+            self.writes.append((address, value, cycle))
+            machine.mpu.stall(513)
+
+        def peek(self, address):
+            return 0
+
+    machine = machine_with({ORIGIN: [
+        0xAD, 0x00, 0x40,  # C000 LDA $4000  4 (RAM)
+        0x8D, 0x14, 0x40,  # C003 STA $4014  4 + 513 stalled
+        0x8D, 0x15, 0x40,  # C006 STA $4015  4 (RAM)
+        0x60,              # C009 RTS        6
+    ]}, variant="2a03")
+    dma = machine.attach(Dma(), 0x4014, 0x4014)
+    machine.poke(0x4000, 7)
+    start = machine.cycle
+    result = machine.call(ORIGIN)
+    assert result.cycles == 4 + 4 + 513 + 4 + 6
+    assert dma.writes == [(0x4014, 7, start + 4 + 3)]
+    assert machine.peek(0x4015) == [7]
+
+
+def test_overlapping_or_out_of_range_devices_are_refused():
+    machine = Machine()
+
+    class Nothing:
+        def read(self, address, cycle): return 0
+        def write(self, address, value, cycle): pass
+        def peek(self, address): return 0
+
+    machine.attach(Nothing(), 0xD000, 0xD3FF)
+    with pytest.raises(InputError, match="overlaps"):
+        machine.attach(Nothing(), 0xD3F0, 0xD400)
+    with pytest.raises(InputError, match="outside"):
+        machine.attach(Nothing(), 0xFFF0, 0x10000)
+
+
+def test_decimal_mode_is_bcd_on_the_6510_and_ignored_on_the_2a03():
+    code = {ORIGIN: [0xF8,        # SED
+                     0x18,        # CLC
+                     0xA9, 0x09,  # LDA #$09
+                     0x69, 0x01,  # ADC #$01
+                     0x60]}       # RTS
+    c64 = machine_with(code).call(ORIGIN)
+    nes = machine_with(code, variant="2a03").call(ORIGIN)
+    assert c64.a == 0x10  # 09 + 01 in BCD
+    assert nes.a == 0x0A  # binary
+    assert c64.p & FLAG_D and nes.p & FLAG_D  # the flag itself still exists on the 2A03
+
+
+def test_dec_absolute_takes_six_cycles_and_lax_works():
+    machine = machine_with({ORIGIN: [0xCE, 0x00, 0x02,  # DEC $0200  6 (py65 1.2.0 charged 3)
+                                     0xA7, 0x10,        # LAX $10    3 (undocumented)
+                                     0x60]})            # RTS        6
+    machine.poke(0x0200, 0)
+    machine.poke(0x10, 0x5A)
+    result = machine.call(ORIGIN)
+    assert result.cycles == 6 + 3 + 6
+    assert machine.peek(0x0200) == [0xFF]
+    assert (result.a, result.x) == (0x5A, 0x5A)
+
+
+def test_reported_p_has_bit_5_set_and_no_b_flag():
+    # LDA #$FF, PHA, PLP, RTS: every flag bit popped into P; B is not a register bit.
+    result = machine_with({ORIGIN: [0xA9, 0xFF, 0x48, 0x28, 0x60]}).call(ORIGIN)
+    assert result.p == 0xEF
+    assert all(result.flags.values())
+
+
+def test_call_inputs_memory_and_targets():
+    machine = machine_with(COUNT_DOWN)
+    machine.symbols["count_down"] = ORIGIN
+    result = machine.call("count_down", memory={"$0300": [1, 2, 3], 0x0310: 9})
+    assert result.cycles == 24
+    assert machine.peek("$0300", 3) == [1, 2, 3] and machine.peek("0x310") == [9]
+    for text in ("$C000", "0xc000", "49152", "%1100000000000000", "count_down"):
+        assert machine.resolve(text) == ORIGIN
+    with pytest.raises(InputError, match="unknown label 'nowhere'"):
+        machine.call("nowhere")
+    with pytest.raises(InputError, match="not a byte"):
+        machine.call(ORIGIN, a=256)
+    with pytest.raises(InputError, match="not a byte"):
+        machine.poke("$0300", [1, 300])
+    with pytest.raises(InputError):
+        machine.resolve("$10000")
+    with pytest.raises(InputError, match="unknown CPU variant"):
+        Machine("z80")

@@ -1,0 +1,72 @@
+"""The three commands: exit codes, one-line errors, and what the stability and advice outputs say."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from retro.cli import main
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "retro", *args], capture_output=True, text=True, timeout=120)
+
+
+@pytest.mark.parametrize("args,field", [
+    (["advise", "no-such-scene.toml"], "no-such-scene.toml"),
+    (["advise", "examples/vic_two_balls.toml", "--accuracy", "1.5"], "--accuracy"),
+    (["advise", "examples/vic_two_balls.toml", "--accuracy", "most"], "--accuracy"),
+    (["advise", "examples/nes_sprite0.toml"], "chip"),
+    (["chart", "--workers", "0"], "--workers"),
+])
+def test_bad_input_is_one_line_and_exit_2(args, field, capsys):
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and field in err and "Traceback" not in err
+
+
+def test_advise_two_sprite_scene(tmp_path):
+    scene = tmp_path / "pair.toml"
+    from retro.analysis.study.corpus import SPRITES_DIR
+
+    scene.write_text(f"""chip = "vic-ii"
+video = "pal"
+[[sprite]]
+index = 0
+x = 100
+y = 100
+file = "{SPRITES_DIR / 'ball.spr'}"
+[[sprite]]
+index = 3
+x = 130
+y = 100
+file = "{SPRITES_DIR / 'bar.spr'}"
+""")
+    done = run_cli("advise", str(scene), "--accuracy", "0.9", "--quiet", "--workers", "1")
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    advice = next(line for line in lines if line.startswith("advice:"))
+    # Two sprites: the latch is exact and the cheapest measured method.
+    assert "VIC-II latch" in advice
+    assert any(line.startswith("runner-up: tight hitbox AABB") for line in lines), lines
+
+
+def test_advise_many_sprites_excludes_the_latch():
+    done = run_cli("advise", "examples/vic_two_balls.toml", "--accuracy", "99%", "--quiet", "--workers", "1")
+    assert done.returncode == 0, done.stderr
+    assert "cannot say which pair" in done.stdout
+    advice = next(line for line in done.stdout.splitlines() if line.startswith("advice:"))
+    assert "software pixel-perfect" in advice  # the only exact software method
+
+
+def test_stability_reduced(tmp_path):
+    from retro.analysis.study.stability.run import run_stability
+
+    output = run_stability(tmp_path, reduced=True)
+    names = {p.name for p in output.files}
+    assert {"tunnelling.png", "wrap.png", "stability.md", "latch_pitfalls.csv", "edges.csv"} <= names
+    report = (tmp_path / "stability.md").read_text()
+    for kind in ("misattributed", "missed", "late", "false pairs"):
+        assert kind in report

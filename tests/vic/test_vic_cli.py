@@ -1,0 +1,101 @@
+"""`retro vic`: JSON output, human output, PNG, and one-line errors (exit 2) for bad scenes."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from PIL import Image
+
+from retro.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+GOOD_SPRITE = 'index = 0\nx = 100\ny = 100\ndata = "' + "ff " * 63 + '"\n'
+
+
+def write_scene(tmp_path: Path, body: str, name: str = "scene.toml") -> Path:
+    path = tmp_path / name
+    path.write_text('chip = "vic-ii"\nvideo = "pal"\n' + body)
+    return path
+
+
+def test_json_output_has_the_exact_keys(capsys):
+    assert main(["vic", str(ROOT / "examples" / "vic_text_collision.toml"), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert set(out) == {"d01e", "d01f", "d019", "first"}
+    assert set(out["first"]) == {"d01e", "d01f"}
+    # by hand (see the scene's comments): the ship's pixel at X 107 meets glyph 1's row 0 (%00011000,
+    # pixel 3 of column 10 at X 104) on line 48+3+8*5 = 91; sprites 0 and 2 hit text, nothing overlaps.
+    assert out["d01e"] == 0 and out["d01f"] == 0b101
+    assert out["first"] == {"d01e": None, "d01f": {"line": 91, "x": 107}}
+    assert out["d019"] == 0x70 | 0x02 | 0x01  # sprite-background + raster (compare line 0), nothing enabled
+
+
+def test_human_output_and_png(tmp_path, capsys):
+    png = tmp_path / "out.png"
+    assert main(["vic", str(ROOT / "examples" / "vic_two_balls.toml"), "--png", str(png), "--scale", "1"]) == 0
+    text = capsys.readouterr().out
+    assert "$D01E = $0F %00001111" in text and "0+1" in text and "2+3" in text
+    image = Image.open(png)
+    assert image.width > 504 and image.height > 312  # full frame at x1 plus the zoom panel and legend
+
+
+def test_frames_option(capsys):
+    assert main(["vic", str(ROOT / "examples" / "vic_two_balls.toml"), "--frames", "3", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["d01e"] == 0x0F
+
+
+@pytest.mark.parametrize("body, field", [
+    ("bogus = 1\n", "bogus"),
+    ("[[sprite]]\n" + GOOD_SPRITE.replace("index = 0", "index = 8"), "sprite[0].index"),
+    ("[[sprite]]\n" + GOOD_SPRITE.replace("x = 100", "x = 512"), "sprite[0].x"),
+    ("[[sprite]]\n" + GOOD_SPRITE.replace("y = 100", "y = 256"), "sprite[0].y"),
+    ("[[sprite]]\n" + GOOD_SPRITE.replace("ff " * 63, "ff " * 62), "sprite[0].data"),
+    ("[[sprite]]\nindex = 0\nrows = [" + ", ".join(['"' + "#" * 23 + '"'] * 21) + "]\n", "sprite[0].rows[0]"),
+    ("[[sprite]]\nindex = 0\nmulticolor = true\nrows = [" + ", ".join(['"' + "#" * 24 + '"'] * 21) + "]\n",
+     "sprite[0].rows[0]"),
+    ("[[sprite]]\nindex = 0\nfile = \"missing.spr\"\n", "sprite[0].file"),
+    ("[[sprite]]\nindex = 0\ncolour = 1\n" + 'data = "' + "00" * 63 + '"\n', "sprite[0].colour"),
+    ("[registers]\n\"$d040\" = 1\n", "registers.$d040"),
+    ("[registers]\n\"$d01e\" = 1\n", "registers.$d01e"),
+    ("[memory]\nscreen = { fill = 1, cells = [{ col = 40, row = 0, value = 1 }] }\n", "memory.screen.cells[0].col"),
+    ("[memory]\ncharset = { \"1\" = [1, 2, 3] }\n", "memory.charset.1"),
+    ("video = \"secam\"\n".replace("video", "bad"), "bad"),
+])
+def test_bad_scene_is_one_line_naming_file_and_field(tmp_path, capsys, body, field):
+    path = write_scene(tmp_path, body)
+    assert main(["vic", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert str(path) in err and field in err
+
+
+def test_png_of_the_wrong_size(tmp_path, capsys):
+    Image.new("RGB", (20, 21)).save(tmp_path / "small.png")
+    path = write_scene(tmp_path, "[[sprite]]\nindex = 0\nfile = \"small.png\"\n")
+    assert main(["vic", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "sprite[0]" in err and "24x21" in err and "20x21" in err and err.count("\n") == 1
+
+
+def test_sprite_file_resolves_relative_to_the_scene(tmp_path, capsys):
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "ball.spr").write_bytes((ROOT / "sprites" / "ball.spr").read_bytes())
+    path = write_scene(tmp_path, '[[sprite]]\nindex = 0\nfile = "sub/ball.spr"\n'
+                       '[[sprite]]\nindex = 1\nx = 10\nfile = "sub/ball.spr"\n')
+    assert main(["vic", str(path), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["d01e"] == 0b11
+
+
+def test_bad_scale_exit_2(capsys):
+    assert main(["vic", str(ROOT / "examples" / "vic_two_balls.toml"), "--scale", "0"]) == 2
+    assert "--scale" in capsys.readouterr().err
+
+
+def test_console_script_without_traceback(tmp_path):
+    path = write_scene(tmp_path, "[[sprite]]\nindex = 9\n")
+    proc = subprocess.run([sys.executable, "-m", "retro", "vic", str(path)], capture_output=True, text=True)
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
