@@ -17,6 +17,7 @@ DEMO_STEPS: list[tuple[str, str]] = [
     ("VIC-II collision scene: $D01E/$D01F/$D019 and the overlap image", "retro.vic_report:demo_step"),
     ("Parry pipeline: padded AABB window, SAT contact, MTV knock-back", "retro.render.parry:demo_step"),
     ("NES sprite-zero hit: model, picture, polling loop", "retro.demo_nes:sprite_zero"),
+    ("Collision routines: cross-checked results and cycles", "retro.routines.demo_step:cycles_table"),
     ("Speed against accuracy: cycles and error rates of every collision method", "retro.analysis.study.demo_step:chart_step"),
 ]
 

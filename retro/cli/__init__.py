@@ -14,7 +14,7 @@ import sys
 from retro.errors import RetroError
 
 # Module names inside retro.cli, in the order `retro --help` lists them.
-COMMAND_MODULES = ["asm", "run", "demo", "parry", "nes", "vic", "chart", "stability", "advise"]
+COMMAND_MODULES = ["asm", "run", "demo", "parry", "nes", "vic", "chart", "stability", "advise", "check", "cycles"]
 
 
 class _Parser(argparse.ArgumentParser):

@@ -14,6 +14,7 @@ from retro.errors import InputError
 MEMORY_SIZE = 0x10000
 PAGE_SIZE = 0x100
 PAGE_COUNT = MEMORY_SIZE // PAGE_SIZE
+FIRST_DEVICE_ADDRESS = 0x0200  # zero page and stack stay RAM: their accesses bypass device timing
 
 
 class Device(Protocol):
@@ -68,6 +69,9 @@ class Bus:
         """Give device the addresses start..end (inclusive)."""
         if not 0 <= start <= end < MEMORY_SIZE:
             raise InputError(f"device range ${start:04X}-${end:04X} is outside the 64 KiB address space")
+        if start < FIRST_DEVICE_ADDRESS:
+            raise InputError(f"device range ${start:04X}-${end:04X}: pages $00 and $01 (zero page, stack) are RAM only, "
+                             "because pointer and stack accesses are not timed per bus cycle")
         for other_start, other_end, _ in self.devices:
             if start <= other_end and other_start <= end:
                 raise InputError(f"device range ${start:04X}-${end:04X} overlaps ${other_start:04X}-${other_end:04X}")

@@ -23,7 +23,7 @@ from retro.geometry.circle import (
 )
 from retro.geometry.masks import mask_bounds, mask_from_rows, mask_overlap, mask_overlap_area, mask_overlap_mask
 from retro.geometry.polygon import (
-    convex_decompose, convex_polygon, is_ccw, is_convex, polygon_centroid, regular_polygon, rotate_point,
+    convex_decompose, convex_hull, convex_polygon, is_ccw, is_convex, polygon_centroid, regular_polygon, rotate_point,
     rotate_polygon, signed_area, simple_polygon, simplify_polygon, translate_polygon, triangulate,
 )
 from retro.geometry.raycast import Box, Circle, RayHit, RayScene, Segment
@@ -37,7 +37,7 @@ __all__ = [
     "Segment", "SweptHit", "aabb_contains_point", "aabb_from_center", "aabb_mtv", "aabb_overlap",
     "aabb_overlap_centered", "aabb_to_center", "aabb_tree_pairs", "bounce", "brute_force_pairs",
     "brute_force_pairs_numpy", "circle_aabb_mtv", "circle_aabb_overlap", "circle_mtv", "circle_overlap",
-    "closest_point_on_aabb", "convex_decompose", "convex_polygon", "grid_pairs", "is_ccw", "is_convex",
+    "closest_point_on_aabb", "convex_decompose", "convex_hull", "convex_polygon", "grid_pairs", "is_ccw", "is_convex",
     "layers_match", "mask_bounds", "mask_from_rows", "mask_overlap", "mask_overlap_area", "mask_overlap_mask",
     "pieces_overlap", "point_in_circle", "polygon_centroid", "polygons_overlap", "quadtree_pairs",
     "ray_aabb", "ray_circle", "ray_segment", "regular_polygon", "rotate_point", "rotate_polygon", "sat",

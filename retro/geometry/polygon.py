@@ -268,3 +268,27 @@ def convex_decompose(points: object, name: str = "polygon") -> list[Polygon]:
                     owner[(merged[e], merged[(e + 1) % n])] = p
                 merged_something = True
     return [[pts[i] for i in piece] for piece in pieces.values()]
+
+
+def convex_hull(points: Sequence[PointLike] | np.ndarray) -> list[tuple]:
+    """Convex hull of a set of points by Andrew's monotone chain: counter-clockwise (y up), without
+    collinear vertices. Fewer than three distinct points come back as they are (sorted).
+    """
+    pts = sorted(set(map(tuple, np.asarray(points).tolist())))
+    if len(pts) < 3:
+        return [tuple(p) for p in pts]
+
+    def cross(o, a, b):
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower: list = []
+    for p in pts:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
+            lower.pop()
+        lower.append(p)
+    upper: list = []
+    for p in reversed(pts):
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
+            upper.pop()
+        upper.append(p)
+    return lower[:-1] + upper[:-1]

@@ -6,13 +6,24 @@ import io
 from pathlib import Path
 
 import numpy as np
-from PIL import Image, ImageDraw
+from PIL import Image, ImageDraw, ImageFont
 
 from retro.fileio import write_atomic
 
 PANEL_GAP = 8
 PANEL_BACKGROUND = (32, 32, 32)
 LABEL_COLOUR = (230, 230, 230)
+
+
+LABEL_SIZE = 12
+
+
+def label_font(size: int = LABEL_SIZE) -> ImageFont.ImageFont:
+    """Pillow's bundled scalable font (Pillow >= 10.1), else its small bitmap font."""
+    try:
+        return ImageFont.load_default(size=size)
+    except TypeError:
+        return ImageFont.load_default()
 
 
 def from_rgb_array(pixels: np.ndarray) -> Image.Image:
@@ -37,7 +48,7 @@ def zoom(image: Image.Image, box: tuple[int, int, int, int], scale: int) -> Imag
 
 def side_by_side(panels: list[Image.Image], titles: list[str] | None = None) -> Image.Image:
     """Panels left to right on a dark background, each with an optional title above it."""
-    title_height = 14 if titles else 0
+    title_height = LABEL_SIZE + 4 if titles else 0
     width = sum(p.width for p in panels) + PANEL_GAP * (len(panels) + 1)
     height = max(p.height for p in panels) + title_height + PANEL_GAP * 2
     sheet = Image.new("RGB", (width, height), PANEL_BACKGROUND)
@@ -45,7 +56,7 @@ def side_by_side(panels: list[Image.Image], titles: list[str] | None = None) -> 
     x = PANEL_GAP
     for index, panel in enumerate(panels):
         if titles:
-            draw.text((x, PANEL_GAP // 2), titles[index], fill=LABEL_COLOUR)
+            draw.text((x, PANEL_GAP // 2), titles[index], fill=LABEL_COLOUR, font=label_font())
         sheet.paste(panel, (x, PANEL_GAP + title_height))
         x += panel.width + PANEL_GAP
     return sheet

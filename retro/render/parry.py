@@ -11,11 +11,11 @@ import io
 from dataclasses import dataclass
 from pathlib import Path
 
-from PIL import Image, ImageDraw, ImageFont
+from PIL import Image, ImageDraw
 
 from retro.fileio import read_text, write_atomic
 from retro.geometry.parry import DEFAULT_FRAMES, DEFAULT_SCRIPT, Event, FrameState, ParryParams, events_of, parse_script, simulate
-from retro.render.images import save_png
+from retro.render.images import label_font, save_png
 
 SCALE = 2
 STATUS_HEIGHT = 22
@@ -51,12 +51,6 @@ def load_script(spec: str | None) -> tuple[str, str]:
     return spec, "--script"
 
 
-def _font(size: int) -> ImageFont.ImageFont:
-    try:
-        return ImageFont.load_default(size=size)  # scalable font in Pillow >= 10.1
-    except TypeError:
-        return ImageFont.load_default()
-
 
 def _poly(draw: ImageDraw.ImageDraw, points, fill: int, outline: int) -> None:
     draw.polygon([(x * SCALE, y * SCALE) for x, y in points], fill=fill, outline=outline)
@@ -78,7 +72,7 @@ def render_frame(states: list[FrameState], index: int, params: ParryParams = Par
     image = Image.new("P", (width, STATUS_HEIGHT + height + TIMELINE_HEIGHT), BACKGROUND)
     image.putpalette([c for rgb in PALETTE for c in rgb])
     state = states[index]
-    small, big = _font(12), _font(26)
+    small, big = label_font(12), label_font(26)
 
     arena = Image.new("P", (width, height), BACKGROUND)
     draw = ImageDraw.Draw(arena)

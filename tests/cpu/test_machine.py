@@ -276,3 +276,24 @@ def test_call_inputs_memory_and_targets():
         machine.resolve("$10000")
     with pytest.raises(InputError, match="unknown CPU variant"):
         Machine("z80")
+
+
+def test_devices_cannot_be_mapped_on_zero_page_or_stack():
+    from retro.cpu.bus import Bus
+    from retro.errors import InputError
+
+    class Quiet:
+        def read(self, address, cycle):
+            return 0
+
+        def write(self, address, value, cycle):
+            pass
+
+        def peek(self, address):
+            return 0
+
+    bus = Bus()
+    for start, end in ((0x0000, 0x00FF), (0x01F0, 0x0200)):
+        with pytest.raises(InputError, match="pages \\$00 and \\$01"):
+            bus.map(Quiet(), start, end)
+    bus.map(Quiet(), 0x0200, 0x02FF)  # the first page after the stack is allowed

@@ -85,3 +85,21 @@ def test_convex_polygon_decomposes_into_itself():
     assert len(convex_decompose(hexagon)) == 1
     l_shape = [(0, 0), (4, 0), (4, 1), (1, 1), (1, 4), (0, 4)]
     assert len(convex_decompose(l_shape)) == 2  # one reflex vertex: two convex pieces suffice
+
+
+def test_convex_hull_matches_shapely_on_random_point_sets():
+    import numpy as np
+    from shapely.geometry import MultiPoint, Polygon as ShapelyPolygon
+
+    from retro.geometry import convex_hull, is_ccw
+
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        points = rng.integers(-20, 21, size=(int(rng.integers(3, 40)), 2))
+        hull = convex_hull(points)
+        expected = MultiPoint([tuple(p) for p in points.tolist()]).convex_hull
+        if expected.geom_type != "Polygon":
+            continue  # all points collinear: no area to compare
+        assert is_ccw(hull)
+        assert ShapelyPolygon(hull).symmetric_difference(expected).area == 0
+        assert len(hull) == len(expected.exterior.coords) - 1  # no collinear or repeated vertices

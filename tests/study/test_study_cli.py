@@ -70,3 +70,17 @@ def test_stability_reduced(tmp_path):
     report = (tmp_path / "stability.md").read_text()
     for kind in ("misattributed", "missed", "late", "false pairs"):
         assert kind in report
+
+
+def test_range_search_on_the_assembly():
+    """The documented domains hold on the searched inputs; outside (r1 + r2 = 256) the search finds
+    the routine wrong rather than assuming."""
+    from retro.analysis.study.stability.ranges import range_rows
+
+    rows = range_rows(reduced=True)
+    if not rows:
+        pytest.skip("issue 5's routines are not in the tree")
+    for r in rows:
+        assert r.cases > 0 and 0 <= r.wrong <= r.cases
+        if "sum 256" not in r.searched:
+            assert r.wrong == 0, r

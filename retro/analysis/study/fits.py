@@ -11,6 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from retro.geometry import convex_hull
+
 from retro.geometry.masks import mask_bounds
 
 Box = tuple[int, int, int, int]  # x0, y0, x1, y1 with x1, y1 exclusive (half-open pixel box)
@@ -62,32 +64,6 @@ def fitted_circle(mask: np.ndarray, touching_hits: bool = False) -> Circle:
                 best = Circle(cx, cy, r)
     assert best is not None
     return best
-
-
-def convex_hull(points: np.ndarray) -> list[tuple[int, int]]:
-    """Convex hull (counter-clockwise in a y-up frame, no collinear vertices) by the monotone chain.
-
-    Kept here because retro.geometry offers no hull function; the study needs it only to build
-    the polygon that retro.geometry.sat tests.
-    """
-    pts = sorted(set(map(tuple, points.tolist())))
-    if len(pts) < 3:
-        return [tuple(p) for p in pts]
-
-    def cross(o, a, b):
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower: list = []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    upper: list = []
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return lower[:-1] + upper[:-1]
 
 
 def pixel_hull(mask: np.ndarray) -> list[tuple[int, int]]:

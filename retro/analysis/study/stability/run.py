@@ -77,7 +77,7 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
                          "first example (xa, xb)"],
                         [[r.video.upper(), r.test, r.software_only, r.hardware_only,
                           r.example_software_only or r.example_hardware_only] for r in wrap_rows]))
-    routine_wrap = ranges.wrap_routine_rows()
+    routine_wrap = ranges.wrap_routine_rows(reduced=reduced)
     if routine_wrap:
         md.append("\nThe 6502 routines across the boundary, run in the emulator:\n\n")
         md.append(_md_table(["routine", "inputs", "cases", "mismatches against the 9-bit truth", "example"],
@@ -94,7 +94,7 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
     md.append("## Arithmetic range\n\n")
     if range_rows:
         md.append("Found by running the assembly over the input space (exhaustively where stated):\n\n")
-        md.append(_md_table(["routine", "input space searched", "cases", "wrong answers", "correct exactly when"],
+        md.append(_md_table(["routine", "input space searched", "cases", "wrong answers", "finding"],
                             [[r.routine, r.searched, r.cases, r.wrong, r.domain] for r in range_rows]))
     else:
         md.append("No 6502 routines found in asm/ (issue 5): nothing to search.\n")

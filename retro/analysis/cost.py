@@ -1,0 +1,49 @@
+"""The cost report of the routines: bytes, measured and static cycles, cases and mismatches.
+
+`cost_rows` gives the rows `retro cycles --json` prints (exactly the fields COST_FIELDS);
+`format_cost_table` the text table. Targets are the issue's worst-case (or mean, for mul8) goals.
+"""
+
+from __future__ import annotations
+
+from retro.analysis.check import RoutineCheck
+
+COST_FIELDS = ("routine", "code_bytes", "table_bytes", "min", "mean", "max", "static_min", "static_max",
+               "cases", "mismatches")
+
+# Issue 5's targets: (statistic, cycles). The statistic is "max" (worst case) or "mean".
+TARGETS: dict[str, tuple[str, int]] = {"aabb8": ("max", 30), "aabb_sprite": ("max", 45), "circle": ("max", 65),
+                                       "tile": ("max", 45), "mul8": ("mean", 46)}
+
+
+def cost_row(check: RoutineCheck) -> dict:
+    t = check.totals
+    return {"routine": check.routine.name, "code_bytes": check.size.code_bytes, "table_bytes": check.size.table_bytes,
+            "min": t.cycles_min, "mean": round(check.mean, 2), "max": t.cycles_max,
+            "static_min": check.static.best, "static_max": check.static.worst, "cases": t.cases,
+            "mismatches": check.mismatches}
+
+
+def target_note(row: dict) -> str:
+    target = TARGETS.get(row["routine"])
+    if not target:
+        return ""
+    statistic, cycles = target
+    value = row[statistic]
+    return f"{statistic} {value} vs target <= {cycles}: {'met' if value <= cycles else 'missed'}"
+
+
+def format_cost_table(checks: list[RoutineCheck]) -> list[str]:
+    header = ("routine", "code", "tables", "min", "mean", "max", "static", "worst hit", "cases", "mismatch", "target")
+    rows = []
+    for check in checks:
+        r = cost_row(check)
+        rows.append((r["routine"], str(r["code_bytes"]), str(r["table_bytes"]), str(r["min"]), f"{r['mean']:.2f}",
+                     str(r["max"]), f"{r['static_min']}-{r['static_max']}", "yes" if check.worst_reached else "no",
+                     str(r["cases"]), str(r["mismatches"]), target_note(r)))
+    widths = [max(len(h), *(len(row[i]) for row in rows)) for i, h in enumerate(header)]
+    lines = ["  ".join(h.ljust(w) for h, w in zip(header, widths)).rstrip()]
+    lines += ["  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip() for row in rows]
+    lines.append("cycles: from the routine's first instruction through its RTS (the caller's JSR, 6, not included); "
+                 "bytes of tables exclude storage the caller fills")
+    return lines

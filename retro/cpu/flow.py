@@ -1,0 +1,167 @@
+"""Static best/worst-case cycles of a routine from its bytes, by control-flow analysis.
+
+The routine is decoded from its entry, following both ways of every branch and JMP absolute, up to
+each RTS. Each instruction costs its datasheet cycles (retro.cpu.timing) plus the penalties the
+bytes cannot rule out: an indexed read whose base address has a non-zero low byte may cross a page
+(+0 or +1); an (indirect),Y read may always cross (its pointer is data); a taken branch costs +1,
+and +1 more when its target lies in another page (known from the addresses).
+
+Loops: every back edge of the decoded graph closes a loop whose header needs a bound, the most
+times the header runs per entry into the loop (`loop_bounds`: header address -> count; the asm
+headers state them). The analysis then takes the longest and shortest path through the graph of
+states (instruction, iteration counts of the loops it is in), which is acyclic because each count
+only grows within one entry into its loop. It is an over-approximation: paths the data can never
+take are included, so the static worst case bounds every run and may not be reached.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from retro.cpu.timing import BRANCH_PAGE_CYCLES, BRANCH_TAKEN_CYCLES, PAGE_CROSS_CYCLES, branch_target, crosses_page, timing_of
+from retro.errors import InputError
+
+OPCODE_JMP_ABS = 0x4C
+OPCODE_RTS = 0x60
+UNSUPPORTED = {0x20: "JSR", 0x6C: "JMP (indirect)", 0x40: "RTI", 0x00: "BRK"}
+
+
+@dataclass
+class Node:
+    pc: int
+    cycles: tuple[int, int]  # (least, most) cycles of the instruction itself, branch outcome excluded
+    successors: list[tuple[int, int]] = field(default_factory=list)  # (pc, extra cycles on that edge)
+    returns: bool = False
+
+
+@dataclass(frozen=True)
+class Bounds:
+    best: int
+    worst: int
+    instructions: int  # distinct instructions reachable from the entry
+
+
+def decode(read: Callable[[int], int], entry: int) -> dict[int, Node]:
+    nodes: dict[int, Node] = {}
+    pending = [entry]
+    while pending:
+        pc = pending.pop()
+        if pc in nodes:
+            continue
+        opcode = read(pc)
+        if opcode in UNSUPPORTED:
+            raise InputError(f"${pc:04X}: {UNSUPPORTED[opcode]} is not supported by the static analysis")
+        op = timing_of(opcode)
+        operand = read((pc + 1) & 0xFFFF) | read((pc + 2) & 0xFFFF) << 8
+        extra = 0
+        if op.page_penalty and (op.mode == "iny" or (op.mode in ("abx", "aby") and operand & 0xFF)):
+            extra = PAGE_CROSS_CYCLES
+        node = Node(pc, (op.cycles, op.cycles + extra))
+        following = (pc + op.length) & 0xFFFF
+        if opcode == OPCODE_RTS:
+            node.returns = True
+        elif opcode == OPCODE_JMP_ABS:
+            node.successors.append((operand, 0))
+        elif op.mode == "rel":
+            target = branch_target(pc, operand & 0xFF)
+            taken = BRANCH_TAKEN_CYCLES + (BRANCH_PAGE_CYCLES if crosses_page(following, target) else 0)
+            node.successors += [(following, 0), (target, taken)]
+        else:
+            node.successors.append((following, 0))
+        nodes[pc] = node
+        pending.extend(s for s, _ in node.successors)
+    return nodes
+
+
+def _loops(nodes: dict[int, Node], entry: int) -> dict[int, frozenset[int]]:
+    """Header -> body (natural loops of the back edges found by depth-first search)."""
+    back_edges: list[tuple[int, int]] = []
+    state: dict[int, int] = {}  # 1 on the stack, 2 done
+    stack = [(entry, iter(nodes[entry].successors))]
+    state[entry] = 1
+    while stack:
+        pc, successors = stack[-1]
+        for target, _ in successors:
+            if state.get(target) == 1:
+                back_edges.append((pc, target))
+            elif target not in state:
+                state[target] = 1
+                stack.append((target, iter(nodes[target].successors)))
+                break
+        else:
+            state[pc] = 2
+            stack.pop()
+    predecessors: dict[int, set[int]] = {pc: set() for pc in nodes}
+    for pc, node in nodes.items():
+        for target, _ in node.successors:
+            predecessors[target].add(pc)
+    loops: dict[int, set[int]] = {}
+    for tail, header in back_edges:
+        body = loops.setdefault(header, {header})
+        work = [tail]
+        while work:
+            pc = work.pop()
+            if pc not in body:
+                body.add(pc)
+                work.extend(predecessors[pc])
+    return {header: frozenset(body) for header, body in loops.items()}
+
+
+def analyse(read: Callable[[int], int], entry: int, loop_bounds: dict[int, int] | None = None,
+            name: str = "routine") -> Bounds:
+    """Best and worst cycles from the entry through an RTS over every path the bytes allow."""
+    nodes = decode(read, entry)
+    loops = _loops(nodes, entry)
+    bounds = dict(loop_bounds or {})
+    for header in loops:
+        if header not in bounds:
+            raise InputError(f"{name}: the loop at ${header:04X} needs a bound (the most times it runs per entry)")
+    # Loops ordered outermost first (a larger body contains the smaller ones nested in it).
+    order = sorted(loops, key=lambda h: -len(loops[h]))
+    containing = {pc: tuple(h for h in order if pc in loops[h]) for pc in nodes}
+
+    def next_state(state, target: int):
+        source_pc, counts = state
+        active = dict(zip(containing[source_pc], counts))
+        new_counts = []
+        for header in containing[target]:
+            if header == target:
+                count = active[header] + 1 if header in active else 1
+                if count > bounds[header]:
+                    return None
+            elif header in active:
+                count = active[header]
+            else:
+                raise InputError(f"{name}: ${target:04X} enters the loop at ${header:04X} other than through its start")
+            new_counts.append(count)
+        return target, tuple(new_counts)
+
+    start = (entry, tuple(1 for _ in containing[entry]))
+    best: dict = {}
+    worst: dict = {}
+    # Iterative post-order over the acyclic state graph.
+    stack = [(start, False)]
+    while stack:
+        state, expanded = stack.pop()
+        if state in worst:
+            continue
+        node = nodes[state[0]]
+        successors = [(s, extra) for s, extra in ((next_state(state, t), e) for t, e in node.successors) if s is not None]
+        if not expanded:
+            stack.append((state, True))
+            stack.extend((s, False) for s, _ in successors if s not in worst)
+            continue
+        low, high = node.cycles
+        if node.returns:
+            best[state], worst[state] = low, high
+            continue
+        options = [(best[s] + extra, worst[s] + extra) for s, extra in successors if worst.get(s) is not None]
+        if not options:
+            best[state] = worst[state] = None
+            continue
+        best[state] = low + min(b for b, _ in options)
+        worst[state] = high + max(w for _, w in options)
+    if worst[start] is None:
+        raise InputError(f"{name}: no path from ${entry:04X} reaches an RTS within the loop bounds")
+    return Bounds(best=best[start], worst=worst[start], instructions=len(nodes))

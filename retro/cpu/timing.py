@@ -1,0 +1,174 @@
+"""NMOS 6502 cycle timing kept in the project, independent of py65's tables.
+
+Sources: the MOS MCS6500 Microcomputer Family Programming Manual (1976), appendix "Instruction
+timing", for the documented opcodes, and 64doc (J. Ahola, M. Korpi et al., "6502 instructions and
+their cycle counts") for the stable undocumented NMOS opcodes. Rules:
+- every opcode has a base cycle count;
+- reads in the absolute,X / absolute,Y / (indirect),Y modes take one more cycle when the indexed
+  address lies in another page than the base address (stores and read-modify-writes always take
+  the longer count, so they have no penalty);
+- a relative branch takes one more cycle when taken, and one more again when the target lies in
+  another page than the instruction that follows the branch.
+
+`model_cycles(trace)` sums these over an executed path, deriving every penalty from addresses
+(the operand bytes, the index registers before the instruction, the next PC), never from the
+emulator's own cycle bookkeeping.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+
+PAGE_MASK = 0xFF00
+BRANCH_TAKEN_CYCLES = 1
+BRANCH_PAGE_CYCLES = 1
+PAGE_CROSS_CYCLES = 1
+
+# Operand bytes per addressing mode.
+MODE_LENGTH = {"imp": 1, "acc": 1, "imm": 2, "zpg": 2, "zpx": 2, "zpy": 2, "inx": 2, "iny": 2, "rel": 2,
+               "abs": 3, "abx": 3, "aby": 3, "ind": 3}
+
+
+@dataclass(frozen=True)
+class OpTiming:
+    mnemonic: str
+    mode: str
+    cycles: int
+    page_penalty: bool  # +1 when the indexed address crosses a page (reads only)
+
+    @property
+    def length(self) -> int:
+        return MODE_LENGTH[self.mode]
+
+
+def _build() -> dict[int, OpTiming]:
+    table: dict[int, OpTiming] = {}
+
+    def put(mnemonic: str, rows: Iterable[tuple[int, str, int]], penalised: tuple[str, ...] = ()) -> None:
+        for opcode, mode, cycles in rows:
+            if opcode in table:
+                raise AssertionError(f"opcode ${opcode:02X} listed twice")
+            table[opcode] = OpTiming(mnemonic, mode, cycles, mode in penalised)
+
+    read_modes = ("abx", "aby", "iny")
+    # The eight-mode ALU/load group: imm, zp, zp,X, abs, abs,X, abs,Y, (zp,X), (zp),Y.
+    group = (("imm", 2), ("zpg", 3), ("zpx", 4), ("abs", 4), ("abx", 4), ("aby", 4), ("inx", 6), ("iny", 5))
+    low = {"imm": 0x09, "zpg": 0x05, "zpx": 0x15, "abs": 0x0D, "abx": 0x1D, "aby": 0x19, "inx": 0x01, "iny": 0x11}
+    for mnemonic, base in (("ORA", 0x00), ("AND", 0x20), ("EOR", 0x40), ("ADC", 0x60),
+                           ("LDA", 0xA0), ("CMP", 0xC0), ("SBC", 0xE0)):
+        put(mnemonic, [(base + low[m], m, c) for m, c in group], read_modes)
+    put("STA", [(0x85, "zpg", 3), (0x95, "zpx", 4), (0x8D, "abs", 4), (0x9D, "abx", 5), (0x99, "aby", 5),
+                (0x81, "inx", 6), (0x91, "iny", 6)])
+    for mnemonic, base in (("ASL", 0x00), ("ROL", 0x20), ("LSR", 0x40), ("ROR", 0x60)):
+        put(mnemonic, [(base + 0x0A, "acc", 2), (base + 0x06, "zpg", 5), (base + 0x16, "zpx", 6),
+                       (base + 0x0E, "abs", 6), (base + 0x1E, "abx", 7)])
+    for mnemonic, base in (("DEC", 0xC0), ("INC", 0xE0)):
+        put(mnemonic, [(base + 0x06, "zpg", 5), (base + 0x16, "zpx", 6), (base + 0x0E, "abs", 6), (base + 0x1E, "abx", 7)])
+    put("LDX", [(0xA2, "imm", 2), (0xA6, "zpg", 3), (0xB6, "zpy", 4), (0xAE, "abs", 4), (0xBE, "aby", 4)], read_modes)
+    put("LDY", [(0xA0, "imm", 2), (0xA4, "zpg", 3), (0xB4, "zpx", 4), (0xAC, "abs", 4), (0xBC, "abx", 4)], read_modes)
+    put("STX", [(0x86, "zpg", 3), (0x96, "zpy", 4), (0x8E, "abs", 4)])
+    put("STY", [(0x84, "zpg", 3), (0x94, "zpx", 4), (0x8C, "abs", 4)])
+    put("CPX", [(0xE0, "imm", 2), (0xE4, "zpg", 3), (0xEC, "abs", 4)])
+    put("CPY", [(0xC0, "imm", 2), (0xC4, "zpg", 3), (0xCC, "abs", 4)])
+    put("BIT", [(0x24, "zpg", 3), (0x2C, "abs", 4)])
+    for mnemonic, opcode in (("BPL", 0x10), ("BMI", 0x30), ("BVC", 0x50), ("BVS", 0x70),
+                             ("BCC", 0x90), ("BCS", 0xB0), ("BNE", 0xD0), ("BEQ", 0xF0)):
+        put(mnemonic, [(opcode, "rel", 2)])
+    put("JMP", [(0x4C, "abs", 3), (0x6C, "ind", 5)])
+    put("JSR", [(0x20, "abs", 6)])
+    put("RTS", [(0x60, "imp", 6)])
+    put("RTI", [(0x40, "imp", 6)])
+    put("BRK", [(0x00, "imp", 7)])
+    for mnemonic, opcode in (("CLC", 0x18), ("SEC", 0x38), ("CLI", 0x58), ("SEI", 0x78), ("CLV", 0xB8),
+                             ("CLD", 0xD8), ("SED", 0xF8), ("TAX", 0xAA), ("TXA", 0x8A), ("TAY", 0xA8),
+                             ("TYA", 0x98), ("TSX", 0xBA), ("TXS", 0x9A), ("INX", 0xE8), ("INY", 0xC8),
+                             ("DEX", 0xCA), ("DEY", 0x88), ("NOP", 0xEA)):
+        put(mnemonic, [(opcode, "imp", 2)])
+    put("PHA", [(0x48, "imp", 3)])
+    put("PHP", [(0x08, "imp", 3)])
+    put("PLA", [(0x68, "imp", 4)])
+    put("PLP", [(0x28, "imp", 4)])
+    # ---- stable undocumented NMOS opcodes (64doc) ----
+    rmw = (("zpg", 0x07, 5), ("zpx", 0x17, 6), ("inx", 0x03, 8), ("iny", 0x13, 8),
+           ("abs", 0x0F, 6), ("abx", 0x1F, 7), ("aby", 0x1B, 7))
+    for mnemonic, base in (("SLO", 0x00), ("RLA", 0x20), ("SRE", 0x40), ("RRA", 0x60), ("DCP", 0xC0), ("ISC", 0xE0)):
+        put(mnemonic, [(base + low_, mode, cycles) for mode, low_, cycles in rmw])
+    put("LAX", [(0xA7, "zpg", 3), (0xB7, "zpy", 4), (0xA3, "inx", 6), (0xB3, "iny", 5), (0xAF, "abs", 4),
+                (0xBF, "aby", 4)], read_modes)
+    put("SAX", [(0x87, "zpg", 3), (0x97, "zpy", 4), (0x83, "inx", 6), (0x8F, "abs", 4)])
+    put("ANC", [(0x0B, "imm", 2), (0x2B, "imm", 2)])
+    put("ALR", [(0x4B, "imm", 2)])
+    put("ARR", [(0x6B, "imm", 2)])
+    put("SBX", [(0xCB, "imm", 2)])
+    put("USBC", [(0xEB, "imm", 2)])
+    put("NOP", [(op, "imp", 2) for op in (0x1A, 0x3A, 0x5A, 0x7A, 0xDA, 0xFA)]
+        + [(op, "imm", 2) for op in (0x80, 0x82, 0x89, 0xC2, 0xE2)]
+        + [(op, "zpg", 3) for op in (0x04, 0x44, 0x64)]
+        + [(op, "zpx", 4) for op in (0x14, 0x34, 0x54, 0x74, 0xD4, 0xF4)]
+        + [(0x0C, "abs", 4)]
+        + [(op, "abx", 4) for op in (0x1C, 0x3C, 0x5C, 0x7C, 0xDC, 0xFC)], read_modes)
+    return table
+
+
+OPCODES: dict[int, OpTiming] = _build()
+
+
+class TimingError(ValueError):
+    """An opcode the table does not know (an unstable or JAM opcode)."""
+
+
+def timing_of(opcode: int) -> OpTiming:
+    try:
+        return OPCODES[opcode]
+    except KeyError:
+        raise TimingError(f"opcode ${opcode:02X} has no entry in the timing table") from None
+
+
+def branch_target(pc: int, offset: int) -> int:
+    next_pc = (pc + 2) & 0xFFFF
+    return (next_pc + (offset - 256 if offset & 0x80 else offset)) & 0xFFFF
+
+
+def crosses_page(base: int, address: int) -> bool:
+    return (base & PAGE_MASK) != (address & PAGE_MASK)
+
+
+# Branch opcode -> (status flag bit, value that takes the branch).
+BRANCH_CONDITIONS = {0x10: (0x80, 0), 0x30: (0x80, 1), 0x50: (0x40, 0), 0x70: (0x40, 1),
+                     0x90: (0x01, 0), 0xB0: (0x01, 1), 0xD0: (0x02, 0), 0xF0: (0x02, 1)}
+
+
+def branch_taken(opcode: int, p: int) -> bool:
+    flag, wanted = BRANCH_CONDITIONS[opcode]
+    return bool(p & flag) == bool(wanted)
+
+
+def instruction_cycles(read: Callable[[int], int], pc: int, x: int, y: int, p: int, pointer: int) -> int:
+    """Cycles of the instruction at pc, given the registers before it.
+
+    `pointer` is the 16-bit pointer an (indirect),Y instruction reads from zero page (else unused).
+    """
+    opcode = read(pc)
+    op = timing_of(opcode)
+    cycles = op.cycles
+    mode = op.mode
+    if mode == "rel":
+        if branch_taken(opcode, p):
+            cycles += BRANCH_TAKEN_CYCLES
+            if crosses_page((pc + 2) & 0xFFFF, branch_target(pc, read((pc + 1) & 0xFFFF))):
+                cycles += BRANCH_PAGE_CYCLES
+    elif op.page_penalty:
+        if mode == "iny":
+            base, index = pointer, y
+        else:
+            base = read((pc + 1) & 0xFFFF) | read((pc + 2) & 0xFFFF) << 8
+            index = x if mode == "abx" else y
+        if crosses_page(base, base + index):
+            cycles += PAGE_CROSS_CYCLES
+    return cycles
+
+
+def model_cycles(read: Callable[[int], int], steps: Iterable[tuple[int, int, int, int, int]]) -> int:
+    """Total cycles of an executed path; steps are (pc, x, y, p, pointer) before each instruction."""
+    return sum(instruction_cycles(read, pc, x, y, p, pointer) for pc, x, y, p, pointer in steps)

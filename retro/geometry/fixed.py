@@ -1,0 +1,109 @@
+"""Integer references for the 6502 collision routines in asm/, written from each test's definition.
+
+One pure function per routine with the routine's inputs and outputs (issue 5). They know nothing
+of how the assembly computes its answer: boxes are pixel sets, circles compare squared distances,
+the product is a product. Every function accepts plain ints or numpy integer arrays of one shape
+(a batch), and returns a bool / int or an array of them.
+
+Edge convention (as the rest of retro.geometry): half-open boxes, a box at x with width w covers
+pixels x .. x+w-1, so boxes that touch do not overlap and a box of width 0 covers nothing;
+circles whose distance equals r1 + r2 do not overlap.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from retro.routines.screen import CELL_PIXELS, COLUMNS, ROWS, SPRITE_HEIGHT, SPRITE_X_AT_COLUMN_0, SPRITE_Y_AT_ROW_0
+
+HIGH_BIT_WEIGHT = 256  # the $D010 bit is bit 8 of a sprite's X
+
+
+def _intervals_share_a_pixel(a_start, a_size, b_start, b_size):
+    a_start, a_size, b_start, b_size = (np.asarray(v, dtype=np.int64) for v in (a_start, a_size, b_start, b_size))
+    return np.maximum(a_start, b_start) < np.minimum(a_start + a_size, b_start + b_size)
+
+
+def _result(value):
+    if isinstance(value, np.generic) or isinstance(value, np.ndarray) and value.ndim == 0:
+        return value.item()
+    return value
+
+
+def aabb8(ax, ay, aw, ah, bx, by, bw, bh):
+    """Boxes (ax, ay, aw, ah) and (bx, by, bw, bh) share at least one pixel."""
+    return _result(_intervals_share_a_pixel(ax, aw, bx, bw) & _intervals_share_a_pixel(ay, ah, by, bh))
+
+
+def aabb_sprite(x1, x1h, y1, ox1, oy1, w1, h1, x2, x2h, y2, ox2, oy2, w2, h2):
+    """Sprite hitboxes overlap: sprite n at X = xn + 256 * xnh, Y = yn, hitbox (oxn, oyn, wn, hn) inside it."""
+    left1 = np.asarray(x1, dtype=np.int64) + HIGH_BIT_WEIGHT * np.asarray(x1h, dtype=np.int64) + ox1
+    left2 = np.asarray(x2, dtype=np.int64) + HIGH_BIT_WEIGHT * np.asarray(x2h, dtype=np.int64) + ox2
+    top1 = np.asarray(y1, dtype=np.int64) + oy1
+    top2 = np.asarray(y2, dtype=np.int64) + oy2
+    return _result(_intervals_share_a_pixel(left1, w1, left2, w2) & _intervals_share_a_pixel(top1, h1, top2, h2))
+
+
+def circle(x1, y1, r1, x2, y2, r2):
+    """Circles overlap: squared distance of the centres below (r1 + r2)^2 (tangent circles do not)."""
+    x1, y1, r1, x2, y2, r2 = (np.asarray(v, dtype=np.int64) for v in (x1, y1, r1, x2, y2, r2))
+    return _result((x1 - x2) ** 2 + (y1 - y2) ** 2 < (r1 + r2) ** 2)
+
+
+def mul8(a, b):
+    """The 16-bit product of two bytes."""
+    return _result(np.asarray(a, dtype=np.int64) * np.asarray(b, dtype=np.int64))
+
+
+def cell_under(x, xh, y):
+    """(column, row, on_screen) of the text-screen cell under sprite-coordinate pixel (x + 256 xh, y)."""
+    px = np.asarray(x, dtype=np.int64) + HIGH_BIT_WEIGHT * np.asarray(xh, dtype=np.int64) - SPRITE_X_AT_COLUMN_0
+    py = np.asarray(y, dtype=np.int64) - SPRITE_Y_AT_ROW_0
+    on = (px >= 0) & (px < COLUMNS * CELL_PIXELS) & (py >= 0) & (py < ROWS * CELL_PIXELS)
+    return px // CELL_PIXELS, py // CELL_PIXELS, on
+
+
+def tile(x, xh, y, screen, props):
+    """Property byte of the cell under the point: props[screen code], 0 off the screen.
+
+    screen: COLUMNS * ROWS screen codes, row by row; props: 256 property bytes.
+    """
+    screen = np.asarray(screen, dtype=np.int64)
+    props = np.asarray(props, dtype=np.int64)
+    column, row, on = cell_under(x, xh, y)
+    index = np.where(on, row * COLUMNS + column, 0)
+    return _result(np.where(on, props[screen[index]], 0))
+
+
+def tile_box(x, xh, y, w, h, screen, props) -> int:
+    """OR of the property bytes of every on-screen cell that shares a pixel with the box."""
+    left = x + HIGH_BIT_WEIGHT * xh
+    grid = np.asarray(props, dtype=np.int64)[np.asarray(screen, dtype=np.int64)].reshape(ROWS, COLUMNS)
+    result = 0
+    for row in range(ROWS):
+        top = SPRITE_Y_AT_ROW_0 + row * CELL_PIXELS
+        if not _intervals_share_a_pixel(top, CELL_PIXELS, y, h):
+            continue
+        for column in range(COLUMNS):
+            if _intervals_share_a_pixel(SPRITE_X_AT_COLUMN_0 + column * CELL_PIXELS, CELL_PIXELS, left, w):
+                result |= int(grid[row, column])
+    return result
+
+
+def mask_bits(rows: bytes | list[int]) -> np.ndarray:
+    """A C64 sprite mask (3 bytes a row, bit 7 leftmost) as a SPRITE_HEIGHT x SPRITE_WIDTH bool array."""
+    data = np.frombuffer(bytes(rows), dtype=np.uint8)[:SPRITE_HEIGHT * 3].reshape(SPRITE_HEIGHT, 3)
+    return np.unpackbits(data, axis=1).astype(bool)
+
+
+def pixel(dx: int, dy: int, mask_a, mask_b) -> bool:
+    """Some pixel is set in both masks when mask B's top-left is at (dx, dy) relative to mask A's."""
+    a = np.asarray(mask_a, dtype=bool)
+    b = np.asarray(mask_b, dtype=bool)
+    height, width = a.shape
+    canvas = np.zeros((height + 2 * b.shape[0], width + 2 * b.shape[1]), dtype=bool)
+    oy, ox = b.shape
+    if not (-oy < dy < height and -ox < dx < width):
+        return False
+    canvas[oy + dy:oy + dy + b.shape[0], ox + dx:ox + dx + b.shape[1]] = b
+    return bool((canvas[oy:oy + height, ox:ox + width] & a).any())
