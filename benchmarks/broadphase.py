@@ -25,7 +25,13 @@ import numpy as np
 
 from retro.fileio import write_atomic
 from retro.geometry.broadphase import (
-    AABBTree, BoxSet, brute_force_pairs, brute_force_pairs_numpy, grid_pairs, quadtree_pairs, sweep_and_prune_pairs,
+    AABBTree,
+    BoxSet,
+    brute_force_pairs,
+    brute_force_pairs_numpy,
+    grid_pairs,
+    quadtree_pairs,
+    sweep_and_prune_pairs,
 )
 
 REBUILT = {

@@ -90,7 +90,9 @@ def _assemble_cached(resolved: str, shown: str, fingerprint: str) -> Program:
 
 
 def _assemble(resolved: str, shown: str, text: str) -> Program:
-    from retro import tables  # tables are pure generators; imported late to keep start-up light
+    from retro import (
+        tables,  # tables are pure generators; imported late to keep start-up light
+    )
 
     with tempfile.TemporaryDirectory(prefix="retro-asm-") as tmp:
         out = Path(tmp)

@@ -18,8 +18,14 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from retro.chips.vic.constants import (SPRITE_BLOCK, SPRITE_BYTES, SPRITE_BYTES_PER_ROW, SPRITE_HEIGHT,
-                                       SPRITE_MC_WIDTH, SPRITE_WIDTH)
+from retro.chips.vic.constants import (
+    SPRITE_BLOCK,
+    SPRITE_BYTES,
+    SPRITE_BYTES_PER_ROW,
+    SPRITE_HEIGHT,
+    SPRITE_MC_WIDTH,
+    SPRITE_WIDTH,
+)
 from retro.errors import InputError
 from retro.fileio import read_bytes, write_atomic
 

@@ -84,7 +84,9 @@ table("circle_dyn_hi")(lambda: _hi(_CIRCLE_DYN))
 
 
 def _screen():
-    from retro.routines import screen  # plain constants; imported here to keep this module light
+    from retro.routines import (
+        screen,  # plain constants; imported here to keep this module light
+    )
     return screen
 
 

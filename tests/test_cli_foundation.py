@@ -161,3 +161,14 @@ def test_errors_from_the_installed_script_are_one_line_without_traceback(source)
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 1
     assert done.stderr.count("\n") == 1 and "BRK (opcode $00) at $C008" in done.stderr
+
+
+def test_commands_with_output_folders_fail_fast_with_one_line(tmp_path):
+    blocker = tmp_path / "a-file"
+    blocker.write_text("not a folder")
+    for command in (["demo", "--out"], ["chart", "--reduced", "--out"], ["stability", "--reduced", "--out"]):
+        done = subprocess.run([sys.executable, "-m", "retro", *command, str(blocker / "sub")],
+                              capture_output=True, text=True, timeout=60)
+        assert done.returncode == 2, command
+        lines = done.stderr.strip().splitlines()
+        assert len(lines) == 1 and "cannot create output folder" in lines[0], done.stderr

@@ -5,8 +5,14 @@ from __future__ import annotations
 import pytest
 
 from retro.errors import InputError
-from retro.program import (Program, format_vice_labels, load_prg_file, parse_prg, parse_vice_labels,
-                           prg_bytes)
+from retro.program import (
+    Program,
+    format_vice_labels,
+    load_prg_file,
+    parse_prg,
+    parse_vice_labels,
+    prg_bytes,
+)
 
 
 def test_prg_round_trip_and_header_is_little_endian():

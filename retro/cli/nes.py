@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 
+from retro.app.nes import MAX_SCALE, check_scene, describe
 from retro.numbers import parse_int
-from retro.sprite_zero import MAX_SCALE, check_scene, describe
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 import json
 
+from retro.app.run import run_routine
 from retro.cpu.machine import DEFAULT_BUDGET, JSR_CYCLES
 from retro.numbers import parse_int
-from retro.runner import run_routine
 
 
 def _byte(text: str) -> int:

@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 import json
 
+from retro.app.vic import MAX_FRAMES, MAX_SCALE, report_json, report_lines, run_scene
 from retro.numbers import parse_int
 from retro.render.palette import C64_DEFAULT_PALETTE
-from retro.vic_report import MAX_FRAMES, MAX_SCALE, report_json, report_lines, run_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -19,7 +19,14 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from retro.cpu.timing import BRANCH_PAGE_CYCLES, BRANCH_TAKEN_CYCLES, PAGE_CROSS_CYCLES, branch_target, crosses_page, timing_of
+from retro.cpu.timing import (
+    BRANCH_PAGE_CYCLES,
+    BRANCH_TAKEN_CYCLES,
+    PAGE_CROSS_CYCLES,
+    branch_target,
+    crosses_page,
+    timing_of,
+)
 from retro.errors import InputError
 
 OPCODE_JMP_ABS = 0x4C

@@ -11,8 +11,19 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from retro.cpu.bus import Bus, Device
-from retro.cpu.mpu import (FLAG_B, FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_U, FLAG_V, FLAG_Z, RECENT_MASK,
-                           VARIANTS, CpuHalt)
+from retro.cpu.mpu import (
+    FLAG_B,
+    FLAG_C,
+    FLAG_D,
+    FLAG_I,
+    FLAG_N,
+    FLAG_U,
+    FLAG_V,
+    FLAG_Z,
+    RECENT_MASK,
+    VARIANTS,
+    CpuHalt,
+)
 from retro.errors import InputError, RunError
 from retro.numbers import parse_int
 from retro.program import Program
@@ -132,23 +143,33 @@ class Machine:
             raise InputError(f"budget: {budget} is not a positive number of cycles")
         for target, values in (memory or {}).items():
             self.poke(target, values)
+        entries: list[TraceEntry] | None = [] if trace else None
+        start = self._enter(address, a, x, y, p)
+        count = self._execute(RETURN_TRAP, CALL_STACK_TOP, start + budget, entries)
+        cycles = self._returned(start, budget, count)
+        mpu = self.mpu
+        status = _status(mpu.p)
+        return CallResult(a=mpu.a, x=mpu.x, y=mpu.y, s=mpu.sp, p=status, cycles=cycles,
+                          instructions=count, trace=entries, flags=_flags(status))
+
+    def _enter(self, address: int, a: int, x: int, y: int, p: int) -> int:
+        """Set registers and the stack as a JSR from the return trap would; return the start cycle."""
         mpu = self.mpu
         mpu.a, mpu.x, mpu.y, mpu.p = a, x, y, _status(p)
         mpu.sp = CALL_STACK_TOP
         mpu.stPushWord((RETURN_TRAP - 1) & 0xFFFF)
         mpu.pc = address
-        start = mpu.processorCycles
-        limit = start + budget
-        entries: list[TraceEntry] | None = [] if trace else None
-        count = self._execute(RETURN_TRAP, CALL_STACK_TOP, limit, entries)
+        return mpu.processorCycles
+
+    def _returned(self, start: int, budget: int, count: int) -> int:
+        """The routine's cycles, or a RunError if it did not return within the budget."""
+        mpu = self.mpu
         if mpu.pc != RETURN_TRAP or mpu.sp != CALL_STACK_TOP:
             self._over_budget(budget, count)
-        if mpu.processorCycles - start > budget:  # returned, but its last instruction ran past the budget
-            raise RunError(f"cycle budget of {budget} cycles exceeded: the routine returned after "
-                           f"{mpu.processorCycles - start} cycles")
-        status = _status(mpu.p)
-        return CallResult(a=mpu.a, x=mpu.x, y=mpu.y, s=mpu.sp, p=status, cycles=mpu.processorCycles - start,
-                          instructions=count, trace=entries, flags=_flags(status))
+        cycles = mpu.processorCycles - start
+        if cycles > budget:  # returned, but its last instruction ran past the budget
+            raise RunError(f"cycle budget of {budget} cycles exceeded: the routine returned after {cycles} cycles")
+        return cycles
 
     def call_fast(self, address: int, writes=(), *, a: int = 0, x: int = 0, y: int = 0, p: int = DEFAULT_FLAGS,
                   budget: int = DEFAULT_BUDGET, record: list | None = None,
@@ -164,23 +185,14 @@ class Machine:
         memory = self.bus.memory
         for target, value in writes:
             memory[target] = value
-        mpu = self.mpu
-        mpu.a, mpu.x, mpu.y, mpu.p = a, x, y, _status(p)
-        mpu.sp = CALL_STACK_TOP
-        mpu.stPushWord((RETURN_TRAP - 1) & 0xFFFF)
-        mpu.pc = address
-        start = mpu.processorCycles
-        limit = start + budget
+        start = self._enter(address, a, x, y, p)
         if record is None:
-            count = self._execute(RETURN_TRAP, CALL_STACK_TOP, limit, None)
+            count = self._execute(RETURN_TRAP, CALL_STACK_TOP, start + budget, None)
         else:
-            count = self._execute_recorded(limit, record, pointer_pcs)
-        if mpu.pc != RETURN_TRAP or mpu.sp != CALL_STACK_TOP:
-            self._over_budget(budget, count)
-        if mpu.processorCycles - start > budget:
-            raise RunError(f"cycle budget of {budget} cycles exceeded: the routine returned after "
-                           f"{mpu.processorCycles - start} cycles")
-        return mpu.processorCycles - start, mpu.a, mpu.x, mpu.y, _status(mpu.p)
+            count = self._execute_recorded(start + budget, record, pointer_pcs)
+        cycles = self._returned(start, budget, count)
+        mpu = self.mpu
+        return cycles, mpu.a, mpu.x, mpu.y, _status(mpu.p)
 
     def _execute_recorded(self, limit: int, record: list, pointer_pcs: frozenset[int]) -> int:
         mpu = self.mpu

@@ -12,19 +12,57 @@ This package imports nothing from retro.cpu or retro.chips.
 """
 
 from retro.geometry.aabb import (
-    aabb_contains_point, aabb_from_center, aabb_mtv, aabb_overlap, aabb_overlap_centered, aabb_to_center,
+    aabb_contains_point,
+    aabb_from_center,
+    aabb_mtv,
+    aabb_overlap,
+    aabb_overlap_centered,
+    aabb_to_center,
 )
 from retro.geometry.broadphase import (
-    ALL_LAYERS, AABBTree, BoxSet, PairResult, Quadtree, aabb_tree_pairs, brute_force_pairs,
-    brute_force_pairs_numpy, grid_pairs, layers_match, quadtree_pairs, sweep_and_prune_pairs,
+    ALL_LAYERS,
+    AABBTree,
+    BoxSet,
+    PairResult,
+    Quadtree,
+    aabb_tree_pairs,
+    brute_force_pairs,
+    brute_force_pairs_numpy,
+    grid_pairs,
+    layers_match,
+    quadtree_pairs,
+    sweep_and_prune_pairs,
 )
 from retro.geometry.circle import (
-    circle_aabb_mtv, circle_aabb_overlap, circle_mtv, circle_overlap, closest_point_on_aabb, point_in_circle,
+    circle_aabb_mtv,
+    circle_aabb_overlap,
+    circle_mtv,
+    circle_overlap,
+    closest_point_on_aabb,
+    point_in_circle,
 )
-from retro.geometry.masks import mask_bounds, mask_from_rows, mask_overlap, mask_overlap_area, mask_overlap_mask
+from retro.geometry.masks import (
+    mask_bounds,
+    mask_from_rows,
+    mask_overlap,
+    mask_overlap_area,
+    mask_overlap_mask,
+)
 from retro.geometry.polygon import (
-    convex_decompose, convex_hull, convex_polygon, is_ccw, is_convex, polygon_centroid, regular_polygon, rotate_point,
-    rotate_polygon, signed_area, simple_polygon, simplify_polygon, translate_polygon, triangulate,
+    convex_decompose,
+    convex_hull,
+    convex_polygon,
+    is_ccw,
+    is_convex,
+    polygon_centroid,
+    regular_polygon,
+    rotate_point,
+    rotate_polygon,
+    signed_area,
+    simple_polygon,
+    simplify_polygon,
+    translate_polygon,
+    triangulate,
 )
 from retro.geometry.raycast import Box, Circle, RayHit, RayScene, Segment
 from retro.geometry.rays import ray_aabb, ray_circle, ray_segment

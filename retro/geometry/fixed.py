@@ -14,7 +14,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from retro.routines.screen import CELL_PIXELS, COLUMNS, ROWS, SPRITE_HEIGHT, SPRITE_X_AT_COLUMN_0, SPRITE_Y_AT_ROW_0
+from retro.routines.screen import (
+    CELL_PIXELS,
+    COLUMNS,
+    ROWS,
+    SPRITE_HEIGHT,
+    SPRITE_X_AT_COLUMN_0,
+    SPRITE_Y_AT_ROW_0,
+)
 
 HIGH_BIT_WEIGHT = 256  # the $D010 bit is bit 8 of a sprite's X
 

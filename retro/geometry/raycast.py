@@ -11,7 +11,14 @@ from retro.errors import InputError
 from retro.geometry.aabb import as_box
 from retro.geometry.broadphase.aabbtree import AABBTree
 from retro.geometry.rays import ray_aabb, ray_circle, ray_segment
-from retro.geometry.vectors import Number, Point, PointLike, as_nonzero_vector, as_point, as_positive
+from retro.geometry.vectors import (
+    Number,
+    Point,
+    PointLike,
+    as_nonzero_vector,
+    as_point,
+    as_positive,
+)
 
 
 @dataclass(frozen=True)

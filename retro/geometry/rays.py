@@ -14,7 +14,14 @@ import math
 
 from retro.errors import InputError
 from retro.geometry.aabb import as_box
-from retro.geometry.vectors import Number, PointLike, as_nonzero_vector, as_point, as_positive, cross
+from retro.geometry.vectors import (
+    Number,
+    PointLike,
+    as_nonzero_vector,
+    as_point,
+    as_positive,
+    cross,
+)
 
 
 def slab_interval(origin: tuple[Number, Number], direction: tuple[Number, Number],

@@ -19,7 +19,12 @@ from __future__ import annotations
 
 import math
 
-from retro.geometry.polygon import Polygon, convex_polygon, convex_decompose, simple_polygon
+from retro.geometry.polygon import (
+    Polygon,
+    convex_decompose,
+    convex_polygon,
+    simple_polygon,
+)
 from retro.geometry.vectors import PointLike, as_nonzero_vector, as_points
 
 Axis = tuple[float, float]

@@ -12,7 +12,13 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from retro.chips.ppu.constants import (
-    LEFT_COLUMN_WIDTH, MASK_BACKGROUND, MASK_LEFT_COLUMN, MASK_SPRITES, NO_HIT_X, SCREEN_HEIGHT, SCREEN_WIDTH,
+    LEFT_COLUMN_WIDTH,
+    MASK_BACKGROUND,
+    MASK_LEFT_COLUMN,
+    MASK_SPRITES,
+    NO_HIT_X,
+    SCREEN_HEIGHT,
+    SCREEN_WIDTH,
 )
 from retro.chips.ppu.hit import SpriteZeroHit
 from retro.chips.ppu.pixels import background_frame, sprite_values

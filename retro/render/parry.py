@@ -14,7 +14,16 @@ from pathlib import Path
 from PIL import Image, ImageDraw
 
 from retro.fileio import read_text, write_atomic
-from retro.geometry.parry import DEFAULT_FRAMES, DEFAULT_SCRIPT, Event, FrameState, ParryParams, events_of, parse_script, simulate
+from retro.geometry.parry import (
+    DEFAULT_FRAMES,
+    DEFAULT_SCRIPT,
+    Event,
+    FrameState,
+    ParryParams,
+    events_of,
+    parse_script,
+    simulate,
+)
 from retro.render.images import label_font, save_png
 
 SCALE = 2
@@ -168,13 +177,3 @@ def write_parry(out_dir: str | Path, script: str = DEFAULT_SCRIPT, frames: int =
     text = "".join(f"{e.frame} {e.kind}\n" for e in events)
     files.append(write_atomic(out / "parry_events.txt", text))
     return ParryRun(states, events, files)
-
-
-def demo_step(out_dir: Path) -> list[str]:
-    """`retro demo` step: the built-in parry script."""
-    run = write_parry(out_dir, DEFAULT_SCRIPT, DEFAULT_FRAMES, source="built-in script")
-    counts = {k: sum(e.kind == k for e in run.events) for k in ("window", "parry", "hit", "whiff", "expired")}
-    return [f"script: {DEFAULT_SCRIPT}",
-            "events: " + " ".join(str(e) for e in run.events),
-            ", ".join(f"{v} {k}" for k, v in counts.items()),
-            f"wrote {run.files[0].name} ({len(run.states)} frames) and {len(run.files) - 2} event frames as PNG"]

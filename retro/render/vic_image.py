@@ -13,12 +13,28 @@ from __future__ import annotations
 import numpy as np
 from PIL import Image, ImageDraw
 
-from retro.chips.vic.constants import (REG_CONTROL1, REG_CONTROL2, REG_SPRITE_COLOR0, REG_SPRITE_EXPAND_X,
-                                       REG_SPRITE_EXPAND_Y, REG_SPRITE_MC0, REG_SPRITE_MC1, REG_SPRITE_MULTICOLOR,
-                                       REG_SPRITE_PRIORITY, SPRITE_COUNT, COLOR_MASK)
+from retro.chips.vic.constants import (
+    COLOR_MASK,
+    REG_CONTROL1,
+    REG_CONTROL2,
+    REG_SPRITE_COLOR0,
+    REG_SPRITE_EXPAND_X,
+    REG_SPRITE_EXPAND_Y,
+    REG_SPRITE_MC0,
+    REG_SPRITE_MC1,
+    REG_SPRITE_MULTICOLOR,
+    REG_SPRITE_PRIORITY,
+    SPRITE_COUNT,
+)
 from retro.chips.vic.graphics import colours, foreground_at
 from retro.chips.vic.model import FrameCollisions, VicState, placement, sprite_rows
-from retro.render.images import PANEL_BACKGROUND, LABEL_COLOUR, from_rgb_array, side_by_side, upscale
+from retro.render.images import (
+    LABEL_COLOUR,
+    PANEL_BACKGROUND,
+    from_rgb_array,
+    side_by_side,
+    upscale,
+)
 from retro.render.palette import C64_DEFAULT_PALETTE, palette
 from retro.sprites import decode
 

@@ -1,6 +1,7 @@
 """Run one registered routine on cases: a loaded machine, the world in memory, the fast call path.
 
-`RoutineRunner(routine, world).run(case)` writes the case's bytes to the routine's zero-page inputs,
+`RoutineRunner(routine, world).run(case)` writes the case's bytes to the routine's zero-page inputs
+and registers (inputs named A, X, Y, or C for the carry flag, set when the case's value is non-zero),
 calls it with `Machine.call_fast` and returns (answer, cycles, steps) where steps is the executed
 path that the independent timing model (retro.cpu.timing) needs.
 """
@@ -10,16 +11,16 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from retro.assembler import assemble_file
-from retro.cpu.machine import Machine
+from retro.assembler import assemble_file, requested_tables
+from retro.cpu.machine import DEFAULT_FLAGS, Machine
 from retro.cpu.timing import OPCODES
 from retro.program import Program
 from retro.routines.registry import Routine, World
 from retro.routines.screen import SCREEN_BASE
-from retro.assembler import requested_tables
 from retro.tables import GENERATORS, STORAGE_TABLES
 
 FLAG_C = 0x01
+REGISTER_INPUTS = ("A", "X", "Y", "C")  # input names that are registers (C: the carry flag), not zero page
 _INSTRUCTION_LINE = re.compile(r"^\s*(?P<address>[0-9A-Fa-f]{4})  (?P<bytes>(?:[0-9A-Fa-f]{2} ){1,3})\s*[A-Z]{3}\b")
 
 
@@ -53,7 +54,10 @@ class RoutineRunner:
         self.machine.load(self.program)
         symbols = self.program.symbols
         self.entry = symbols[routine.name]
-        self.addresses = [symbols[name] for name in routine.inputs]
+        zero_page = [(i, name) for i, name in enumerate(routine.inputs) if name not in REGISTER_INPUTS]
+        self.addresses = [symbols[name] for _, name in zero_page]
+        self.zero_page_slots = [i for i, _ in zero_page]
+        self.register_slots = {name: i for i, name in enumerate(routine.inputs) if name in REGISTER_INPUTS}
         memory = self.machine.memory
         self.pointer_pcs = self._indirect_y_pcs()
         if routine.init:
@@ -92,8 +96,11 @@ class RoutineRunner:
         """(answer, cycles) of one call; with `record`, the executed path is appended to it."""
         if self.routine.name == "pixel":
             self._set_masks(case[2])
-        writes = list(zip(self.addresses, case))
-        cycles, a, x, _, p = self.machine.call_fast(self.entry, writes, record=record, pointer_pcs=self.pointer_pcs)
+        writes = [(address, case[i]) for address, i in zip(self.addresses, self.zero_page_slots)]
+        registers = {name.lower(): case[i] for name, i in self.register_slots.items() if name != "C"}
+        carry = "C" in self.register_slots and case[self.register_slots["C"]] != 0
+        cycles, a, x, _, p = self.machine.call_fast(self.entry, writes, **registers, p=DEFAULT_FLAGS | (FLAG_C if carry else 0),
+                                                    record=record, pointer_pcs=self.pointer_pcs)
         output = self.routine.output
         if output == "carry":
             return p & FLAG_C, cycles

@@ -1,9 +1,9 @@
 """The collision routines: asm entry <-> reference function <-> input generators <-> valid domain.
 
 A case is a tuple of byte values in the order of the routine's `inputs` (zero-page aliases of its
-source); pixel cases carry a third item, the index of a mask pair in the run's world. A world is the
-memory a routine reads besides its inputs (screen codes and properties, sprite masks), chosen once
-per run from a seed so every worker sees the same.
+source, or the registers A, X, Y and the carry C); pixel cases carry a third item, the index of a
+mask pair in the run's world. A world is the memory a routine reads besides its inputs (screen
+codes and properties, sprite masks), chosen once per run from a seed so every worker sees the same.
 
 Input sets (`cases(routine, exhaustive, seed)`):
 - boundary: touching, one apart, overlapping by one, 0, 255/256, maximum sizes, screen edges;
@@ -26,9 +26,9 @@ import numpy as np
 
 from retro.errors import InputError
 from retro.geometry import fixed
+from retro.paths import ASM_DIR
 from retro.routines.screen import COLUMNS, ROWS, SPRITE_HEIGHT, SPRITE_ROW_BYTES
 
-ASM_DIR = Path(__file__).resolve().parents[2] / "asm"
 RANDOM_FULL = 100_000
 RANDOM_BOUNDED = 2_000
 BYTE = 256
@@ -44,7 +44,7 @@ class World:
 @dataclass(frozen=True)
 class Routine:
     name: str  # entry label in asm/NAME.s, and the name the CLI uses
-    inputs: tuple[str, ...]  # zero-page aliases, in case order
+    inputs: tuple[str, ...]  # zero-page aliases or registers (A, X, Y, C = carry), in case order
     output: str  # "carry", "a" or "product" (X low, A high)
     reference: Callable[[tuple, World], int]
     boundary: Callable[[], list[tuple]]
@@ -373,7 +373,7 @@ ROUTINES: dict[str, Routine] = {r.name: r for r in (
             domain=(("aw >= 1", lambda c: c[2] >= 1), ("ah >= 1", lambda c: c[3] >= 1),
                     ("bw >= 1", lambda c: c[6] >= 1), ("bh >= 1", lambda c: c[7] >= 1)),
             summary="two 8-bit boxes share a pixel (carry)"),
-    Routine("aabb_sprite", ("x1", "x1h", "y1", "ox1", "oy1", "w1", "h1", "x2", "x2h", "y2", "ox2", "oy2", "w2", "h2"),
+    Routine("aabb_sprite", ("x1", "X", "y1", "ox1", "oy1", "w1", "h1", "A", "C", "Y", "ox2", "oy2", "w2", "h2"),
             "carry", _aabb_sprite_reference, _aabb_sprite_boundary, _aabb_sprite_random, _aabb_sprite_exhaustive,
             domain=(("x1h <= 1", lambda c: c[1] <= 1), ("x2h <= 1", lambda c: c[8] <= 1),
                     ("w1 >= 1", lambda c: c[5] >= 1), ("h1 >= 1", lambda c: c[6] >= 1),
@@ -383,10 +383,10 @@ ROUTINES: dict[str, Routine] = {r.name: r for r in (
             _circle_boundary, _circle_random, _circle_exhaustive,
             domain=(("r1 + r2 <= 255", lambda c: c[2] + c[5] <= 255),),
             summary="two circles by squared distance against (r1+r2)^2 (carry)"),
-    Routine("mul8", ("mul_a", "mul_b"), "product", lambda c, w: int(fixed.mul8(*c)),
+    Routine("mul8", ("A", "Y"), "product", lambda c, w: int(fixed.mul8(*c)),
             _mul8_boundary, _mul8_random, _mul8_exhaustive, init="mul8_init",
             summary="unsigned 8x8 -> 16 product (X low, A high)"),
-    Routine("tile", ("px", "pxh", "py"), "a", _tile_reference, _tile_boundary, _tile_random, _tile_exhaustive,
+    Routine("tile", ("X", "C", "Y"), "a", _tile_reference, _tile_boundary, _tile_random, _tile_exhaustive,
             domain=(("x high bit <= 1", lambda c: c[1] <= 1),), world=_screen_world,
             summary="property byte of the screen cell under a point (A)"),
     Routine("tile_box", ("bx", "bxh", "by", "bw", "bh"), "a", _tile_box_reference, _tile_box_boundary,

@@ -32,9 +32,22 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from retro.chips.ppu.constants import (
-    CHR_SIZE, CIRAM_SIZE, MIRRORING, NAMETABLE_COLUMNS, NAMETABLE_COUNT, NAMETABLE_ROWS, NAMETABLE_SIZE,
-    OAM_ENTRY_SIZE, OAM_SIZE, PATTERN_TABLE_SIZE, PLANE_OFFSET, TILE_BYTES, TILE_SIZE, TILES_PER_TABLE,
-    VIDEO_STANDARDS, VideoStandard,
+    CHR_SIZE,
+    CIRAM_SIZE,
+    MIRRORING,
+    NAMETABLE_COLUMNS,
+    NAMETABLE_COUNT,
+    NAMETABLE_ROWS,
+    NAMETABLE_SIZE,
+    OAM_ENTRY_SIZE,
+    OAM_SIZE,
+    PATTERN_TABLE_SIZE,
+    PLANE_OFFSET,
+    TILE_BYTES,
+    TILE_SIZE,
+    TILES_PER_TABLE,
+    VIDEO_STANDARDS,
+    VideoStandard,
 )
 from retro.chips.ppu.device import PpuDevice, attach_ppu
 from retro.chips.ppu.state import PpuState

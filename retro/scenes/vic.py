@@ -11,12 +11,33 @@ from pathlib import Path
 
 import numpy as np
 
-from retro.chips.vic.constants import (BITMAP_BYTES, CHAR_HEIGHT, CHARSET_BYTES, COLOR_MASK, REG_IRQ_LATCH,
-                                       REG_SPRITE_COLOR0, REG_SPRITE_ENABLE, REG_SPRITE_EXPAND_X,
-                                       REG_SPRITE_EXPAND_Y, REG_SPRITE_MULTICOLOR, REG_SPRITE_PRIORITY,
-                                       REG_SPRITE_X0, REG_SPRITE_X_MSB, REG_SPRITE_Y0, READ_ONLY_LATCHES,
-                                       REGISTER_COUNT, SCREEN_CELLS, SPRITE_BYTES, SPRITE_COUNT, TEXT_COLUMNS,
-                                       TEXT_ROWS, VIC_BASE, VIDEOS, X_BITS_MASK, Y_COMPARE_MASK)
+from retro.chips.vic.constants import (
+    BITMAP_BYTES,
+    CHAR_HEIGHT,
+    CHARSET_BYTES,
+    COLOR_MASK,
+    READ_ONLY_LATCHES,
+    REG_IRQ_LATCH,
+    REG_SPRITE_COLOR0,
+    REG_SPRITE_ENABLE,
+    REG_SPRITE_EXPAND_X,
+    REG_SPRITE_EXPAND_Y,
+    REG_SPRITE_MULTICOLOR,
+    REG_SPRITE_PRIORITY,
+    REG_SPRITE_X0,
+    REG_SPRITE_X_MSB,
+    REG_SPRITE_Y0,
+    REGISTER_COUNT,
+    SCREEN_CELLS,
+    SPRITE_BYTES,
+    SPRITE_COUNT,
+    TEXT_COLUMNS,
+    TEXT_ROWS,
+    VIC_BASE,
+    VIDEOS,
+    X_BITS_MASK,
+    Y_COMPARE_MASK,
+)
 from retro.chips.vic.graphics import VicMemory
 from retro.chips.vic.model import VicState
 from retro.errors import InputError
@@ -173,6 +194,8 @@ def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: _Where) 
             source = f"file {entry['file']}"
     except InputError as exc:
         message = str(exc)
+        if message.startswith(f"{where.source}: "):
+            raise
         if message.startswith(kind) or message.startswith("rows["):
             raise InputError(f"{where.source}: {name}.{message}") from None
         raise InputError(f"{where.source}: {name}: {message}") from None

@@ -7,12 +7,23 @@ import math
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from shapely.geometry import Point, box
 
 from retro.geometry import (
-    aabb_contains_point, aabb_from_center, aabb_mtv, aabb_overlap, aabb_overlap_centered, aabb_to_center,
-    circle_aabb_mtv, circle_aabb_overlap, circle_mtv, circle_overlap, point_in_circle, sat,
+    aabb_contains_point,
+    aabb_from_center,
+    aabb_mtv,
+    aabb_overlap,
+    aabb_overlap_centered,
+    aabb_to_center,
+    circle_aabb_mtv,
+    circle_aabb_overlap,
+    circle_mtv,
+    circle_overlap,
+    point_in_circle,
+    sat,
 )
 
 coords = st.integers(-20, 20)

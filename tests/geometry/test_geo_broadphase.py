@@ -8,7 +8,12 @@ import numpy as np
 import pytest
 
 from retro.geometry import AABBTree, BoxSet, aabb_overlap, layers_match
-from retro.geometry.broadphase import METHODS, Quadtree, grid_pairs, sweep_and_prune_pairs
+from retro.geometry.broadphase import (
+    METHODS,
+    Quadtree,
+    grid_pairs,
+    sweep_and_prune_pairs,
+)
 
 ENEMY, BULLET, PLAYER = 1, 2, 4
 

@@ -3,10 +3,17 @@
 from __future__ import annotations
 
 import numpy as np
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from retro.geometry import mask_bounds, mask_from_rows, mask_overlap, mask_overlap_area, mask_overlap_mask
+from retro.geometry import (
+    mask_bounds,
+    mask_from_rows,
+    mask_overlap,
+    mask_overlap_area,
+    mask_overlap_mask,
+)
 
 
 def per_pixel(a: np.ndarray, b: np.ndarray, dx: int, dy: int) -> np.ndarray:

@@ -7,15 +7,25 @@ import math
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, settings, strategies as st
+from geometry_shapes import random_star
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from shapely.geometry import Polygon
 from shapely.ops import unary_union
 
-from geometry_shapes import random_star
 from retro.errors import InputError
 from retro.geometry import (
-    convex_decompose, convex_polygon, is_ccw, is_convex, polygon_centroid, regular_polygon, rotate_point,
-    rotate_polygon, signed_area, simplify_polygon, triangulate,
+    convex_decompose,
+    convex_polygon,
+    is_ccw,
+    is_convex,
+    polygon_centroid,
+    regular_polygon,
+    rotate_point,
+    rotate_polygon,
+    signed_area,
+    simplify_polygon,
+    triangulate,
 )
 
 
@@ -89,7 +99,8 @@ def test_convex_polygon_decomposes_into_itself():
 
 def test_convex_hull_matches_shapely_on_random_point_sets():
     import numpy as np
-    from shapely.geometry import MultiPoint, Polygon as ShapelyPolygon
+    from shapely.geometry import MultiPoint
+    from shapely.geometry import Polygon as ShapelyPolygon
 
     from retro.geometry import convex_hull, is_ccw
 

@@ -8,7 +8,15 @@ import numpy as np
 import pytest
 from shapely.geometry import LineString
 
-from retro.geometry import Box, Circle, RayScene, Segment, ray_aabb, ray_circle, ray_segment
+from retro.geometry import (
+    Box,
+    Circle,
+    RayScene,
+    Segment,
+    ray_aabb,
+    ray_circle,
+    ray_segment,
+)
 from retro.geometry.raycast import hit_time
 
 T_MAX, STEP = 30.0, 0.002

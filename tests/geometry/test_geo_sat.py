@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 import shapely
-from shapely.geometry import LineString, MultiPoint, Polygon
-from shapely.affinity import translate
-
 from geometry_shapes import interiors_intersect, random_convex, random_star
+from shapely.affinity import translate
+from shapely.geometry import LineString, MultiPoint, Polygon
+
 from retro.geometry import polygons_overlap, sat, sat_overlap
 
 

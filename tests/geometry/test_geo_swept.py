@@ -5,7 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from retro.geometry import aabb_overlap, circle_overlap, swept_aabb, swept_aabb_hit, swept_circle
+from retro.geometry import (
+    aabb_overlap,
+    circle_overlap,
+    swept_aabb,
+    swept_aabb_hit,
+    swept_circle,
+)
 
 TS = np.linspace(0, 1, 4001)
 

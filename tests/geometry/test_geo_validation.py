@@ -9,8 +9,18 @@ import pytest
 
 from retro.errors import InputError
 from retro.geometry import (
-    aabb_overlap, circle_overlap, convex_decompose, mask_overlap, polygons_overlap, ray_aabb, ray_circle,
-    ray_segment, sat, sat_overlap, swept_aabb, swept_circle,
+    aabb_overlap,
+    circle_overlap,
+    convex_decompose,
+    mask_overlap,
+    polygons_overlap,
+    ray_aabb,
+    ray_circle,
+    ray_segment,
+    sat,
+    sat_overlap,
+    swept_aabb,
+    swept_circle,
 )
 
 SQUARE = [(0, 0), (2, 0), (2, 2), (0, 2)]

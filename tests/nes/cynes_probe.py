@@ -1,4 +1,4 @@
-"""Run probe cartridges (retro.nes_probe) in cynes and measure when $2002 bits appear.
+"""Run probe cartridges (retro.analysis.nes_probe) in cynes and measure when $2002 bits appear.
 
 Each run powers the emulated console on with one image and reads RAM after a few frames. For a
 scene, the first delay at which a bit is seen is found by bisection (a flag stays set from the dot
@@ -11,9 +11,15 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
+from retro.analysis.nes_probe import (
+    DONE_ADDRESS,
+    DONE_MARK,
+    MIN_DELAY,
+    RESULT_ADDRESS,
+    probe_image,
+)
 from retro.chips.ppu.constants import STATUS_SPRITE0_HIT, STATUS_VBLANK
 from retro.chips.ppu.state import PpuState
-from retro.nes_probe import DONE_ADDRESS, DONE_MARK, MIN_DELAY, RESULT_ADDRESS, probe_image
 
 MAX_FRAMES = 8
 LOCAL_STEPS = 4                # a hint is trusted only after checking both sides of the boundary

@@ -1,6 +1,6 @@
 """The PPU model against cynes (a C++ NES emulator that passes blargg's sprite-hit tests).
 
-For each generated scene, a probe cartridge (retro.nes_probe) sets the scene up during a vblank,
+For each generated scene, a probe cartridge (retro.analysis.nes_probe) sets the scene up during a vblank,
 turns rendering on and reads $2002 once after an exact delay. Bisection over the delay finds, in
 cynes, the first CPU cycle at which the hit flag is visible and the first at which the vblank flag
 of the same frame is visible. Their difference M is compared with the model:

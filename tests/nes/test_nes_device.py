@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import math
 
+from nes_build import make_state
+
 from retro.assembler import assemble_text
 from retro.chips.ppu.constants import PAL
 from retro.chips.ppu.device import PpuDevice, attach_ppu
 from retro.cpu.machine import Machine
-
-from nes_build import make_state
 
 FULL_FRAME = 262 * 341          # 89342
 SHORT_FRAME = FULL_FRAME - 1
@@ -222,6 +222,7 @@ def test_polling_loop_pal():
 
 def test_polling_without_hit_hits_budget():
     import pytest
+
     from retro.errors import RunError
     machine, device = ppu_machine(make_state(mask=0x1E, cells={}, sprite=(119, 1, 0, 128)))
     program = machine.load(assemble_text(".org $c000\nwait: bit $2002\n bvc wait\n rts\n"))

@@ -5,11 +5,10 @@ sprite_hit_tests readme), in the comment next to it."""
 from __future__ import annotations
 
 import pytest
+from nes_build import SOLID, make_state, one_pixel
 
 from retro.chips.ppu.constants import PAL
 from retro.chips.ppu.hit import sprite_zero_hit
-
-from nes_build import SOLID, make_state, one_pixel
 
 BG_TILE_AT_120_128 = {(0, 15, 16): 1}     # nametable 0, row 15 (lines 120-127), column 16 (x 128-135)
 

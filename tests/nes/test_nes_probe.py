@@ -6,13 +6,12 @@ from __future__ import annotations
 import random
 
 import pytest
+from nes_build import make_state
 
+from retro.analysis.nes_probe import MIN_DELAY, probe_image, probe_program
 from retro.chips.ines import HEADER_SIZE, PRG_BANK_SIZE, nrom_image, parse_header
 from retro.cpu.machine import Machine
 from retro.errors import InputError
-from retro.nes_probe import MIN_DELAY, probe_image, probe_program
-
-from nes_build import make_state
 
 
 def test_nrom_header_fields():

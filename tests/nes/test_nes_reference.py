@@ -7,9 +7,9 @@ from __future__ import annotations
 import os
 import random
 
-from retro.chips.ppu.hit import sprite_zero_hit
-
 from nes_scenes import random_scene
+
+from retro.chips.ppu.hit import sprite_zero_hit
 
 SCENES = 2000 if os.environ.get("RETRO_EXHAUSTIVE") == "1" else 300
 PAGES = {"horizontal": (0, 0, 1, 1), "vertical": (0, 1, 0, 1), "single": (0, 0, 0, 0)}

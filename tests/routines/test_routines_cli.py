@@ -30,7 +30,7 @@ def test_check_exits_1_on_a_mismatch_and_prints_the_inputs(monkeypatch, capsys):
     routine = get("mul8")
     monkeypatch.setitem(ROUTINES, "mul8", type(routine)(**{**routine.__dict__, "reference": lambda c, w: c[0] * c[1] + 1}))
     assert main(["check", "mul8", "--random", "0", "--jobs", "1"]) == 1
-    assert "mul_a=0, mul_b=0" in capsys.readouterr().out
+    assert "A=0, Y=0" in capsys.readouterr().out
 
 
 def test_unknown_routine_is_one_line_exit_2(capsys):

@@ -83,8 +83,12 @@ def test_measured_routines_agree_with_the_study_verdicts(sprite_shapes):
 
 @pytest.mark.parametrize("length,thickness", [(4, 1), (4, 8), (2, 3)])
 def test_tunnelling_matches_the_closed_form(length, thickness):
-    from retro.analysis.study.stability.tunnelling import (miss_rate_from_hits, static_hits_by_dx, swept_miss_rate,
-                                                           wall)
+    from retro.analysis.study.stability.tunnelling import (
+        miss_rate_from_hits,
+        static_hits_by_dx,
+        swept_miss_rate,
+        wall,
+    )
 
     mask = np.zeros((21, 24), dtype=bool)
     mask[9:11, 3:3 + length] = True

@@ -9,11 +9,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from vic_scenes import rows_with, scene, sprite
+
+from retro.app.run import run_routine
 from retro.assembler import assemble_text
 from retro.chips.vic.device import VicDevice
 from retro.cpu import Machine
-from retro.runner import run_routine
-from vic_scenes import scene, sprite
 
 PAL_LINE = 63
 OVERLAP_LINE = 101  # sprites 0 (X 100) and 1 (X 110), both full at Y 100: first common pixel (101, 110)
@@ -42,6 +43,35 @@ def test_bit_appears_when_the_beam_draws_the_overlap_pixel():
     assert OVERLAP_TIME == 6389
     assert device().read(0xD01E, OVERLAP_TIME) == 0
     assert device().read(0xD01E, OVERLAP_TIME + 1) == 0b11
+
+
+# VICE test programs VICII/spritecollisions/sprite-sprite-collision-cycle and
+# sprite-gfx-collision-cycle (PAL; readme: C64 and C64C show "CC@@@@@" and "CCBBBBB", i.e. 3,3,0,0,0,0,0
+# and 3,3,2,2,2,2,2). Sprites 0 and 1 hold one pixel (row 0, column 0) at Y $34 -> line 53; X starts
+# at $56 (86) and sprite 0 (both sprites in the $D01E test) moves right by one each frame; the
+# $D01F test has solid characters in text row 0, columns 7-14 (X 80-143, lines 51-58).
+# When the program reads, worked out by hand from Bauer 3.6.3's 6569 timing diagrams: the stable
+# double raster IRQ leaves the handler at cycle 4 of line 51 (RASTER increments at cycle 1); line 51
+# is a Bad Line (YSCROLL 3), so the opcode fetch of LDX #1 in cycle 12 waits until cycle 55; the
+# clearing LDA $D01E reads in cycle 1 of line 52; the delay loop (74 cycles) loses cycles 55-61 of
+# line 52 to the DMA of sprites 0 and 1 (BA low three cycles before sprite 0's s-access in cycle
+# 58); the second LDA $D01E reads in cycle 25 of line 53.
+VICE_READ_TIME = 53 * PAL_LINE + 24
+ONE_PIXEL = rows_with([(0, 0)])
+
+
+def test_vice_sprite_sprite_collision_cycle():
+    for x, expected in zip(range(86, 93), (3, 3, 0, 0, 0, 0, 0)):
+        vic = VicDevice(scene(sprite(0, x, 0x34, ONE_PIXEL), sprite(1, x, 0x34, ONE_PIXEL)).state)
+        assert vic.read(0xD01E, VICE_READ_TIME) == expected, x
+
+
+def test_vice_sprite_gfx_collision_cycle():
+    memory = {"screen": {"fill": 32, "cells": [{"col": c, "row": 0, "value": 0xA0} for c in range(7, 15)]},
+              "charset": {"160": [0xFF] * 8}}  # $A0: the reversed space, all pixels set
+    for x, expected in zip(range(86, 93), (3, 3, 2, 2, 2, 2, 2)):
+        vic = VicDevice(scene(sprite(0, x, 0x34, ONE_PIXEL), sprite(1, 86, 0x34, ONE_PIXEL), memory=memory).state)
+        assert vic.read(0xD01F, VICE_READ_TIME) == expected, x
 
 
 def test_start_cycle_offsets_the_frame():
@@ -268,3 +298,13 @@ def test_retro_run_attaches_the_scene(tmp_path: Path):
     source.write_text(POLL)
     report = run_routine(source, "poll", scene=scene_file, peeks=["result:2"])
     assert report.peeks["result"] == [0b11, OVERLAP_LINE]
+
+
+def test_unused_bits_of_every_register_read_1():
+    # Bauer 3.2 register table: unused are $D016 bits 6-7, $D018 bit 0, $D019 bits 4-6, $D01A bits 4-7,
+    # $D020-$D02E bits 4-7; every other register uses all 8 bits; $D02F-$D03F read $FF.
+    unused = {0x16: 0xC0, 0x18: 0x01, 0x1A: 0xF0, **{r: 0xF0 for r in range(0x20, 0x2F)}}
+    vic = VicDevice(scene(registers={f"$d0{r:02x}": 0 for r in (0x16, 0x18, 0x1A, 0x20, 0x2E)}).state)
+    for register in (0x15, 0x16, 0x17, 0x18, 0x1A, 0x1B, 0x1C, 0x1D, 0x20, 0x21, 0x25, 0x27, 0x2E):
+        assert vic.read(0xD000 + register, 10) == unused.get(register, 0), hex(register)
+    assert vic.read(0xD019, 10) == 0x70 | 0x01  # bits 4-6; raster compare line 0 passed at cycle 2

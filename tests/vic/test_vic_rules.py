@@ -4,7 +4,6 @@ the rule as documented (Bauer's VIC-II article, PRG p.145), never copied from th
 from __future__ import annotations
 
 import pytest
-
 from vic_scenes import FULL, latches, rows_with, sprite
 
 PIXEL = rows_with([(0, 0)])  # one opaque pixel: row 0, column 0
@@ -227,3 +226,13 @@ def test_sprite_past_the_last_line_continues_at_the_top():
     r = latches(sprite(0, 100, 40), sprite(1, 100, 40, rows_with([(20, 0)])))
     # sprite 1's row 20 shows on line 61 and (second display) on line 296+1+20-312 = 5
     assert r.first_d01e == (5, 100)
+
+
+# VICE test program VICII/spritecollisions/sprite-sprite.tas (PAL; readme: C64 and C64C pass): sprites
+# 6 and 7 with one pixel (row 0, column 0) at the same (X, Y); $D01E after a few frames is $C0
+# everywhere except at X $1FF, which the 6569 does not have.
+@pytest.mark.parametrize("x, y, expected", [
+    (0, 0, 0xC0), (23, 50, 0xC0), (24, 50, 0xC0), (0, 50, 0xC0), (50, 50, 0xC0), (255, 50, 0xC0),
+    (250, 250, 0xC0), (255, 100, 0xC0), (0x1FF, 50, 0), (0x157, 50, 0xC0)])
+def test_vice_sprite_sprite_table(x, y, expected):
+    assert latches(sprite(6, x, y, PIXEL), sprite(7, x, y, PIXEL)).d01e == expected

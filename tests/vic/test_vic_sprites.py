@@ -8,8 +8,17 @@ import numpy as np
 import pytest
 
 from retro.errors import InputError
-from retro.sprites import (decode, encode, opaque_mask, parse_hex, parse_rows, read_png, read_spr, write_png,
-                           write_spr)
+from retro.sprites import (
+    decode,
+    encode,
+    opaque_mask,
+    parse_hex,
+    parse_rows,
+    read_png,
+    read_spr,
+    write_png,
+    write_spr,
+)
 
 SPRITES = Path(__file__).resolve().parents[2] / "sprites"
 SAMPLES = ["ball", "ring", "ship", "bullet", "bar", "pentagon", "lshape", "full", "mc_ball", "mc_ship", "mc_gem"]

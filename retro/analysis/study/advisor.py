@@ -53,8 +53,14 @@ class Advice:
 
 def scene_shapes(path: str) -> list[tuple[int, Shape]]:
     """(sprite index, shape) for each enabled sprite of a VIC-II scene."""
-    from retro.chips.vic.constants import (REG_SPRITE_ENABLE, REG_SPRITE_EXPAND_X, REG_SPRITE_EXPAND_Y,
-                                           REG_SPRITE_MULTICOLOR, SPRITE_BYTES, SPRITE_COUNT)
+    from retro.chips.vic.constants import (
+        REG_SPRITE_ENABLE,
+        REG_SPRITE_EXPAND_X,
+        REG_SPRITE_EXPAND_Y,
+        REG_SPRITE_MULTICOLOR,
+        SPRITE_BYTES,
+        SPRITE_COUNT,
+    )
     from retro.scenes import load_scene
     from retro.sprites import opaque_mask
 

@@ -11,7 +11,7 @@ from retro.analysis.study import report
 from retro.analysis.study.corpus import DEFAULT_SHAPES, REDUCED_SHAPES, load_shapes
 from retro.analysis.study.evaluate import Progress, evaluate, quiet
 from retro.analysis.study.methods import METHODS
-from retro.fileio import write_atomic
+from retro.fileio import output_folder, write_atomic
 
 # Cases per pair whose 6502 cycles are measured: a deterministic, evenly spread sample of the
 # pair's offsets (every k-th case in row-major order). The full corpus is ~54,000 cases per method;
@@ -36,6 +36,7 @@ def run_chart(out_dir: Path, reduced: bool = False, workers: int | None = None, 
               shape_names: tuple[str, ...] | None = None, cost_samples: int | None = None) -> ChartOutput:
     from retro.analysis.study.cost_runs import measure_costs
 
+    output_folder(out_dir)
     start = time.perf_counter()
     names = shape_names or (REDUCED_SHAPES if reduced else DEFAULT_SHAPES)
     shapes = load_shapes(names)

@@ -26,8 +26,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from retro.errors import InputError
-
-SPRITES_DIR = Path(__file__).resolve().parents[3] / "sprites"
+from retro.paths import SPRITES_DIR
 
 # The shapes the issue names (round, ring, ship, bullet, thin bar, pentagon, L-shape), by file stem,
 # and a multicolor one whose rim is the 01 pair (opaque on the VIC-II although it is "colour 1").

@@ -12,7 +12,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from retro.geometry import convex_hull
-
 from retro.geometry.masks import mask_bounds
 
 Box = tuple[int, int, int, int]  # x0, y0, x1, y1 with x1, y1 exclusive (half-open pixel box)

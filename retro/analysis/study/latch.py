@@ -14,9 +14,21 @@ from collections.abc import Callable
 import numpy as np
 
 from retro.analysis.study.corpus import Pair, Shape
-from retro.chips.vic.constants import (PAL, REG_SPRITE_ENABLE, REG_SPRITE_EXPAND_X, REG_SPRITE_EXPAND_Y,
-                                       REG_SPRITE_MULTICOLOR, REG_SPRITE_X0, REG_SPRITE_X_MSB, REG_SPRITE_Y0,
-                                       REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT, VIC_BASE, VIC_LAST)
+from retro.chips.vic.constants import (
+    PAL,
+    REG_SPRITE_ENABLE,
+    REG_SPRITE_EXPAND_X,
+    REG_SPRITE_EXPAND_Y,
+    REG_SPRITE_MULTICOLOR,
+    REG_SPRITE_X0,
+    REG_SPRITE_X_MSB,
+    REG_SPRITE_Y0,
+    REGISTER_COUNT,
+    SPRITE_BYTES,
+    SPRITE_COUNT,
+    VIC_BASE,
+    VIC_LAST,
+)
 from retro.chips.vic.model import VicState, frame_collisions
 
 BASE_X = 100  # both sprites well inside the 9-bit X range and the frame: no wrap (see stability.wrap)

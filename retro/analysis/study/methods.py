@@ -16,7 +16,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from retro.analysis.study.corpus import Pair
-from retro.analysis.study.fits import Box, bit_rows, fitted_circle, full_box, pixel_hull, tight_box
+from retro.analysis.study.fits import (
+    Box,
+    bit_rows,
+    fitted_circle,
+    full_box,
+    pixel_hull,
+    tight_box,
+)
 
 CELL = 8  # a C64 text cell / NES tile is 8x8 pixels: the grid of the tile method
 

@@ -10,11 +10,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
-from pathlib import Path
 
 from retro.analysis.study.corpus import Pair
-
-ASM_DIR = Path(__file__).resolve().parents[3] / "asm"
+from retro.paths import ASM_DIR
 
 
 @lru_cache(maxsize=None)

@@ -23,8 +23,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from retro.chips.ppu.constants import (
-    DOTS_PER_LINE, HIT_DOT_OFFSET, LEFT_COLUMN_WIDTH, MASK_BACKGROUND, MASK_LEFT_COLUMN, MASK_SPRITES,
-    NO_HIT_X, SCREEN_HEIGHT, SCREEN_WIDTH, VBLANK_DOT, VBLANK_LINE, VideoStandard,
+    DOTS_PER_LINE,
+    HIT_DOT_OFFSET,
+    LEFT_COLUMN_WIDTH,
+    MASK_BACKGROUND,
+    MASK_LEFT_COLUMN,
+    MASK_SPRITES,
+    NO_HIT_X,
+    SCREEN_HEIGHT,
+    SCREEN_WIDTH,
+    VBLANK_DOT,
+    VBLANK_LINE,
+    VideoStandard,
 )
 from retro.chips.ppu.pixels import background_values, sprite_values
 from retro.chips.ppu.state import PpuState

@@ -11,7 +11,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from retro.chips.ppu.constants import (
-    CHR_SIZE, CIRAM_SIZE, MIRRORING, NAMETABLE_SIZE, NTSC, OAM_SIZE, VideoStandard,
+    CHR_SIZE,
+    CIRAM_SIZE,
+    MIRRORING,
+    NAMETABLE_SIZE,
+    NTSC,
+    OAM_SIZE,
+    VideoStandard,
 )
 
 

@@ -9,8 +9,12 @@ Timing model (docs/vic.md):
   which run up to $1F7 (6569) or $1FF (6567R8) and continue at 0. So pixel X of line L is drawn in
   cycle 1 + ((X - first_x) mod x_positions) // 8 of line L. The 6567R8's 65th cycle has no X
   coordinate of its own in this model.
-- "Frame time" of a pixel = line * cycles_per_line + (its cycle - 1). A collision latch bit set by a
-  pixel drawn at frame time p is seen by a read at frame time t > p. A register write at t changes
+- A collision at pixel X is latched COLLISION_LATCH_DELAY (4) X coordinates later than that, in
+  cycle 1 + ((X + 4 - first_x) mod x_positions) // 8 (measured by the VICE test programs
+  VICII/spritecollisions/*-collision-cycle; see constants.py). On the 6569 the last four X
+  coordinates of a line ($190-$193) therefore latch in cycle 1 of the next line.
+- "Frame time" of a latch = line * cycles_per_line + (its cycle - 1), modulo the frame. A collision
+  latch bit set at frame time p is seen by a read at frame time t > p. A register write at t changes
   what is drawn from t + 1 on.
 """
 
@@ -18,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from retro.chips.vic.constants import PIXELS_PER_CYCLE, Video
+from retro.chips.vic.constants import COLLISION_LATCH_DELAY, PIXELS_PER_CYCLE, Video
 
 
 def beam_order(video: Video, x: np.ndarray | int) -> np.ndarray | int:
@@ -27,8 +31,9 @@ def beam_order(video: Video, x: np.ndarray | int) -> np.ndarray | int:
 
 
 def pixel_time(video: Video, line: np.ndarray | int, x: np.ndarray | int) -> np.ndarray | int:
-    """Frame time (0-based cycle index in the frame) at which pixel (line, x) is drawn."""
-    return line * video.cycles_per_line + beam_order(video, x) // PIXELS_PER_CYCLE
+    """Frame time (0-based cycle index in the frame) at which a collision at pixel (line, x) latches."""
+    cycle = (beam_order(video, x) + COLLISION_LATCH_DELAY) // PIXELS_PER_CYCLE
+    return (line * video.cycles_per_line + cycle) % video.frame_cycles
 
 
 def beam_key(video: Video, line: np.ndarray | int, x: np.ndarray | int) -> np.ndarray | int:

@@ -121,6 +121,15 @@ class Video:
 
 
 PIXELS_PER_CYCLE = 8
+# A collision latch bit is set as if the pixel were drawn 4 X coordinates later than Bauer's X
+# counter says (the X coordinate at the beginning of each clock phase [Bauer 3.6.3]). Measured:
+# the VICE test programs VICII/spritecollisions/sprite-sprite-collision-cycle and
+# sprite-gfx-collision-cycle (readme: "CC@@@@@" / "CCBBBBB" on C64 and C64C) read $D01E/$D01F in
+# PAL cycle 25 of the line that shows a one-pixel overlap: X 86 and 87 are seen, X 88-92 are not.
+# Cycle 25 covers X 92-99 by Bauer's counter, so without a delay X 84-91 would all be seen; with
+# this delay a read in cycle c sees X up to 8(c-1) + first_x - 5, i.e. 87 (docs/vic.md, timing).
+# The NTSC versions of those programs are unverified; the same delay is assumed for the 6567R8.
+COLLISION_LATCH_DELAY = 4
 PAL = Video("pal", "6569", lines=312, cycles_per_line=63, x_positions=0x1F8, first_x=0x194,
             first_visible_line=16, visible_lines=284, first_visible_x=0x1E0, visible_pixels=403)
 # 65 cycles draw 520 pixels but only 512 X coordinates exist: the model gives the 65th cycle no

@@ -22,13 +22,34 @@ from __future__ import annotations
 import numpy as np
 
 from retro.chips.vic.beam import position
-from retro.chips.vic.constants import (CONTROL1_RST8, IRQ_RASTER, IRQ_SOURCES, IRQ_SPRITE_BACKGROUND,
-                                       IRQ_SPRITE_SPRITE, MIRROR_SIZE, REG_CONTROL1, REG_IRQ_ENABLE,
-                                       REG_IRQ_LATCH, REG_LIGHTPEN_X, REG_LIGHTPEN_Y, REG_RASTER,
-                                       REG_SPRITE_BACKGROUND, REG_SPRITE_SPRITE, REGISTER_COUNT, UNUSED_BITS,
-                                       UNUSED_READ, Y_COMPARE_MASK)
-from retro.chips.vic.model import (COLLISION_REGISTERS, FrameCollisions, VicState, frame_collisions,
-                                   irq_register, raster_irq_time)
+from retro.chips.vic.constants import (
+    CONTROL1_RST8,
+    IRQ_RASTER,
+    IRQ_SOURCES,
+    IRQ_SPRITE_BACKGROUND,
+    IRQ_SPRITE_SPRITE,
+    MIRROR_SIZE,
+    REG_CONTROL1,
+    REG_IRQ_ENABLE,
+    REG_IRQ_LATCH,
+    REG_LIGHTPEN_X,
+    REG_LIGHTPEN_Y,
+    REG_RASTER,
+    REG_SPRITE_BACKGROUND,
+    REG_SPRITE_SPRITE,
+    REGISTER_COUNT,
+    UNUSED_BITS,
+    UNUSED_READ,
+    Y_COMPARE_MASK,
+)
+from retro.chips.vic.model import (
+    COLLISION_REGISTERS,
+    FrameCollisions,
+    VicState,
+    frame_collisions,
+    irq_register,
+    raster_irq_time,
+)
 
 SCHEDULE_CACHE_SIZE = 256
 _COLLISION_SET = frozenset(COLLISION_REGISTERS)

@@ -22,13 +22,36 @@ from functools import lru_cache
 
 import numpy as np
 
-from retro.chips.vic.constants import (BITMAP_BYTES, CELL_WIDTH, CHAR_HEIGHT, CHARSET_BYTES, CONTROL1_BMM,
-                                       CONTROL1_DEN, CONTROL1_ECM, CONTROL1_RSEL, CONTROL1_YSCROLL,
-                                       CONTROL2_CSEL, CONTROL2_MCM, CONTROL2_XSCROLL, COLOR_MASK,
-                                       ECM_BITMAP_ADDRESS_MASK, ECM_CODE_MASK, GRAPHICS_FIRST_LINE,
-                                       GRAPHICS_FIRST_X, MULTICOLOR_TEXT_FLAG, REG_BACKGROUND0,
-                                       REG_BORDER_COLOR, REG_CONTROL1, REG_CONTROL2, SCREEN_CELLS, TEXT_COLUMNS, TEXT_ROWS, WINDOW_LINES,
-                                       WINDOW_X, Video)
+from retro.chips.vic.constants import (
+    BITMAP_BYTES,
+    CELL_WIDTH,
+    CHAR_HEIGHT,
+    CHARSET_BYTES,
+    COLOR_MASK,
+    CONTROL1_BMM,
+    CONTROL1_DEN,
+    CONTROL1_ECM,
+    CONTROL1_RSEL,
+    CONTROL1_YSCROLL,
+    CONTROL2_CSEL,
+    CONTROL2_MCM,
+    CONTROL2_XSCROLL,
+    ECM_BITMAP_ADDRESS_MASK,
+    ECM_CODE_MASK,
+    GRAPHICS_FIRST_LINE,
+    GRAPHICS_FIRST_X,
+    MULTICOLOR_TEXT_FLAG,
+    REG_BACKGROUND0,
+    REG_BORDER_COLOR,
+    REG_CONTROL1,
+    REG_CONTROL2,
+    SCREEN_CELLS,
+    TEXT_COLUMNS,
+    TEXT_ROWS,
+    WINDOW_LINES,
+    WINDOW_X,
+    Video,
+)
 
 IDLE_ROW = TEXT_ROWS  # line slot: the line is in the display window but in idle state
 BORDER_ROW = TEXT_ROWS + 1  # line slot: vertical border (no foreground at all)

@@ -24,12 +24,34 @@ from functools import lru_cache
 import numpy as np
 
 from retro.chips.vic.beam import beam_key, pixel_time
-from retro.chips.vic.constants import (CONTROL1_RST8, IRQ_ANY, IRQ_RASTER, IRQ_SOURCES, IRQ_SPRITE_BACKGROUND,
-                                       IRQ_SPRITE_SPRITE, RASTER_IRQ_LINE0_DELAY, REG_CONTROL1, REG_CONTROL2,
-                                       REG_IRQ_ENABLE, REG_IRQ_LATCH, REG_RASTER, REG_SPRITE_ENABLE, REG_SPRITE_EXPAND_X,
-                                       REG_SPRITE_EXPAND_Y, REG_SPRITE_MULTICOLOR, REG_SPRITE_X0,
-                                       REG_SPRITE_X_MSB, REG_SPRITE_Y0, REGISTER_COUNT, SPRITE_BYTES,
-                                       SPRITE_COUNT, SPRITE_HEIGHT, UNUSED_BITS, Y_COMPARE_MASK, Video)
+from retro.chips.vic.constants import (
+    CONTROL1_RST8,
+    IRQ_ANY,
+    IRQ_RASTER,
+    IRQ_SOURCES,
+    IRQ_SPRITE_BACKGROUND,
+    IRQ_SPRITE_SPRITE,
+    RASTER_IRQ_LINE0_DELAY,
+    REG_CONTROL1,
+    REG_CONTROL2,
+    REG_IRQ_ENABLE,
+    REG_IRQ_LATCH,
+    REG_RASTER,
+    REG_SPRITE_ENABLE,
+    REG_SPRITE_EXPAND_X,
+    REG_SPRITE_EXPAND_Y,
+    REG_SPRITE_MULTICOLOR,
+    REG_SPRITE_X0,
+    REG_SPRITE_X_MSB,
+    REG_SPRITE_Y0,
+    REGISTER_COUNT,
+    SPRITE_BYTES,
+    SPRITE_COUNT,
+    SPRITE_HEIGHT,
+    UNUSED_BITS,
+    Y_COMPARE_MASK,
+    Video,
+)
 from retro.chips.vic.graphics import VicMemory, foreground_at
 from retro.sprites import opaque_mask
 

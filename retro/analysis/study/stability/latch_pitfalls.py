@@ -14,7 +14,13 @@ from dataclasses import dataclass
 
 from retro.analysis.study.corpus import Shape
 from retro.analysis.study.latch import sprites_state
-from retro.chips.vic.constants import PAL, REG_SPRITE_SPRITE, REG_SPRITE_X0, REG_SPRITE_Y0, VIC_BASE
+from retro.chips.vic.constants import (
+    PAL,
+    REG_SPRITE_SPRITE,
+    REG_SPRITE_X0,
+    REG_SPRITE_Y0,
+    VIC_BASE,
+)
 from retro.chips.vic.device import VicDevice
 from retro.chips.vic.model import frame_collisions
 

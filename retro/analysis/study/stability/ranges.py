@@ -72,6 +72,7 @@ def wrap_routine_rows(reduced: bool = False) -> list[WrapRoutineRow]:
     """aabb8 with boxes reaching past 255 (x + w > 255), and aabb_sprite with X across 255/256,
     against the plain-integer overlap of the same boxes. Every pair of positions in the window."""
     from retro.analysis.study.stability.routine_edges import _machine
+    from retro.cpu.machine import DEFAULT_FLAGS
 
     rows = []
     step = 3 if reduced else 1
@@ -94,8 +95,10 @@ def wrap_routine_rows(reduced: bool = False) -> list[WrapRoutineRow]:
         wrong, example, cases = 0, None, 0
         for x1 in xs:
             for x2 in xs:
-                memory = {0x10: [x1 & 0xFF, x1 >> 8, 100, 0, 0, WRAP_W, 21], 0x18: [x2 & 0xFF, x2 >> 8, 100, 0, 0, WRAP_W, 21]}
-                said = machine.call("aabb_sprite", memory=memory).flags["C"]
+                # asm/aabb_sprite.s: sprite 2's X in A and the carry, y2 in Y, x1h in X, the rest zero page
+                memory = {0x10: [x1 & 0xFF, 100, 0, 0, WRAP_W, 21, 0, 0, WRAP_W, 21]}
+                said = machine.call("aabb_sprite", a=x2 & 0xFF, x=x1 >> 8, y=100, p=DEFAULT_FLAGS | (x2 >> 8),
+                                    memory=memory).flags["C"]
                 truth = x1 < x2 + WRAP_W and x2 < x1 + WRAP_W
                 cases += 1
                 if said != truth:

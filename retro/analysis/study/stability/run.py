@@ -10,7 +10,7 @@ from pathlib import Path
 
 from retro.analysis.study.corpus import load_shapes
 from retro.analysis.study.evaluate import Progress, quiet
-from retro.fileio import write_atomic
+from retro.fileio import output_folder, write_atomic
 
 REDUCED_SPEEDS = tuple(range(1, 25))
 FULL_SPEEDS = tuple(range(1, 65))
@@ -40,8 +40,16 @@ def _md_table(header: list[str], body: list[list[object]]) -> str:
 
 
 def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = quiet) -> StabilityOutput:
-    from retro.analysis.study.stability import charts, edges, latch_pitfalls, ranges, tunnelling, wrap
+    from retro.analysis.study.stability import (
+        charts,
+        edges,
+        latch_pitfalls,
+        ranges,
+        tunnelling,
+        wrap,
+    )
 
+    output_folder(out_dir)
     start = time.perf_counter()
     files: list[Path] = []
     md = ["# Stability: where each method breaks\n"]

@@ -16,8 +16,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from retro.chips.vic.constants import NTSC, PAL, REG_SPRITE_ENABLE, REG_SPRITE_X0, REG_SPRITE_X_MSB, \
-    REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT, SPRITE_WIDTH, Video
+from retro.chips.vic.constants import (
+    NTSC,
+    PAL,
+    REG_SPRITE_ENABLE,
+    REG_SPRITE_X0,
+    REG_SPRITE_X_MSB,
+    REGISTER_COUNT,
+    SPRITE_BYTES,
+    SPRITE_COUNT,
+    SPRITE_WIDTH,
+    Video,
+)
 from retro.chips.vic.model import VicState, placement
 
 X_RANGE = 512  # 9-bit sprite X: 0..511 can be written to $D000/$D010

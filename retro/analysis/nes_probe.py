@@ -8,16 +8,22 @@ The program is assembled once; each image is a copy with the scene and the delay
 from __future__ import annotations
 
 from functools import lru_cache
-from pathlib import Path
 
 from retro.assembler import assemble_file
 from retro.chips.ines import nrom_image
-from retro.chips.ppu.constants import CIRAM_SIZE, NAMETABLE_BASE, NAMETABLE_SIZE, MIRRORING, OAM_SIZE
+from retro.chips.ppu.constants import (
+    CIRAM_SIZE,
+    MIRRORING,
+    NAMETABLE_BASE,
+    NAMETABLE_SIZE,
+    OAM_SIZE,
+)
 from retro.chips.ppu.state import PpuState
 from retro.errors import InputError
+from retro.paths import ASM_DIR
 from retro.program import Program
 
-PROBE_SOURCE = Path(__file__).resolve().parent.parent / "asm" / "nes_sprite0_probe.s"
+PROBE_SOURCE = ASM_DIR / "nes_sprite0_probe.s"
 RESULT_ADDRESS = 0x0010
 DONE_ADDRESS = 0x0011
 DONE_MARK = 0xA5

@@ -11,19 +11,21 @@ import importlib
 from collections.abc import Callable
 from pathlib import Path
 
+from retro.fileio import output_folder
+
 # (title, "module:function")
 DEMO_STEPS: list[tuple[str, str]] = [
-    ("Assemble and run a 6502 routine", "retro.demo_steps:assemble_and_run"),
-    ("VIC-II collision scene: $D01E/$D01F/$D019 and the overlap image", "retro.vic_report:demo_step"),
-    ("Parry pipeline: padded AABB window, SAT contact, MTV knock-back", "retro.render.parry:demo_step"),
-    ("NES sprite-zero hit: model, picture, polling loop", "retro.demo_nes:sprite_zero"),
-    ("Collision routines: cross-checked results and cycles", "retro.routines.demo_step:cycles_table"),
-    ("Speed against accuracy: cycles and error rates of every collision method", "retro.analysis.study.demo_step:chart_step"),
+    ("Assemble and run a 6502 routine", "retro.demo.cpu:assemble_and_run"),
+    ("VIC-II collision scene: $D01E/$D01F/$D019 and the overlap image", "retro.demo.vic:latch_scene"),
+    ("Parry pipeline: padded AABB window, SAT contact, MTV knock-back", "retro.demo.parry:parry_sequence"),
+    ("NES sprite-zero hit: model, picture, polling loop", "retro.demo.nes:sprite_zero"),
+    ("Collision routines: cross-checked results and cycles", "retro.demo.routines:cycles_table"),
+    ("Speed against accuracy: cycles and error rates of every collision method", "retro.demo.study:chart_step"),
 ]
 
 
 def run_demo(out_dir: Path, emit: Callable[[str], None] = print) -> Path:
-    out_dir.mkdir(parents=True, exist_ok=True)
+    output_folder(out_dir)
     for title, target in DEMO_STEPS:
         module_name, func_name = target.split(":")
         step = getattr(importlib.import_module(module_name), func_name)

@@ -9,11 +9,12 @@ from retro.chips.ppu.clock import first_cycle_seeing
 from retro.chips.ppu.constants import DOTS_PER_LINE
 from retro.chips.ppu.hit import sprite_zero_hit
 from retro.cpu import Machine
+from retro.paths import EXAMPLES_DIR
 from retro.render.images import save_png
 from retro.render.nes_image import sprite_zero_image
 from retro.scenes import load_scene
 
-EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "nes_sprite0.toml"
+EXAMPLE = EXAMPLES_DIR / "nes_sprite0.toml"
 POLL_LOOP = ".org $c000\nwait: bit $2002\n bvc wait\n rts\n"
 POLL_EXIT_CYCLES = 2 + 6 + 1      # BVC not taken, RTS, and the BIT's read is its last cycle
 

@@ -7,9 +7,8 @@ from pathlib import Path
 from retro.assembler import assemble_file
 from retro.cpu import Machine
 from retro.fileio import write_atomic
+from retro.paths import ASM_DIR
 from retro.program import format_vice_labels, prg_bytes
-
-ASM_DIR = Path(__file__).resolve().parent.parent / "asm"
 
 
 def assemble_and_run(out_dir: Path) -> list[str]:

@@ -8,13 +8,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from retro.chips.vic.constants import IRQ_ANY, IRQ_RASTER, IRQ_SPRITE_BACKGROUND, IRQ_SPRITE_SPRITE, SPRITE_COUNT
+from retro.chips.vic.constants import (
+    IRQ_ANY,
+    IRQ_RASTER,
+    IRQ_SPRITE_BACKGROUND,
+    IRQ_SPRITE_SPRITE,
+    SPRITE_COUNT,
+)
 from retro.chips.vic.model import LatchReport, run_frames
 from retro.errors import InputError
 from retro.render.palette import C64_DEFAULT_PALETTE
 from retro.scenes.vic import VicScene, load
 
-EXAMPLES_DIR = Path(__file__).resolve().parent.parent / "examples"
 DEMO_SCENE = "vic_two_balls.toml"
 MAX_SCALE = 8
 MAX_FRAMES = 1_000_000
@@ -80,9 +85,3 @@ def report_lines(run: VicRun) -> list[str]:
     if run.png is not None:
         lines.append(f"wrote {run.png}")
     return lines
-
-
-def demo_step(out_dir: Path) -> list[str]:
-    """`retro demo`: the two-balls scene, its latch values and its overlap image."""
-    run = run_scene(EXAMPLES_DIR / DEMO_SCENE, png=out_dir / "vic_two_balls.png", scale=2)
-    return [f"examples/{DEMO_SCENE}:"] + report_lines(run)[1:-1] + ["wrote vic_two_balls.png (overlap image)"]
