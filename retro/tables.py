@@ -66,19 +66,20 @@ table("qsqd_lo")(lambda: _lo(_quarter_squares_of_difference()))
 table("qsqd_hi")(lambda: _hi(_quarter_squares_of_difference()))
 
 _SQUARES = [i * i for i in range(256)]
-# circle: x1 - x2 - 1 with x1 <= x2 is 255 - |dx|; with x1 > x2 it is |dx| - 1 and the table holds
-# dx^2 + 1 (the routine subtracts R^2 - 1 - dx^2 with the carry set); y1 - y2 with y1 < y2 is
-# 256 - |dy| and the table holds dy^2 - 1 (subtracted with the carry clear). Index 0 of the last
-# is never read.
-_CIRCLE_DXN = [(255 - i) ** 2 for i in range(256)]
-_CIRCLE_DXP = [(i + 1) ** 2 + 1 for i in range(256)]
+# circle (asm/circle.s): x1 - x2 with x1 >= x2 leaves the carry set, so r1 + r2 + C = R + 1
+# indexes (i - 1)^2 (R = 255 wraps to 0 with the carry set: entry 0 holds 255^2 - 1, the "- 1"
+# that the carry no longer subtracts); x1 - x2 with x1 < x2 is 256 - |dx| and the table holds
+# |dx|^2; y1 - y2 with y1 < y2 is 256 - |dy| and the table holds dy^2 - 1 (subtracted with the
+# carry clear). Index 0 of the last two is never read.
+_CIRCLE_RSQ1 = [255 ** 2 - 1] + [(i - 1) ** 2 for i in range(1, 256)]
+_CIRCLE_DXNEG = [0] + [(256 - i) ** 2 for i in range(1, 256)]
 _CIRCLE_DYN = [0] + [(256 - i) ** 2 - 1 for i in range(1, 256)]
 table("sq_lo")(lambda: _lo(_SQUARES))
 table("sq_hi")(lambda: _hi(_SQUARES))
-table("circle_dxn_lo")(lambda: _lo(_CIRCLE_DXN))
-table("circle_dxn_hi")(lambda: _hi(_CIRCLE_DXN))
-table("circle_dxp_lo")(lambda: _lo(_CIRCLE_DXP))
-table("circle_dxp_hi")(lambda: _hi(_CIRCLE_DXP))
+table("circle_rsq1_lo")(lambda: _lo(_CIRCLE_RSQ1))
+table("circle_rsq1_hi")(lambda: _hi(_CIRCLE_RSQ1))
+table("circle_dxneg_lo")(lambda: _lo(_CIRCLE_DXNEG))
+table("circle_dxneg_hi")(lambda: _hi(_CIRCLE_DXNEG))
 table("circle_dyn_lo")(lambda: _lo(_CIRCLE_DYN))
 table("circle_dyn_hi")(lambda: _hi(_CIRCLE_DYN))
 

@@ -24,10 +24,11 @@ from pathlib import Path
 
 import numpy as np
 
+from retro.chips.vic.constants import SPRITE_HEIGHT
 from retro.errors import InputError
-from retro.geometry import fixed
 from retro.paths import ASM_DIR
-from retro.routines.screen import COLUMNS, ROWS, SPRITE_HEIGHT, SPRITE_ROW_BYTES
+from retro.routines import reference
+from retro.routines.screen import COLUMNS, ROWS, SPRITE_ROW_BYTES
 
 RANDOM_FULL = 100_000
 RANDOM_BOUNDED = 2_000
@@ -91,7 +92,7 @@ def _bytes(rng: np.random.Generator, n: int, columns: int) -> np.ndarray:
 # ---- aabb8 -----------------------------------------------------------------------------------
 
 def _aabb8_reference(case: tuple, world: World) -> int:
-    return int(fixed.aabb8(*case))
+    return int(reference.aabb8(*case))
 
 
 def _aabb8_boundary() -> list[tuple]:
@@ -133,7 +134,7 @@ def _aabb8_exhaustive() -> Iterable[tuple]:
 # ---- aabb_sprite -------------------------------------------------------------------------------
 
 def _aabb_sprite_reference(case: tuple, world: World) -> int:
-    return int(fixed.aabb_sprite(*case))
+    return int(reference.aabb_sprite(*case))
 
 
 def _sprite_case(x1: int, y1: int, box1: tuple, x2: int, y2: int, box2: tuple) -> tuple:
@@ -182,7 +183,7 @@ def _aabb_sprite_exhaustive() -> Iterable[tuple]:
 # ---- circle ------------------------------------------------------------------------------------
 
 def _circle_reference(case: tuple, world: World) -> int:
-    return int(fixed.circle(*case))
+    return int(reference.circle(*case))
 
 
 def _circle_case(dx: int, dy: int, radius_sum: int, cx: int = 0, cy: int = 0) -> tuple:
@@ -254,7 +255,7 @@ def _screen_world(rng: np.random.Generator) -> World:
 
 
 def _tile_reference(case: tuple, world: World) -> int:
-    return int(fixed.tile(*case, world.screen, world.props))
+    return int(reference.tile(*case, world.screen, world.props))
 
 
 _EDGE_X = (0, 23, 24, 25, 31, 32, 255, 256, 343, 344, 345, 511)
@@ -277,7 +278,7 @@ def _tile_exhaustive() -> Iterable[tuple]:
 
 def _tile_box_reference(case: tuple, world: World) -> int:
     x, xh, y, w, h = case
-    return fixed.tile_box(x, xh, y, w, h, world.screen, world.props)
+    return reference.tile_box(x, xh, y, w, h, world.screen, world.props)
 
 
 def _tile_box_boundary() -> list[tuple]:
@@ -343,7 +344,7 @@ def _signed(value: int) -> int:
 def _pixel_reference(case: tuple, world: World) -> int:
     dx, dy, pair = case
     a, b = world.masks[pair]
-    return int(fixed.pixel(_signed(dx), _signed(dy), fixed.mask_bits(a), fixed.mask_bits(b)))
+    return int(reference.pixel(_signed(dx), _signed(dy), reference.mask_bits(a), reference.mask_bits(b)))
 
 
 def _pixel_boundary() -> list[tuple]:
@@ -368,7 +369,7 @@ def _pixel_exhaustive() -> Iterable[tuple]:
 # ---- the registry -------------------------------------------------------------------------------
 
 ROUTINES: dict[str, Routine] = {r.name: r for r in (
-    Routine("aabb8", ("ax", "ay", "aw", "ah", "bx", "by", "bw", "bh"), "carry", _aabb8_reference,
+    Routine("aabb8", ("A", "X", "aw", "ah", "bx", "by", "bw", "bh"), "carry", _aabb8_reference,  # ax in A, ay in X
             _aabb8_boundary, _aabb8_random, _aabb8_exhaustive,
             domain=(("aw >= 1", lambda c: c[2] >= 1), ("ah >= 1", lambda c: c[3] >= 1),
                     ("bw >= 1", lambda c: c[6] >= 1), ("bh >= 1", lambda c: c[7] >= 1)),
@@ -379,11 +380,11 @@ ROUTINES: dict[str, Routine] = {r.name: r for r in (
                     ("w1 >= 1", lambda c: c[5] >= 1), ("h1 >= 1", lambda c: c[6] >= 1),
                     ("w2 >= 1", lambda c: c[12] >= 1), ("h2 >= 1", lambda c: c[13] >= 1)),
             summary="two sprite hitboxes, 9-bit X, offsets inside the sprite (carry)"),
-    Routine("circle", ("x1", "y1", "r1", "x2", "y2", "r2"), "carry", _circle_reference,
+    Routine("circle", ("A", "y1", "X", "x2", "y2", "r2"), "carry", _circle_reference,
             _circle_boundary, _circle_random, _circle_exhaustive,
             domain=(("r1 + r2 <= 255", lambda c: c[2] + c[5] <= 255),),
             summary="two circles by squared distance against (r1+r2)^2 (carry)"),
-    Routine("mul8", ("A", "Y"), "product", lambda c, w: int(fixed.mul8(*c)),
+    Routine("mul8", ("A", "Y"), "product", lambda c, w: int(reference.mul8(*c)),
             _mul8_boundary, _mul8_random, _mul8_exhaustive, init="mul8_init",
             summary="unsigned 8x8 -> 16 product (X low, A high)"),
     Routine("tile", ("X", "C", "Y"), "a", _tile_reference, _tile_boundary, _tile_random, _tile_exhaustive,

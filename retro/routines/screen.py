@@ -7,18 +7,26 @@ sprite X 24, Y 50 (Programmer's Reference Guide, "Sprite positioning").
 
 from __future__ import annotations
 
-SCREEN_BASE = 0x0400
-COLUMNS = 40
-ROWS = 25
-CELL_PIXELS = 8
-SPRITE_X_AT_COLUMN_0 = 24
-SPRITE_Y_AT_ROW_0 = 50
-SPRITE_X_LIMIT = 512  # 9-bit X: low byte plus the $D010 bit
+from retro.chips.vic.constants import (
+    CELL_WIDTH,
+    GRAPHICS_FIRST_LINE,
+    GRAPHICS_FIRST_X,
+    SPRITE_BYTES_PER_ROW,
+    TEXT_COLUMNS,
+    TEXT_ROWS,
+    X_BITS_MASK,
+)
 
-# Sprite masks (C64 layout): 24 x 21 pixels, 3 bytes a row, bit 7 of a row's first byte leftmost.
-SPRITE_WIDTH = 24
-SPRITE_HEIGHT = 21
-SPRITE_ROW_BYTES = 3
+SCREEN_BASE = 0x0400  # screen memory after power-on (Programmer's Reference Guide)
+COLUMNS = TEXT_COLUMNS
+ROWS = TEXT_ROWS
+CELL_PIXELS = CELL_WIDTH
+POWER_ON_YSCROLL = 3  # $D011 = $1B after power-on
+SPRITE_X_AT_COLUMN_0 = GRAPHICS_FIRST_X
+# A sprite's first row is shown on line Y + 1, and text row 0 starts on line 48 + YSCROLL.
+SPRITE_Y_AT_ROW_0 = GRAPHICS_FIRST_LINE + POWER_ON_YSCROLL - 1
+SPRITE_X_LIMIT = X_BITS_MASK + 1  # 9-bit X: low byte plus the $D010 bit
+SPRITE_ROW_BYTES = SPRITE_BYTES_PER_ROW
 
 
 def cell_of(x: int, y: int) -> tuple[int, int] | None:

@@ -210,14 +210,20 @@ def _fill_cells(spec, name: str, where: _Where, hi: int) -> np.ndarray:
         raise where.error(f"memory.{name}.cells", "expected a list of {col, row, value} tables")
     for i, cell in enumerate(cells):
         field_name = f"memory.{name}.cells[{i}]"
-        cell = where.table(cell, field_name, SCREEN_CELL_KEYS)
-        for key in SCREEN_CELL_KEYS:
-            if key not in cell:
-                raise where.error(f"{field_name}.{key}", "missing")
-        col = where.number(cell["col"], f"{field_name}.col", 0, TEXT_COLUMNS - 1)
-        row = where.number(cell["row"], f"{field_name}.row", 0, TEXT_ROWS - 1)
-        values[row * TEXT_COLUMNS + col] = where.number(cell["value"], f"{field_name}.value", 0, hi)
+        cell, index = _cell(cell, field_name, SCREEN_CELL_KEYS, where)
+        values[index] = where.number(cell["value"], f"{field_name}.value", 0, hi)
     return values
+
+
+def _cell(cell, field_name: str, keys, where: _Where) -> tuple[dict, int]:
+    """A {col, row, ...} table with all its keys: (the table, the cell's index in the 40 x 25 screen)."""
+    cell = where.table(cell, field_name, keys)
+    for key in keys:
+        if key not in cell:
+            raise where.error(f"{field_name}.{key}", "missing")
+    col = where.number(cell["col"], f"{field_name}.col", 0, TEXT_COLUMNS - 1)
+    row = where.number(cell["row"], f"{field_name}.row", 0, TEXT_ROWS - 1)
+    return cell, row * TEXT_COLUMNS + col
 
 
 def _file_bytes(value, field_name: str, size: int, where: _Where) -> np.ndarray:
@@ -256,13 +262,8 @@ def _memory(doc, where: _Where) -> VicMemory:
             raise where.error("memory.bitmap.cells", "expected a list of {col, row, bytes} tables")
         for i, cell in enumerate(cells):
             field_name = f"memory.bitmap.cells[{i}]"
-            cell = where.table(cell, field_name, BITMAP_CELL_KEYS)
-            for key in BITMAP_CELL_KEYS:
-                if key not in cell:
-                    raise where.error(f"{field_name}.{key}", "missing")
-            col = where.number(cell["col"], f"{field_name}.col", 0, TEXT_COLUMNS - 1)
-            row = where.number(cell["row"], f"{field_name}.row", 0, TEXT_ROWS - 1)
-            start = (row * TEXT_COLUMNS + col) * CHAR_HEIGHT
+            cell, index = _cell(cell, field_name, BITMAP_CELL_KEYS, where)
+            start = index * CHAR_HEIGHT
             bitmap[start:start + CHAR_HEIGHT] = where.byte_list(cell["bytes"], f"{field_name}.bytes", CHAR_HEIGHT)
     idle = where.number(spec.get("idle", 0), "memory.idle", 0, 0xFF)
     return VicMemory(screen, color, charset, bitmap, idle)

@@ -64,8 +64,10 @@ def test_pixel(runners, dx, dy, pair):
 
 
 def test_outside_the_domain_is_reported_not_hidden(runners):
-    # r1 + r2 = 256 breaks the circle's stated domain: the routine answers wrongly there.
-    case = (0, 0, 128, 0, 0, 128)
+    # r1 + r2 = 256 breaks the circle's stated domain: the routine answers wrongly there. Here
+    # R = 256 wraps to 0 (index 1 of the R + 1 table, which holds 0), so dx^2 = 9 already
+    # exceeds "R^2 - 1" and the routine says no overlap, while 3^2 + 4^2 = 25 < 256^2.
+    case = (3, 4, 128, 0, 0, 128)
     runner = runners["circle"]
     assert not runner.routine.in_domain(case)
     assert runner.run(case)[0] != runner.routine.reference(case, runner.world)

@@ -99,21 +99,3 @@ def test_tunnelling_matches_the_closed_form(length, thickness):
         expected = max(0.0, 1 - (thickness + length - 1) / v)
         assert miss_rate_from_hits(dxs, hits, v) == pytest.approx(expected)
         assert swept_miss_rate(mover, obstacle, v) == 0
-
-
-@pytest.mark.parametrize("key", ["box", "tight", "circle", "tile", "pixel"])
-def test_fallback_routines_agree_with_the_verdicts(key, sprite_shapes):
-    """The study's marked fallback routines (used only if an asm/ entry is missing) answer every
-    sampled case as the method's definition does."""
-    from retro.analysis.study.corpus import make_pair
-    from retro.analysis.study.cost_runs import sample_indices
-    from retro.analysis.study.routine_inputs import ADAPTERS, FallbackAdapter
-
-    adapter = ADAPTERS[key]
-    fallback = adapter if isinstance(adapter, FallbackAdapter) else adapter.fallback
-    pair = make_pair(sprite_shapes[0], sprite_shapes[2])
-    session = fallback.session(pair)
-    for index in sample_indices(pair, 60):
-        answer, expected, cycles = session.run(index)
-        assert answer == expected, (key, int(pair.dx[index]), int(pair.dy[index]))
-        assert cycles > 0

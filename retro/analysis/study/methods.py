@@ -53,7 +53,7 @@ def tight_box_verdict(pair: Pair) -> np.ndarray:
 
 
 # The circle routine's edge convention: set from the routine's reference when it is known (costs.py
-# checks it against retro.geometry.fixed); False means tangent circles do not collide.
+# checks it against retro.routines.reference); False means tangent circles do not collide.
 CIRCLE_TOUCHING_HITS = False
 
 

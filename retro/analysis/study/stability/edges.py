@@ -46,7 +46,7 @@ def _inside_offset() -> tuple[int, int]:
 
 
 def box_tests() -> dict[str, Callable[[int], bool]]:
-    """Tests of two BOX_W x BOX_H boxes, b moved right by dx; a 6502 routine joins when available."""
+    """Tests of two BOX_W x BOX_H boxes, b moved right by dx; and the 6502 routine."""
     from retro.analysis.study.latch import two_sprite_state
     from retro.chips.vic.model import frame_collisions
     from retro.geometry.aabb import aabb_overlap

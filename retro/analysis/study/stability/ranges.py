@@ -1,5 +1,6 @@
 """Arithmetic range: the exact input domain where each 6502 routine answers correctly, found by
-running the assembly (filled in from issue 5's routines and domain search when they exist)."""
+running the assembly (the cross-check's domain search, retro.analysis.check), and the coordinate-wrap
+rows of the box routines."""
 
 from __future__ import annotations
 
@@ -24,44 +25,27 @@ class WrapRoutineRow:
     example: str | None
 
 
-def range_rows(reduced: bool = False) -> list[RangeRow]:
-    """A minimal domain search run on the assembly (issue 5's `retro check` domain search was not in
-    the tree; this is the study's own, marked as such): every input in the searched space, compared
-    with the plain-integer definition. `reduced` takes every 5th value of the swept coordinates."""
-    from retro.analysis.study.stability.routine_edges import _machine
+RANGE_RANDOM_CASES = {True: 300, False: 20_000}  # random cases per routine on top of the structured ones
 
-    step = 5 if reduced else 1
+
+def range_rows(reduced: bool = False, progress=None) -> list[RangeRow]:
+    """Per routine: the cases inside its stated domain (all must be right), and for each condition of
+    the domain the cases that break it and how many of those the assembly answers wrong (a condition
+    with wrong answers is needed). The full run uses the exhaustive sweeps of `retro check --exhaustive`."""
+    from retro.analysis.check import run_checks
+
     rows = []
-    machine = _machine("circle.s", "circle")
-    if machine is not None:
-        for r1, r2 in ((1, 1), (50, 60), (127, 128), (128, 128)):
-            wrong, cases, first = 0, 0, None
-            for x2 in range(0, 256, step):
-                for y2 in range(0, 256, step):
-                    said = machine.call("circle", memory={0x10: [128, 128, r1, x2, y2, r2]}).flags["C"]
-                    truth = (128 - x2) ** 2 + (128 - y2) ** 2 < (r1 + r2) ** 2
-                    cases += 1
-                    if said != truth:
-                        wrong += 1
-                        first = first or f"centre 2 ({x2}, {y2}): routine {bool(said)}, truth {truth}"
-            rows.append(RangeRow("circle", f"r1 = {r1}, r2 = {r2} (sum {r1 + r2}); centre 1 (128, 128), centre 2 "
-                                 f"over the 8-bit grid", cases, wrong,
-                                 "correct on every input searched" if wrong == 0 else f"wrong, first at {first}"))
-    machine = _machine("aabb8.s", "aabb8")
-    if machine is not None:
-        wrong, cases, first = 0, 0, None
-        for aw, bw in ((1, 1), (24, 24), (255, 1), (200, 200)):
-            for ax in range(0, 256, step * 4):
-                for bx in range(0, 256, step):
-                    said = machine.call("aabb8", memory={0x10: [ax, 0, aw, 1, bx, 0, bw, 1]}).flags["C"]
-                    truth = ax < bx + bw and bx < ax + aw
-                    cases += 1
-                    if said != truth:
-                        wrong += 1
-                        first = first or f"ax={ax} aw={aw} bx={bx} bw={bw}"
-        rows.append(RangeRow("aabb8", "x of both boxes over 0..255, widths {1,1}, {24,24}, {255,1}, {200,200}",
-                             cases, wrong, "every input searched (x + w past 255 included)" if wrong == 0
-                             else f"wrong answers, first at {first}"))
+    for check in run_checks(None, exhaustive=not reduced, random_count=RANGE_RANDOM_CASES[reduced],
+                            progress=progress):
+        t = check.totals
+        stated = " and ".join(name for name, _ in check.routine.domain) or "every input"
+        rows.append(RangeRow(check.routine.name, f"inside the stated domain ({stated})", t.cases - t.outside,
+                             t.result_mismatches, "exact" if t.result_mismatches == 0 else "WRONG inside the domain"))
+        for name, _ in check.routine.domain:
+            broken, wrong = t.constraint_cases.get(name, 0), t.constraint_wrong.get(name, 0)
+            verdict = ("needed: the routine is wrong there" if wrong else
+                       "no wrong answer among these cases" if broken else "no case breaks it")
+            rows.append(RangeRow(check.routine.name, f"cases breaking {name}", broken, wrong, verdict))
     return rows
 
 
@@ -77,33 +61,31 @@ def wrap_routine_rows(reduced: bool = False) -> list[WrapRoutineRow]:
     rows = []
     step = 3 if reduced else 1
     machine = _machine("aabb8.s", "aabb8")
-    if machine is not None:
-        xs = range(200, 256, step)
-        wrong, example, cases = 0, None, 0
-        for ax in xs:
-            for bx in xs:
-                said = machine.call("aabb8", memory={0x10: [ax, 0, WRAP_W, 8, bx, 0, WRAP_W, 8]}).flags["C"]
-                truth = ax < bx + WRAP_W and bx < ax + WRAP_W
-                cases += 1
-                if said != truth:
-                    wrong += 1
-                    example = example or f"ax={ax}, bx={bx}: routine {said}, truth {truth}"
-        rows.append(WrapRoutineRow("aabb8", f"x = 200..255 (x + 24 up to 279), w = 24", cases, wrong, example))
+    xs = range(200, 256, step)
+    wrong, example, cases = 0, None, 0
+    for ax in xs:
+        for bx in xs:
+            said = machine.call("aabb8", a=ax, x=0, memory={0x10: [WRAP_W, 8, bx, 0, WRAP_W, 8]}).flags["C"]
+            truth = ax < bx + WRAP_W and bx < ax + WRAP_W
+            cases += 1
+            if said != truth:
+                wrong += 1
+                example = example or f"ax={ax}, bx={bx}: routine {said}, truth {truth}"
+    rows.append(WrapRoutineRow("aabb8", "x = 200..255 (x + 24 up to 279), w = 24", cases, wrong, example))
     machine = _machine("aabb_sprite.s", "aabb_sprite")
-    if machine is not None:
-        xs = range(220, 300, step)
-        wrong, example, cases = 0, None, 0
-        for x1 in xs:
-            for x2 in xs:
-                # asm/aabb_sprite.s: sprite 2's X in A and the carry, y2 in Y, x1h in X, the rest zero page
-                memory = {0x10: [x1 & 0xFF, 100, 0, 0, WRAP_W, 21, 0, 0, WRAP_W, 21]}
-                said = machine.call("aabb_sprite", a=x2 & 0xFF, x=x1 >> 8, y=100, p=DEFAULT_FLAGS | (x2 >> 8),
-                                    memory=memory).flags["C"]
-                truth = x1 < x2 + WRAP_W and x2 < x1 + WRAP_W
-                cases += 1
-                if said != truth:
-                    wrong += 1
-                    example = example or f"x1={x1}, x2={x2}: routine {said}, truth {truth}"
-        rows.append(WrapRoutineRow("aabb_sprite", "9-bit X = 220..299 across 255/256, full 24x21 hitboxes",
-                                   cases, wrong, example))
+    xs = range(220, 300, step)
+    wrong, example, cases = 0, None, 0
+    for x1 in xs:
+        for x2 in xs:
+            # asm/aabb_sprite.s: sprite 2's X in A and the carry, y2 in Y, x1h in X, the rest zero page
+            memory = {0x10: [x1 & 0xFF, 100, 0, 0, WRAP_W, 21, 0, 0, WRAP_W, 21]}
+            said = machine.call("aabb_sprite", a=x2 & 0xFF, x=x1 >> 8, y=100, p=DEFAULT_FLAGS | (x2 >> 8),
+                                memory=memory).flags["C"]
+            truth = x1 < x2 + WRAP_W and x2 < x1 + WRAP_W
+            cases += 1
+            if said != truth:
+                wrong += 1
+                example = example or f"x1={x1}, x2={x2}: routine {said}, truth {truth}"
+    rows.append(WrapRoutineRow("aabb_sprite", "9-bit X = 220..299 across 255/256, full 24x21 hitboxes",
+                               cases, wrong, example))
     return rows

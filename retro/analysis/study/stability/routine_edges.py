@@ -11,34 +11,25 @@ def _machine(source: str, entry: str):
     from retro.analysis.study.routine_inputs import _program
     from retro.cpu import Machine
 
-    try:
-        program = _program(source)
-    except Exception:  # the routine is not in the tree: the table simply lacks its column
-        return None
-    if entry not in program.symbols:
-        return None
     machine = Machine()
-    machine.load(program)
+    machine.load(_program(source))
+    machine.resolve(entry, "entry")  # a renamed entry fails here, not as a silently missing column
     return machine
 
 
 def box_tests(width: int, height: int) -> dict[str, Callable[[int], bool]]:
     machine = _machine("aabb8.s", "aabb8")
-    if machine is None:
-        return {}
 
     def test(dx: int) -> bool:
-        values = [BASE, BASE, width, height, BASE + dx, BASE, width, height]
-        return bool(machine.call("aabb8", memory={0x10: values}).flags["C"])
+        values = [width, height, BASE + dx, BASE, width, height]  # asm/aabb8.s: box a's x in A, y in X
+        return bool(machine.call("aabb8", a=BASE, x=BASE, memory={0x10: values}).flags["C"])
     return {"6502 aabb8": test}
 
 
 def circle_tests(radius: int) -> dict[str, Callable[[int, int], bool]]:
     machine = _machine("circle.s", "circle")
-    if machine is None:
-        return {}
 
     def test(dx: int, dy: int) -> bool:
-        values = [BASE, BASE, radius, BASE + dx, BASE + dy, radius]
-        return bool(machine.call("circle", memory={0x10: values}).flags["C"])
+        values = [BASE + dx, BASE + dy, radius]  # asm/circle.s: circle a's x in A, radius in X
+        return bool(machine.call("circle", a=BASE, x=radius, memory={"y1": BASE, "x2": values}).flags["C"])
     return {"6502 circle": test}

@@ -97,15 +97,13 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
 
     # Arithmetic range
     progress("stability: arithmetic range")
-    range_rows = ranges.range_rows(reduced=reduced)
+    range_rows = ranges.range_rows(reduced=reduced, progress=progress)
     files.append(write_atomic(out_dir / "ranges.csv", _csv(range_rows)))
     md.append("## Arithmetic range\n\n")
-    if range_rows:
-        md.append("Found by running the assembly over the input space (exhaustively where stated):\n\n")
-        md.append(_md_table(["routine", "input space searched", "cases", "wrong answers", "finding"],
-                            [[r.routine, r.searched, r.cases, r.wrong, r.domain] for r in range_rows]))
-    else:
-        md.append("No 6502 routines found in asm/ (issue 5): nothing to search.\n")
+    md.append("Found by running the assembly (`retro check`'s domain search: structured and random cases, "
+              + ("bounded" if reduced else "with the exhaustive sweeps of `retro check --exhaustive`") + "):\n\n")
+    md.append(_md_table(["routine", "cases", "count", "wrong answers", "finding"],
+                        [[r.routine, r.searched, r.cases, r.wrong, r.domain] for r in range_rows]))
     md.append("\n")
 
     # Edge conventions

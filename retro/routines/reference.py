@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from retro.chips.vic.constants import SPRITE_HEIGHT
 from retro.routines.screen import (
     CELL_PIXELS,
     COLUMNS,
     ROWS,
-    SPRITE_HEIGHT,
     SPRITE_X_AT_COLUMN_0,
     SPRITE_Y_AT_ROW_0,
 )
