@@ -11,10 +11,11 @@ import argparse
 import importlib
 import sys
 
+from retro import __version__
 from retro.errors import RetroError
 
 # Module names inside retro.cli, in the order `retro --help` lists them.
-COMMAND_MODULES = ["asm", "run", "demo", "parry", "nes", "vic", "chart", "stability", "advise", "check", "cycles"]
+COMMAND_MODULES = ["demo", "asm", "run", "vic", "nes", "check", "cycles", "chart", "stability", "advise", "parry"]
 
 
 class _Parser(argparse.ArgumentParser):
@@ -25,6 +26,7 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="retro", description="Collision detection on retro hardware (C64, NES).")
+    parser.add_argument("--version", action="version", version=f"retro {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for name in COMMAND_MODULES:

@@ -99,3 +99,20 @@ def test_console_script_without_traceback(tmp_path):
     path = write_scene(tmp_path, "[[sprite]]\nindex = 9\n")
     proc = subprocess.run([sys.executable, "-m", "retro", "vic", str(path)], capture_output=True, text=True)
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+
+
+@pytest.mark.parametrize("video, cycles_per_line", [("pal", 63), ("ntsc", 65)])
+def test_run_with_a_scene_attaches_the_vic(tmp_path, capsys, video, cycles_per_line):
+    """`retro run --scene`: a delay loop, then LDA $D012. The run starts at raster line 0, cycle 1,
+    and LDA abs reads in its 4th cycle. By the MOS cycle table (LDX #/LDY # 2, DEX/DEY 2, BNE 3 taken,
+    2 not) the read happens 2 + outer * (2 + (5 * inner - 1) + 2 + 3) - 1 + 3 cycles in: 2016 here,
+    line 32 on PAL (63 cycles a line) but line 31 on NTSC (65)."""
+    outer, inner = 2, 200
+    source = tmp_path / "raster.s"
+    source.write_text(f".org $c000\nstart: ldy #{outer}\nouter: ldx #{inner}\ninner: dex\n bne inner\n"
+                      " dey\n bne outer\n lda $d012\n rts\n")
+    scene = tmp_path / "scene.toml"
+    scene.write_text(f'chip = "vic-ii"\nvideo = "{video}"\n')
+    assert main(["run", str(source), "--entry", "start", "--scene", str(scene), "--json"]) == 0
+    read_at = 2 + outer * (2 + (5 * inner - 1) + 2 + 3) - 1 + 3
+    assert json.loads(capsys.readouterr().out)["a"] == read_at // cycles_per_line

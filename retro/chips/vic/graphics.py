@@ -155,6 +155,14 @@ def foreground_at(video: Video, memory: VicMemory, control1: int, control2: int,
     return foreground(memory, control1, control2, r[:, None], rcs[lines][:, None], c[None, :], ks[xs][None, :])
 
 
+def foreground_points(video: Video, memory: VicMemory, control1: int, control2: int,
+                      lines: np.ndarray, xs: np.ndarray) -> np.ndarray:
+    """Foreground bit of each pixel (lines[i], xs[i]): decodes only those pixels, in one pass."""
+    rows, rcs = line_slots(video, control1 & GEOMETRY_CONTROL1)
+    cols, ks = column_slots(video, control2 & CONTROL2_XSCROLL)
+    return foreground(memory, control1, control2, rows[lines], rcs[lines], cols[xs], ks[xs])
+
+
 def colours(video: Video, memory: VicMemory, registers: bytes, lines: np.ndarray, xs: np.ndarray) -> np.ndarray:
     """C64 colour numbers of the graphics and border at (lines x xs), sprites not included (for images)."""
     control1, control2 = registers[REG_CONTROL1], registers[REG_CONTROL2]
