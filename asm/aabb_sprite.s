@@ -13,8 +13,8 @@
 ;      the rest of the sum that know the high part of d and the +-1 left by a carry they did not
 ;      reset (the program counter holds them, so no INY/DEY, CLC or SEC is paid for them). At the
 ;      end only high part 0 (0 <= d < 256: overlap iff d < w1) or -1 (overlap iff d > -w2) can
-;      overlap, and each copy does the one compare its state needs. The blocks were laid out
-;      from a search over the orders of the terms (the script is not kept); each block's comment
+;      overlap, and each copy does the one compare its state needs. The blocks are laid out by
+;      asm/generate/aabb_sprite.py (a search over the orders of the terms); each block's comment
 ;      gives its state (terms left, high part, offset, carry) and the worst case from its first
 ;      instruction as that search counted it, i.e. without the 13 `bXX _tN / jmp` detours that
 ;      keep branches in range (they add up to 6 cycles to some paths).
