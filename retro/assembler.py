@@ -24,7 +24,7 @@ from pathlib import Path
 
 from retro.errors import InputError
 from retro.fileio import read_text
-from retro.program import Program
+from retro.program import ADDRESS_LIMIT, Program
 
 _OPHIS_DRIVER = "import sys; from Ophis.Main import run_ophis; sys.exit(run_ophis(sys.argv[1:]))"
 _ERROR_LINE = re.compile(r"^(?P<file>.+?):(?P<line>\d+): (?P<message>.+)$")
@@ -114,7 +114,10 @@ def _assemble(resolved: str, shown: str, text: str) -> Program:
         code = (out / "out.bin").read_bytes()
         listing = (out / "out.lst").read_text()
         symbols = _parse_map((out / "out.map").read_text())
-    return Program(code=code, origin=_origin(listing), symbols=symbols, listing=listing, source=shown)
+    origin = _origin(listing)
+    if origin + len(code) > ADDRESS_LIMIT + 1:  # the PRG could not be loaded, nor the code run
+        raise InputError(f"{shown}: {len(code)} bytes at ${origin:04X} run past ${ADDRESS_LIMIT:04X}")
+    return Program(code=code, origin=origin, symbols=symbols, listing=listing, source=shown)
 
 
 def _first_error(output: str, resolved: str, shown: str) -> str:

@@ -63,6 +63,8 @@ def read_text(path: str | os.PathLike, what: str = "file") -> str:
 def output_folder(path: str | os.PathLike) -> Path:
     """Create an output folder (and parents) up front, so a long run fails before it starts, not after."""
     folder = Path(path)
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"{folder}: is a file, not a folder")
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

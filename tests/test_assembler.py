@@ -143,3 +143,14 @@ def test_text_sources_include_from_the_working_directory_and_errors_use_their_na
     assert program.code == bytes([0xAD, 0x03, 0x10, 7, 8]) and program.symbols == {"values": 0x1003}
     with pytest.raises(InputError, match="^snippet.s:2: "):
         assemble_text(".org $1000\nlda (\n", name="snippet.s")
+
+
+def test_code_running_past_ffff_is_an_error_naming_the_source(tmp_path):
+    # 20 bytes from $FFF0 would end at $10003: no 6502 can hold them, and the PRG would not load.
+    source = tmp_path / "wrap.s"
+    source.write_text(".org $fff0\n.byte " + ", ".join(["1"] * 20) + "\n")
+    with pytest.raises(InputError, match=r"wrap\.s: 20 bytes at \$FFF0 run past \$FFFF"):
+        assemble_file(source)
+    # exactly up to $FFFF is fine
+    source.write_text(".org $fff0\n.byte " + ", ".join(["1"] * 16) + "\n")
+    assert assemble_file(source).end == 0x10000

@@ -94,6 +94,17 @@ def test_usage_errors_exit_2(capsys, source):
     assert code == 2 and "not found" in err and err.count("\n") == 1
 
 
+def test_control_characters_in_names_cannot_split_or_colour_the_error_line(capsys, tmp_path):
+    # A file name (or TOML key) with a newline or an ANSI escape is echoed in the error: it must
+    # stay one line on stderr and must not reach the terminal as a control sequence.
+    for name in ("two\nlines.s", "\x1b[31mred.s", "bell\a\r.s"):
+        code, out, err = run_cli(capsys, "asm", tmp_path / name)
+        assert code == 2 and out == ""
+        assert err.count("\n") == 1 and err.endswith("\n")
+        assert not any(ord(c) < 0x20 or c == "\x7f" for c in err[:-1]), repr(err)
+        assert "source file not found" in err
+
+
 def test_asm_writes_prg_labels_and_listing_that_run_reads_back(capsys, source, tmp_path):
     prg, lbl, lst = tmp_path / "out.prg", tmp_path / "out.lbl", tmp_path / "out.lst"
     code, out, _ = run_cli(capsys, "asm", source, "-o", prg, "--labels", lbl, "--list", lst)
@@ -172,3 +183,33 @@ def test_commands_with_output_folders_fail_fast_with_one_line(tmp_path):
         assert done.returncode == 2, command
         lines = done.stderr.strip().splitlines()
         assert len(lines) == 1 and "cannot create output folder" in lines[0], done.stderr
+
+
+def test_run_refuses_trace_with_json(capsys):
+    from retro.cli import main
+
+    source = str(Path(__file__).resolve().parent.parent / "asm" / "demo_sum.s")
+    with pytest.raises(SystemExit) as stopped:
+        main(["run", source, "--entry", "demo_sum", "--trace", "--json"])
+    assert stopped.value.code == 2
+    assert "not allowed with" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("option", [["--set", "$ffff=7,9"], ["--peek", "$ffff:3"]])
+def test_set_and_peek_never_wrap_past_ffff(capsys, option):
+    from retro.cli import main
+
+    source = str(Path(__file__).resolve().parent.parent / "asm" / "demo_sum.s")
+    assert main(["run", source, "--entry", "demo_sum", *option]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "run past $FFFF" in err
+
+
+def test_output_folder_that_is_a_file(tmp_path):
+    from retro.errors import InputError
+    from retro.fileio import output_folder
+
+    blocker = tmp_path / "afile"
+    blocker.write_text("x")
+    with pytest.raises(InputError, match="is a file, not a folder"):
+        output_folder(blocker)

@@ -14,13 +14,19 @@ import sys
 from retro import __version__
 from retro.errors import RetroError
 
+def one_line(text: str) -> str:
+    """User text (file names, TOML keys) echoed in a message can hold newlines or terminal escapes:
+    show every control character as a Python escape so the error stays one plain line."""
+    return "".join(repr(c)[1:-1] if ord(c) < 0x20 or ord(c) == 0x7F else c for c in text)
+
+
 # Module names inside retro.cli, in the order `retro --help` lists them.
 COMMAND_MODULES = ["demo", "asm", "run", "vic", "nes", "check", "cycles", "chart", "stability", "advise", "parry"]
 
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> None:  # one line, exit 2, no usage dump
-        print(f"{self.prog}: {message}", file=sys.stderr)
+        print(one_line(f"{self.prog}: {message}"), file=sys.stderr)
         raise SystemExit(2)
 
 
@@ -40,7 +46,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return int(args.func(args) or 0)
     except RetroError as exc:
-        print(f"retro {args.command}: {exc}", file=sys.stderr)
+        print(one_line(f"retro {args.command}: {exc}"), file=sys.stderr)
         return exc.exit_code
     except KeyboardInterrupt:
         print(f"retro {args.command}: interrupted", file=sys.stderr)

@@ -25,7 +25,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def cmd_parry(args: argparse.Namespace) -> int:
     frames = parse_int(args.frames, field="--frames", lo=1, hi=MAX_FRAMES)
-    text, source = load_script(args.script)
+    text, source = load_script(args.script, frames)
     run = write_parry(args.out, text, frames, source=source)
     for event in run.events:
         print(f"frame {event.frame:4d}  {event.kind}")

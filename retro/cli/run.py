@@ -26,8 +26,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--peek", dest="peeks", action="append", default=[], metavar="TARGET[:N]")
     p.add_argument("--budget", default=str(DEFAULT_BUDGET), metavar="CYCLES")
     p.add_argument("--scene", metavar="SCENE.toml", help="attach a VIC-II or NES PPU scene to the machine")
-    p.add_argument("--trace", action="store_true", help="print every instruction executed")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    output = p.add_mutually_exclusive_group()  # the JSON object's keys are fixed: no room for a trace
+    output.add_argument("--trace", action="store_true", help="print every instruction executed")
+    output.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=cmd_run)
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from retro.cpu.bus import Bus, Device
+from retro.cpu.bus import MEMORY_SIZE, Bus, Device
 from retro.cpu.mpu import (
     FLAG_B,
     FLAG_C,
@@ -115,16 +115,23 @@ class Machine:
         return parse_int(text, field=field, lo=0, hi=0xFFFF)
 
     def poke(self, target: str | int, values: int | bytes | list[int]) -> None:
-        address = self.resolve(target)
         data = [values] if isinstance(values, int) else list(values)
+        address = self._span(target, len(data))
         for offset, value in enumerate(data):
             if not 0 <= value <= 0xFF:
                 raise InputError(f"value {value} for {target} is not a byte (0-255)")
-            self.bus.poke((address + offset) & 0xFFFF, value)
+            self.bus.poke(address + offset, value)
 
     def peek(self, target: str | int, count: int = 1) -> list[int]:
+        address = self._span(target, count)
+        return [self.bus.peek(address + i) for i in range(count)]
+
+    def _span(self, target: str | int, count: int) -> int:
+        """The address of target, checking that count bytes from it stay below $10000 (no wrap to $0000)."""
         address = self.resolve(target)
-        return [self.bus.peek((address + i) & 0xFFFF) for i in range(count)]
+        if address + count > MEMORY_SIZE:
+            raise InputError(f"{target}: {count} bytes from ${address:04X} run past $FFFF")
+        return address
 
     # ---- running ---------------------------------------------------------------------------
 

@@ -108,7 +108,7 @@ def parse_script(text: str, source: str = "script") -> list[tuple[int, str]]:
 
 
 def simulate(script: list[tuple[int, str]] | str, frames: int = DEFAULT_FRAMES,
-             params: ParryParams = ParryParams()) -> list[FrameState]:
+             params: ParryParams = ParryParams(), source: str = "script") -> list[FrameState]:
     """Run the parry loop for `frames` frames under the scripted input (a parsed list, or text for
     `parse_script`). Inputs scheduled at or after `frames` are an error."""
     if isinstance(frames, bool) or not isinstance(frames, int) or not 1 <= frames <= MAX_FRAMES:
@@ -116,9 +116,9 @@ def simulate(script: list[tuple[int, str]] | str, frames: int = DEFAULT_FRAMES,
     steps = parse_script(script) if isinstance(script, str) else list(script)
     for frame, action in steps:
         if action not in ACTIONS:
-            raise InputError(f"script: unknown action {action!r} (expected {', '.join(ACTIONS)})")
+            raise InputError(f"{source}: unknown action {action!r} (expected {', '.join(ACTIONS)})")
         if not 0 <= frame < frames:
-            raise InputError(f"script: {frame}:{action}: frame {frame} is outside 0..{frames - 1} (--frames {frames})")
+            raise InputError(f"{source}: {frame}:{action}: frame {frame} is outside 0..{frames - 1} (--frames {frames})")
     inputs: dict[int, list[str]] = {}
     for frame, action in steps:
         inputs.setdefault(frame, []).append(action)

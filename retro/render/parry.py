@@ -13,7 +13,7 @@ from pathlib import Path
 
 from PIL import Image, ImageDraw
 
-from retro.fileio import read_text, write_atomic
+from retro.fileio import output_folder, read_text, write_atomic
 from retro.geometry.parry import (
     DEFAULT_FRAMES,
     DEFAULT_SCRIPT,
@@ -49,11 +49,13 @@ class ParryRun:
     files: list[Path]
 
 
-def load_script(spec: str | None) -> tuple[str, str]:
+def load_script(spec: str | None, frames: int = DEFAULT_FRAMES) -> tuple[str, str]:
     """(script text, source name): '@FILE' reads a script file, anything else is the script itself,
-    None gives the built-in script."""
+    None gives the built-in script, cut to the inputs that fall within `frames`."""
     if spec is None:
-        return DEFAULT_SCRIPT, "built-in script"
+        kept = [token for frame, token in zip(parse_script(DEFAULT_SCRIPT), DEFAULT_SCRIPT.split())
+                if frame[0] < frames]
+        return " ".join(kept), "built-in script"
     if spec.startswith("@"):
         path = spec[1:]
         return read_text(path, "parry script"), path
@@ -162,8 +164,8 @@ def write_parry(out_dir: str | Path, script: str = DEFAULT_SCRIPT, frames: int =
                 source: str = "script", params: ParryParams = ParryParams()) -> ParryRun:
     """Simulate the script and write parry.gif, parry_FFF_EVENT.png for each event frame and
     parry_events.txt into out_dir."""
-    states = simulate(parse_script(script, source), frames, params)
-    out = Path(out_dir)
+    states = simulate(parse_script(script, source), frames, params, source)
+    out = output_folder(out_dir)
     images = [render_frame(states, i, params) for i in range(len(states))]
     buffer = io.BytesIO()
     images[0].save(buffer, format="GIF", save_all=True, append_images=images[1:], duration=GIF_FRAME_MS,

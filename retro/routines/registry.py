@@ -410,7 +410,7 @@ def get(name: str) -> Routine:
 
 
 def select(names: Iterable[str] | None) -> list[Routine]:
-    names = list(names or [])
+    names = list(dict.fromkeys(names or []))  # each routine once, in the order first named
     return [get(n) for n in names] if names else list(ROUTINES.values())
 
 

@@ -218,7 +218,10 @@ def _parse_chr(value, source: str) -> bytes:
         if not isinstance(name, str):
             raise _fail(source, "chr.file", f"expected a file name, got {type(name).__name__}")
         path = Path(source).parent / name
-        content = read_bytes(path, "CHR file")
+        try:
+            content = read_bytes(path, "CHR file")
+        except InputError as exc:
+            raise _fail(source, "chr.file", str(exc)) from None
         if len(content) != CHR_SIZE:
             raise _fail(source, "chr.file", f"{path} is {len(content)} bytes, expected {CHR_SIZE} (8 KiB)")
         data[:] = content

@@ -279,8 +279,12 @@ def parse(doc: dict, source: str) -> VicScene:
     table = doc.get("registers", {})
     if not isinstance(table, dict):
         raise where.error("registers", "expected a table of \"$d0xx\" = value")
+    spelled: dict[int, str] = {}  # offset -> the key that set it ("$d011" and "d011" are one register)
     for key, value in table.items():
         offset = register_offset(key, where)
+        if offset in spelled:
+            raise where.error(f"registers.{key}", f"the same register as {spelled[offset]!r}; give it once")
+        spelled[offset] = key
         registers[offset] = where.number(value, f"registers.{key}", 0, 0xFF)
     entries = doc.get("sprite", [])
     if not isinstance(entries, list):

@@ -122,3 +122,12 @@ def test_cli_bad_input_is_one_line(tmp_path, capsys):
     assert err.count("\n") == 1 and "unknown action 'dance'" in err
     assert main(["parry", "--out", str(tmp_path), "--script", "@" + str(tmp_path / "missing.txt")]) == 2
     assert "not found" in capsys.readouterr().err
+
+
+def test_built_in_script_is_cut_to_the_frames_asked_for(tmp_path):
+    from retro.cli import main
+
+    assert main(["parry", "--frames", "100", "--out", str(tmp_path / "p")]) == 0
+    events = (tmp_path / "p" / "parry_events.txt").read_text().split()
+    frames = [int(token) for token in events[::2]]
+    assert frames and max(frames) < 100

@@ -119,6 +119,13 @@ def test_chr_file_must_be_8_kib(tmp_path):
         load_scene(write(tmp_path, text))
 
 
+def test_missing_or_unreadable_chr_file_names_the_scene_and_field(tmp_path):
+    for name in ("nope.chr", "."):  # a file that is not there, and a directory
+        text = SCENE.replace('tiles = { "0:3"', f'file = "{name}"\ntiles = {{ "0:3"')
+        with pytest.raises(InputError, match=r"scene.toml: chr.file: "):
+            load_scene(write(tmp_path, text))
+
+
 def test_two_nametables_on_the_same_memory_are_refused(tmp_path):
     text = SCENE + "[[nametable]]\nindex = 1\nfill = 2\n"      # horizontal: $2400 is $2000
     with pytest.raises(InputError, match=r"nametable\[1\].index: nametable 1 is the same memory as nametable 0"):

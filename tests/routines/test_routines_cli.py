@@ -38,3 +38,8 @@ def test_unknown_routine_is_one_line_exit_2(capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "unknown routine 'aabb9'" in err
     assert main(["cycles", "nope", "--json"]) == 2
+
+
+def test_a_routine_named_twice_is_reported_once(capsys):
+    assert main(["cycles", "aabb8", "aabb8", "--json"]) == 0
+    assert [row["routine"] for row in json.loads(capsys.readouterr().out)] == ["aabb8"]
