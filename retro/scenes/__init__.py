@@ -38,3 +38,11 @@ def load_scene(path: str | Path):
         raise InputError(f"{path}: chip: expected one of {', '.join(repr(c) for c in CHIP_MODULES)}, got {chip!r}")
     module = importlib.import_module(CHIP_MODULES[chip])
     return module.parse(doc, source=str(path))
+
+
+def earlier_spelling(seen: dict, canonical, spelling: str) -> str | None:
+    """The key that already named `canonical` (e.g. "$d011" before "d011", "0:3" before "0:03"), or
+    None; records `spelling` as the first. Scenes reject a second spelling: the last one would win."""
+    earlier = seen.get(canonical)
+    seen.setdefault(canonical, spelling)
+    return earlier

@@ -54,6 +54,7 @@ from retro.chips.ppu.state import PpuState
 from retro.errors import InputError
 from retro.fileio import read_bytes
 from retro.numbers import parse_int
+from retro.scenes import earlier_spelling
 
 DEFAULT_MASK = 0x1E          # background and sprites on, left columns shown
 UNUSED_OAM_BYTE = 0xFF       # Y = $FF puts unused sprites below the screen
@@ -226,9 +227,12 @@ def _parse_chr(value, source: str) -> bytes:
             raise _fail(source, "chr.file", f"{path} is {len(content)} bytes, expected {CHR_SIZE} (8 KiB)")
         data[:] = content
     tiles = _table(table.get("tiles", {}), source, "chr.tiles")
+    spelled: dict[int, str] = {}
     for key, rows in tiles.items():
         field = f'chr.tiles."{key}"'
         address = _tile_address(key, source, field)
+        if earlier := earlier_spelling(spelled, address, key):
+            raise _fail(source, field, f"the same tile as \"{earlier}\"; give it once")
         data[address: address + TILE_BYTES] = _tile_bytes(rows, source, field)
     return bytes(data)
 

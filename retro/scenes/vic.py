@@ -43,6 +43,7 @@ from retro.chips.vic.model import VicState
 from retro.errors import InputError
 from retro.fileio import read_bytes
 from retro.numbers import parse_int
+from retro.scenes import earlier_spelling
 from retro.sprites import parse_hex, parse_rows, read_png, read_spr
 
 TOP_KEYS = {"chip", "video", "registers", "sprite", "memory"}
@@ -246,10 +247,13 @@ def _memory(doc, where: _Where) -> VicMemory:
             raise where.error("memory.charset", "expected a table of glyphs by code (\"1\" = [8 bytes]) or file =")
         if "file" in table:
             charset = _file_bytes(table["file"], "memory.charset.file", CHARSET_BYTES, where)
+        spelled: dict[int, str] = {}
         for key, glyph in table.items():
             if key == "file":
                 continue
             code = where.number(key, f"memory.charset.{key}", 0, 0xFF)
+            if earlier := earlier_spelling(spelled, code, key):
+                raise where.error(f"memory.charset.{key}", f"the same character code as {earlier!r}; give it once")
             charset[code * CHAR_HEIGHT:(code + 1) * CHAR_HEIGHT] = where.byte_list(glyph, f"memory.charset.{key}",
                                                                                    CHAR_HEIGHT)
     bitmap = memory.bitmap
@@ -282,9 +286,8 @@ def parse(doc: dict, source: str) -> VicScene:
     spelled: dict[int, str] = {}  # offset -> the key that set it ("$d011" and "d011" are one register)
     for key, value in table.items():
         offset = register_offset(key, where)
-        if offset in spelled:
-            raise where.error(f"registers.{key}", f"the same register as {spelled[offset]!r}; give it once")
-        spelled[offset] = key
+        if earlier := earlier_spelling(spelled, offset, key):
+            raise where.error(f"registers.{key}", f"the same register as {earlier!r}; give it once")
         registers[offset] = where.number(value, f"registers.{key}", 0, 0xFF)
     entries = doc.get("sprite", [])
     if not isinstance(entries, list):

@@ -104,6 +104,8 @@ def test_chr_file_relative_to_scene(tmp_path, monkeypatch):
     (("row = 15", "row = 30"), "nametable[0].cells[0].row"),
     (("mirroring = \"horizontal\"", "mirroring = \"diagonal\""), "ppu.mirroring"),
     (("video = \"ntsc\"", "video = \"secam\""), "video"),
+    (('tiles = { "0:3"', 'tiles = { "0:03" = [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0], "0:3"'),
+     'chr.tiles."0:3": the same tile as "0:03"'),  # one tile, two spellings: the last would win
 ])
 def test_bad_scene_one_line_error_names_file_and_field(tmp_path, capsys, edit, field):
     path = write(tmp_path, SCENE.replace(*edit))

@@ -62,6 +62,8 @@ def test_frames_option(capsys):
     ("[registers]\n\"$d040\" = 1\n", "registers.$d040"),
     ("[registers]\n\"$d01e\" = 1\n", "registers.$d01e"),
     ("[registers]\n\"$d011\" = 1\n\"d011\" = 2\n", "registers.d011"),  # one register, two spellings
+    ("[memory]\ncharset = { \"1\" = [1, 1, 1, 1, 1, 1, 1, 1], \"$01\" = [2, 2, 2, 2, 2, 2, 2, 2] }\n",
+     "memory.charset.$01: the same character code as '1'"),
     ("[memory]\nscreen = { fill = 1, cells = [{ col = 40, row = 0, value = 1 }] }\n", "memory.screen.cells[0].col"),
     ("[memory]\ncharset = { \"1\" = [1, 2, 3] }\n", "memory.charset.1"),
     ("video = \"secam\"\n".replace("video", "bad"), "bad"),
