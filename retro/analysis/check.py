@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 
 from retro.cpu.flow import Bounds, analyse
 from retro.cpu.timing import model_cycles
-from retro.routines.harness import RoutineRunner, Size, program_size
+from retro.routines.harness import RoutineRunner, Size
 from retro.routines.registry import Routine, cases, get, world_for
 
 CHUNK = 4_000
@@ -184,7 +184,7 @@ def check_routine(name: str, *, exhaustive: bool = False, seed: int = 0, random_
     if totals.cycles_count and totals.cycles_max > static.worst:
         violations.append(f"{name}: measured maximum {totals.cycles_max} is above the static worst case {static.worst}")
     runner = _runner(name, seed)
-    size = program_size(runner.program, routine.source.read_text())
+    size = runner.size()
     return RoutineCheck(routine, size, static, totals, violations)
 
 

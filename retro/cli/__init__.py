@@ -14,6 +14,7 @@ import sys
 from retro import __version__
 from retro.errors import RetroError
 
+
 def one_line(text: str) -> str:
     """User text (file names, TOML keys) echoed in a message can hold newlines or terminal escapes:
     show every control character as a Python escape so the error stays one plain line."""

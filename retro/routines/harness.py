@@ -69,6 +69,10 @@ class RoutineRunner:
             memory[start:start + len(world.props)] = list(world.props)
         self.current_pair = -1
 
+    def size(self) -> Size:
+        """Bytes of code, lookup tables and caller-filled storage of the routine's program."""
+        return program_size(self.program, self.routine.source.read_text())
+
     def _indirect_y_pcs(self) -> frozenset[int]:
         """PCs of the (indirect),Y instructions reachable in the listing (the model needs their pointer)."""
         pcs = set()

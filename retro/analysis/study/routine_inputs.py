@@ -1,8 +1,8 @@
-"""From a corpus case to a 6502 routine call: one adapter per method, following the calling
-conventions written in each routine's asm/ header (and retro/routines.py).
+"""From a corpus case to a 6502 routine call: one adapter per method.
 
-An adapter knows its source file and entry, what its cycle figure counts, and how to turn case
-`index` of a pair into memory/register inputs; its session runs the call and returns
+An adapter knows its source file and entry and what its cycle figure counts; its session turns case
+`index` of a pair into the routine's logical case (the reference's argument order) and runs it
+through the registry's RoutineRunner, which alone knows the calling conventions, returning
 (routine's answer, the study's verdict for that case, cycles).
 """
 
@@ -76,64 +76,48 @@ def _opacity_bytes(shape) -> bytes:
     return encode(shape.mask.astype("uint8"))
 
 
-# ---- issue 5's routines (asm/), preferred whenever they assemble ---------------------------------
+# ---- issue 5's routines (asm/), called through their registry entries -------------------------
+# The registry (retro/routines/registry.py) knows each routine's calling convention; the study only
+# builds the logical case (the reference's argument order) and lets RoutineRunner pass it.
 
-DATA_BUFFERS = ("pixel_mask_a", "pixel_mask_b")  # filled by the caller: data, not tables
 
+def routine_runner(name: str, world=None):
+    """A loaded RoutineRunner for the routine `name` (an empty world unless given)."""
+    from retro.routines.harness import RoutineRunner
+    from retro.routines.registry import World, get
 
-def _split_sizes(source: str) -> tuple[int, int]:
-    """(code bytes, table bytes) of an asm/ program: code runs from the origin to the first
-    generated table (Ophis's zero padding before the page-aligned table stripped); tables are the
-    generated ones, the caller-filled mask buffers excluded."""
-    from retro import tables
-    from retro.assembler import requested_tables
-    from retro.fileio import read_text
-
-    program = _program(source)
-    names = requested_tables(read_text(ASM_DIR / source))
-    storage = getattr(tables, "STORAGE_TABLES", frozenset(DATA_BUFFERS))
-    starts = [program.symbols[n] for n in names if n in program.symbols]
-    end = (min(starts) if starts else program.origin + len(program.code)) - program.origin
-    code = program.code[:end].rstrip(b"\0")
-    table_bytes = sum(len(tables.GENERATORS[n]()) for n in names if n not in storage)
-    return len(code), table_bytes
+    return RoutineRunner(get(name), world if world is not None else World())
 
 
 class _Issue5Session(Session):
     def __init__(self, pair: Pair, adapter: "Issue5Adapter") -> None:
         from retro.analysis.study.methods import method
-        from retro.cpu import Machine
+        from retro.routines.registry import World
 
         self.pair = pair
-        self.adapter = adapter
-        self.machine = Machine()
-        self.machine.load(_program(adapter.source))
-        self.verdict = method(adapter.key).verdict(pair)
-        if adapter.key == "pixel":
-            self.machine.poke("pixel_mask_a", list(_opacity_bytes(pair.a)))
-            self.machine.poke("pixel_mask_b", list(_opacity_bytes(pair.b)))
+        self.key = adapter.key
+        world = World(masks=((_opacity_bytes(pair.a), _opacity_bytes(pair.b)),)) if self.key == "pixel" else None
+        self.runner = routine_runner(adapter.routine, world)
+        self.verdict = method(self.key).verdict(pair)
 
     def run(self, index: int) -> tuple[bool, bool, int]:
         from retro.analysis.study.fits import fitted_circle, full_box, tight_box
         from retro.analysis.study.methods import CIRCLE_TOUCHING_HITS
 
         pair, dx, dy = self.pair, int(self.pair.dx[index]), int(self.pair.dy[index])
-        key = self.adapter.key
-        registers: dict[str, int] = {}
-        if key in ("box", "tight"):
-            fit = full_box if key == "box" else tight_box
+        if self.key in ("box", "tight"):
+            fit = full_box if self.key == "box" else tight_box
             ax0, ay0, ax1, ay1 = fit(pair.a.mask)
             bx0, by0, bx1, by1 = fit(pair.b.mask)
-            registers = {"a": ORIGIN + ax0, "x": ORIGIN + ay0}  # asm/aabb8.s: box a's x in A, y in X
-            memory = {0x10: [ax1 - ax0, ay1 - ay0, ORIGIN + dx + bx0, ORIGIN + dy + by0, bx1 - bx0, by1 - by0]}
-        elif key == "circle":
+            case = (ORIGIN + ax0, ORIGIN + ay0, ax1 - ax0, ay1 - ay0,
+                    ORIGIN + dx + bx0, ORIGIN + dy + by0, bx1 - bx0, by1 - by0)
+        elif self.key == "circle":
             ca, cb = fitted_circle(pair.a.mask, CIRCLE_TOUCHING_HITS), fitted_circle(pair.b.mask, CIRCLE_TOUCHING_HITS)
-            registers = {"a": ORIGIN + ca.cx, "x": ca.r}  # asm/circle.s: circle a's x in A, radius in X
-            memory = {"y1": ORIGIN + ca.cy, "x2": [ORIGIN + dx + cb.cx, ORIGIN + dy + cb.cy, cb.r]}
-        else:  # pixel
-            memory = {0x10: [dx & 0xFF, dy & 0xFF]}
-        result = self.machine.call(self.adapter.routine, memory=memory, **registers)
-        return bool(result.flags["C"]), bool(self.verdict[index]), result.cycles
+            case = (ORIGIN + ca.cx, ORIGIN + ca.cy, ca.r, ORIGIN + dx + cb.cx, ORIGIN + dy + cb.cy, cb.r)
+        else:  # pixel: the offset as two's-complement bytes, and the world's only mask pair
+            case = (dx & 0xFF, dy & 0xFF, 0)
+        answer, cycles = self.runner.run(case)
+        return bool(answer), bool(self.verdict[index]), cycles
 
 
 class _TileBoxSession(Session):
@@ -144,13 +128,13 @@ class _TileBoxSession(Session):
     MARK = 1
 
     def __init__(self, pair: Pair, adapter: "Issue5Adapter") -> None:
-        from retro.cpu import Machine
         from retro.routines import screen
+        from retro.routines.registry import World
 
-        self.pair, self.adapter, self.screen = pair, adapter, screen
-        self.machine = Machine()
-        self.machine.load(_program(adapter.source))
-        self.machine.poke(self.machine.resolve("tile_props") + self.MARK, self.MARK)
+        self.pair, self.screen = pair, screen
+        props = [0] * 256
+        props[self.MARK] = self.MARK
+        self.runner = routine_runner(adapter.routine, World(props=tuple(props)))
         self.marked: list[int] = []
 
     def run(self, index: int) -> tuple[bool, bool, int]:
@@ -162,26 +146,28 @@ class _TileBoxSession(Session):
         ox, oy = ORIGIN + align % 8, ORIGIN + align // 8  # pixel offsets from the screen's cell grid
         ax0, ay0, ax1, ay1 = tight_box(pair.a.mask)
         bx0, by0, bx1, by1 = tight_box(pair.b.mask)
+        memory = self.runner.machine.memory
         for address in self.marked:
-            self.machine.poke(address, 0)
+            memory[address] = 0
         a_cells = {(c, r) for r in range((oy + ay0) // s.CELL_PIXELS, (oy + ay1 - 1) // s.CELL_PIXELS + 1)
                    for c in range((ox + ax0) // s.CELL_PIXELS, (ox + ax1 - 1) // s.CELL_PIXELS + 1)}
         self.marked = [s.row_address(r) + c for c, r in a_cells]
         for address in self.marked:
-            self.machine.poke(address, self.MARK)
+            memory[address] = self.MARK
         x = s.SPRITE_X_AT_COLUMN_0 + ox + dx + bx0
         y = s.SPRITE_Y_AT_ROW_0 + oy + dy + by0
-        result = self.machine.call(self.adapter.routine,
-                                   memory={0x10: [x & 0xFF, x >> 8, y, bx1 - bx0, by1 - by0]})
+        answer, cycles = self.runner.run((x & 0xFF, x >> 8, y, bx1 - bx0, by1 - by0))
         b_cells = {(c, r) for r in range((oy + dy + by0) // s.CELL_PIXELS, (oy + dy + by1 - 1) // s.CELL_PIXELS + 1)
                    for c in range((ox + dx + bx0) // s.CELL_PIXELS, (ox + dx + bx1 - 1) // s.CELL_PIXELS + 1)}
-        return result.a != 0, bool(a_cells & b_cells), result.cycles
+        return answer != 0, bool(a_cells & b_cells), cycles
 
 
 @dataclass(frozen=True)
 class Issue5Adapter(Adapter):
     def size(self) -> tuple[int, int]:
-        return _split_sizes(self.source)
+        """(bytes of code, bytes of lookup tables), counted as `retro cycles` counts them."""
+        size = routine_runner(self.routine).size()
+        return size.code_bytes, size.table_bytes
 
     def session(self, pair: Pair) -> Session:
         return _TileBoxSession(pair, self) if self.key == "tile" else _Issue5Session(pair, self)

@@ -55,37 +55,30 @@ WRAP_W = 24  # full sprite width
 def wrap_routine_rows(reduced: bool = False) -> list[WrapRoutineRow]:
     """aabb8 with boxes reaching past 255 (x + w > 255), and aabb_sprite with X across 255/256,
     against the plain-integer overlap of the same boxes. Every pair of positions in the window."""
-    from retro.analysis.study.stability.routine_edges import _machine
-    from retro.cpu.machine import DEFAULT_FLAGS
+    from retro.analysis.study.routine_inputs import routine_runner
 
-    rows = []
     step = 3 if reduced else 1
-    machine = _machine("aabb8.s", "aabb8")
-    xs = range(200, 256, step)
-    wrong, example, cases = 0, None, 0
-    for ax in xs:
-        for bx in xs:
-            said = machine.call("aabb8", a=ax, x=0, memory={0x10: [WRAP_W, 8, bx, 0, WRAP_W, 8]}).flags["C"]
-            truth = ax < bx + WRAP_W and bx < ax + WRAP_W
-            cases += 1
-            if said != truth:
-                wrong += 1
-                example = example or f"ax={ax}, bx={bx}: routine {said}, truth {truth}"
-    rows.append(WrapRoutineRow("aabb8", "x = 200..255 (x + 24 up to 279), w = 24", cases, wrong, example))
-    machine = _machine("aabb_sprite.s", "aabb_sprite")
-    xs = range(220, 300, step)
-    wrong, example, cases = 0, None, 0
-    for x1 in xs:
-        for x2 in xs:
-            # asm/aabb_sprite.s: sprite 2's X in A and the carry, y2 in Y, x1h in X, the rest zero page
-            memory = {0x10: [x1 & 0xFF, 100, 0, 0, WRAP_W, 21, 0, 0, WRAP_W, 21]}
-            said = machine.call("aabb_sprite", a=x2 & 0xFF, x=x1 >> 8, y=100, p=DEFAULT_FLAGS | (x2 >> 8),
-                                memory=memory).flags["C"]
-            truth = x1 < x2 + WRAP_W and x2 < x1 + WRAP_W
-            cases += 1
-            if said != truth:
-                wrong += 1
-                example = example or f"x1={x1}, x2={x2}: routine {said}, truth {truth}"
-    rows.append(WrapRoutineRow("aabb_sprite", "9-bit X = 220..299 across 255/256, full 24x21 hitboxes",
-                               cases, wrong, example))
+    aabb8 = routine_runner("aabb8")
+    aabb_sprite = routine_runner("aabb_sprite")
+    # logical cases: aabb8 (ax, ay, aw, ah, bx, by, bw, bh); aabb_sprite (x1 low, x1 bit 8, y1, ox1,
+    # oy1, w1, h1, x2 low, x2 bit 8, y2, ox2, oy2, w2, h2)
+    windows = [
+        ("aabb8", "x = 200..255 (x + 24 up to 279), w = 24", range(200, 256, step),
+         lambda a, b: aabb8.run((a, 0, WRAP_W, 8, b, 0, WRAP_W, 8))[0]),
+        ("aabb_sprite", "9-bit X = 220..299 across 255/256, full 24x21 hitboxes", range(220, 300, step),
+         lambda a, b: aabb_sprite.run((a & 0xFF, a >> 8, 100, 0, 0, WRAP_W, 21,
+                                       b & 0xFF, b >> 8, 100, 0, 0, WRAP_W, 21))[0]),
+    ]
+    rows = []
+    for routine, inputs, xs, call in windows:
+        wrong, example, cases = 0, None, 0
+        for a in xs:
+            for b in xs:
+                said = bool(call(a, b))
+                truth = a < b + WRAP_W and b < a + WRAP_W
+                cases += 1
+                if said != truth:
+                    wrong += 1
+                    example = example or f"x1={a}, x2={b}: routine {said}, truth {truth}"
+        rows.append(WrapRoutineRow(routine, inputs, cases, wrong, example))
     return rows
