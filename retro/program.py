@@ -25,6 +25,10 @@ class Program:
     symbols: dict[str, int] = field(default_factory=dict)
     listing: str = ""
     source: str = ""
+    # bare name -> its qualified candidates ("proc::loop", or "loop@$C005" where the format has no
+    # scopes): a name defined twice is never resolved silently to one of them
+    ambiguous: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    cpu: str | None = None  # the CPU the file implies ("2a03" for an iNES image), None when it does not say
 
     @property
     def end(self) -> int:
@@ -32,10 +36,16 @@ class Program:
         return self.origin + len(self.code)
 
     def address_of(self, label: str) -> int:
+        if label in self.ambiguous:
+            raise InputError(f"{self.source or 'program'}: {ambiguity_message(label, self.ambiguous[label])}")
         try:
             return self.symbols[label]
         except KeyError:
             raise InputError(f"{self.source or 'program'}: unknown label {label!r}") from None
+
+
+def ambiguity_message(name: str, candidates: tuple[str, ...]) -> str:
+    return f"label {name!r} is defined more than once ({', '.join(candidates)}); name one of them"
 
 
 def prg_bytes(program: Program) -> bytes:

@@ -26,7 +26,7 @@ from retro.cpu.mpu import (
 )
 from retro.errors import InputError, RunError
 from retro.numbers import parse_int
-from retro.program import Program
+from retro.program import Program, ambiguity_message
 
 DEFAULT_BUDGET = 5_000_000  # cycles; about five seconds of C64 time, a few seconds on the host
 RETURN_TRAP = 0x0000  # the routine "returns" here: RTS to $0000 with the stack back where it started
@@ -81,6 +81,7 @@ class Machine:
         self.mpu = VARIANTS[variant](memory=self.bus.memory, page_devices=self.bus.page_devices)
         self.mpu.stop_on_brk = True
         self.symbols: dict[str, int] = {}
+        self.ambiguous: dict[str, tuple[str, ...]] = {}
 
     # ---- set-up ----------------------------------------------------------------------------
 
@@ -100,6 +101,7 @@ class Machine:
     def load(self, program: Program) -> Program:
         self.bus.load(program.origin, program.code)
         self.symbols.update(program.symbols)
+        self.ambiguous.update(program.ambiguous)
         return program
 
     def resolve(self, target: str | int, field: str = "address") -> int:
@@ -107,6 +109,8 @@ class Machine:
         if isinstance(target, int):
             return parse_int(target, field=field, lo=0, hi=0xFFFF)
         text = str(target).strip()
+        if text in self.ambiguous and text not in self.symbols:
+            raise InputError(f"{field}: {ambiguity_message(text, self.ambiguous[text])}")
         if text in self.symbols:
             return self.symbols[text]
         if text[:1].isalpha() or text[:1] == "_":
