@@ -1,28 +1,49 @@
-"""Cross-check the 6502 routines against their references, for results and for cycles.
+"""Cross-check a routine (a spec: built-in or the user's) against its reference, results and cycles.
 
-For every case: the routine's answer must equal the reference's (inside the routine's stated
+For every case: the routine's outputs must equal the reference's (inside the spec's `where`
 domain), and the measured cycle count must equal the independent timing model summed over the
-executed path (retro.cpu.timing). Cases outside the stated domain are run too: their failures are
-what shows the domain is exact (each stated condition is needed), and a failure inside it is a
-mismatch. Measured extremes must lie within the static best/worst case (retro.cpu.flow).
+executed path (retro.cpu.timing). Cases outside the domain are run too: their failures are what
+shows each condition of the domain is needed, and a failure inside it is a mismatch. Measured
+extremes must lie within the static best/worst case (retro.cpu.flow), and both within the spec's
+cycle budget (`[cycles] max`) when it has one.
 
-Long runs split the cases into chunks over worker processes (`jobs`), reporting progress.
+Cases are made lazily (retro.routines.cases) and run in chunks over worker processes (`jobs`);
+the first run failure (BRK, JAM, a runaway past `[cycles] limit`) stops the check and is reported
+with its inputs.
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
+import signal
+from collections.abc import Callable, Iterator
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
 
+import numpy as np
+
+from retro.analysis.raster import format_raster, raster_figures
 from retro.cpu.flow import Bounds, analyse
 from retro.cpu.timing import model_cycles
-from retro.routines.harness import RoutineRunner, Size
-from retro.routines.registry import Routine, cases, get, world_for
+from retro.errors import InputError, RunError
+from retro.routines import cases as case_sets
+from retro.routines.registry import select
+from retro.routines.runner import RoutineRunner, Size, describe_value
+from retro.routines.spec import Routine, load_spec
 
-CHUNK = 4_000
 EXAMPLES_KEPT = 5
+TRACE_SHOWN = 400  # instructions of the first failing case's trace in the report
+
+
+@dataclass
+class Failure:
+    """The first failing case of a chunk: what the routine and the reference said."""
+
+    case: tuple
+    kind: str  # "result", "cycles" or "run"
+    outputs: tuple | None = None
+    expected: tuple | None = None
+    message: str = ""
 
 
 @dataclass
@@ -30,21 +51,26 @@ class ChunkResult:
     cases: int = 0
     result_mismatches: int = 0
     cycle_mismatches: int = 0
+    run_errors: int = 0
     outside: int = 0
     outside_wrong: int = 0
     constraint_cases: dict[str, int] = field(default_factory=dict)
     constraint_wrong: dict[str, int] = field(default_factory=dict)
     cycles_min: int | None = None
     cycles_max: int | None = None
+    min_case: tuple | None = None
+    max_case: tuple | None = None
     cycles_sum: int = 0
     cycles_count: int = 0
     examples: list[str] = field(default_factory=list)
     outside_examples: list[str] = field(default_factory=list)
+    failure: Failure | None = None
 
     def merge(self, other: "ChunkResult") -> None:
         self.cases += other.cases
         self.result_mismatches += other.result_mismatches
         self.cycle_mismatches += other.cycle_mismatches
+        self.run_errors += other.run_errors
         self.outside += other.outside
         self.outside_wrong += other.outside_wrong
         for target, source in ((self.constraint_cases, other.constraint_cases),
@@ -52,25 +78,40 @@ class ChunkResult:
             for key, value in source.items():
                 target[key] = target.get(key, 0) + value
         if other.cycles_count:
-            self.cycles_min = other.cycles_min if self.cycles_min is None else min(self.cycles_min, other.cycles_min)
-            self.cycles_max = other.cycles_max if self.cycles_max is None else max(self.cycles_max, other.cycles_max)
+            if self.cycles_min is None or other.cycles_min < self.cycles_min:
+                self.cycles_min, self.min_case = other.cycles_min, other.min_case
+            if self.cycles_max is None or other.cycles_max > self.cycles_max:
+                self.cycles_max, self.max_case = other.cycles_max, other.max_case
         self.cycles_sum += other.cycles_sum
         self.cycles_count += other.cycles_count
         self.examples = (self.examples + other.examples)[:EXAMPLES_KEPT]
         self.outside_examples = (self.outside_examples + other.outside_examples)[:EXAMPLES_KEPT]
+        self.failure = self.failure or other.failure
+
+
+@dataclass(frozen=True)
+class PartRun:
+    name: str
+    cases: int
+    total: int  # cases of the space the part stands for (exhaustive: the whole product)
 
 
 @dataclass
 class RoutineCheck:
     routine: Routine
     size: Size
-    static: Bounds
+    static: Bounds | None
     totals: ChunkResult
     bounds_violations: list[str]
+    budget_violations: list[str] = field(default_factory=list)
+    parts: list[PartRun] = field(default_factory=list)
+    trace: list[str] = field(default_factory=list)  # the first failing case's instructions
 
     @property
     def mismatches(self) -> int:
-        return self.totals.result_mismatches + self.totals.cycle_mismatches + len(self.bounds_violations)
+        t = self.totals
+        return (t.result_mismatches + t.cycle_mismatches + t.run_errors + len(self.bounds_violations)
+                + len(self.budget_violations))
 
     @property
     def mean(self) -> float:
@@ -78,156 +119,388 @@ class RoutineCheck:
 
     @property
     def worst_reached(self) -> bool:
-        return self.totals.cycles_max == self.static.worst
+        return self.static is not None and self.totals.cycles_max == self.static.worst
 
     def domain_report(self) -> list[str]:
         t = self.totals
-        lines = []
-        inside = t.cases - t.outside
-        lines.append(f"inside the domain: {inside} cases, {t.result_mismatches} wrong")
-        for name, _ in self.routine.domain:
-            violating = t.constraint_cases.get(name, 0)
-            wrong = t.constraint_wrong.get(name, 0)
+        lines = [f"inside the domain: {t.cases - t.outside} cases, {t.result_mismatches} wrong"]
+        for condition in self.routine.domain:
+            violating = t.constraint_cases.get(condition.text, 0)
+            wrong = t.constraint_wrong.get(condition.text, 0)
             verdict = "needed" if wrong else "not shown to be needed by these cases"
-            lines.append(f"  condition {name}: {violating} cases break it, {wrong} of them wrong: {verdict}")
+            lines.append(f"  condition {condition.text}: {violating} cases break it, {wrong} of them wrong: {verdict}")
         return lines
 
 
-def _describe(routine: Routine, case: tuple) -> str:
-    return ", ".join(f"{name}={value}" for name, value in zip(routine.inputs, case)) + (
-        f", mask pair {case[2]}" if routine.name == "pixel" else "")
+# ---- one case, one chunk -----------------------------------------------------------------------------
+
+def inputs_by_name(routine: Routine, case: tuple) -> dict:
+    return {port.name: list(value) if port.table else value for port, value in zip(routine.inputs, case)}
+
+
+def describe_case(routine: Routine, case: tuple) -> str:
+    return ", ".join(f"{port.name}={describe_value(port, value)}" for port, value in zip(routine.inputs, case))
+
+
+def describe_outputs(routine: Routine, values: tuple) -> str:
+    return ", ".join(f"{port.name}={describe_value(port, value)}" for port, value in zip(routine.outputs, values))
+
+
+def expected_outputs(routine: Routine, case: tuple, memory: dict) -> tuple:
+    """The reference's answer for a case, as a tuple in the outputs' order (a one-line error for a
+    reference that raises or answers in the wrong shape)."""
+    arguments = dict(zip(routine.input_names, case))
+    arguments.update({name: memory[name] for name in routine.reference_memory})
+    try:
+        value = routine.reference(**arguments)
+    except Exception as exc:  # the user's reference: whatever it raises is reported in one line
+        raise InputError(f"{routine.spec_path}: reference {routine.reference_name} raised {type(exc).__name__}: "
+                         f"{str(exc)[:200]} (inputs {describe_case(routine, case)})") from None
+    return normalise_outputs(routine, value, case)
+
+
+def normalise_outputs(routine: Routine, value, case: tuple) -> tuple:
+    outputs = routine.outputs
+    where = f"{routine.spec_path}: reference {routine.reference_name}"
+    if isinstance(value, dict):
+        if set(value) != set(routine.output_names):
+            raise InputError(f"{where} returned keys {sorted(value)} for the outputs {list(routine.output_names)} "
+                             f"(inputs {describe_case(routine, case)})")
+        values = [value[name] for name in routine.output_names]
+    elif len(outputs) == 1:
+        values = [value]
+    else:
+        raise InputError(f"{where} returned {type(value).__name__}; with {len(outputs)} outputs it must return a "
+                         f"dict {{{', '.join(routine.output_names)}}} (inputs {describe_case(routine, case)})")
+    out = []
+    for port, item in zip(outputs, values):
+        out.append(_output_value(port, item, where, routine, case))
+    return tuple(out)
+
+
+def _output_value(port, item, where: str, routine: Routine, case: tuple):
+    if isinstance(item, np.ndarray) and item.ndim == 0 or isinstance(item, np.generic):
+        item = item.item()
+    if port.table:
+        try:
+            values = tuple(int(v) for v in item)
+        except (TypeError, ValueError):
+            values = None
+        if values is None or len(values) != len(port.places) or any(not 0 <= v <= 0xFF for v in values):
+            raise InputError(f"{where} returned {item!r:.60} for {port.name}: expected {len(port.places)} bytes "
+                             f"(inputs {describe_case(routine, case)})")
+        return values
+    if isinstance(item, bool):
+        item = int(item)
+    limit = 1 << port.bits
+    if not isinstance(item, int) or not 0 <= item < limit:
+        raise InputError(f"{where} returned {item!r:.60} for {port.name}: expected a whole number 0..{limit - 1} "
+                         f"({'a flag: true or false' if port.flag else port.describe()}) "
+                         f"(inputs {describe_case(routine, case)})")
+    return item
 
 
 _RUNNERS: dict[tuple[str, int], RoutineRunner] = {}
 
 
-def _runner(name: str, seed: int) -> RoutineRunner:
-    key = (name, seed)
+def runner_for(spec: str, seed: int) -> RoutineRunner:
+    key = (str(spec), seed)
     if key not in _RUNNERS:
-        _RUNNERS[key] = RoutineRunner(get(name), world_for(name, seed))
+        _RUNNERS[key] = RoutineRunner(load_spec(spec), seed)
     return _RUNNERS[key]
 
 
-def check_chunk(name: str, seed: int, chunk: list[tuple]) -> ChunkResult:
-    """Run cases of one routine; pure function of its arguments (used in worker processes)."""
-    runner = _runner(name, seed)
-    routine = get(name)  # the registry's entry now (the runner keeps the one it was built from)
+def check_chunk(spec: str, seed: int, chunk: list[tuple]) -> ChunkResult:
+    """Run cases of one routine; a pure function of its arguments (used in worker processes)."""
+    runner = runner_for(spec, seed)
+    routine = runner.routine
+    name = routine.name
     read = runner.machine.memory.__getitem__
     out = ChunkResult()
     for case in chunk:
         steps: list = []
-        answer, cycles = runner.run(case, steps)
-        expected = routine.reference(case, runner.world)
+        try:
+            answer, cycles = runner.run(case, steps)
+        except RunError as exc:
+            out.cases += 1
+            out.run_errors += 1
+            out.examples.append(f"{name}({describe_case(routine, case)}): {exc}")
+            out.failure = out.failure or Failure(case, "run", message=str(exc))
+            break  # a broken routine stops the check: the next case could run away as well
+        expected = expected_outputs(routine, case, runner.memory_values)
         out.cases += 1
         modelled = model_cycles(read, steps)
         if modelled != cycles:
             out.cycle_mismatches += 1
+            out.failure = out.failure or Failure(case, "cycles", answer, expected,
+                                                 f"measured {cycles} cycles, the timing model says {modelled}")
             if len(out.examples) < EXAMPLES_KEPT:
-                out.examples.append(f"{name}({_describe(routine, case)}): measured {cycles} cycles, "
+                out.examples.append(f"{name}({describe_case(routine, case)}): measured {cycles} cycles, "
                                     f"the timing model says {modelled}")
-        broken = [rule_name for rule_name, rule in routine.domain if not rule(case)]
-        for rule_name in broken:
-            out.constraint_cases[rule_name] = out.constraint_cases.get(rule_name, 0) + 1
+        broken = [c.text for c in routine.domain if not c.test(*case)]
+        for text in broken:
+            out.constraint_cases[text] = out.constraint_cases.get(text, 0) + 1
         if broken:
             out.outside += 1
             if answer != expected:
                 out.outside_wrong += 1
-                for rule_name in broken:
-                    out.constraint_wrong[rule_name] = out.constraint_wrong.get(rule_name, 0) + 1
+                for text in broken:
+                    out.constraint_wrong[text] = out.constraint_wrong.get(text, 0) + 1
                 if len(out.outside_examples) < EXAMPLES_KEPT:
-                    out.outside_examples.append(f"{name}({_describe(routine, case)}): returned {answer}, "
-                                                f"reference {expected} (outside: {', '.join(broken)})")
+                    out.outside_examples.append(
+                        f"{name}({describe_case(routine, case)}): returned {describe_outputs(routine, answer)}, "
+                        f"reference {describe_outputs(routine, expected)} (outside: {', '.join(broken)})")
             continue
         if answer != expected:
             out.result_mismatches += 1
+            out.failure = out.failure or Failure(case, "result", answer, expected)
             if len(out.examples) < EXAMPLES_KEPT:
-                out.examples.append(f"{name}({_describe(routine, case)}): returned {answer}, reference {expected}")
-        out.cycles_min = cycles if out.cycles_min is None else min(out.cycles_min, cycles)
-        out.cycles_max = cycles if out.cycles_max is None else max(out.cycles_max, cycles)
+                out.examples.append(f"{name}({describe_case(routine, case)}): returned "
+                                    f"{describe_outputs(routine, answer)}, reference {describe_outputs(routine, expected)}")
+        if out.cycles_min is None or cycles < out.cycles_min:
+            out.cycles_min, out.min_case = cycles, case
+        if out.cycles_max is None or cycles > out.cycles_max:
+            out.cycles_max, out.max_case = cycles, case
         out.cycles_sum += cycles
         out.cycles_count += 1
     return out
 
 
-def static_bounds(routine: Routine) -> Bounds:
-    runner_program = _runner(routine.name, 0).program
-    memory = [0] * 0x10000
-    memory[runner_program.origin:runner_program.end] = list(runner_program.code)
-    bounds = {runner_program.symbols[label]: count for label, count in routine.loop_bounds.items()}
-    return analyse(memory.__getitem__, runner_program.symbols[routine.name], bounds, name=routine.name)
+# ---- static bounds -------------------------------------------------------------------------------------
+
+def static_bounds(routine: Routine, runner: RoutineRunner | None = None) -> Bounds | None:
+    """Best and worst cycles from the routine's bytes (as loaded, after init), subroutines included;
+    None when the spec turns the analysis off (`[cycles] static = false`)."""
+    if not routine.static:
+        return None
+    runner = runner or runner_for(str(routine.spec_path), 0)
+    machine = runner.machine
+    program = runner.program
+    memory = list(machine.memory)
+    bounds = {machine.resolve(label, f"cycles.loops.{label}"): count for label, count in routine.loop_bounds.items()}
+    names = {address: label for label, address in sorted(program.symbols.items(), key=lambda kv: len(kv[0]))[::-1]}
+
+    def describe(address: int) -> str:
+        return f"${address:04X}" + (f" ({names[address]})" if address in names else "")
+    try:
+        return analyse(memory.__getitem__, runner.entry, bounds, name=routine.name,
+                       within=(program.origin, program.end), describe=describe)
+    except InputError as exc:
+        raise InputError(f"{routine.spec_path}: static analysis: {exc} ([cycles] static = false skips it)") from None
 
 
-def check_routine(name: str, *, exhaustive: bool = False, seed: int = 0, random_count: int | None = None,
+# ---- a whole check -----------------------------------------------------------------------------------
+
+def _ignore_interrupt() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C goes to the parent, which stops the pool
+
+
+def _chunks(parts: list[case_sets.Part]) -> Iterator[list[tuple]]:
+    for part in parts:
+        yield from case_sets.chunks(part.cases)
+
+
+def check_routine(spec: str, *, exhaustive: bool = False, seed: int | None = None, random_count: int | None = None,
                   jobs: int = 1, progress: Callable[[str], None] | None = None) -> RoutineCheck:
-    routine = get(name)
-    all_cases = cases(routine, exhaustive=exhaustive, seed=seed, random_count=random_count)
-    chunks = [all_cases[i:i + CHUNK] for i in range(0, len(all_cases), CHUNK)]
+    routine = load_spec(spec)
+    seed = routine.seed if seed is None else seed
+    parts = case_sets.plan(routine, exhaustive=exhaustive, seed=seed, random=random_count)
+    known = sum(p.count for p in parts if p.count is not None)
+    unknown = any(p.count is None for p in parts)
+    runner = runner_for(spec, seed)  # loads and validates in this process before any worker starts
     totals = ChunkResult()
     done = 0
-    if jobs > 1 and len(chunks) > 1:
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
-            for result in pool.map(check_chunk, [name] * len(chunks), [seed] * len(chunks), chunks):
-                totals.merge(result)
-                done += result.cases
-                if progress:
-                    progress(f"check {name}: {done}/{len(all_cases)} cases")
+
+    def report(result: ChunkResult) -> None:
+        nonlocal done
+        totals.merge(result)
+        done += result.cases
+        if progress and (known > case_sets.CHUNK or unknown):
+            progress(f"check {routine.name}: {done:,} cases of {known:,} and the sweep" if unknown else
+                     f"check {routine.name}: {done:,}/{known:,} cases")
+
+    chunk_iter = _chunks(parts)
+    if jobs > 1 and (known > case_sets.CHUNK or unknown):
+        pool = ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_interrupt)
+        pending: set[Future] = set()
+        try:
+            for chunk in chunk_iter:
+                pending.add(pool.submit(check_chunk, spec, seed, chunk))
+                if len(pending) >= 2 * jobs:  # bounded: cases are made as workers take them
+                    finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+                    for future in finished:
+                        report(future.result())
+                if totals.run_errors:
+                    break
+            for future in pending:
+                report(future.result())
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
     else:
-        for chunk in chunks:
-            totals.merge(check_chunk(name, seed, chunk))
-            done += len(chunk)
-            if progress and len(chunks) > 1:
-                progress(f"check {name}: {done}/{len(all_cases)} cases")
-    static = static_bounds(routine)
+        for chunk in chunk_iter:
+            report(check_chunk(spec, seed, chunk))
+            if totals.run_errors:
+                break
+    part_runs = [PartRun(p.name, p.count if p.count is not None else 0, p.total) for p in parts]
+    if unknown:  # the sweep's count is whatever was left after the counted parts
+        counted = sum(p.cases for p in part_runs if p.name != "sweep")
+        part_runs = [PartRun(p.name, max(totals.cases - counted, 0), max(totals.cases - counted, 0))
+                     if p.name == "sweep" else p for p in part_runs]
+    static = static_bounds(routine, runner)
     violations = []
-    if totals.cycles_count and totals.cycles_min < static.best:
-        violations.append(f"{name}: measured minimum {totals.cycles_min} is below the static best case {static.best}")
-    if totals.cycles_count and totals.cycles_max > static.worst:
-        violations.append(f"{name}: measured maximum {totals.cycles_max} is above the static worst case {static.worst}")
-    runner = _runner(name, seed)
-    size = runner.size()
-    return RoutineCheck(routine, size, static, totals, violations)
+    t = totals
+    if static is not None and t.cycles_count and t.cycles_min < static.best:
+        violations.append(f"{routine.name}: measured minimum {t.cycles_min} is below the static best case {static.best}")
+    if static is not None and t.cycles_count and t.cycles_max > static.worst:
+        violations.append(f"{routine.name}: measured maximum {t.cycles_max} is above the static worst case {static.worst}")
+    budget_violations = []
+    if routine.budget is not None:
+        if t.cycles_count and t.cycles_max > routine.budget:
+            budget_violations.append(f"{routine.name}: measured maximum {t.cycles_max} cycles is over the budget of "
+                                     f"{routine.budget} (inputs {describe_case(routine, t.max_case)})")
+        if static is not None and static.worst > routine.budget:
+            budget_violations.append(f"{routine.name}: the static worst case {static.worst} cycles is over the budget "
+                                     f"of {routine.budget}")
+    check = RoutineCheck(routine, runner.size(), static, totals, violations, budget_violations, part_runs)
+    if totals.failure is not None:
+        check.trace = failure_trace(spec, seed, totals.failure.case)
+    return check
+
+
+def failure_trace(spec: str, seed: int, case: tuple) -> list[str]:
+    """The instructions of one case, run again on a fresh machine with the trace on."""
+    runner = RoutineRunner(load_spec(spec), seed)
+    try:
+        result = runner.traced(case)
+    except RunError as exc:
+        return [f"(the traced run failed too: {exc})"]
+    lines = []
+    total = 0
+    for entry in result.trace[:TRACE_SHOWN]:
+        total += entry.cycles
+        notes = " ".join(n for n, on in (("taken", entry.branch_taken), ("page+1", entry.page_crossed)) if on)
+        lines.append(f"${entry.address:04X}  {runner.machine.disassemble_at(entry.address):<14} "
+                     f"{entry.cycles}  {total:>6}  {notes}".rstrip())
+    if len(result.trace) > TRACE_SHOWN:
+        lines.append(f"... {len(result.trace) - TRACE_SHOWN} more instructions")
+    return lines
 
 
 def default_jobs() -> int:
     return max(1, min(2, os.cpu_count() or 1))
 
 
-def run_checks(names: list[str] | None, *, exhaustive: bool = False, seed: int = 0, random_count: int | None = None,
-               jobs: int | None = None, progress: Callable[[str], None] | None = None) -> list[RoutineCheck]:
-    """Check the named routines (all when none are named); unknown names fail before any work."""
-    from retro.routines.registry import select
-
-    routines = select(names)
+def run_checks(names: list[str] | None, *, exhaustive: bool = False, seed: int | None = None,
+               random_count: int | None = None, jobs: int | None = None,
+               progress: Callable[[str], None] | None = None) -> list[RoutineCheck]:
+    """Check the named routines (built-in names or spec paths; all built-ins when none are named);
+    every name is loaded and validated before any work starts."""
+    specs = select(names)
     workers = default_jobs() if jobs is None else jobs
-    return [check_routine(r.name, exhaustive=exhaustive, seed=seed, random_count=random_count, jobs=workers,
-                          progress=progress) for r in routines]
+    return [check_routine(spec, exhaustive=exhaustive, seed=seed, random_count=random_count, jobs=workers,
+                          progress=progress) for spec in specs]
+
+
+# ---- reports -------------------------------------------------------------------------------------------
+
+def coverage(check: RoutineCheck) -> list[dict]:
+    out = []
+    for part in check.parts:
+        item = {"part": part.name, "cases": part.cases}
+        if part.name == "exhaustive":
+            item["space"] = part.total
+            item["inputs"] = list(check.routine.exhaustive)
+            item["complete"] = part.cases == part.total
+        out.append(item)
+    return out
+
+
+def cycle_figures(check: RoutineCheck) -> dict:
+    """The cycle fields shared by `retro check --json` and `retro cycles --json`."""
+    t = check.totals
+    routine = check.routine
+    return {"min": t.cycles_min, "mean": round(check.mean, 2), "max": t.cycles_max,
+            "static_min": check.static.best if check.static else None,
+            "static_max": check.static.worst if check.static else None,
+            "min_inputs": inputs_by_name(routine, t.min_case) if t.min_case is not None else None,
+            "max_inputs": inputs_by_name(routine, t.max_case) if t.max_case is not None else None,
+            "budget": routine.budget,
+            "raster": raster_figures(routine.cpu, t.cycles_min, check.mean if t.cycles_count else None, t.cycles_max)}
 
 
 def check_record(check: RoutineCheck) -> dict:
     """One routine's check as plain data (what `retro check --json` prints)."""
     t = check.totals
-    return {"routine": check.routine.name, "cases": t.cases, "mismatches": check.mismatches,
-            "result_mismatches": t.result_mismatches, "cycle_mismatches": t.cycle_mismatches,
-            "bounds_violations": check.bounds_violations,
-            "outside_domain": t.outside, "outside_domain_wrong": t.outside_wrong,
-            "domain": [{"condition": name, "cases": t.constraint_cases.get(name, 0),
-                        "wrong": t.constraint_wrong.get(name, 0)} for name, _ in check.routine.domain],
-            "min": t.cycles_min, "mean": round(check.mean, 2), "max": t.cycles_max,
-            "static_min": check.static.best, "static_max": check.static.worst, "worst_reached": check.worst_reached,
-            "examples": t.examples, "outside_examples": t.outside_examples}
+    record = {"routine": check.routine.name, "spec": str(check.routine.spec_path), "cpu": check.routine.cpu,
+              "cases": t.cases, "mismatches": check.mismatches,
+              "result_mismatches": t.result_mismatches, "cycle_mismatches": t.cycle_mismatches,
+              "run_errors": t.run_errors, "bounds_violations": check.bounds_violations,
+              "budget_violations": check.budget_violations,
+              "outside_domain": t.outside, "outside_domain_wrong": t.outside_wrong,
+              "domain": [{"condition": c.text, "cases": t.constraint_cases.get(c.text, 0),
+                          "wrong": t.constraint_wrong.get(c.text, 0)} for c in check.routine.domain],
+              **cycle_figures(check), "worst_reached": check.worst_reached, "coverage": coverage(check),
+              "examples": t.examples, "outside_examples": t.outside_examples, "first_failure": None}
+    failure = t.failure
+    if failure is not None:
+        routine = check.routine
+        record["first_failure"] = {
+            "kind": failure.kind, "inputs": inputs_by_name(routine, failure.case),
+            "outputs": None if failure.outputs is None else dict(zip(routine.output_names, _plain(failure.outputs))),
+            "expected": None if failure.expected is None else dict(zip(routine.output_names, _plain(failure.expected))),
+            "message": failure.message, "trace": check.trace}
+    return record
+
+
+def _plain(values: tuple) -> list:
+    return [list(v) if isinstance(v, tuple) else v for v in values]
+
+
+def format_coverage(check: RoutineCheck) -> str:
+    parts = []
+    for part in check.parts:
+        if part.name == "exhaustive":
+            scope = ", ".join(check.routine.exhaustive)
+            parts.append(f"exhaustive over {scope}: {part.cases:,} of {part.total:,}"
+                         + ("" if part.cases == part.total else " (sampled; --exhaustive runs all)"))
+        else:
+            parts.append(f"{part.name} {part.cases:,}")
+    return "; ".join(parts)
 
 
 def format_check(check: RoutineCheck) -> list[str]:
     t = check.totals
+    routine = check.routine
     verdict = "OK" if not check.mismatches else f"{check.mismatches} MISMATCH(ES)"
-    lines = [f"{check.routine.name}: {t.cases} cases, {verdict}; cycles {t.cycles_min}-{t.cycles_max} "
-             f"(mean {check.mean:.2f}), static {check.static.best}-{check.static.worst}, worst case "
-             f"{'reached' if check.worst_reached else 'not reached'}; timing model equal on "
-             f"{t.cases - t.cycle_mismatches} of {t.cases} calls"]
-    lines += [f"  {line}" for line in check.domain_report()[1:]] if check.routine.domain else []
+    static = (f"static {check.static.best}-{check.static.worst}, worst case "
+              f"{'reached' if check.worst_reached else 'not reached'}" if check.static else "static analysis off")
+    lines = [f"{routine.name}: {t.cases} cases, {verdict}; cycles {t.cycles_min}-{t.cycles_max} "
+             f"(mean {check.mean:.2f}), {static}; timing model equal on "
+             f"{t.cases - t.cycle_mismatches - t.run_errors} of {t.cases} calls"]
+    if check.parts:
+        lines.append(f"  cases: {format_coverage(check)}")
+    if t.cycles_count:
+        lines.append(f"  fastest: {describe_case(routine, t.min_case)}")
+        lines.append(f"  slowest: {describe_case(routine, t.max_case)}")
+        raster = format_raster(routine.cpu, raster_figures(routine.cpu, t.cycles_min, check.mean, t.cycles_max))
+        if raster:
+            lines.append(f"  raster: {raster}")
+    if routine.budget is not None:
+        lines.append(f"  budget: {routine.budget} cycles: {'broken' if check.budget_violations else 'kept'}")
+    lines += [f"  {line}" for line in check.domain_report()[1:]] if routine.domain else []
     if t.outside:
         lines.append(f"  outside the stated domain: {t.outside} cases, {t.outside_wrong} wrong"
                      + (f", e.g. {t.outside_examples[0]}" if t.outside_examples else ""))
     lines += [f"  MISMATCH {example}" for example in t.examples]
     lines += [f"  MISMATCH {violation}" for violation in check.bounds_violations]
+    lines += [f"  BUDGET {violation}" for violation in check.budget_violations]
+    if t.failure is not None:
+        lines.append(f"  first failing case: {describe_case(routine, t.failure.case)}")
+        if t.failure.outputs is not None:
+            lines.append(f"    routine:   {describe_outputs(routine, t.failure.outputs)}")
+            lines.append(f"    reference: {describe_outputs(routine, t.failure.expected)}")
+        if t.failure.message:
+            lines.append(f"    {t.failure.message}")
+        lines.append("    trace (address, instruction, cycles, running total):")
+        lines += [f"    {line}" for line in check.trace]
     return lines

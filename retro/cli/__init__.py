@@ -26,6 +26,10 @@ COMMAND_MODULES = ["demo", "asm", "run", "vic", "nes", "check", "cycles", "chart
 
 
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kwargs) -> None:
+        kwargs.setdefault("allow_abbrev", False)  # `--exhaustiv` must not pass for `--exhaustive`
+        super().__init__(*args, **kwargs)
+
     def error(self, message: str) -> None:  # one line, exit 2, no usage dump
         print(one_line(f"{self.prog}: {message}"), file=sys.stderr)
         raise SystemExit(2)

@@ -6,7 +6,8 @@ import argparse
 from pathlib import Path
 
 from retro.assembler import assemble_file
-from retro.fileio import write_atomic
+from retro.fileio import read_bytes, write_atomic
+from retro.loaders import refuse_foreign_source
 from retro.program import format_vice_labels, prg_bytes
 
 
@@ -20,6 +21,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run_asm(args: argparse.Namespace) -> int:
+    refuse_foreign_source(args.source, read_bytes(args.source, "source file"))
     program = assemble_file(args.source)
     output = Path(args.output) if args.output else Path(args.source).with_suffix(".prg")
     write_atomic(output, prg_bytes(program))

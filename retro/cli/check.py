@@ -1,4 +1,4 @@
-"""`retro check [ROUTINE ...] [--exhaustive] [--json]`: routines against references, results and cycles."""
+"""`retro check [ROUTINE|SPEC.toml ...] [--exhaustive] [--json]`: routines against references, results and cycles."""
 
 from __future__ import annotations
 
@@ -9,29 +9,45 @@ import sys
 from retro.analysis.check import check_record, format_check, run_checks
 from retro.numbers import parse_int
 
+ROUTINES_HELP = ("built-in routine names (aabb8 aabb_sprite circle mul8 tile tile_box pixel; all when none is "
+                 "given) or routine spec files (NAME.toml, docs/specs.md)")
+MAX_RANDOM = 10 ** 9
 
-def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("check", help="cross-check the 6502 collision routines against their references "
-                                     "(results and cycles); exit 1 on any mismatch")
-    p.add_argument("routines", nargs="*", metavar="ROUTINE", help="aabb8 aabb_sprite circle mul8 tile tile_box pixel")
+
+def add_case_options(p: argparse.ArgumentParser) -> None:
+    """Options `retro check` and `retro cycles` share."""
+    p.add_argument("routines", nargs="*", metavar="ROUTINE|SPEC.toml", help=ROUTINES_HELP)
     p.add_argument("--exhaustive", action="store_true",
-                   help="the full run: exhaustive sweeps and 100,000 random cases per routine (minutes)")
-    p.add_argument("--seed", default="0", help="seed of the random cases and of the screen/mask world")
-    p.add_argument("--random", dest="random_count", metavar="N", help="random cases per routine")
+                   help="the full run: every exhaustive set and sweep, and each spec's full random count (minutes)")
+    p.add_argument("--seed", help="seed of the random cases and of random memory (default: the spec's, 0)")
+    p.add_argument("--random", dest="random_count", metavar="N",
+                   help="random cases per routine (default: the spec's count, at most 2,000 without --exhaustive)")
     p.add_argument("--jobs", metavar="N", help="worker processes (default: up to 2)")
     p.add_argument("--json", action="store_true", help="print a JSON list, one object per routine")
-    p.set_defaults(func=cmd_check)
 
 
-def _progress(message: str) -> None:
+def case_options(args: argparse.Namespace) -> dict:
+    return {"exhaustive": args.exhaustive,
+            "seed": None if args.seed is None else parse_int(args.seed, field="--seed", lo=0, hi=2 ** 63 - 1),
+            "random_count": None if args.random_count is None else parse_int(args.random_count, field="--random",
+                                                                             lo=0, hi=MAX_RANDOM),
+            "jobs": None if args.jobs is None else parse_int(args.jobs, field="--jobs", lo=1, hi=64),
+            "progress": progress}
+
+
+def progress(message: str) -> None:
     print(message, file=sys.stderr, flush=True)
 
 
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("check", help="cross-check 6502 routines (built-in or your own spec) against their references "
+                                     "(results and cycles); exit 1 on any mismatch or broken budget")
+    add_case_options(p)
+    p.set_defaults(func=cmd_check)
+
+
 def cmd_check(args: argparse.Namespace) -> int:
-    checks = run_checks(args.routines, exhaustive=args.exhaustive, seed=parse_int(args.seed, field="--seed", lo=0),
-                        random_count=None if args.random_count is None else parse_int(args.random_count, field="--random", lo=0),
-                        jobs=None if args.jobs is None else parse_int(args.jobs, field="--jobs", lo=1, hi=64),
-                        progress=_progress)
+    checks = run_checks(args.routines, **case_options(args))
     if args.json:
         print(json.dumps([check_record(c) for c in checks], indent=1))
     else:

@@ -1,27 +1,30 @@
-"""`retro run FILE.s|FILE.prg --entry LABEL|ADDR [...] [--json]`"""
+"""`retro run FILE.s|FILE.prg|FILE.bin|FILE.nes --entry LABEL|ADDR [--labels F] [--load ADDR] [...] [--json]`"""
 
 from __future__ import annotations
 
 import argparse
 import json
 
-from retro.app.run import run_routine
+from retro.app.run import SETTABLE_FLAGS, run_routine
 from retro.cpu.machine import DEFAULT_BUDGET, JSR_CYCLES
 from retro.numbers import parse_int
 
-
-def _byte(text: str) -> int:
-    return parse_int(text, field="register value", lo=0, hi=0xFF)
+# P from bit 7 down to bit 0, as the 6502 manuals draw it
+STATUS_BITS_HEADER = "N V - B D I Z C"
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("run", help="call a 6502 routine in the emulator and report registers, cycles and memory")
-    p.add_argument("program", metavar="FILE.s|FILE.prg")
-    p.add_argument("--labels", metavar="F.lbl", help="VICE label file for a .prg")
+    p.add_argument("program", metavar="FILE.s|FILE.prg|FILE.bin|FILE.nes")
+    p.add_argument("--labels", metavar="F", help="symbol file of a .prg, .bin or .nes, in any supported format "
+                                                   "(docs/symbols.md)")
+    p.add_argument("--load", metavar="ADDR", help="load address of a raw binary")
     p.add_argument("--entry", required=True, metavar="LABEL|ADDR")
     p.add_argument("--a", default="0", metavar="V")
     p.add_argument("--x", default="0", metavar="V")
     p.add_argument("--y", default="0", metavar="V")
+    for flag in SETTABLE_FLAGS:
+        p.add_argument(f"--{flag}", metavar="0|1", help=f"{flag.upper()} flag on entry")
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="TARGET=V")
     p.add_argument("--peek", dest="peeks", action="append", default=[], metavar="TARGET[:N]")
     p.add_argument("--budget", default=str(DEFAULT_BUDGET), metavar="CYCLES")
@@ -33,10 +36,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    flags = {flag: parse_int(getattr(args, flag), field=f"--{flag}", lo=0, hi=1)
+             for flag in SETTABLE_FLAGS if getattr(args, flag) is not None}
     report = run_routine(
-        args.program, args.entry, labels=args.labels,
+        args.program, args.entry, labels=args.labels, load=args.load,
         a=parse_int(args.a, field="--a", lo=0, hi=0xFF), x=parse_int(args.x, field="--x", lo=0, hi=0xFF),
-        y=parse_int(args.y, field="--y", lo=0, hi=0xFF), sets=args.sets, peeks=args.peeks,
+        y=parse_int(args.y, field="--y", lo=0, hi=0xFF), flags=flags, sets=args.sets, peeks=args.peeks,
         budget=parse_int(args.budget, field="--budget", lo=1), scene=args.scene, trace=args.trace)
     r = report.result
     if args.json:
@@ -47,8 +52,9 @@ def cmd_run(args: argparse.Namespace) -> int:
         for e in r.trace:
             notes = " ".join(n for n, on in (("taken", e.branch_taken), ("page+1", e.page_crossed)) if on)
             print(f"${e.address:04X}  {report.machine.disassemble_at(e.address):<14} {e.cycles}  {notes}".rstrip())
-    flags = "".join(name if on else "." for name, on in r.flags.items())
-    print(f"A=${r.a:02X} X=${r.x:02X} Y=${r.y:02X} S=${r.s:02X} P=${r.p:02X} [{flags}]")
+    print(f"A=${r.a:02X} X=${r.x:02X} Y=${r.y:02X} S=${r.s:02X} P=${r.p:02X}")
+    print(STATUS_BITS_HEADER)
+    print(" ".join(str(r.p >> bit & 1) for bit in range(7, -1, -1)))
     print(f"{r.cycles} cycles, {r.instructions} instructions "
           f"(from the entry ${report.entry:04X} through its RTS; the caller's JSR, {JSR_CYCLES} cycles, is not included)")
     for target, values in report.peeks.items():

@@ -30,8 +30,10 @@ from retro.cpu.timing import (
 from retro.errors import InputError
 
 OPCODE_JMP_ABS = 0x4C
+OPCODE_JSR = 0x20
 OPCODE_RTS = 0x60
-UNSUPPORTED = {0x20: "JSR", 0x6C: "JMP (indirect)", 0x40: "RTI", 0x00: "BRK"}
+UNSUPPORTED = {0x6C: "JMP (indirect)", 0x40: "RTI", 0x00: "BRK"}
+JSR_LENGTH = 3
 
 
 @dataclass
@@ -49,7 +51,10 @@ class Bounds:
     instructions: int  # distinct instructions reachable from the entry
 
 
-def decode(read: Callable[[int], int], entry: int) -> dict[int, Node]:
+def decode(read: Callable[[int], int], entry: int,
+           call_cost: Callable[[int, int], tuple[int, int]] | None = None) -> dict[int, Node]:
+    """The instructions reachable from entry. A JSR costs its own cycles plus the callee's best and
+    worst (`call_cost(pc, target)`), then continues after it, as the callee's RTS returns there."""
     nodes: dict[int, Node] = {}
     pending = [entry]
     while pending:
@@ -57,8 +62,9 @@ def decode(read: Callable[[int], int], entry: int) -> dict[int, Node]:
         if pc in nodes:
             continue
         opcode = read(pc)
-        if opcode in UNSUPPORTED:
-            raise InputError(f"${pc:04X}: {UNSUPPORTED[opcode]} is not supported by the static analysis")
+        if opcode in UNSUPPORTED or (opcode == OPCODE_JSR and call_cost is None):
+            name = UNSUPPORTED.get(opcode, "JSR")
+            raise InputError(f"${pc:04X}: {name} is not supported by the static analysis")
         op = timing_of(opcode)
         operand = read((pc + 1) & 0xFFFF) | read((pc + 2) & 0xFFFF) << 8
         extra = 0
@@ -66,7 +72,11 @@ def decode(read: Callable[[int], int], entry: int) -> dict[int, Node]:
             extra = PAGE_CROSS_CYCLES
         node = Node(pc, (op.cycles, op.cycles + extra))
         following = (pc + op.length) & 0xFFFF
-        if opcode == OPCODE_RTS:
+        if opcode == OPCODE_JSR:
+            best, worst = call_cost(pc, operand)
+            node.cycles = (op.cycles + best, op.cycles + worst)
+            node.successors.append((following, 0))
+        elif opcode == OPCODE_RTS:
             node.returns = True
         elif opcode == OPCODE_JMP_ABS:
             node.successors.append((operand, 0))
@@ -116,14 +126,34 @@ def _loops(nodes: dict[int, Node], entry: int) -> dict[int, frozenset[int]]:
 
 
 def analyse(read: Callable[[int], int], entry: int, loop_bounds: dict[int, int] | None = None,
-            name: str = "routine") -> Bounds:
-    """Best and worst cycles from the entry through an RTS over every path the bytes allow."""
-    nodes = decode(read, entry)
+            name: str = "routine", within: tuple[int, int] | None = None,
+            describe: Callable[[int], str] | None = None) -> Bounds:
+    """Best and worst cycles from the entry through an RTS over every path the bytes allow.
+
+    Subroutines called with JSR are analysed the same way (their loops bounded by the same
+    `loop_bounds`) and their cost is included, as long as they lie in `within` (start, end) when
+    given; recursion is an error. `describe(address)` names an address in errors (a label)."""
+    return _analyse(read, entry, dict(loop_bounds or {}), name, within, describe or (lambda a: f"${a:04X}"), {}, ())
+
+
+def _analyse(read, entry: int, bounds: dict[int, int], name: str, within, describe, done: dict, calling: tuple) -> Bounds:
+    def call_cost(pc: int, target: int) -> tuple[int, int]:
+        if within is not None and not within[0] <= target < within[1]:
+            raise InputError(f"{name}: JSR {describe(target)} at ${pc:04X} calls outside the program "
+                             f"(${within[0]:04X}-${within[1] - 1:04X}); its cost is unknown")
+        if target in calling or target == entry:
+            raise InputError(f"{name}: JSR {describe(target)} at ${pc:04X} is recursive")
+        if target not in done:
+            done[target] = _analyse(read, target, bounds, name, within, describe, done, (*calling, entry))
+        callee = done[target]
+        return callee.best, callee.worst
+
+    nodes = decode(read, entry, call_cost)
     loops = _loops(nodes, entry)
-    bounds = dict(loop_bounds or {})
     for header in loops:
         if header not in bounds:
-            raise InputError(f"{name}: the loop at ${header:04X} needs a bound (the most times it runs per entry)")
+            raise InputError(f"{name}: the loop at {describe(header)} needs a bound (the most times it runs per "
+                             f"entry), e.g. [cycles] loops = {{ LABEL = N }} with a label at its first instruction")
     # Loops ordered outermost first (a larger body contains the smaller ones nested in it).
     order = sorted(loops, key=lambda h: -len(loops[h]))
     containing = {pc: tuple(h for h in order if pc in loops[h]) for pc in nodes}
@@ -170,5 +200,5 @@ def analyse(read: Callable[[int], int], entry: int, loop_bounds: dict[int, int] 
         best[state] = low + min(b for b, _ in options)
         worst[state] = high + max(w for _, w in options)
     if worst[start] is None:
-        raise InputError(f"{name}: no path from ${entry:04X} reaches an RTS within the loop bounds")
+        raise InputError(f"{name}: no path from {describe(entry)} reaches an RTS within the loop bounds")
     return Bounds(best=best[start], worst=worst[start], instructions=len(nodes))

@@ -1,430 +1,51 @@
-"""The collision routines: asm entry <-> reference function <-> input generators <-> valid domain.
-
-A case is a tuple of byte values in the order of the routine's `inputs` (zero-page aliases of its
-source, or the registers A, X, Y and the carry C); pixel cases carry a third item, the index of a
-mask pair in the run's world. A world is the memory a routine reads besides its inputs (screen
-codes and properties, sprite masks), chosen once per run from a seed so every worker sees the same.
-
-Input sets (`cases(routine, exhaustive, seed)`):
-- boundary: touching, one apart, overlapping by one, 0, 255/256, maximum sizes, screen edges;
-- exhaustive where the space is about 2^17 or less (mul8: all 65,536 products; tile: every 9-bit
-  X by every Y; pixel: every (dx, dy) per mask pair; circle: every pair of 8-bit deltas at the two
-  radii sums that bracket their distance), and exhaustive slices across each domain boundary;
-- random: RANDOM_FULL per routine with --exhaustive, RANDOM_BOUNDED otherwise.
+"""Routines by name or by spec file: the built-in ones are the spec files in asm/ (NAME.toml beside
+NAME.s), read by the same code as a user's spec. Adding a built-in routine is one source, one spec
+and one reference function; nothing here names a routine.
 """
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
-from functools import lru_cache
-from itertools import product
+from collections.abc import Iterable
 from pathlib import Path
 
-import numpy as np
-
-from retro.chips.vic.constants import SPRITE_HEIGHT
 from retro.errors import InputError
 from retro.paths import ASM_DIR
-from retro.routines import reference
-from retro.routines.screen import COLUMNS, ROWS, SPRITE_ROW_BYTES
+from retro.routines.spec import Routine, load_spec
 
-RANDOM_FULL = 100_000
-RANDOM_BOUNDED = 2_000
-BYTE = 256
+SPEC_SUFFIX = ".toml"
 
 
-@dataclass(frozen=True)
-class World:
-    screen: tuple[int, ...] = ()
-    props: tuple[int, ...] = ()
-    masks: tuple[tuple[bytes, bytes], ...] = ()
+def builtin_names() -> list[str]:
+    """The built-in routines, in the order `retro check` runs them (docs/routines.md's order)."""
+    names = sorted(p.stem for p in ASM_DIR.glob(f"*{SPEC_SUFFIX}"))
+    preferred = ["aabb8", "aabb_sprite", "circle", "mul8", "tile", "tile_box", "pixel"]
+    return [n for n in preferred if n in names] + [n for n in names if n not in preferred]
 
 
-@dataclass(frozen=True)
-class Routine:
-    name: str  # entry label in asm/NAME.s, and the name the CLI uses
-    inputs: tuple[str, ...]  # zero-page aliases or registers (A, X, Y, C = carry), in case order
-    output: str  # "carry", "a" or "product" (X low, A high)
-    reference: Callable[[tuple, World], int]
-    boundary: Callable[[], list[tuple]]
-    random: Callable[[np.random.Generator, int], list[tuple]]
-    exhaustive: Callable[[], Iterable[tuple]] | None = None
-    domain: tuple[tuple[str, Callable[[tuple], bool]], ...] = ()
-    summary: str = ""
-    init: str | None = None
-    loop_bounds: dict[str, int] = field(default_factory=dict)
-    world: Callable[[np.random.Generator], World] = lambda rng: World()
+def is_spec_path(text: str) -> bool:
+    return text.lower().endswith(SPEC_SUFFIX) or "/" in text or "\\" in text
 
-    @property
-    def source(self) -> Path:
-        return ASM_DIR / f"{self.name}.s"
 
-    def in_domain(self, case: tuple) -> bool:
-        return all(rule(case) for _, rule in self.domain)
+def spec_path(name_or_path: str) -> Path:
+    """The spec file of a built-in name, or the path as given."""
+    if is_spec_path(name_or_path):
+        return Path(name_or_path)
+    path = ASM_DIR / f"{name_or_path}{SPEC_SUFFIX}"
+    if not path.is_file():
+        known = ", ".join(builtin_names())
+        raise InputError(f"unknown routine {name_or_path!r} (built-in: {known}; or give a spec file NAME.toml)")
+    return path
 
 
-# ---- shared generators ----------------------------------------------------------------------
+def get(name_or_path: str) -> Routine:
+    return load_spec(spec_path(name_or_path))
 
-def _interval_configs() -> list[tuple[int, int, int, int]]:
-    """(a, aw, b, bw) on one axis: touching, one apart, overlapping by one, nested, 0/255 ends."""
-    configs = []
-    for a, aw in ((0, 1), (10, 8), (100, 24), (200, 55), (250, 5), (230, 26), (255, 1), (128, 127), (0, 255)):
-        for b in {a - 2, a - 1, a, a + 1, a + aw - 2, a + aw - 1, a + aw, a + aw + 1}:
-            for bw in (1, 2, 8, 255, a + aw - b if a + aw > b else 1, max(a - b, 1), max(a - b + 1, 1)):
-                if 0 <= b <= 255 and 0 <= bw <= 255:
-                    configs.append((a, aw, b, bw))
-    return sorted(set(configs))
 
-
-def _axis_pairs(limit: int) -> list[tuple[tuple, tuple]]:
-    configs = _interval_configs()
-    rng = np.random.default_rng(5)
-    picked = [configs[i] for i in rng.choice(len(configs), size=min(limit, len(configs)), replace=False)]
-    return [(x, y) for x in picked for y in picked[: max(1, limit // 4)]]
-
-
-def _bytes(rng: np.random.Generator, n: int, columns: int) -> np.ndarray:
-    return rng.integers(0, BYTE, size=(n, columns))
-
-
-# ---- aabb8 -----------------------------------------------------------------------------------
-
-def _aabb8_reference(case: tuple, world: World) -> int:
-    return int(reference.aabb8(*case))
-
-
-def _aabb8_boundary() -> list[tuple]:
-    out = []
-    for (ax, aw, bx, bw), (ay, ah, by, bh) in _axis_pairs(60):
-        out.append((ax, ay, aw, ah, bx, by, bw, bh))
-        out.append((bx, by, bw, bh, ax, ay, aw, ah))
-    for size in (0, 1):
-        out.append((10, 10, size, 5, 10, 10, 5, 5))
-        out.append((10, 10, 5, 5, 12, 10, size, 5))
-        out.append((10, 10, 5, size, 10, 12, 5, 5))
-        out.append((10, 12, 5, 5, 10, 10, 5, size))
-    return out
-
-
-def _aabb8_random(rng: np.random.Generator, n: int) -> list[tuple]:
-    cases = _bytes(rng, n, 8)
-    near = rng.random(n) < 0.5  # half the cases: b placed near a, so overlaps are common
-    cases[near, 4] = (cases[near, 0] + rng.integers(-40, 40, size=near.sum())) % BYTE
-    cases[near, 5] = (cases[near, 1] + rng.integers(-40, 40, size=near.sum())) % BYTE
-    small = rng.random(n) < 0.5
-    cases[small, 2:4] = rng.integers(0, 48, size=(small.sum(), 2))
-    cases[small, 6:8] = rng.integers(0, 48, size=(small.sum(), 2))
-    return [tuple(int(v) for v in row) for row in cases]
-
-
-def _aabb8_exhaustive() -> Iterable[tuple]:
-    """Every (ax, aw) against boxes placed across the 255/256 end, and every (ay, ah) likewise."""
-    for bx, bw in ((0, 1), (120, 16), (250, 6)):
-        for ax in range(BYTE):
-            for aw in range(BYTE):
-                yield (ax, 10, aw, 5, bx, 8, bw, 5)
-    for by, bh in ((0, 1), (250, 6)):
-        for ay in range(BYTE):
-            for ah in range(BYTE):
-                yield (10, ay, 5, ah, 8, by, 5, bh)
-
-
-# ---- aabb_sprite -------------------------------------------------------------------------------
-
-def _aabb_sprite_reference(case: tuple, world: World) -> int:
-    return int(reference.aabb_sprite(*case))
-
-
-def _sprite_case(x1: int, y1: int, box1: tuple, x2: int, y2: int, box2: tuple) -> tuple:
-    return (x1 & 0xFF, x1 >> 8, y1, *box1, x2 & 0xFF, x2 >> 8, y2, *box2)
-
-
-def _aabb_sprite_boundary() -> list[tuple]:
-    out = []
-    boxes = ((0, 0, 24, 21), (4, 3, 16, 15), (23, 20, 1, 1), (0, 0, 48, 42), (10, 0, 1, 21))
-    for box1, box2 in product(boxes, repeat=2):
-        for x1 in (0, 24, 240, 250, 255, 256, 257, 300, 343, 488, 511):
-            right1 = x1 + box1[0] + box1[2]
-            for x2 in {right1 - box2[0] - 1, right1 - box2[0], right1 - box2[0] + 1,
-                       x1 + box1[0] - box2[0] - box2[2], x1 + box1[0] - box2[0] - box2[2] + 1, x1}:
-                if 0 <= x2 < 512:
-                    out.append(_sprite_case(x1, 100, box1, x2, 100, box2))
-        for y1 in (0, 50, 200, 240, 255):
-            bottom1 = y1 + box1[1] + box1[3]
-            for y2 in {bottom1 - box2[1] - 1, bottom1 - box2[1], y1 + box1[1] - box2[1] - box2[3], y1}:
-                if 0 <= y2 < BYTE:
-                    out.append(_sprite_case(300, y1, box1, 300, y2, box2))
-    return out
-
-
-def _aabb_sprite_random(rng: np.random.Generator, n: int) -> list[tuple]:
-    x1 = rng.integers(0, 512, size=n)
-    x2 = np.where(rng.random(n) < 0.6, (x1 + rng.integers(-48, 48, size=n)) % 512, rng.integers(0, 512, size=n))
-    y1 = rng.integers(0, BYTE, size=n)
-    y2 = np.where(rng.random(n) < 0.6, (y1 + rng.integers(-42, 42, size=n)) % BYTE, rng.integers(0, BYTE, size=n))
-    small = rng.random(n) < 0.7
-    boxes = np.where(small[:, None], rng.integers(0, 48, size=(n, 8)), rng.integers(0, BYTE, size=(n, 8)))
-    out = []
-    for i in range(n):
-        b = [int(v) for v in boxes[i]]
-        out.append(_sprite_case(int(x1[i]), int(y1[i]), tuple(b[:4]), int(x2[i]), int(y2[i]), tuple(b[4:])))
-    return out
-
-
-def _aabb_sprite_exhaustive() -> Iterable[tuple]:
-    """Every pair of 9-bit X positions with two fixed hitboxes (the 255/256 boundary included)."""
-    for x1 in range(512):
-        for x2 in range(512):
-            yield _sprite_case(x1, 100, (4, 3, 16, 15), x2, 104, (0, 0, 24, 21))
-
-
-# ---- circle ------------------------------------------------------------------------------------
-
-def _circle_reference(case: tuple, world: World) -> int:
-    return int(reference.circle(*case))
-
-
-def _circle_case(dx: int, dy: int, radius_sum: int, cx: int = 0, cy: int = 0) -> tuple:
-    x1, x2 = (dx, 0) if dx >= 0 else (0, -dx)
-    y1, y2 = (dy, 0) if dy >= 0 else (0, -dy)
-    r1 = radius_sum // 2
-    r2 = radius_sum - r1
-    return (x1, y1, min(r1, 255), x2, y2, min(r2, 255))
-
-
-def _circle_boundary() -> list[tuple]:
-    out = []
-    for dx, dy in ((0, 0), (3, 4), (-3, 4), (3, -4), (-3, -4), (255, 0), (0, 255), (-255, 0), (0, -255),
-                   (255, 255), (-255, -255), (180, 180), (-181, 180), (1, 0), (0, -1), (127, 128)):
-        distance = math.isqrt(dx * dx + dy * dy)
-        for radius_sum in {0, 1, distance, distance + 1, 254, 255, 256, 300, 510}:
-            out.append(_circle_case(dx, dy, radius_sum))
-    return out
-
-
-def _circle_random(rng: np.random.Generator, n: int) -> list[tuple]:
-    cases = _bytes(rng, n, 6)
-    tight = rng.random(n) < 0.5  # half: radius sum at the distance, where the answer flips
-    for i in np.flatnonzero(tight):
-        x1, y1, _, x2, y2, _ = (int(v) for v in cases[i])
-        radius_sum = math.isqrt((x1 - x2) ** 2 + (y1 - y2) ** 2) + int(rng.integers(0, 2))
-        if radius_sum <= 255:
-            cases[i, 2] = radius_sum // 2
-            cases[i, 5] = radius_sum - radius_sum // 2
-    return [tuple(int(v) for v in row) for row in cases]
-
-
-def _circle_exhaustive() -> Iterable[tuple]:
-    """Every pair of 8-bit deltas (both signs) at the radius sums just below and at its distance,
-    where reachable (<= 255); then every radius pair at a few deltas (the radius domain)."""
-    for dx in range(-255, 256):
-        for dy in range(-255, 256):
-            distance_ceiling = math.isqrt(dx * dx + dy * dy - 1) + 1 if dx or dy else 0
-            for radius_sum in (distance_ceiling, distance_ceiling + 1):
-                if radius_sum <= 255:
-                    yield _circle_case(dx, dy, radius_sum)
-    for dx, dy in ((0, 0), (200, 100), (-255, -255)):
-        for r1 in range(BYTE):
-            for r2 in range(0, BYTE, 3):
-                case = _circle_case(dx, dy, 0)
-                yield (case[0], case[1], r1, case[3], case[4], r2)
-
-
-# ---- mul8 ----------------------------------------------------------------------------------------
-
-def _mul8_boundary() -> list[tuple]:
-    values = (0, 1, 2, 127, 128, 129, 254, 255)
-    return list(product(values, repeat=2))
-
-
-def _mul8_random(rng: np.random.Generator, n: int) -> list[tuple]:
-    return [tuple(int(v) for v in row) for row in _bytes(rng, n, 2)]
-
-
-def _mul8_exhaustive() -> Iterable[tuple]:
-    return product(range(BYTE), repeat=2)
-
-
-# ---- tile and tile_box ---------------------------------------------------------------------------
-
-def _screen_world(rng: np.random.Generator) -> World:
-    return World(screen=tuple(int(v) for v in rng.integers(0, BYTE, size=COLUMNS * ROWS)),
-                 props=tuple(int(v) for v in rng.integers(0, BYTE, size=BYTE)))
-
-
-def _tile_reference(case: tuple, world: World) -> int:
-    return int(reference.tile(*case, world.screen, world.props))
-
-
-_EDGE_X = (0, 23, 24, 25, 31, 32, 255, 256, 343, 344, 345, 511)
-_EDGE_Y = (0, 49, 50, 51, 57, 58, 249, 250, 251, 255)
-
-
-def _tile_boundary() -> list[tuple]:
-    return [(x & 0xFF, x >> 8, y) for x in _EDGE_X for y in _EDGE_Y]
-
-
-def _tile_random(rng: np.random.Generator, n: int) -> list[tuple]:
-    x = rng.integers(0, 512, size=n)
-    y = rng.integers(0, BYTE, size=n)
-    return [(int(a) & 0xFF, int(a) >> 8, int(b)) for a, b in zip(x, y)]
-
-
-def _tile_exhaustive() -> Iterable[tuple]:
-    return ((x & 0xFF, x >> 8, y) for x in range(512) for y in range(BYTE))
-
-
-def _tile_box_reference(case: tuple, world: World) -> int:
-    x, xh, y, w, h = case
-    return reference.tile_box(x, xh, y, w, h, world.screen, world.props)
-
-
-def _tile_box_boundary() -> list[tuple]:
-    out = []
-    for x in _EDGE_X:
-        for y in _EDGE_Y:
-            for w, h in ((0, 5), (5, 0), (1, 1), (8, 8), (9, 9), (24, 21), (255, 255)):
-                out.append((x & 0xFF, x >> 8, y, w, h))
-    return out
-
-
-def _tile_box_random(rng: np.random.Generator, n: int) -> list[tuple]:
-    x = rng.integers(0, 512, size=n)
-    y = rng.integers(0, BYTE, size=n)
-    small = rng.random(n) < 0.8
-    w = np.where(small, rng.integers(0, 33, size=n), rng.integers(0, BYTE, size=n))
-    h = np.where(small, rng.integers(0, 33, size=n), rng.integers(0, BYTE, size=n))
-    return [(int(a) & 0xFF, int(a) >> 8, int(b), int(c), int(d)) for a, b, c, d in zip(x, y, w, h)]
-
-
-def _tile_box_exhaustive() -> Iterable[tuple]:
-    """Every 9-bit X and every Y for a sprite-sized box; every width at a few heights and back."""
-    for x in range(512):
-        for y in range(0, BYTE):
-            yield (x & 0xFF, x >> 8, y, 24, 21)
-    for size in range(BYTE):
-        for other in (0, 1, 8, 21, 255):
-            yield (20, 0, 45, size, other)
-            yield (20, 0, 45, other, size)
-
-
-# ---- pixel ---------------------------------------------------------------------------------------
-
-MASK_BYTES = SPRITE_HEIGHT * SPRITE_ROW_BYTES
-
-
-def _pixel_world(rng: np.random.Generator) -> World:
-    full = bytes([0xFF] * MASK_BYTES)
-    dot = bytearray(MASK_BYTES)
-    dot[10 * 3 + 1] = 0x10  # one pixel near the middle
-    corner = bytearray(MASK_BYTES)
-    corner[0] = 0x80
-    corner[-1] = 0x01
-    ring = bytearray(MASK_BYTES)
-    for row in range(SPRITE_HEIGHT):
-        for col in range(24):
-            if 7 <= math.hypot(col - 11.5, row - 10) < 10:
-                ring[row * 3 + col // 8] |= 0x80 >> (col % 8)
-    masks = [(full, full), (bytes(dot), full), (bytes(corner), bytes(corner)), (bytes(ring), bytes(dot)),
-             (bytes(ring), bytes(ring))]
-    for density in (0.02, 0.1, 0.5):
-        for _ in range(4):
-            a = np.packbits(rng.random((SPRITE_HEIGHT, 24)) < density, axis=1).tobytes()
-            b = np.packbits(rng.random((SPRITE_HEIGHT, 24)) < density, axis=1).tobytes()
-            masks.append((a, b))
-    return World(masks=tuple(masks))
-
-
-def _signed(value: int) -> int:
-    return value - BYTE if value & 0x80 else value
-
-
-def _pixel_reference(case: tuple, world: World) -> int:
-    dx, dy, pair = case
-    a, b = world.masks[pair]
-    return int(reference.pixel(_signed(dx), _signed(dy), reference.mask_bits(a), reference.mask_bits(b)))
-
-
-def _pixel_boundary() -> list[tuple]:
-    offsets = (-128, -25, -24, -23, -22, -8, -1, 0, 1, 7, 8, 9, 16, 22, 23, 24, 127)
-    return [(dx & 0xFF, dy & 0xFF, pair) for pair in range(5) for dx in offsets for dy in offsets if abs(dy) <= 25 or dx == 0]
-
-
-def _pixel_random(rng: np.random.Generator, n: int) -> list[tuple]:
-    dx = rng.integers(-26, 27, size=n)
-    dy = rng.integers(-23, 24, size=n)
-    pair = rng.integers(0, 17, size=n)
-    return [(int(a) & 0xFF, int(b) & 0xFF, int(c)) for a, b, c in zip(dx, dy, pair)]
-
-
-def _pixel_exhaustive() -> Iterable[tuple]:
-    for pair in (0, 3, 8):
-        for dx in range(BYTE):
-            for dy in range(BYTE):
-                yield (dx, dy, pair)
-
-
-# ---- the registry -------------------------------------------------------------------------------
-
-ROUTINES: dict[str, Routine] = {r.name: r for r in (
-    Routine("aabb8", ("A", "X", "aw", "ah", "bx", "by", "bw", "bh"), "carry", _aabb8_reference,  # ax in A, ay in X
-            _aabb8_boundary, _aabb8_random, _aabb8_exhaustive,
-            domain=(("aw >= 1", lambda c: c[2] >= 1), ("ah >= 1", lambda c: c[3] >= 1),
-                    ("bw >= 1", lambda c: c[6] >= 1), ("bh >= 1", lambda c: c[7] >= 1)),
-            summary="two 8-bit boxes share a pixel (carry)"),
-    Routine("aabb_sprite", ("x1", "X", "y1", "ox1", "oy1", "w1", "h1", "A", "C", "Y", "ox2", "oy2", "w2", "h2"),
-            "carry", _aabb_sprite_reference, _aabb_sprite_boundary, _aabb_sprite_random, _aabb_sprite_exhaustive,
-            domain=(("x1h <= 1", lambda c: c[1] <= 1), ("x2h <= 1", lambda c: c[8] <= 1),
-                    ("w1 >= 1", lambda c: c[5] >= 1), ("h1 >= 1", lambda c: c[6] >= 1),
-                    ("w2 >= 1", lambda c: c[12] >= 1), ("h2 >= 1", lambda c: c[13] >= 1)),
-            summary="two sprite hitboxes, 9-bit X, offsets inside the sprite (carry)"),
-    Routine("circle", ("A", "y1", "X", "x2", "y2", "r2"), "carry", _circle_reference,
-            _circle_boundary, _circle_random, _circle_exhaustive,
-            domain=(("r1 + r2 <= 255", lambda c: c[2] + c[5] <= 255),),
-            summary="two circles by squared distance against (r1+r2)^2 (carry)"),
-    Routine("mul8", ("A", "Y"), "product", lambda c, w: int(reference.mul8(*c)),
-            _mul8_boundary, _mul8_random, _mul8_exhaustive, init="mul8_init",
-            summary="unsigned 8x8 -> 16 product (X low, A high)"),
-    Routine("tile", ("X", "C", "Y"), "a", _tile_reference, _tile_boundary, _tile_random, _tile_exhaustive,
-            domain=(("x high bit <= 1", lambda c: c[1] <= 1),), world=_screen_world,
-            summary="property byte of the screen cell under a point (A)"),
-    Routine("tile_box", ("bx", "bxh", "by", "bw", "bh"), "a", _tile_box_reference, _tile_box_boundary,
-            _tile_box_random, _tile_box_exhaustive,
-            domain=(("x high bit <= 1", lambda c: c[1] <= 1), ("w >= 1", lambda c: c[3] >= 1),
-                    ("h >= 1", lambda c: c[4] >= 1)),
-            loop_bounds={"_row": ROWS, "_col": COLUMNS}, world=_screen_world,
-            summary="OR of the properties of every screen cell a box touches (A)"),
-    Routine("pixel", ("pdx", "pdy"), "carry", _pixel_reference, _pixel_boundary, _pixel_random, _pixel_exhaustive,
-            loop_bounds={"_row": SPRITE_HEIGHT, "_byte": SPRITE_ROW_BYTES}, world=_pixel_world,
-            summary="software pixel-perfect test of two 24x21 masks (carry)"),
-)}
-
-
-def get(name: str) -> Routine:
-    try:
-        return ROUTINES[name]
-    except KeyError:
-        raise InputError(f"unknown routine {name!r} (known: {', '.join(ROUTINES)})") from None
-
-
-def select(names: Iterable[str] | None) -> list[Routine]:
-    names = list(dict.fromkeys(names or []))  # each routine once, in the order first named
-    return [get(n) for n in names] if names else list(ROUTINES.values())
-
-
-def cases(routine: Routine, *, exhaustive: bool, seed: int = 0, random_count: int | None = None) -> list[tuple]:
-    """The inputs a check runs: boundary, then exhaustive (with --exhaustive), then random."""
-    rng = np.random.default_rng(seed)
-    out = list(routine.boundary())
-    if exhaustive and routine.exhaustive is not None:
-        out.extend(routine.exhaustive())
-    count = random_count if random_count is not None else (RANDOM_FULL if exhaustive else RANDOM_BOUNDED)
-    out.extend(routine.random(rng, count))
-    return out
-
-
-@lru_cache(maxsize=None)
-def world_for(name: str, seed: int = 0) -> World:
-    return get(name).world(np.random.default_rng(seed + 1))
+def select(names: Iterable[str] | None) -> list[str]:
+    """Spec paths of the named routines (all built-ins when none are named), each once, in the order
+    first named; every name is checked before any work starts."""
+    names = list(dict.fromkeys(names or [])) or builtin_names()
+    paths = [str(spec_path(n)) for n in names]
+    for path in paths:
+        load_spec(path)
+    return list(dict.fromkeys(paths))

@@ -1,13 +1,13 @@
-"""Shared fixtures for the routine tests: one loaded runner per routine for the whole session."""
+"""Shared fixtures for the routine tests: one loaded runner per built-in routine for the whole session."""
 
 from __future__ import annotations
 
 import pytest
 
-from retro.routines.harness import RoutineRunner
-from retro.routines.registry import ROUTINES, world_for
+from retro.routines.registry import builtin_names, get
+from retro.routines.runner import RoutineRunner
 
 
 @pytest.fixture(scope="session")
 def runners() -> dict[str, RoutineRunner]:
-    return {name: RoutineRunner(routine, world_for(name)) for name, routine in ROUTINES.items()}
+    return {name: RoutineRunner(get(name)) for name in builtin_names()}

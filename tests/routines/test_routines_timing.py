@@ -46,8 +46,9 @@ def test_call_fast_equals_call(runners):
     runner = runners["circle"]
     machine = runner.machine
     for case in ((10, 20, 5, 14, 23, 1), (0, 0, 0, 255, 255, 255), (200, 3, 40, 190, 60, 30)):
-        writes = [(address, case[i]) for address, i in zip(runner.addresses, runner.zero_page_slots)]
-        registers = {name.lower(): case[i] for name, i in runner.register_slots.items()}  # x1 in A, r1 in X
+        writes, registers, _ = runner.inputs_for_call(case)
+        assert registers == {"a": case[0], "x": case[2], "y": 0}  # x1 in A, r1 in X (asm/circle.toml)
+        assert writes == [(0x11, case[1]), (0x13, case[3]), (0x14, case[4]), (0x15, case[5])]
         fast = machine.call_fast(runner.entry, writes, **registers)
         slow = machine.call(runner.entry, memory={address: [value] for address, value in writes}, **registers)
         assert fast == (slow.cycles, slow.a, slow.x, slow.y, slow.p)

@@ -2,7 +2,7 @@
 
 An adapter knows its source file and entry and what its cycle figure counts; its session turns case
 `index` of a pair into the routine's logical case (the reference's argument order) and runs it
-through the registry's RoutineRunner, which alone knows the calling conventions, returning
+through a RoutineRunner on the routine's spec (asm/NAME.toml), which alone knows the calling conventions, returning
 (routine's answer, the study's verdict for that case, cycles).
 """
 
@@ -76,28 +76,27 @@ def _opacity_bytes(shape) -> bytes:
     return encode(shape.mask.astype("uint8"))
 
 
-# ---- issue 5's routines (asm/), called through their registry entries -------------------------
-# The registry (retro/routines/registry.py) knows each routine's calling convention; the study only
+# ---- issue 5's routines (asm/), called through their specs ---------------------------------------
+# Each spec (asm/NAME.toml) holds the routine's calling convention; the study only
 # builds the logical case (the reference's argument order) and lets RoutineRunner pass it.
 
 
-def routine_runner(name: str, world=None):
-    """A loaded RoutineRunner for the routine `name` (an empty world unless given)."""
-    from retro.routines.harness import RoutineRunner
-    from retro.routines.registry import World, get
+def routine_runner(name: str):
+    """A loaded RoutineRunner for the built-in routine `name` (its spec in asm/)."""
+    from retro.routines.registry import get
+    from retro.routines.runner import RoutineRunner
 
-    return RoutineRunner(get(name), world if world is not None else World())
+    return RoutineRunner(get(name))
 
 
 class _Issue5Session(Session):
     def __init__(self, pair: Pair, adapter: "Issue5Adapter") -> None:
         from retro.analysis.study.methods import method
-        from retro.routines.registry import World
 
         self.pair = pair
         self.key = adapter.key
-        world = World(masks=((_opacity_bytes(pair.a), _opacity_bytes(pair.b)),)) if self.key == "pixel" else None
-        self.runner = routine_runner(adapter.routine, world)
+        self.masks = (tuple(_opacity_bytes(pair.a)), tuple(_opacity_bytes(pair.b))) if self.key == "pixel" else ()
+        self.runner = routine_runner(adapter.routine)
         self.verdict = method(self.key).verdict(pair)
 
     def run(self, index: int) -> tuple[bool, bool, int]:
@@ -114,9 +113,9 @@ class _Issue5Session(Session):
         elif self.key == "circle":
             ca, cb = fitted_circle(pair.a.mask, CIRCLE_TOUCHING_HITS), fitted_circle(pair.b.mask, CIRCLE_TOUCHING_HITS)
             case = (ORIGIN + ca.cx, ORIGIN + ca.cy, ca.r, ORIGIN + dx + cb.cx, ORIGIN + dy + cb.cy, cb.r)
-        else:  # pixel: the offset as two's-complement bytes, and the world's only mask pair
-            case = (dx & 0xFF, dy & 0xFF, 0)
-        answer, cycles = self.runner.run(case)
+        else:  # pixel: the offset as two's-complement bytes, and the pair's opacity masks
+            case = (dx & 0xFF, dy & 0xFF, *self.masks)
+        (answer,), cycles = self.runner.run(case)
         return bool(answer), bool(self.verdict[index]), cycles
 
 
@@ -129,12 +128,13 @@ class _TileBoxSession(Session):
 
     def __init__(self, pair: Pair, adapter: "Issue5Adapter") -> None:
         from retro.routines import screen
-        from retro.routines.registry import World
 
         self.pair, self.screen = pair, screen
         props = [0] * 256
         props[self.MARK] = self.MARK
-        self.runner = routine_runner(adapter.routine, World(props=tuple(props)))
+        self.runner = routine_runner(adapter.routine)
+        self.runner.set_memory("screen", [0] * (screen.COLUMNS * screen.ROWS))
+        self.runner.set_memory("props", props)
         self.marked: list[int] = []
 
     def run(self, index: int) -> tuple[bool, bool, int]:
@@ -156,7 +156,7 @@ class _TileBoxSession(Session):
             memory[address] = self.MARK
         x = s.SPRITE_X_AT_COLUMN_0 + ox + dx + bx0
         y = s.SPRITE_Y_AT_ROW_0 + oy + dy + by0
-        answer, cycles = self.runner.run((x & 0xFF, x >> 8, y, bx1 - bx0, by1 - by0))
+        (answer,), cycles = self.runner.run((x & 0xFF, x >> 8, y, bx1 - bx0, by1 - by0))
         b_cells = {(c, r) for r in range((oy + dy + by0) // s.CELL_PIXELS, (oy + dy + by1 - 1) // s.CELL_PIXELS + 1)
                    for c in range((ox + dx + bx0) // s.CELL_PIXELS, (ox + dx + bx1 - 1) // s.CELL_PIXELS + 1)}
         return answer != 0, bool(a_cells & b_cells), cycles

@@ -38,10 +38,10 @@ def range_rows(reduced: bool = False, progress=None) -> list[RangeRow]:
     for check in run_checks(None, exhaustive=not reduced, random_count=RANGE_RANDOM_CASES[reduced],
                             progress=progress):
         t = check.totals
-        stated = " and ".join(name for name, _ in check.routine.domain) or "every input"
+        stated = " and ".join(c.text for c in check.routine.domain) or "every input"
         rows.append(RangeRow(check.routine.name, f"inside the stated domain ({stated})", t.cases - t.outside,
                              t.result_mismatches, "exact" if t.result_mismatches == 0 else "WRONG inside the domain"))
-        for name, _ in check.routine.domain:
+        for name in (c.text for c in check.routine.domain):
             broken, wrong = t.constraint_cases.get(name, 0), t.constraint_wrong.get(name, 0)
             verdict = ("needed: the routine is wrong there" if wrong else
                        "no wrong answer among these cases" if broken else "no case breaks it")
@@ -64,10 +64,10 @@ def wrap_routine_rows(reduced: bool = False) -> list[WrapRoutineRow]:
     # oy1, w1, h1, x2 low, x2 bit 8, y2, ox2, oy2, w2, h2)
     windows = [
         ("aabb8", "x = 200..255 (x + 24 up to 279), w = 24", range(200, 256, step),
-         lambda a, b: aabb8.run((a, 0, WRAP_W, 8, b, 0, WRAP_W, 8))[0]),
+         lambda a, b: aabb8.answer((a, 0, WRAP_W, 8, b, 0, WRAP_W, 8))),
         ("aabb_sprite", "9-bit X = 220..299 across 255/256, full 24x21 hitboxes", range(220, 300, step),
-         lambda a, b: aabb_sprite.run((a & 0xFF, a >> 8, 100, 0, 0, WRAP_W, 21,
-                                       b & 0xFF, b >> 8, 100, 0, 0, WRAP_W, 21))[0]),
+         lambda a, b: aabb_sprite.answer((a & 0xFF, a >> 8, 100, 0, 0, WRAP_W, 21,
+                                          b & 0xFF, b >> 8, 100, 0, 0, WRAP_W, 21))),
     ]
     rows = []
     for routine, inputs, xs, call in windows:

@@ -1,6 +1,6 @@
 """The 6502 routines' answers on the edge-convention cases (issue 5's asm/aabb8.s, asm/circle.s).
 
-Calls go through the routine registry (logical cases in the reference's argument order), so the
+Calls go through the routines' specs (logical cases in the reference's argument order), so the
 calling conventions live in one place.
 """
 
@@ -17,7 +17,7 @@ def box_tests(width: int, height: int) -> dict[str, Callable[[int], bool]]:
     runner = routine_runner("aabb8")
 
     def test(dx: int) -> bool:
-        return bool(runner.run((BASE, BASE, width, height, BASE + dx, BASE, width, height))[0])
+        return bool(runner.answer((BASE, BASE, width, height, BASE + dx, BASE, width, height)))
     return {"6502 aabb8": test}
 
 
@@ -27,5 +27,5 @@ def circle_tests(radius: int) -> dict[str, Callable[[int, int], bool]]:
     runner = routine_runner("circle")
 
     def test(dx: int, dy: int) -> bool:
-        return bool(runner.run((BASE, BASE, radius, BASE + dx, BASE + dy, radius))[0])
+        return bool(runner.answer((BASE, BASE, radius, BASE + dx, BASE + dy, radius)))
     return {"6502 circle": test}

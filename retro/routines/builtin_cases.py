@@ -1,0 +1,309 @@
+"""Case generators of the seven built-in routines (asm/*.toml name them as `boundary`, `sweep` and
+`random_generator`), and the adapters their specs need.
+
+Cases are tuples in each spec's input order (the reference's argument order):
+- boundary: touching, one apart, overlapping by one, 0, 255/256, maximum sizes, screen edges;
+- sweep (with --exhaustive): mul8 every product; tile every 9-bit X by every Y; pixel every (dx, dy)
+  for three mask pairs; circle every pair of 8-bit deltas at the two radius sums that bracket their
+  distance; exhaustive slices across each domain boundary for the others;
+- random: distributions that put half the cases near the answer's edge.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from functools import lru_cache
+from itertools import product
+
+import numpy as np
+
+from retro.chips.vic.constants import SPRITE_HEIGHT, SPRITE_WIDTH
+from retro.routines import reference
+from retro.routines.screen import SPRITE_ROW_BYTES
+
+BYTE = 256
+MASK_BYTES = SPRITE_HEIGHT * SPRITE_ROW_BYTES
+
+
+# ---- shared generators ----------------------------------------------------------------------
+
+def _interval_configs() -> list[tuple[int, int, int, int]]:
+    """(a, aw, b, bw) on one axis: touching, one apart, overlapping by one, nested, 0/255 ends."""
+    configs = []
+    for a, aw in ((0, 1), (10, 8), (100, 24), (200, 55), (250, 5), (230, 26), (255, 1), (128, 127), (0, 255)):
+        for b in {a - 2, a - 1, a, a + 1, a + aw - 2, a + aw - 1, a + aw, a + aw + 1}:
+            for bw in (1, 2, 8, 255, a + aw - b if a + aw > b else 1, max(a - b, 1), max(a - b + 1, 1)):
+                if 0 <= b <= 255 and 0 <= bw <= 255:
+                    configs.append((a, aw, b, bw))
+    return sorted(set(configs))
+
+
+def _axis_pairs(limit: int) -> list[tuple[tuple, tuple]]:
+    configs = _interval_configs()
+    rng = np.random.default_rng(5)
+    picked = [configs[i] for i in rng.choice(len(configs), size=min(limit, len(configs)), replace=False)]
+    return [(x, y) for x in picked for y in picked[: max(1, limit // 4)]]
+
+
+def _bytes(rng: np.random.Generator, n: int, columns: int) -> np.ndarray:
+    return rng.integers(0, BYTE, size=(n, columns))
+
+
+# ---- aabb8 -----------------------------------------------------------------------------------
+
+def aabb8_boundary() -> list[tuple]:
+    out = []
+    for (ax, aw, bx, bw), (ay, ah, by, bh) in _axis_pairs(60):
+        out.append((ax, ay, aw, ah, bx, by, bw, bh))
+        out.append((bx, by, bw, bh, ax, ay, aw, ah))
+    for size in (0, 1):
+        out.append((10, 10, size, 5, 10, 10, 5, 5))
+        out.append((10, 10, 5, 5, 12, 10, size, 5))
+        out.append((10, 10, 5, size, 10, 12, 5, 5))
+        out.append((10, 12, 5, 5, 10, 10, 5, size))
+    return out
+
+
+def aabb8_random(rng: np.random.Generator, n: int) -> list[tuple]:
+    cases = _bytes(rng, n, 8)
+    near = rng.random(n) < 0.5  # half the cases: b placed near a, so overlaps are common
+    cases[near, 4] = (cases[near, 0] + rng.integers(-40, 40, size=near.sum())) % BYTE
+    cases[near, 5] = (cases[near, 1] + rng.integers(-40, 40, size=near.sum())) % BYTE
+    small = rng.random(n) < 0.5
+    cases[small, 2:4] = rng.integers(0, 48, size=(small.sum(), 2))
+    cases[small, 6:8] = rng.integers(0, 48, size=(small.sum(), 2))
+    return [tuple(int(v) for v in row) for row in cases]
+
+
+def aabb8_sweep() -> Iterable[tuple]:
+    """Every (ax, aw) against boxes placed across the 255/256 end, and every (ay, ah) likewise."""
+    for bx, bw in ((0, 1), (120, 16), (250, 6)):
+        for ax in range(BYTE):
+            for aw in range(BYTE):
+                yield (ax, 10, aw, 5, bx, 8, bw, 5)
+    for by, bh in ((0, 1), (250, 6)):
+        for ay in range(BYTE):
+            for ah in range(BYTE):
+                yield (10, ay, 5, ah, 8, by, 5, bh)
+
+
+# ---- aabb_sprite -------------------------------------------------------------------------------
+
+def _sprite_case(x1: int, y1: int, box1: tuple, x2: int, y2: int, box2: tuple) -> tuple:
+    return (x1 & 0xFF, x1 >> 8, y1, *box1, x2 & 0xFF, x2 >> 8, y2, *box2)
+
+
+def aabb_sprite_boundary() -> list[tuple]:
+    out = []
+    boxes = ((0, 0, 24, 21), (4, 3, 16, 15), (23, 20, 1, 1), (0, 0, 48, 42), (10, 0, 1, 21))
+    for box1, box2 in product(boxes, repeat=2):
+        for x1 in (0, 24, 240, 250, 255, 256, 257, 300, 343, 488, 511):
+            right1 = x1 + box1[0] + box1[2]
+            for x2 in {right1 - box2[0] - 1, right1 - box2[0], right1 - box2[0] + 1,
+                       x1 + box1[0] - box2[0] - box2[2], x1 + box1[0] - box2[0] - box2[2] + 1, x1}:
+                if 0 <= x2 < 512:
+                    out.append(_sprite_case(x1, 100, box1, x2, 100, box2))
+        for y1 in (0, 50, 200, 240, 255):
+            bottom1 = y1 + box1[1] + box1[3]
+            for y2 in {bottom1 - box2[1] - 1, bottom1 - box2[1], y1 + box1[1] - box2[1] - box2[3], y1}:
+                if 0 <= y2 < BYTE:
+                    out.append(_sprite_case(300, y1, box1, 300, y2, box2))
+    return out
+
+
+def aabb_sprite_random(rng: np.random.Generator, n: int) -> list[tuple]:
+    x1 = rng.integers(0, 512, size=n)
+    x2 = np.where(rng.random(n) < 0.6, (x1 + rng.integers(-48, 48, size=n)) % 512, rng.integers(0, 512, size=n))
+    y1 = rng.integers(0, BYTE, size=n)
+    y2 = np.where(rng.random(n) < 0.6, (y1 + rng.integers(-42, 42, size=n)) % BYTE, rng.integers(0, BYTE, size=n))
+    small = rng.random(n) < 0.7
+    boxes = np.where(small[:, None], rng.integers(0, 48, size=(n, 8)), rng.integers(0, BYTE, size=(n, 8)))
+    out = []
+    for i in range(n):
+        b = [int(v) for v in boxes[i]]
+        out.append(_sprite_case(int(x1[i]), int(y1[i]), tuple(b[:4]), int(x2[i]), int(y2[i]), tuple(b[4:])))
+    return out
+
+
+def aabb_sprite_sweep() -> Iterable[tuple]:
+    """Every pair of 9-bit X positions with two fixed hitboxes (the 255/256 boundary included)."""
+    for x1 in range(512):
+        for x2 in range(512):
+            yield _sprite_case(x1, 100, (4, 3, 16, 15), x2, 104, (0, 0, 24, 21))
+
+
+# ---- circle ------------------------------------------------------------------------------------
+
+def _circle_case(dx: int, dy: int, radius_sum: int, cx: int = 0, cy: int = 0) -> tuple:
+    x1, x2 = (dx, 0) if dx >= 0 else (0, -dx)
+    y1, y2 = (dy, 0) if dy >= 0 else (0, -dy)
+    r1 = radius_sum // 2
+    r2 = radius_sum - r1
+    return (x1, y1, min(r1, 255), x2, y2, min(r2, 255))
+
+
+def circle_boundary() -> list[tuple]:
+    out = []
+    for dx, dy in ((0, 0), (3, 4), (-3, 4), (3, -4), (-3, -4), (255, 0), (0, 255), (-255, 0), (0, -255),
+                   (255, 255), (-255, -255), (180, 180), (-181, 180), (1, 0), (0, -1), (127, 128)):
+        distance = math.isqrt(dx * dx + dy * dy)
+        for radius_sum in {0, 1, distance, distance + 1, 254, 255, 256, 300, 510}:
+            out.append(_circle_case(dx, dy, radius_sum))
+    return out
+
+
+def circle_random(rng: np.random.Generator, n: int) -> list[tuple]:
+    cases = _bytes(rng, n, 6)
+    tight = rng.random(n) < 0.5  # half: radius sum at the distance, where the answer flips
+    for i in np.flatnonzero(tight):
+        x1, y1, _, x2, y2, _ = (int(v) for v in cases[i])
+        radius_sum = math.isqrt((x1 - x2) ** 2 + (y1 - y2) ** 2) + int(rng.integers(0, 2))
+        if radius_sum <= 255:
+            cases[i, 2] = radius_sum // 2
+            cases[i, 5] = radius_sum - radius_sum // 2
+    return [tuple(int(v) for v in row) for row in cases]
+
+
+def circle_sweep() -> Iterable[tuple]:
+    """Every pair of 8-bit deltas (both signs) at the radius sums just below and at its distance,
+    where reachable (<= 255); then every radius pair at a few deltas (the radius domain)."""
+    for dx in range(-255, 256):
+        for dy in range(-255, 256):
+            distance_ceiling = math.isqrt(dx * dx + dy * dy - 1) + 1 if dx or dy else 0
+            for radius_sum in (distance_ceiling, distance_ceiling + 1):
+                if radius_sum <= 255:
+                    yield _circle_case(dx, dy, radius_sum)
+    for dx, dy in ((0, 0), (200, 100), (-255, -255)):
+        for r1 in range(BYTE):
+            for r2 in range(0, BYTE, 3):
+                case = _circle_case(dx, dy, 0)
+                yield (case[0], case[1], r1, case[3], case[4], r2)
+
+
+# ---- mul8 ----------------------------------------------------------------------------------------
+
+def mul8_boundary() -> list[tuple]:
+    values = (0, 1, 2, 127, 128, 129, 254, 255)
+    return list(product(values, repeat=2))
+
+
+def mul8_random(rng: np.random.Generator, n: int) -> list[tuple]:
+    return [tuple(int(v) for v in row) for row in _bytes(rng, n, 2)]
+
+
+def mul8_sweep() -> Iterable[tuple]:
+    return product(range(BYTE), repeat=2)
+
+
+# ---- tile and tile_box ---------------------------------------------------------------------------
+
+_EDGE_X = (0, 23, 24, 25, 31, 32, 255, 256, 343, 344, 345, 511)
+_EDGE_Y = (0, 49, 50, 51, 57, 58, 249, 250, 251, 255)
+
+def tile_boundary() -> list[tuple]:
+    return [(x & 0xFF, x >> 8, y) for x in _EDGE_X for y in _EDGE_Y]
+
+
+def tile_random(rng: np.random.Generator, n: int) -> list[tuple]:
+    x = rng.integers(0, 512, size=n)
+    y = rng.integers(0, BYTE, size=n)
+    return [(int(a) & 0xFF, int(a) >> 8, int(b)) for a, b in zip(x, y)]
+
+
+def tile_sweep() -> Iterable[tuple]:
+    return ((x & 0xFF, x >> 8, y) for x in range(512) for y in range(BYTE))
+
+
+def tile_box_boundary() -> list[tuple]:
+    out = []
+    for x in _EDGE_X:
+        for y in _EDGE_Y:
+            for w, h in ((0, 5), (5, 0), (1, 1), (8, 8), (9, 9), (24, 21), (255, 255)):
+                out.append((x & 0xFF, x >> 8, y, w, h))
+    return out
+
+
+def tile_box_random(rng: np.random.Generator, n: int) -> list[tuple]:
+    x = rng.integers(0, 512, size=n)
+    y = rng.integers(0, BYTE, size=n)
+    small = rng.random(n) < 0.8
+    w = np.where(small, rng.integers(0, 33, size=n), rng.integers(0, BYTE, size=n))
+    h = np.where(small, rng.integers(0, 33, size=n), rng.integers(0, BYTE, size=n))
+    return [(int(a) & 0xFF, int(a) >> 8, int(b), int(c), int(d)) for a, b, c, d in zip(x, y, w, h)]
+
+
+def tile_box_sweep() -> Iterable[tuple]:
+    """Every 9-bit X and every Y for a sprite-sized box; every width at a few heights and back."""
+    for x in range(512):
+        for y in range(0, BYTE):
+            yield (x & 0xFF, x >> 8, y, 24, 21)
+    for size in range(BYTE):
+        for other in (0, 1, 8, 21, 255):
+            yield (20, 0, 45, size, other)
+            yield (20, 0, 45, other, size)
+
+
+# ---- pixel ---------------------------------------------------------------------------------------
+
+FIXED_MASK_PAIRS = 5  # full, one dot, corners, ring/dot, ring/ring; the rest are random
+
+
+@lru_cache(maxsize=8)
+def pixel_masks(seed: int = 0) -> tuple[tuple[tuple[int, ...], tuple[int, ...]], ...]:
+    """Mask pairs the pixel cases use: five shapes, then twelve random pairs of three densities
+    drawn from seed + 1."""
+    rng = np.random.default_rng(seed + 1)
+    full = bytes([0xFF] * MASK_BYTES)
+    dot = bytearray(MASK_BYTES)
+    dot[10 * SPRITE_ROW_BYTES + 1] = 0x10  # one pixel near the middle
+    corner = bytearray(MASK_BYTES)
+    corner[0] = 0x80
+    corner[-1] = 0x01
+    ring = bytearray(MASK_BYTES)
+    for row in range(SPRITE_HEIGHT):
+        for col in range(SPRITE_WIDTH):
+            if 7 <= math.hypot(col - 11.5, row - 10) < 10:
+                ring[row * SPRITE_ROW_BYTES + col // 8] |= 0x80 >> (col % 8)
+    masks = [(full, full), (bytes(dot), full), (bytes(corner), bytes(corner)), (bytes(ring), bytes(dot)),
+             (bytes(ring), bytes(ring))]
+    for density in (0.02, 0.1, 0.5):
+        for _ in range(4):
+            a = np.packbits(rng.random((SPRITE_HEIGHT, SPRITE_WIDTH)) < density, axis=1).tobytes()
+            b = np.packbits(rng.random((SPRITE_HEIGHT, SPRITE_WIDTH)) < density, axis=1).tobytes()
+            masks.append((a, b))
+    return tuple((tuple(a), tuple(b)) for a, b in masks)
+
+
+def _signed(value: int) -> int:
+    return value - BYTE if value & 0x80 else value
+
+
+def pixel_reference(dx: int, dy: int, mask_a, mask_b) -> bool:
+    """reference.pixel on the routine's inputs: offsets as two's-complement bytes, masks as 63 bytes."""
+    return reference.pixel(_signed(dx), _signed(dy), reference.mask_bits(bytes(mask_a)),
+                           reference.mask_bits(bytes(mask_b)))
+
+
+def pixel_boundary(seed: int = 0) -> list[tuple]:
+    masks = pixel_masks(seed)
+    offsets = (-128, -25, -24, -23, -22, -8, -1, 0, 1, 7, 8, 9, 16, 22, 23, 24, 127)
+    return [(dx & 0xFF, dy & 0xFF, *masks[pair]) for pair in range(FIXED_MASK_PAIRS) for dx in offsets
+            for dy in offsets if abs(dy) <= 25 or dx == 0]
+
+
+def pixel_random(rng: np.random.Generator, n: int, seed: int = 0) -> list[tuple]:
+    masks = pixel_masks(seed)
+    dx = rng.integers(-26, 27, size=n)
+    dy = rng.integers(-23, 24, size=n)
+    pair = rng.integers(0, len(masks), size=n)
+    return [(int(a) & 0xFF, int(b) & 0xFF, *masks[int(c)]) for a, b, c in zip(dx, dy, pair)]
+
+
+def pixel_sweep(seed: int = 0) -> Iterable[tuple]:
+    """Every pair of offset bytes for the full pair, the ring/dot pair and one random pair."""
+    masks = pixel_masks(seed)
+    for pair in (0, 3, 8):
+        for dx in range(BYTE):
+            for dy in range(BYTE):
+                yield (dx, dy, *masks[pair])

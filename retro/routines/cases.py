@@ -1,0 +1,228 @@
+"""The cases a check runs, made lazily in chunks (memory stays bounded whatever the counts).
+
+Parts, in order:
+- boundary: the spec's `boundary` function (hand-picked edges), always;
+- exhaustive: every combination of the values of the inputs named in `exhaustive` (the other inputs
+  drawn at random per case). Without --exhaustive, all of it when it has at most BOUNDED_PRODUCT
+  cases, else a seeded random sample of BOUNDED_SAMPLE of them;
+- sweep: the spec's `sweep` function (structured exhaustive slices), with --exhaustive only;
+- random: `random` cases over every input (the spec's `random_generator`, or uniform over each
+  input's values), at most RANDOM_BOUNDED without --exhaustive.
+A case is a tuple in the inputs' order: an int per number or flag, a tuple of bytes per table.
+Cases from a user's function may also be dicts by input name; each is checked against its inputs'
+widths (one-line error naming the function and the case).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from itertools import islice
+
+import numpy as np
+
+from retro.errors import InputError
+from retro.routines.spec import Port, Routine, call_with
+
+RANDOM_BOUNDED = 2_000  # random cases without --exhaustive
+BOUNDED_PRODUCT = 1 << 16  # an exhaustive set this small runs in full even without --exhaustive
+BOUNDED_SAMPLE = 4_096  # cases sampled from a larger exhaustive set without --exhaustive
+CHUNK = 4_000
+RANDOM_BLOCK = 1_000_000  # a random generator is called once per block of this many cases
+EXHAUSTIVE_RNG_OFFSET = 2  # the non-swept inputs of the exhaustive part draw from seed + 2
+
+
+@dataclass(frozen=True)
+class Part:
+    name: str  # "boundary", "exhaustive", "sweep", "random"
+    count: int | None  # None when a sweep function does not say
+    total: int  # cases of the full space this part stands for (exhaustive: the whole product)
+    cases: Iterable[tuple]
+
+
+def random_count(routine: Routine, exhaustive: bool, override: int | None) -> int:
+    if override is not None:
+        return override
+    return routine.random if exhaustive else min(routine.random, RANDOM_BOUNDED)
+
+
+def plan(routine: Routine, *, exhaustive: bool, seed: int | None = None, random: int | None = None) -> list[Part]:
+    """The parts of a check, each with its case count and a lazy iterable of cases."""
+    seed = routine.seed if seed is None else seed
+    parts = []
+    if routine.boundary is not None:
+        made = list(_checked(routine, "cases.boundary",
+                             call_with(routine.boundary, {"seed": seed, "rng": np.random.default_rng(seed)})))
+        parts.append(Part("boundary", len(made), len(made), made))
+    if routine.exhaustive:
+        total = routine.exhaustive_count()
+        if exhaustive or total <= BOUNDED_PRODUCT:
+            parts.append(Part("exhaustive", total, total, _product(routine, seed, None)))
+        else:
+            parts.append(Part("exhaustive", BOUNDED_SAMPLE, total, _product(routine, seed, BOUNDED_SAMPLE)))
+    if exhaustive and routine.sweep is not None:
+        parts.append(Part("sweep", None, 0, _lazy_sweep(routine, seed)))
+    count = random_count(routine, exhaustive, random)
+    if count:
+        parts.append(Part("random", count, count, _random(routine, seed, count)))
+    return parts
+
+
+def chunks(cases: Iterable[tuple], size: int = CHUNK) -> Iterator[list[tuple]]:
+    iterator = iter(cases)
+    while True:
+        chunk = list(islice(iterator, size))
+        if not chunk:
+            return
+        yield chunk
+
+
+# ---- exhaustive product ----------------------------------------------------------------------------
+
+def _product(routine: Routine, seed: int, sample: int | None) -> Iterator[tuple]:
+    """Every combination (mixed-radix counting over the swept inputs' values), in chunks; or a seeded
+    sample of `sample` distinct combinations."""
+    swept = [i for i, port in enumerate(routine.inputs) if port.name in routine.exhaustive]
+    radices = [routine.inputs[i].count for i in swept]
+    total = int(np.prod(radices, dtype=object))
+    rng = np.random.default_rng(seed + EXHAUSTIVE_RNG_OFFSET)
+    if sample is None:
+        indices: Iterable[np.ndarray] = (np.arange(start, min(start + CHUNK, total), dtype=np.uint64)
+                                         for start in range(0, total, CHUNK))
+    else:
+        picked = np.sort(rng.choice(total, size=sample, replace=False).astype(np.uint64))
+        indices = (picked[i:i + CHUNK] for i in range(0, sample, CHUNK))
+    for block in indices:
+        n = len(block)
+        columns: list = [None] * len(routine.inputs)
+        rest = block.copy()
+        for i, radix in zip(reversed(swept), reversed(radices)):  # the last swept input varies fastest
+            digit = rest % np.uint64(radix)
+            rest //= np.uint64(radix)
+            columns[i] = _digit_values(routine.inputs[i], digit)
+        for i, port in enumerate(routine.inputs):
+            if columns[i] is None:
+                columns[i] = _random_column(port, rng, n)
+        yield from zip(*columns)
+
+
+def _digit_values(port: Port, digit: np.ndarray) -> list:
+    values = port.values
+    if not port.table:
+        if values.listed is None:
+            return (digit.astype(np.int64) + values.lo).tolist()
+        return np.asarray(values.listed, dtype=np.int64)[digit.astype(np.int64)].tolist()
+    size = len(port.places)
+    out = np.empty((len(digit), size), dtype=np.int64)
+    rest = digit.copy()
+    for byte in range(size):  # the first byte varies fastest
+        out[:, byte] = rest % np.uint64(values.count)
+        rest //= np.uint64(values.count)
+    mapped = out + values.lo if values.listed is None else np.asarray(values.listed, dtype=np.int64)[out]
+    return [tuple(row) for row in mapped.tolist()]
+
+
+def _random_column(port: Port, rng: np.random.Generator, n: int) -> list:
+    values = port.values
+    shape = (n, len(port.places)) if port.table else (n,)
+    if values.listed is not None:
+        drawn = np.asarray(values.listed, dtype=np.int64)[rng.integers(0, len(values.listed), size=shape)]
+    else:
+        drawn = rng.integers(values.lo, values.hi + 1, size=shape, dtype=np.int64)
+    return [tuple(row) for row in drawn.tolist()] if port.table else drawn.tolist()
+
+
+# ---- random ------------------------------------------------------------------------------------------
+
+def _random(routine: Routine, seed: int, count: int) -> Iterator[tuple]:
+    rng = np.random.default_rng(seed)
+    done = 0
+    while done < count:
+        n = min(RANDOM_BLOCK, count - done)
+        if routine.random_generator is not None:
+            made = call_with(routine.random_generator, {"rng": rng, "count": n, "n": n, "seed": seed})
+            yield from _checked(routine, "cases.random_generator", made, expected=n)
+        else:
+            for start in range(0, n, CHUNK):
+                m = min(CHUNK, n - start)
+                yield from zip(*(_random_column(port, rng, m) for port in routine.inputs))
+        done += n
+
+
+def _lazy_sweep(routine: Routine, seed: int) -> Iterator[tuple]:
+    yield from _checked(routine, "cases.sweep", call_with(routine.sweep, {"seed": seed,
+                                                                       "rng": np.random.default_rng(seed)}))
+
+
+# ---- cases from users' functions ----------------------------------------------------------------------
+
+def _checked(routine: Routine, key: str, made, expected: int | None = None) -> Iterator[tuple]:
+    """Cases from a spec's function, normalised to tuples and checked against the inputs' widths."""
+    names = routine.input_names
+    where = f"{routine.spec_path}: {key}"
+    try:
+        iterator = iter(made)
+    except TypeError:
+        raise InputError(f"{where}: the function must return a list or iterable of cases, "
+                         f"got {type(made).__name__}") from None
+    produced = 0
+    for chunk in chunks(iterator):
+        cases = [_normalise(case, names, where) for case in chunk]
+        _check_widths(routine, cases, where)
+        produced += len(cases)
+        yield from cases
+    if expected is not None and produced != expected:
+        raise InputError(f"{where}: asked for {expected} cases, the function returned {produced}")
+
+
+def _normalise(case, names: tuple[str, ...], where: str) -> tuple:
+    if isinstance(case, dict):
+        missing = [n for n in names if n not in case]
+        extra = [k for k in case if k not in names]
+        if missing or extra:
+            raise InputError(f"{where}: case {_short(case)} " + (f"lacks {missing[0]!r}" if missing else
+                                                                 f"has unknown input {extra[0]!r}"))
+        case = tuple(case[n] for n in names)
+    elif isinstance(case, np.ndarray):
+        case = tuple(case.tolist())
+    elif not isinstance(case, (tuple, list)):
+        raise InputError(f"{where}: a case must be a tuple in the inputs' order or a dict by name, got {_short(case)}")
+    if len(case) != len(names):
+        raise InputError(f"{where}: case {_short(case)} has {len(case)} values for {len(names)} inputs "
+                         f"({', '.join(names)})")
+    return tuple(tuple(int(b) for b in v) if isinstance(v, (list, tuple, bytes, bytearray, np.ndarray))
+                 else v for v in case)
+
+
+def _check_widths(routine: Routine, cases: list[tuple], where: str) -> None:
+    for index, port in enumerate(routine.inputs):
+        column = [case[index] for case in cases]
+        if port.table:
+            size = len(port.places)
+            for case, value in zip(cases, column):
+                if not isinstance(value, tuple) or len(value) != size or not all(
+                        isinstance(b, int) and 0 <= b <= 0xFF for b in value):
+                    raise InputError(f"{where}: case {_short(case)}: {port.name} must be {size} bytes (0..255)")
+            continue
+        try:
+            values = np.asarray(column, dtype=np.int64)
+        except (TypeError, ValueError, OverflowError):
+            bad = next(c for c in cases if not isinstance(c[index], (int, np.integer)) or isinstance(c[index], bool)
+                       or not -2**63 <= c[index] < 2**63)
+            raise InputError(f"{where}: case {_short(bad)}: {port.name} must be a whole number") from None
+        limit = 1 << port.bits
+        wrong = np.flatnonzero((values < 0) | (values >= limit))
+        if len(wrong):
+            case = cases[int(wrong[0])]
+            raise InputError(f"{where}: case {_short(case)}: {port.name} = {case[index]} does not fit in "
+                             f"{port.describe()} (0..{limit - 1})")
+        for i, v in enumerate(column):  # numpy integers become plain ints (JSON, hashing, shifts)
+            if type(v) is not int:
+                if isinstance(v, float) or isinstance(v, bool):
+                    raise InputError(f"{where}: case {_short(cases[i])}: {port.name} must be a whole number")
+                cases[i] = cases[i][:index] + (int(v),) + cases[i][index + 1:]
+
+
+def _short(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."

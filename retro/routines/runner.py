@@ -1,0 +1,208 @@
+"""Run one routine (a validated spec) on cases: a loaded machine, its memory set, the fast call path.
+
+`RoutineRunner(routine, seed).run(case)` puts the case's values where the spec says (registers,
+flags, memory; numbers little-endian, tables as bytes), calls the routine with `Machine.call_fast`
+and returns (outputs, cycles): the outputs as a tuple in the spec's order. With `record`, the
+executed path is appended for the independent timing model (retro.cpu.timing).
+
+Memory persists between calls: every input is written before each call, the `[memory]` blocks once
+after loading (then `init` runs). A routine must not depend on what it wrote in an earlier call.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from retro.assembler import requested_tables
+from retro.cpu.machine import DEFAULT_BUDGET, DEFAULT_FLAGS, CallResult, Machine
+from retro.cpu.timing import OPCODES
+from retro.errors import InputError
+from retro.fileio import read_text
+from retro.program import Program
+from retro.routines.spec import Port, Routine, call_with
+from retro.tables import GENERATORS, STORAGE_TABLES
+
+MEMORY_RNG_OFFSET = 1  # memory blocks draw from seed + 1, cases from seed: changing one never moves the other
+
+
+@dataclass(frozen=True)
+class Size:
+    code_bytes: int  # from the origin up to the first generated table (the program's length without them)
+    table_bytes: int  # lookup tables (storage the caller fills is not counted)
+    storage_bytes: int
+
+
+def program_size(program: Program, source_text: str | None) -> Size:
+    """Bytes of code and of generated tables. A program without `; retro-tables:` is all code."""
+    names = requested_tables(source_text) if source_text else []
+    starts = [program.symbols[n] for n in names if n in program.symbols]
+    if not starts:
+        return Size(code_bytes=len(program.code), table_bytes=0, storage_bytes=0)
+    tables_start = min(starts)
+    code_end = program.origin
+    for line in program.listing.splitlines():  # instructions, not the page-alignment padding
+        parts = line.split()
+        if len(parts) >= 2 and len(parts[0]) == 4:
+            try:
+                address = int(parts[0], 16)
+                count = sum(1 for p in parts[1:4] if len(p) == 2 and int(p, 16) >= 0)
+            except ValueError:
+                continue
+            if address < tables_start and count and _looks_like_instruction(line):
+                code_end = max(code_end, address + count)
+    lookup = sum(len(GENERATORS[n]()) for n in names if n not in STORAGE_TABLES)
+    storage = sum(len(GENERATORS[n]()) for n in names if n in STORAGE_TABLES)
+    return Size(code_bytes=code_end - program.origin, table_bytes=lookup, storage_bytes=storage)
+
+
+def _looks_like_instruction(line: str) -> bool:
+    """An Ophis listing line of an instruction: address, 1-3 bytes, then an upper-case mnemonic."""
+    import re
+
+    return re.match(r"^\s*[0-9A-Fa-f]{4}  (?:[0-9A-Fa-f]{2} ){1,3}\s*[A-Z]{3}\b", line) is not None
+
+
+def memory_values(routine: Routine, seed: int) -> dict[str, tuple[int, ...]]:
+    """The bytes of every `[memory]` block for this seed (generators share one numpy Generator,
+    called in the spec's order)."""
+    rng = np.random.default_rng(seed + MEMORY_RNG_OFFSET)
+    out = {}
+    for block in routine.memory:
+        if block.data is not None:
+            out[block.name] = block.data
+            continue
+        try:
+            made = call_with(block.make, {"rng": rng, "seed": seed})
+            data = tuple(int(v) for v in (made.tolist() if isinstance(made, np.ndarray) else made))
+        except InputError:
+            raise
+        except Exception as exc:
+            raise InputError(f"{routine.spec_path}: memory.{block.name}: the generator raised "
+                             f"{type(exc).__name__}: {exc}") from None
+        if not data or any(not 0 <= v <= 0xFF for v in data) or block.address + len(data) > 0x10000:
+            raise InputError(f"{routine.spec_path}: memory.{block.name}: the generator must return 1 or more "
+                             f"bytes (0..255) that fit below $10000")
+        out[block.name] = data
+    return out
+
+
+class RoutineRunner:
+    def __init__(self, routine: Routine, seed: int = 0) -> None:
+        from retro.loaders import load_program
+
+        self.routine = routine
+        self.seed = seed
+        self.program = load_program(routine.program_file, symbols=routine.symbols_file, load=routine.load)
+        self.machine = Machine(routine.cpu)
+        self.machine.load(self.program)
+        self.entry = self.machine.resolve(routine.entry, "program.entry")
+        self.memory_values = memory_values(routine, seed)
+        memory = self.machine.memory
+        for block in routine.memory:
+            data = self.memory_values[block.name]
+            memory[block.address:block.address + len(data)] = list(data)
+        if routine.init is not None:
+            self.machine.call_fast(self.machine.resolve(routine.init, "program.init"), budget=self.limit)
+        # (indirect),Y instructions: the timing model needs their pointer. Every byte of the program
+        # that could be such an opcode is listed; a data byte in the set only costs a lookup.
+        indirect_y = {opcode for opcode, op in OPCODES.items() if op.mode == "iny"}
+        self.pointer_pcs = frozenset(self.program.origin + i for i, b in enumerate(self.program.code) if b in indirect_y)
+        self._plan()
+
+    @property
+    def limit(self) -> int:
+        return self.routine.limit or DEFAULT_BUDGET
+
+    def _plan(self) -> None:
+        """Precompute how each input is stored, so a call does no lookups by name."""
+        self.register_inputs: list[tuple[int, str, int]] = []  # (case index, register, byte shift)
+        self.flag_inputs: list[tuple[int, int]] = []  # (case index, P bit)
+        self.byte_inputs: list[tuple[int, int, int]] = []  # (case index, address, byte shift)
+        self.table_inputs: list[tuple[int, tuple[int, ...]]] = []  # (case index, addresses)
+        for index, port in enumerate(self.routine.inputs):
+            if port.flag:
+                self.flag_inputs.append((index, port.places[0].bit))
+            elif port.table:
+                self.table_inputs.append((index, tuple(p.address for p in port.places)))
+            else:
+                for byte, place in enumerate(port.places):
+                    if place.kind == "register":
+                        self.register_inputs.append((index, place.register, 8 * byte))
+                    else:
+                        self.byte_inputs.append((index, place.address, 8 * byte))
+        forced = 0
+        for _, bit in self.flag_inputs:
+            forced |= bit
+        self.base_flags = DEFAULT_FLAGS & ~forced
+
+    def inputs_for_call(self, case: Sequence) -> tuple[list[tuple[int, int]], dict[str, int], int]:
+        """(memory writes, register values, P) that put the case where the spec says."""
+        writes = [(address, (case[index] >> shift) & 0xFF) for index, address, shift in self.byte_inputs]
+        for index, addresses in self.table_inputs:
+            writes.extend(zip(addresses, case[index]))
+        registers = {"a": 0, "x": 0, "y": 0}
+        for index, register, shift in self.register_inputs:
+            registers[register] |= (case[index] >> shift) & 0xFF
+        p = self.base_flags
+        for index, bit in self.flag_inputs:
+            if case[index]:
+                p |= bit
+        return writes, registers, p
+
+    def run(self, case: Sequence, record: list | None = None) -> tuple[tuple, int]:
+        """(outputs in the spec's order, cycles) of one call."""
+        writes, registers, p = self.inputs_for_call(case)
+        cycles, a, x, y, p = self.machine.call_fast(self.entry, writes, **registers, p=p, budget=self.limit,
+                                                    record=record, pointer_pcs=self.pointer_pcs)
+        return self.outputs(a, x, y, p), cycles
+
+    def answer(self, case: Sequence) -> int:
+        """The first output of one call (the hit flag or value of a single-output routine)."""
+        return self.run(case)[0][0]
+
+    def set_memory(self, name: str, values: Sequence[int]) -> None:
+        """Replace a `[memory]` block's bytes (what the reference is given too)."""
+        block = next((b for b in self.routine.memory if b.name == name), None)
+        if block is None:
+            raise InputError(f"{self.routine.spec_path}: no memory block {name!r}")
+        data = tuple(int(v) for v in values)
+        self.machine.memory[block.address:block.address + len(data)] = list(data)
+        self.memory_values[name] = data
+
+    def outputs(self, a: int, x: int, y: int, p: int) -> tuple:
+        registers = {"a": a, "x": x, "y": y}
+        memory = self.machine.memory
+        values = []
+        for port in self.routine.outputs:
+            if port.flag:
+                values.append(1 if p & port.places[0].bit else 0)
+            elif port.table:
+                values.append(tuple(memory[place.address] for place in port.places))
+            else:
+                value = 0
+                for shift, place in enumerate(port.places):
+                    byte = registers[place.register] if place.kind == "register" else memory[place.address]
+                    value |= byte << (8 * shift)
+                values.append(value)
+        return tuple(values)
+
+    def traced(self, case: Sequence) -> CallResult:
+        """The same call with the instruction trace (for the report of a failing case)."""
+        writes, registers, p = self.inputs_for_call(case)
+        return self.machine.call(self.entry, **registers, p=p, memory={address: [v] for address, v in writes},
+                                 budget=self.limit, trace=True)
+
+    def size(self) -> Size:
+        """Bytes of code, lookup tables and caller-filled storage of the routine's program."""
+        source = self.routine.program_file
+        text = read_text(source, "source file") if source.suffix.lower() in (".s", ".asm", ".oph") else None
+        return program_size(self.program, text)
+
+
+def describe_value(port: Port, value) -> str:
+    if port.table:
+        return "[" + " ".join(f"{v:02x}" for v in value) + "]"
+    return str(value)

@@ -1,0 +1,15 @@
+al C:fb .boxa_x
+al C:fc .boxa_y
+al C:fd .boxa_w
+al C:fe .boxa_h
+al C:c000 .boxhit
+al C:c034 .miss
+al C:c036 .fill
+al C:c038 .fill.loop
+al C:c03f .sum
+al C:c043 .sum.loop
+al C:c04b .boxb_x
+al C:c04c .boxb_y
+al C:c04d .boxb_w
+al C:c04e .boxb_h
+al C:c04f .buf
