@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import os
 import signal
+import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
@@ -33,6 +34,7 @@ from retro.routines.spec import Routine, load_spec
 
 EXAMPLES_KEPT = 5
 TRACE_SHOWN = 400  # instructions of the first failing case's trace in the report
+PROGRESS_SECONDS = 1.0  # at most one progress line a second
 
 
 @dataclass
@@ -201,12 +203,27 @@ def _output_value(port, item, where: str, routine: Routine, case: tuple):
 
 
 _RUNNERS: dict[tuple[str, int], RoutineRunner] = {}
+_BUILT: dict[str, Routine] = {}  # specs built in Python (retro.testing), by a key standing for their path
+_BUILT_PREFIX = "<built>:"
+
+
+def routine_key(spec: str | Routine) -> str:
+    """What names a routine across worker processes: its spec path, or a key for one built in Python."""
+    if isinstance(spec, Routine):
+        key = f"{_BUILT_PREFIX}{spec.spec_path}:{id(spec)}"
+        _BUILT[key] = spec
+        return key
+    return str(spec)
+
+
+def routine_of(key: str) -> Routine:
+    return _BUILT[key] if key.startswith(_BUILT_PREFIX) else load_spec(key)
 
 
 def runner_for(spec: str, seed: int) -> RoutineRunner:
     key = (str(spec), seed)
     if key not in _RUNNERS:
-        _RUNNERS[key] = RoutineRunner(load_spec(spec), seed)
+        _RUNNERS[key] = RoutineRunner(routine_of(str(spec)), seed)
     return _RUNNERS[key]
 
 
@@ -273,7 +290,7 @@ def static_bounds(routine: Routine, runner: RoutineRunner | None = None) -> Boun
     None when the spec turns the analysis off (`[cycles] static = false`)."""
     if not routine.static:
         return None
-    runner = runner or runner_for(str(routine.spec_path), 0)
+    runner = runner or RoutineRunner(routine)
     machine = runner.machine
     program = runner.program
     memory = list(machine.memory)
@@ -300,9 +317,14 @@ def _chunks(parts: list[case_sets.Part]) -> Iterator[list[tuple]]:
         yield from case_sets.chunks(part.cases)
 
 
-def check_routine(spec: str, *, exhaustive: bool = False, seed: int | None = None, random_count: int | None = None,
-                  jobs: int = 1, progress: Callable[[str], None] | None = None) -> RoutineCheck:
-    routine = load_spec(spec)
+def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | None = None,
+                  random_count: int | None = None, jobs: int = 1,
+                  progress: Callable[[str], None] | None = None) -> RoutineCheck:
+    """Check one routine: a spec path, or a Routine built in Python (then in this process only)."""
+    if isinstance(spec, Routine):
+        jobs = 1
+    spec = routine_key(spec)
+    routine = routine_of(spec)
     seed = routine.seed if seed is None else seed
     parts = case_sets.plan(routine, exhaustive=exhaustive, seed=seed, random=random_count)
     known = sum(p.count for p in parts if p.count is not None)
@@ -310,12 +332,15 @@ def check_routine(spec: str, *, exhaustive: bool = False, seed: int | None = Non
     runner = runner_for(spec, seed)  # loads and validates in this process before any worker starts
     totals = ChunkResult()
     done = 0
+    shown = [time.monotonic()]
 
     def report(result: ChunkResult) -> None:
         nonlocal done
         totals.merge(result)
         done += result.cases
-        if progress and (known > case_sets.CHUNK or unknown):
+        now = time.monotonic()
+        if progress and now - shown[0] >= PROGRESS_SECONDS:
+            shown[0] = now
             progress(f"check {routine.name}: {done:,} cases of {known:,} and the sweep" if unknown else
                      f"check {routine.name}: {done:,}/{known:,} cases")
 
@@ -369,7 +394,7 @@ def check_routine(spec: str, *, exhaustive: bool = False, seed: int | None = Non
 
 def failure_trace(spec: str, seed: int, case: tuple) -> list[str]:
     """The instructions of one case, run again on a fresh machine with the trace on."""
-    runner = RoutineRunner(load_spec(spec), seed)
+    runner = RoutineRunner(routine_of(spec), seed)
     try:
         result = runner.traced(case)
     except RunError as exc:

@@ -1,0 +1,187 @@
+"""Routine specs of users' own code: every assembler's build, wrong routines, budgets, bad specs.
+
+The boxhit fixtures (tests/data/foreign, real output of ACME, 64tass, ca65, DASM and xa, and a Kick
+Assembler .sym written from its documented format) are one routine: its cost is counted by hand
+from the datasheet cycles of its instructions:
+- fastest: LDA abs 4, CLC 2, ADC abs 4, CMP zp 3, BEQ taken 3 (to miss), CLC 2, RTS 6 = 24;
+- slowest: three tests passed (17 + 16 + 17: LDA/CLC/ADC/CMP and two branches not taken), the
+  fourth (LDA zp 3, CLC 2, ADC zp 3, CMP abs 4, BEQ 2, BCC taken 3 = 17) missing at its last
+  branch, then CLC 2, RTS 6: 17 + 16 + 17 + 17 + 8 = 75.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from retro.analysis.cost import COST_FIELDS
+from retro.cli import main
+
+SPECS = Path(__file__).resolve().parents[1] / "data" / "specs"
+ASSEMBLERS = ["acme", "64tass", "ca65", "kick", "dasm", "xa"]
+FASTEST, SLOWEST = 24, 75
+
+
+def _check_json(capsys, *args) -> tuple[int, list[dict]]:
+    code = main(["check", *args, "--json", "--jobs", "1"])
+    return code, json.loads(capsys.readouterr().out)
+
+
+@pytest.mark.parametrize("assembler", ASSEMBLERS)
+def test_each_assemblers_build_is_checked(assembler, capsys):
+    code, (record,) = _check_json(capsys, str(SPECS / f"boxhit_{assembler}.toml"), "--random", "200")
+    assert code == 0 and record["mismatches"] == 0
+    assert record["min"] == FASTEST and record["max"] == SLOWEST
+    assert (record["static_min"], record["static_max"]) == (FASTEST, SLOWEST)
+    assert record["budget"] == 80
+    assert set(record["min_inputs"]) == {"ax", "ay", "aw", "ah", "bx", "by", "bw", "bh"}
+    # the exhaustive part: every pair of the two left edges (0..255 for ACME, 0..63 in the others)
+    exhaustive = next(part for part in record["coverage"] if part["part"] == "exhaustive")
+    pairs = 256 * 256 if assembler == "acme" else 64 * 64
+    assert exhaustive["cases"] == exhaustive["space"] == pairs and exhaustive["complete"]
+    # the 8-bit sums wrap: each "x + w <= 255" condition is shown to be needed
+    sums = [item for item in record["domain"] if "+" in item["condition"]]
+    assert len(sums) == 4 and all(item["wrong"] > 0 for item in sums), record["domain"]
+
+
+def test_min_and_max_inputs_cost_what_they_say(capsys):
+    code, (record,) = _check_json(capsys, str(SPECS / "boxhit_acme.toml"), "--random", "100")
+    fast, slow = record["min_inputs"], record["max_inputs"]
+    assert fast["bx"] + fast["bw"] <= fast["ax"]  # B ends before A starts: the first test misses
+    # the slowest case passes three tests and fails the last: A's bottom does not reach B's top
+    assert fast is not slow and slow["ay"] + slow["ah"] <= slow["by"]
+    from retro.routines.registry import get
+    from retro.routines.runner import RoutineRunner
+
+    runner = RoutineRunner(get(str(SPECS / "boxhit_acme.toml")))
+    names = runner.routine.input_names
+    assert runner.run(tuple(fast[n] for n in names))[1] == FASTEST
+    assert runner.run(tuple(slow[n] for n in names))[1] == SLOWEST
+
+
+def test_a_wrong_routine_is_caught_with_its_inputs(capsys):
+    # acme_boxhit_wrong.asm lacks the first `beq miss`: B's right edge touching A's left edge is a hit
+    code, (record,) = _check_json(capsys, str(SPECS / "boxhit_acme_wrong.toml"), "--random", "0")
+    assert code == 1 and record["result_mismatches"] > 0
+    failure = record["first_failure"]
+    inputs = failure["inputs"]
+    assert inputs["bx"] + inputs["bw"] == inputs["ax"]  # touching on x
+    assert failure["outputs"] == {"hit": 1} and failure["expected"] == {"hit": 0}
+    assert failure["trace"][0].startswith("$C000  LDA $C049")
+    main(["check", str(SPECS / "boxhit_acme_wrong.toml"), "--random", "0", "--jobs", "1"])
+    text = capsys.readouterr().out
+    assert "first failing case: ax=" in text and "routine:   hit=1" in text and "reference: hit=0" in text
+
+
+def test_a_broken_budget_fails(capsys):
+    code, (record,) = _check_json(capsys, str(SPECS / "boxhit_acme_tight_budget.toml"), "--random", "50")
+    assert code == 1 and record["mismatches"] == len(record["budget_violations"]) == 2  # measured and static
+    assert "over the budget of 60" in record["budget_violations"][0]
+
+
+def test_cycles_of_a_spec(capsys):
+    assert main(["cycles", str(SPECS / "boxhit_ca65.toml"), "--json", "--random", "50", "--jobs", "1"]) == 0
+    (row,) = json.loads(capsys.readouterr().out)
+    assert tuple(row) == COST_FIELDS
+    assert (row["min"], row["max"], row["budget"]) == (FASTEST, SLOWEST, 80)
+    assert row["code_bytes"] == 0x53  # the whole PRG: $C000-$C052 (the listing's last byte, buf+3)
+    assert main(["cycles", str(SPECS / "boxhit_ca65.toml"), "--random", "50", "--jobs", "1"]) == 0
+    assert "max 75 vs budget <= 80: kept" in capsys.readouterr().out
+
+
+def test_tables_flags_memory_words_jsr_and_loops(capsys):
+    # scan.s: a table input, the carry as input, X and a 16-bit memory word as outputs, a [memory]
+    # block, a JSR to a subroutine with a loop. Cycles counted by hand (datasheet):
+    # cheapest (carry clear, key at index 0, no sum carries): 4+2+3+4+2+4+6 + (2 + 8*22 - 1 + 6)
+    #   + 2+4+4+3+6 = 227; dearest (carry set, bonus 255, all 255, none found):
+    #   28 + (2 + 8*27 - 1 + 6) + (2 + 8*17 - 1 + 2 + 6) = 396. Statically each of the 16 indexed
+    #   reads may cross a page (their bases do not end in $00), so the static worst is 396 + 16.
+    code, (record,) = _check_json(capsys, str(SPECS / "scan" / "scan.toml"))
+    assert code == 0 and record["mismatches"] == 0
+    assert (record["min"], record["max"], record["static_max"]) == (227, 396, 412)
+    assert record["static_min"] <= 227
+    assert record["max_inputs"] == {"key": 0, "carry": 1, "enemies": [255] * 8}
+
+
+def _variant(tmp_path: Path, replace: dict[str, str], name: str = "boxhit_acme.toml") -> Path:
+    text = (SPECS / name).read_text()
+    for old, new in replace.items():
+        assert old in text, old
+        text = text.replace(old, new)
+    for file in SPECS.glob("boxhit_refs.py"):
+        (tmp_path / file.name).write_text(file.read_text())
+    text = text.replace('"../foreign/', f'"{SPECS.parent / "foreign"}/')
+    spec = tmp_path / "spec.toml"
+    spec.write_text(text)
+    return spec
+
+
+BAD_SPECS = [
+    ({'bx = { at = "boxb_x" }': 'bx = { at = "box_b" }'}, "inputs.bx.at: unknown label 'box_b'"),
+    ({'hit = "C"': 'hit = "C"\nextra = { at = "A", colour = 1 }'}, "outputs.extra.colour: unknown key"),
+    ({'by = "boxb_y"': 'by = "boxb_x"'}, "inputs.by.at: $C04B is also where inputs.bx goes"),
+    ({'bx = { at = "boxb_x" }': 'bx = { at = "boxb_x", values = "0..300" }'}, "does not fit in $C04B"),
+    ({'exhaustive = ["ax", "bx"]': 'exhaustive = ["ax", "bx", "ay", "by", "aw"]'}, "is more than 2^32"),
+    ({'where = "aw': 'where = "import os or aw'}, "cases.where: not an expression"),
+    ({'where = "aw': 'where = "zz >= 1 and aw'}, "cases.where: unknown name 'zz'"),
+    ({'"../foreign/acme_boxhit.prg"': '"../foreign/nothing.prg"'}, "program.file: "),
+    ({'entry = "boxhit"': 'entry = "boxhit"\ncpu = "z80"'}, "program.cpu: expected one of"),
+    ({'[cycles]': '[cycles]\nloops = { boxhit = 0 }'}, "cycles.loops.boxhit: expected a number in 1.."),
+    ({'boxhit_refs.py:boxhit': 'boxhit_refs.py:nothing'}, "reference.function: boxhit_refs.py has no function"),
+    ({'max = 80': 'max = 80\n[cycles.extra]'}, "cycles.extra: unknown key"),
+    ({'[inputs]': '[inputs\n'}, "not valid TOML"),
+]
+
+
+@pytest.mark.parametrize("replace, message", BAD_SPECS)
+def test_a_bad_spec_is_one_line_exit_2(tmp_path, capsys, replace, message):
+    spec = _variant(tmp_path, replace)
+    assert main(["check", str(spec), "--random", "10", "--jobs", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err and str(spec) in err, err
+
+
+@pytest.mark.parametrize("body, message", [
+    ("    raise ValueError('no boxes today')", "raised ValueError: no boxes today (inputs ax="),
+    ("    return {'hit': 1, 'miss': 0}", "returned keys ['hit', 'miss'] for the outputs ['hit']"),
+    ("    return 7", "returned 7 for hit: expected a whole number 0..1"),
+])
+def test_a_reference_that_raises_or_answers_in_the_wrong_shape(tmp_path, capsys, body, message):
+    spec = _variant(tmp_path, {"boxhit_refs.py:boxhit": "bad_refs.py:boxhit"})
+    (tmp_path / "bad_refs.py").write_text(f"def boxhit(ax, ay, aw, ah, bx, by, bw, bh):\n{body}\n")
+    assert main(["check", str(spec), "--random", "10", "--jobs", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err, err
+
+
+def test_an_unbounded_loop_is_one_line(tmp_path, capsys):
+    spec = SPECS / "scan" / "scan.toml"
+    for file in ("scan.s", "scan_ref.py"):
+        (tmp_path / file).write_text((spec.parent / file).read_text())
+    (tmp_path / "scan.toml").write_text(spec.read_text().replace("loops = { _loop = 8, _sum = 8 }", "loops = { _loop = 8 }"))
+    assert main(["check", str(tmp_path / "scan.toml"), "--random", "0", "--jobs", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "the loop at $C029 (_sum) needs a bound" in err, err
+
+
+def test_an_ambiguous_label_lists_its_scopes(tmp_path, capsys):
+    spec = _variant(tmp_path, {'"../foreign/acme_boxhit.prg"': '"../foreign/ca65_boxhit.prg"',
+                               '"../foreign/acme_boxhit.sym"': '"../foreign/ca65_boxhit.dbg"',
+                               'entry = "boxhit"': 'entry = "loop"'})
+    assert main(["check", str(spec), "--jobs", "1"]) == 2
+    err = capsys.readouterr().err
+    assert "fill::loop" in err and "sum::loop" in err and err.count("\n") == 1, err
+
+
+def test_a_runaway_routine_stops_the_check_with_its_inputs(tmp_path, capsys):
+    source = tmp_path / "spin.s"
+    source.write_text("        .org $c000\nspin:   cmp #7\n        beq spin\n        rts\n")
+    (tmp_path / "ref.py").write_text("def spin(a):\n    return a\n")
+    (tmp_path / "spin.toml").write_text('[program]\nfile = "spin.s"\nentry = "spin"\n[inputs]\na = "A"\n'
+                                        '[outputs]\na_out = "A"\n[reference]\nfunction = "ref.py:spin"\n'
+                                        '[cases]\nexhaustive = ["a"]\n[cycles]\nlimit = 1000\nstatic = false\n')
+    code, (record,) = _check_json(capsys, str(tmp_path / "spin.toml"))
+    assert code == 1 and record["run_errors"] == 1
+    assert record["first_failure"]["inputs"] == {"a": 7} and "cycle budget of 1000" in record["first_failure"]["message"]
