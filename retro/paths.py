@@ -1,14 +1,23 @@
-"""Where the project's data folders are: asm/, examples/, sprites/ beside the retro package.
+"""Where the project's data folders are: asm/, examples/, sprites/.
 
-They live at the top of the repository (the layout users read), so `retro` is used from a clone
-with `pip install -e .`, as the README says.
+In a clone (and with `pip install -e .`) they are the folders at the top of the repository, the
+layout users read. A wheel (`pip install .`) carries them inside the package as retro/_data/asm,
+retro/_data/examples and retro/_data/sprites (setup.py maps them); those are used when they exist.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-PROJECT_ROOT = Path(__file__).resolve().parent.parent
-ASM_DIR = PROJECT_ROOT / "asm"
-EXAMPLES_DIR = PROJECT_ROOT / "examples"
-SPRITES_DIR = PROJECT_ROOT / "sprites"
+PACKAGE_DIR = Path(__file__).resolve().parent
+PROJECT_ROOT = PACKAGE_DIR.parent
+
+
+def _data_dir(name: str) -> Path:
+    packaged = PACKAGE_DIR / "_data" / name
+    return packaged if packaged.is_dir() else PROJECT_ROOT / name
+
+
+ASM_DIR = _data_dir("asm")
+EXAMPLES_DIR = _data_dir("examples")
+SPRITES_DIR = _data_dir("sprites")
