@@ -7,6 +7,7 @@ import json
 
 from retro.app.run import SETTABLE_FLAGS, run_routine
 from retro.cpu.machine import DEFAULT_BUDGET, JSR_CYCLES
+from retro.machines.c64 import call_budget
 from retro.numbers import parse_int
 
 # P from bit 7 down to bit 0, as the 6502 manuals draw it
@@ -45,18 +46,28 @@ def cmd_run(args: argparse.Namespace) -> int:
         budget=parse_int(args.budget, field="--budget", lo=1), scene=args.scene, trace=args.trace)
     r = report.result
     if args.json:
+        budget = call_budget(report.machine, r)
         print(json.dumps({"cycles": r.cycles, "instructions": r.instructions, "a": r.a, "x": r.x, "y": r.y,
-                          "s": r.s, "p": r.p, "peek": report.peeks}))
+                          "s": r.s, "p": r.p, "peek": report.peeks,
+                          **({"raster": budget.as_dict()} if budget else {})}))
         return 0
     if r.trace:
         for e in r.trace:
             notes = " ".join(n for n, on in (("taken", e.branch_taken), ("page+1", e.page_crossed)) if on)
-            print(f"${e.address:04X}  {report.machine.disassemble_at(e.address):<14} {e.cycles}  {notes}".rstrip())
+            if e.stolen:
+                notes = f"{notes} stolen {e.stolen}".strip()
+            text = e.mnemonic if e.mode == "int" else report.machine.disassemble_at(e.address)
+            print(f"${e.address:04X}  {text:<14} {e.cycles}  {notes}".rstrip())
     print(f"A=${r.a:02X} X=${r.x:02X} Y=${r.y:02X} S=${r.s:02X} P=${r.p:02X}")
     print(STATUS_BITS_HEADER)
     print(" ".join(str(r.p >> bit & 1) for bit in range(7, -1, -1)))
     print(f"{r.cycles} cycles, {r.instructions} instructions "
           f"(from the entry ${report.entry:04X} through its RTS; the caller's JSR, {JSR_CYCLES} cycles, is not included)")
+    budget = call_budget(report.machine, r)
+    if budget is not None:
+        print(f"raster: line {budget.start_line} cycle {budget.start_cycle} -> line {budget.end_line} cycle "
+              f"{budget.end_cycle}, {budget.lines} lines ({budget.stolen} of the cycles stolen by the VIC-II"
+              f"{'; crosses a frame end' if budget.frames else ''})")
     for target, values in report.peeks.items():
         print(f"{target}: " + " ".join(f"${v:02X}" for v in values))
     return 0

@@ -14,6 +14,7 @@ from retro.errors import InputError
 MEMORY_SIZE = 0x10000
 PAGE_SIZE = 0x100
 PAGE_COUNT = MEMORY_SIZE // PAGE_SIZE
+NEVER = 1 << 62  # a cycle no clock reaches: "no interrupt can come", "BA stays high"
 FIRST_DEVICE_ADDRESS = 0x0200  # zero page and stack stay RAM: their accesses bypass device timing
 
 
@@ -26,6 +27,35 @@ class Device(Protocol):
 
     def peek(self, address: int) -> int:
         """The value a read would return now, without its side effects (for the host)."""
+        ...
+
+
+class CpuLines(Protocol):
+    """A chip that drives the CPU's RDY (via BA), IRQ and NMI lines, in machine cycles.
+
+    At most one per machine (the VIC-II on a C64, the PPU on a NES); a device says it is one with
+    `drives_cpu_lines = True`. `irq_next` / `nmi_next` are cheap lower bounds the CPU compares with
+    its poll cycle before asking (a cycle before which the line cannot go low / no edge can come).
+    """
+
+    drives_cpu_lines: bool
+    irq_next: int
+    nmi_next: int
+
+    def ba_wait(self, cycle: int) -> int:
+        """Cycles from `cycle` until BA is high (0 while it is high)."""
+        ...
+
+    def ba_free(self, cycle: int) -> int:
+        """Cycles from `cycle` on during which BA stays high (0 if it is low)."""
+        ...
+
+    def irq_low(self, cycle: int) -> bool:
+        """Whether the IRQ line is low in `cycle`."""
+        ...
+
+    def nmi_edge(self, cycle: int) -> bool:
+        """Whether an NMI edge came at or before `cycle` and was not taken yet (taking it consumes it)."""
         ...
 
 

@@ -47,6 +47,7 @@ class TraceEntry:
     cycles: int
     page_crossed: bool
     branch_taken: bool
+    stolen: int = 0  # cycles of `cycles` the CPU stood still (BA low: Bad Line, sprite DMA)
 
 
 @dataclass
@@ -60,6 +61,7 @@ class CallResult:
     instructions: int
     trace: list[TraceEntry] | None = None
     flags: dict[str, bool] = field(default_factory=dict)
+    stolen: int = 0  # of `cycles`, those the CPU stood still (only with a chip driving BA)
 
 
 def _status(p: int) -> int:
@@ -95,7 +97,12 @@ class Machine:
         return self.bus.memory
 
     def attach(self, device: Device, start: int, end: int) -> Device:
+        drives_lines = getattr(device, "drives_cpu_lines", False)
+        if drives_lines and self.mpu.lines not in (None, device):
+            raise InputError("a second chip driving the CPU's BA/IRQ/NMI lines; a machine has one")
         self.bus.map(device, start, end)
+        if drives_lines:
+            self.mpu.lines = device  # from now on the timed run loop (stalls, interrupts) is used
         return device
 
     def load(self, program: Program) -> Program:
@@ -156,12 +163,14 @@ class Machine:
             self.poke(target, values)
         entries: list[TraceEntry] | None = [] if trace else None
         start = self._enter(address, a, x, y, p)
+        stolen_before = self.mpu.stolen
         count = self._execute(RETURN_TRAP, CALL_STACK_TOP, start + budget, entries)
         cycles = self._returned(start, budget, count)
         mpu = self.mpu
         status = _status(mpu.p)
         return CallResult(a=mpu.a, x=mpu.x, y=mpu.y, s=mpu.sp, p=status, cycles=cycles,
-                          instructions=count, trace=entries, flags=_flags(status))
+                          instructions=count, trace=entries, flags=_flags(status),
+                          stolen=mpu.stolen - stolen_before)
 
     def _enter(self, address: int, a: int, x: int, y: int, p: int) -> int:
         """Set registers and the stack as a JSR from the return trap would; return the start cycle."""
@@ -170,6 +179,7 @@ class Machine:
         mpu.sp = CALL_STACK_TOP
         mpu.stPushWord((RETURN_TRAP - 1) & 0xFFFF)
         mpu.pc = address
+        mpu.pending_interrupt = None  # a poll before the call does not carry into it
         return mpu.processorCycles
 
     def _returned(self, start: int, budget: int, count: int) -> int:
@@ -209,10 +219,13 @@ class Machine:
         mpu = self.mpu
         memory = self.bus.memory
         append = record.append
-        step = mpu.step
+        step = mpu.step if mpu.lines is None else mpu.step_timed
         count = 0
         try:
             while not (mpu.pc == RETURN_TRAP and mpu.sp == CALL_STACK_TOP) and mpu.processorCycles < limit:
+                if mpu.pending_interrupt is not None:
+                    step()  # the interrupt sequence: not an instruction, not recorded
+                    continue
                 pc = mpu.pc
                 mpu.recent[count & RECENT_MASK] = pc
                 count += 1
@@ -245,12 +258,15 @@ class Machine:
         mpu = self.mpu
         try:
             if entries is None:
+                if mpu.lines is not None:
+                    return mpu.run_timed(stop_pc, stop_sp, limit)
                 return mpu.run_until(stop_pc, stop_sp, limit)
             count = 0
             while not (mpu.pc == stop_pc and (stop_sp < 0 or mpu.sp == stop_sp)) and mpu.processorCycles < limit:
-                mpu.recent[count & RECENT_MASK] = mpu.pc
-                count += 1
-                mpu.executed = count
+                if mpu.pending_interrupt is None:
+                    mpu.recent[count & RECENT_MASK] = mpu.pc
+                    count += 1
+                    mpu.executed = count
                 entries.append(self._traced_step())
             return count
         except CpuHalt as halt:
@@ -261,14 +277,24 @@ class Machine:
         address = mpu.pc
         opcode = mpu.memory[address]
         before = mpu.processorCycles
-        mpu.step()
+        if mpu.lines is None:
+            mpu.step()
+            stolen = 0
+        else:
+            interrupt = mpu.pending_interrupt
+            instruction = mpu.step_timed()
+            stolen = mpu.last_stolen
+            if not instruction:  # the interrupt sequence: its own trace line, at the address it interrupts
+                return TraceEntry(address=address, opcode=-1, mnemonic=interrupt, mode="int",
+                                  cycles=mpu.processorCycles - before, page_crossed=False, branch_taken=False,
+                                  stolen=stolen)
         cycles = mpu.processorCycles - before
         mnemonic, mode = mpu.disassemble[opcode]
-        extra = cycles - mpu.cycletime[opcode]
+        extra = cycles - stolen - mpu.cycletime[opcode]
         is_branch = mode == "rel"
         return TraceEntry(address=address, opcode=opcode, mnemonic=mnemonic, mode=mode, cycles=cycles,
                           page_crossed=(extra == 2) if is_branch else extra == 1,
-                          branch_taken=is_branch and extra >= 1)
+                          branch_taken=is_branch and extra >= 1, stolen=stolen)
 
     def _over_budget(self, budget: int, count: int) -> None:
         raise RunError(f"cycle budget of {budget} cycles used up at PC ${self.mpu.pc:04X} after {count} "

@@ -21,6 +21,21 @@ What this adds to py65 1.2.0:
 - BRK optionally stops the run (`stop_on_brk`), which `Machine.call` uses.
 - `run_until`, the loop `Machine` runs: `step` inlined, with a ring of recent instruction addresses
   for error messages. It and the cheaper operand fetches make it faster than bare py65.
+- `run_timed` / `step_timed`, used instead when a chip drives the CPU's control lines (`lines`, a
+  `retro.cpu.bus.CpuLines`; the VIC-II on a C64): RDY/BA stalls and IRQ/NMI. Without such a chip
+  none of this code runs, so plain RAM and passive devices cost nothing extra.
+  * Stalls [Bauer 3.6.3]: while BA is low the CPU stops at its first read cycle and goes on when BA
+    is high again; write cycles go on. Each opcode's write cycles are known (WRITE_CYCLES_FROM_END),
+    every other cycle reads (dummy reads included), so the cycles lost depend on the instruction.
+    A device access sees the cycle after the stalls before it.
+  * Interrupts [64doc; visual6502 wiki "6502 Timing of Interrupt Handling"; VICE's CPU core (an
+    interrupt must be asserted 2 cycles before the next opcode fetch)]: the line is polled in the
+    penultimate cycle of an instruction (stalls included), so an IRQ asserted by then is taken after
+    the instruction, one asserted in its last cycle after the next one. A taken branch that does not
+    cross a page polls one cycle earlier (in its first cycle). CLI, SEI and PLP
+    change I after the poll (their effect shows one instruction later); RTI restores I before it.
+    NMI is edge-triggered and ignores I. The sequence takes 7 cycles (two reads, three pushes, the
+    vector from RAM at $FFFE/$FFFF or $FFFA/$FFFB), pushes P with B clear and sets I.
 """
 
 from __future__ import annotations
@@ -41,6 +56,20 @@ FLAG_Z = 0x02
 FLAG_C = 0x01
 
 OPCODE_BRK = 0x00
+OPCODE_CLI, OPCODE_SEI, OPCODE_PLP = 0x58, 0x78, 0x28
+BRANCH_OPCODES = frozenset({0x10, 0x30, 0x50, 0x70, 0x90, 0xB0, 0xD0, 0xF0})
+I_CHANGED_AFTER_POLL = frozenset({OPCODE_CLI, OPCODE_SEI, OPCODE_PLP})
+IRQ_VECTOR = 0xFFFE
+NMI_VECTOR = 0xFFFA
+INTERRUPT_CYCLES = 7
+# 64doc: the cycles in which an instruction writes, counted back from its last cycle (1 = last).
+# Every other cycle is a read, dummy reads included, and stops the CPU while BA is low.
+_STORES = (0x85, 0x95, 0x8D, 0x9D, 0x99, 0x81, 0x91, 0x86, 0x96, 0x8E, 0x84, 0x94, 0x8C,
+           0x87, 0x97, 0x83, 0x8F)
+WRITE_CYCLES_FROM_END = {**{op: (1,) for op in _STORES}, 0x48: (1,), 0x08: (1,),  # PHA, PHP
+                         0x20: (2, 3), OPCODE_BRK: (3, 4, 5)}  # JSR pushes twice, BRK three times
+# (read-modify-write opcodes write in their last two cycles: RMW_OPCODES)
+INTERRUPT_WRITES = (3, 4, 5)  # the interrupt sequence pushes PCH, PCL, P like BRK
 RECENT_SIZE = 16  # a power of two: run_until keeps the addresses of this many recent instructions
 RECENT_MASK = RECENT_SIZE - 1
 _KEEP_ALL_BUT_NVZC = 0xFF & ~(FLAG_N | FLAG_V | FLAG_Z | FLAG_C)
@@ -61,6 +90,10 @@ class CpuHalt(Exception):
         self.opcode = opcode
         self.address = address
         super().__init__(f"{kind} (opcode ${opcode:02X}) at ${address:04X}")
+
+
+def _mask(cycles: int, from_end) -> int:
+    return sum(1 << (cycles - k) for k in from_end)
 
 
 def _copy_tables(base):
@@ -85,8 +118,16 @@ class MPU6510(_Py65MPU):
         # Addresses of the last RECENT_SIZE instructions started by run_until (a ring, indexed by count).
         self.recent = [0] * RECENT_SIZE
         self.executed = 0  # instructions started by the last run_until, including one that halted
+        self.lines = None  # a CpuLines when a chip drives RDY/IRQ/NMI (run_timed)
+        self.pending_interrupt = None  # "IRQ" or "NMI", decided by the poll of the last instruction
+        self.stolen = 0  # cycles lost to stalls since power-on (part of processorCycles)
+        self.last_stolen = 0  # of the last step_timed
+        self.settled = (0, 0)  # (next cycle index, delay so far) of the instruction being executed
+        self.ba_high_until = -1  # BA is known high up to (not including) this cycle
         super().__init__(memory=memory, pc=pc)
         self.name = type(self).__name__[3:]
+        # instructions that write have a fixed cycle count: their write cycles are known in advance
+        self.write_masks = [self.write_mask(op, self.cycletime[op]) for op in range(256)]
 
     # ---- execution -------------------------------------------------------------------------
 
@@ -140,6 +181,96 @@ class MPU6510(_Py65MPU):
         """The addresses of the last min(count, RECENT_SIZE) instructions, oldest first."""
         n = min(count, RECENT_SIZE)
         return [self.recent[i & RECENT_MASK] for i in range(count - n, count)]
+
+    # ---- control lines: RDY stalls and interrupts (only with `lines` set) -----------------------
+
+    def write_mask(self, op: int, cycles: int) -> int:
+        """Bit i set: cycle i (0 = the opcode fetch) of this instruction is a write."""
+        from_end = (1, 2) if op in self.RMW_OPCODES else WRITE_CYCLES_FROM_END.get(op, ())
+        return _mask(cycles, from_end)
+
+    def stall_before(self, start: int, cycles: int, writes: int, last: int, first: int = 0, delay: int = 0) -> int:
+        """Cycles the CPU waits up to cycle `last` of an instruction of `cycles` cycles begun at `start`,
+        given `delay` already waited before cycle `first`."""
+        lines = self.lines
+        if delay == 0 and lines.ba_free(start + first) >= cycles - first:
+            return 0
+        ba_wait = lines.ba_wait
+        for i in range(first, last + 1):
+            if not writes >> i & 1:
+                delay += ba_wait(start + i + delay)
+        return delay
+
+    def step_timed(self) -> bool:
+        """Run one instruction, or the interrupt sequence the last poll decided; True for an instruction."""
+        start = self.processorCycles
+        kind = self.pending_interrupt
+        if kind is not None:
+            self.pending_interrupt = None
+            self._interrupt(kind, start)
+            return False
+        pc = self.pc
+        op = self.memory[pc]
+        self.current_op = op
+        i_before = self.p & FLAG_I
+        self.pc = (pc + 1) & ADDRESS_MASK
+        self.excycles = 0
+        self.addcycles = self.extracycles[op]
+        self.settled = (0, 0)
+        self.instruct[op](self)
+        self.pc &= ADDRESS_MASK
+        cycles = self.cycletime[op] + self.excycles
+        # the cycles up to the last device access were settled when it happened, against the bus
+        # schedule of that moment (a write to the VIC-II can change BA only for later cycles)
+        first, delay = self.settled
+        if delay or start + cycles > self.ba_high_until:
+            if not delay:
+                self.ba_high_until = start + self.lines.ba_free(start)
+            delay = self.stall_before(start, cycles, self.write_masks[op], cycles - 1, first, delay)
+        end = start + cycles + delay
+        self.processorCycles = end
+        self.stolen += delay
+        self.last_stolen = delay
+        # the poll: penultimate cycle; a taken branch within its page polls a cycle earlier
+        poll = end - 3 if op in BRANCH_OPCODES and self.excycles == 1 else end - 2
+        masked = (i_before if op in I_CHANGED_AFTER_POLL else self.p & FLAG_I)
+        lines = self.lines
+        if poll >= lines.nmi_next and lines.nmi_edge(poll):
+            self.pending_interrupt = "NMI"
+        elif not masked and poll >= lines.irq_next and lines.irq_low(poll):
+            self.pending_interrupt = "IRQ"
+        return True
+
+    def _interrupt(self, kind: str, start: int) -> None:
+        delay = self.stall_before(start, INTERRUPT_CYCLES, _mask(INTERRUPT_CYCLES, INTERRUPT_WRITES),
+                                  INTERRUPT_CYCLES - 1)
+        self.stPushWord(self.pc)
+        self.stPush((self.p | FLAG_U) & ~FLAG_B)
+        self.p |= FLAG_I
+        vector = NMI_VECTOR if kind == "NMI" else IRQ_VECTOR
+        self.pc = self.memory[vector] | self.memory[vector + 1] << 8
+        self.processorCycles = start + INTERRUPT_CYCLES + delay
+        self.stolen += delay
+        self.last_stolen = delay
+
+    def run_timed(self, stop_pc: int, stop_sp: int, limit: int) -> int:
+        """run_until with stalls and interrupts; returns the instructions executed (not interrupt entries)."""
+        recent = self.recent
+        step = self.step_timed
+        count = 0
+        try:
+            while True:
+                pc = self.pc
+                if pc == stop_pc and (stop_sp < 0 or self.sp == stop_sp):
+                    return count
+                if self.processorCycles >= limit:
+                    return count
+                if self.pending_interrupt is None:
+                    recent[count & RECENT_MASK] = pc
+                    count += 1
+                step()
+        finally:
+            self.executed = count
 
     def stall(self, cycles: int) -> None:
         """Add cycles to the current instruction (the CPU halted by DMA)."""
@@ -196,7 +327,18 @@ class MPU6510(_Py65MPU):
 
     def _access_cycle(self, from_end: int) -> int:
         op = self.current_op
-        return self.processorCycles + self.cycletime[op] + self.excycles - from_end
+        cycles = self.cycletime[op] + self.excycles
+        if self.lines is None:
+            return self.processorCycles + cycles - from_end
+        # stalls in the cycles up to and including this access delay it
+        start = self.processorCycles
+        index = cycles - from_end
+        self.ba_high_until = -1  # the access may change when the bus is taken
+        first, delay = self.settled
+        if index >= first:
+            delay = self.stall_before(start, cycles, self.write_masks[op], index, first, delay)
+            self.settled = (index + 1, delay)
+        return start + index + delay
 
     def ByteAt(self, addr):
         device = self.page_devices[addr >> PAGE_SHIFT]

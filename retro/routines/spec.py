@@ -173,10 +173,6 @@ class Routine:
     def output_names(self) -> tuple[str, ...]:
         return tuple(p.name for p in self.outputs)
 
-    @property
-    def source(self) -> Path:
-        return self.program_file
-
     def in_domain(self, case: tuple) -> bool:
         return all(condition.test(*case) for condition in self.domain)
 

@@ -46,7 +46,8 @@ from retro.numbers import parse_int
 from retro.scenes import earlier_spelling
 from retro.sprites import parse_hex, parse_rows, read_png, read_spr
 
-TOP_KEYS = {"chip", "video", "registers", "sprite", "memory"}
+TOP_KEYS = {"chip", "video", "registers", "sprite", "memory", "cpu"}
+CPU_KEYS = {"start_line", "start_cycle", "irq_vector"}  # where the beam is when the routine starts
 SPRITE_KEYS = {"index", "x", "y", "enabled", "multicolor", "expand_x", "expand_y", "behind", "color", "data",
                "rows", "file", "frame"}
 MEMORY_KEYS = {"screen", "color", "charset", "bitmap", "idle"}
@@ -76,13 +77,20 @@ class VicScene:
     memory: VicMemory
     state: VicState = field(repr=False)
     cpu_variant: str = "6510"
+    start_line: int = 0  # [cpu] start_line / start_cycle: the beam when the routine is entered
+    start_cycle: int = 1
+    irq_vector: str = "$fffe"  # or "$0314": the KERNAL's IRQ entry is put in RAM (retro.machines.c64)
 
     def attach(self, machine):
-        """Map a VIC-II device for this scene at $D000-$D3FF; its frame starts now (line 0, cycle 1)."""
+        """Map a VIC-II device for this scene at $D000-$D3FF with the beam at the scene's start position now."""
         from retro.chips.vic.constants import VIC_LAST
         from retro.chips.vic.device import VicDevice
+        from retro.machines.c64 import IRQ_VECTOR_KERNAL, install_kernal_irq_entry
 
-        return machine.attach(VicDevice(self.state, start_cycle=machine.cycle), VIC_BASE, VIC_LAST)
+        device = VicDevice.at_beam(self.state, machine.cycle, self.start_line, self.start_cycle)
+        if self.irq_vector == IRQ_VECTOR_KERNAL:
+            install_kernal_irq_entry(machine)
+        return machine.attach(device, VIC_BASE, VIC_LAST)
 
 
 class _Where:
@@ -299,7 +307,14 @@ def parse(doc: dict, source: str) -> VicScene:
         data[spec.index] = spec.data
     memory = _memory(doc.get("memory", {}), where)
     state = VicState(VIDEOS[video], bytes(registers), tuple(data), memory)
-    return VicScene(source, video, bytes(registers), tuple(specs), memory, state)
+    cpu = where.table(doc.get("cpu", {}), "cpu", CPU_KEYS)
+    start_line = where.number(cpu.get("start_line", 0), "cpu.start_line", 0, VIDEOS[video].lines - 1)
+    start_cycle = where.number(cpu.get("start_cycle", 1), "cpu.start_cycle", 1, VIDEOS[video].cycles_per_line)
+    irq_vector = str(cpu.get("irq_vector", "$fffe")).lower()
+    if irq_vector not in ("$fffe", "$0314"):
+        raise where.error("cpu.irq_vector", f"expected \"$fffe\" or \"$0314\", got {cpu.get('irq_vector')!r}")
+    return VicScene(source, video, bytes(registers), tuple(specs), memory, state, start_line=start_line,
+                    start_cycle=start_cycle, irq_vector=irq_vector)
 
 
 def load(path: str | Path) -> VicScene:

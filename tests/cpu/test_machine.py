@@ -297,3 +297,96 @@ def test_devices_cannot_be_mapped_on_zero_page_or_stack():
         with pytest.raises(InputError, match="pages \\$00 and \\$01"):
             bus.map(Quiet(), start, end)
     bus.map(Quiet(), 0x0200, 0x02FF)  # the first page after the stack is allowed
+
+
+class _Lines:
+    """A stand-in chip driving the CPU's lines: BA low in cycles [ba_from, ba_to), IRQ low from irq_at."""
+
+    drives_cpu_lines = True
+    nmi_next = 1 << 62
+
+    def __init__(self, ba_from: int = -1, ba_to: int = -1, irq_at: int = 1 << 62):
+        self.ba_from, self.ba_to, self.irq_next = ba_from, ba_to, irq_at
+
+    def read(self, address, cycle):
+        return 0
+
+    def write(self, address, value, cycle):
+        pass
+
+    def peek(self, address):
+        return 0
+
+    def ba_wait(self, cycle):
+        return self.ba_to - cycle if self.ba_from <= cycle < self.ba_to else 0
+
+    def ba_free(self, cycle):
+        return 0 if self.ba_from <= cycle < self.ba_to else (self.ba_from - cycle if cycle < self.ba_from else 1 << 62)
+
+    def irq_low(self, cycle):
+        return cycle >= self.irq_next
+
+    def nmi_edge(self, cycle):
+        return False
+
+
+NOPS = {ORIGIN: [0xEA] * 6 + [0x60]}  # NOP x6 (2 each), RTS (6)
+
+
+def test_ba_low_stops_the_cpu_at_its_first_read_and_is_counted_apart():
+    # BA low in cycles 5..14: the NOP at 4-5 stops in its dummy read at 5 and goes on at 15.
+    machine = machine_with(NOPS)
+    machine.attach(_Lines(5, 15), 0xD000, 0xD0FF)
+    result = machine.call(ORIGIN, trace=True)
+    assert (result.cycles, result.stolen) == (6 * 2 + 6 + 10, 10)
+    assert [e.stolen for e in result.trace] == [0, 0, 10, 0, 0, 0, 0]
+    assert result.trace[2].cycles == 12
+
+
+def test_writes_go_on_while_ba_is_low():
+    # STA $0400 (8D 00 04, 4 cycles 0-3, write in 3); BA low 3..9: the write goes on, the next
+    # opcode fetch (4) waits to 10: 6 cycles lost, not 7.
+    machine = machine_with({ORIGIN: [0x8D, 0x00, 0x04, 0x60]})
+    machine.attach(_Lines(3, 10), 0xD000, 0xD0FF)
+    result = machine.call(ORIGIN)
+    assert (result.cycles, result.stolen) == (4 + 6 + 6, 6)
+
+
+def test_irq_sequence_takes_seven_cycles_and_uses_the_vector_in_ram():
+    # IRQ low from cycle 0, I clear: the first NOP (0-1) polls at 0, the sequence runs 2-8, the
+    # handler (INC $C100 = 6, RTI = 6) 9-20, then 5 NOPs and RTS: 2 + 7 + 12 + 10 + 6 = 37.
+    code = dict(NOPS)
+    code[0xC100] = [0xEE, 0x00, 0xC1, 0x40]  # INC $C100 (also the counter), RTI
+    code[0xFFFE] = [0x00, 0xC1]
+    machine = machine_with(code)
+    lines = _Lines(irq_at=0)
+    machine.attach(lines, 0xD000, 0xD0FF)
+    lines.irq_low = lambda cycle: machine.memory[0xC100] == 0xEE  # low until the handler counts once
+    result = machine.call(ORIGIN, p=0x20, trace=True)
+    assert [e.mnemonic for e in result.trace[:4]] == ["NOP", "IRQ", "INC", "RTI"]
+    assert result.trace[1].cycles == 7
+    assert result.cycles == 37
+    assert result.instructions == 9  # the interrupt sequence is not an instruction
+
+
+def test_nes_nmi_at_vblank_when_2000_bit_7_is_set():
+    # 2A03, PPU attached at cycle 0. LDA #$80 (0-1), STA $2000 (2-5); loop LDA $10 (3) / BEQ (3,
+    # taken) from cycle 6, iteration k at 6 + 6k. Vblank: line 241 dot 1 = dot 82182, first seen by
+    # CPU cycle ceil(82182 / 3) = 27394. Polls: LDA zp at s+1, the taken branch at s+3 (its first
+    # cycle). s = 27390 polls at 27391 and 27393: not yet; s = 27396 polls at 27397: NMI after the
+    # LDA (ends 27398), sequence 27399-27405, handler at 27406.
+    from retro.chips.ppu.device import PpuDevice, attach_ppu
+
+    code = {ORIGIN: [0xA9, 0x80, 0x8D, 0x00, 0x20, 0xA5, 0x10, 0xF0, 0xFC, 0x60],
+            0xC100: [0xE6, 0x10, 0x40],  # INC $10, RTI
+            0xFFFA: [0x00, 0xC1]}
+    machine = machine_with(code, "2a03")
+    attach_ppu(machine, PpuDevice())
+    result = machine.call(ORIGIN, trace=True)
+    at = 0
+    for entry in result.trace:
+        if entry.address == 0xC100:
+            break
+        at += entry.cycles
+    assert at == 27406
+    assert [e.mnemonic for e in result.trace].count("NMI") == 1

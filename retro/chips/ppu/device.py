@@ -26,12 +26,13 @@ from collections.abc import Callable
 
 import numpy as np
 
-from retro.chips.ppu.clock import dots_at_cycle, frame_dots, line_and_dot
+from retro.chips.ppu.clock import dots_at_cycle, first_cycle_seeing, frame_dots, line_and_dot
 from retro.chips.ppu.constants import (
     CHR_SIZE,
     COARSE_SHIFT,
     CTRL_INCREMENT_32,
     CTRL_NAMETABLE,
+    CTRL_NMI,
     DOTS_PER_LINE,
     FINE_SCROLL,
     FLAG_CLEAR_DOT,
@@ -78,6 +79,7 @@ from retro.chips.ppu.constants import (
 )
 from retro.chips.ppu.hit import hit_dot, hit_pixels, rendering_enabled_for_hits
 from retro.chips.ppu.state import PpuState
+from retro.cpu.bus import NEVER
 
 PAGE_SIZE = 0x100
 INCREMENT_ACROSS = 1
@@ -86,8 +88,13 @@ PALETTE_MIRROR_MASK = 0x13          # $3F10/$14/$18/$1C -> $3F00/$04/$08/$0C
 PALETTE_MIRRORED = 0x10
 
 
+
+
 class PpuDevice:
     """The PPU on the bus. Create it from a PpuState (the scene), then `attach_ppu(machine, device)`."""
+
+    drives_cpu_lines = True
+    irq_next = NEVER  # the PPU has no IRQ output
 
     def __init__(self, state: PpuState | None = None, *, origin: int = 0,
                  read_memory: Callable[[int], int] | None = None,
@@ -122,6 +129,8 @@ class PpuDevice:
         self._state_from = -1           # absolute dot of the last change that can move the hit
         self._candidates: np.ndarray | None = None
         self.hits: list[tuple[int, int, int]] = []   # (frame, line, dot) of each hit, for inspection
+        self.nmi_pending = False        # an NMI edge the CPU has not taken yet
+        self.nmi_next = NEVER
         pre = self.video.pre_render_line
         self._fixed_events = [
             (VBLANK_LINE * DOTS_PER_LINE + VBLANK_DOT, self._set_vblank),
@@ -193,6 +202,38 @@ class PpuDevice:
 
     def _set_vblank(self, dot: int) -> None:
         self.vblank = True
+        if self.ctrl & CTRL_NMI:
+            self.nmi_pending = True
+        self._refresh_nmi_next()
+
+    # ---- the CPU's lines ---------------------------------------------------------------------
+
+    def _refresh_nmi_next(self) -> None:
+        """A lower bound on the CPU cycle of the next NMI edge (the next vblank flag)."""
+        if self.nmi_pending:
+            self.nmi_next = -NEVER
+        elif not self.ctrl & CTRL_NMI:
+            self.nmi_next = NEVER
+        else:
+            vblank = VBLANK_LINE * DOTS_PER_LINE + VBLANK_DOT
+            # this frame's, or (past it) the next frame's, at most one dot early (the odd-frame skip)
+            dot = self.frame_start + vblank if self._event == 0 else self.frame_start + self.frame_length - 1 + vblank
+            self.nmi_next = first_cycle_seeing(dot, self.origin, self.video)
+
+    def nmi_edge(self, cycle: int) -> bool:
+        self.advance(self.dot_of(cycle))
+        taken, self.nmi_pending = self.nmi_pending, False
+        self._refresh_nmi_next()
+        return taken
+
+    def irq_low(self, cycle: int) -> bool:
+        return False
+
+    def ba_wait(self, cycle: int) -> int:
+        return 0
+
+    def ba_free(self, cycle: int) -> int:
+        return NEVER  # OAM DMA stalls the CPU through `stall`, not through RDY timing
 
     def _clear_flags(self, dot: int) -> None:
         self.vblank = False
@@ -249,7 +290,10 @@ class PpuDevice:
             return
         register = PPU_REGISTER_BASE | (address & PPU_REGISTER_MASK)
         if register == PPUCTRL:
+            if self.vblank and value & CTRL_NMI and not self.ctrl & CTRL_NMI:
+                self.nmi_pending = True  # the NMI output falls now
             self.ctrl = value
+            self._refresh_nmi_next()
             self.t = (self.t & ~V_NAMETABLE) | ((value & CTRL_NAMETABLE) << V_NAMETABLE_SHIFT)
         elif register == PPUMASK:
             self.mask = value
@@ -347,6 +391,7 @@ class PpuDevice:
 def attach_ppu(machine, device: PpuDevice) -> PpuDevice:
     """Map the PPU onto a 2A03 machine ($2000-$3FFF and $4014); its clock starts at the machine's now."""
     device.origin = machine.cycle
+    device._refresh_nmi_next()
     device.read_memory = machine.bus.peek
     device.stall = machine.mpu.stall
     machine.attach(device, PPU_REGISTER_BASE, PPU_REGISTER_END)

@@ -114,6 +114,11 @@ class Video:
     visible_lines: int
     first_visible_x: int
     visible_pixels: int  # per line, in drawing order from first_visible_x (through the X wrap)
+    # First cycle the VIC takes from the CPU for sprite 0's s-accesses, in the line before the one
+    # where the row is shown; sprite n takes this cycle + 2n and the next (numbers past the line's
+    # last cycle fall in the next line) [Bauer 3.6.3 timing diagrams; the 6567R8 has two idle
+    # cycles more before sprite 0's p-access than the 6569 (the "N" in his diagrams)].
+    sprite0_dma_cycle: int
 
     @property
     def frame_cycles(self) -> int:
@@ -131,12 +136,25 @@ PIXELS_PER_CYCLE = 8
 # The NTSC versions of those programs are unverified; the same delay is assumed for the 6567R8.
 COLLISION_LATCH_DELAY = 4
 PAL = Video("pal", "6569", lines=312, cycles_per_line=63, x_positions=0x1F8, first_x=0x194,
-            first_visible_line=16, visible_lines=284, first_visible_x=0x1E0, visible_pixels=403)
+            first_visible_line=16, visible_lines=284, first_visible_x=0x1E0, visible_pixels=403,
+            sprite0_dma_cycle=58)
 # 65 cycles draw 520 pixels but only 512 X coordinates exist: the model gives the 65th cycle no
 # X coordinate (see docs/vic.md, timing model).
 NTSC = Video("ntsc", "6567R8", lines=263, cycles_per_line=65, x_positions=0x200, first_x=0x19C,
-             first_visible_line=41, visible_lines=235, first_visible_x=0x1E9, visible_pixels=418)
+             first_visible_line=41, visible_lines=235, first_visible_x=0x1E9, visible_pixels=418,
+             sprite0_dma_cycle=60)
 VIDEOS = {"pal": PAL, "ntsc": NTSC}
 
 # Raster compare [Bauer 3.12]: the IRQ for line 0 comes one cycle later than for the other lines.
 RASTER_IRQ_LINE0_DELAY = 1
+
+# ---- bus arbitration: BA and AEC [Bauer 3.5, 3.6.3, 3.8.1] --------------------------------------
+# BA goes low BA_LEAD cycles before the first cycle the VIC takes; the CPU goes on through write
+# cycles and stops at its first read cycle while BA is low, until BA is high again.
+BA_LEAD = 3
+# A Bad Line's c-accesses take cycles 15-54 (both chips), so BA is low from cycle 12 to 54.
+BAD_LINE_FIRST_STOLEN = 15
+BAD_LINE_LAST_STOLEN = 54
+SPRITE_DMA_CYCLES = 2  # two s-accesses fall in the CPU's half of the cycles taken per sprite and line
+# Bad Line condition [Bauer 3.5]: a line in GRAPHICS_FIRST_LINE ($30) .. BAD_LINE_LAST ($F7) whose
+# low 3 bits equal YSCROLL, while DEN was set in line $30 (the model takes DEN from the current $D011).

@@ -15,6 +15,12 @@ Register behaviour [Bauer 3.2, 3.8.2, 3.12]:
   compare line begins; bit 7 reads 1 while a latched bit is enabled in $D01A; writing 1s
   acknowledges; reading $D01E/$D01F does not touch $D019.
 Timing model: retro.chips.vic.beam.
+
+CPU lines (a retro.cpu.bus.CpuLines): BA from the Bad Line and sprite DMA schedule of the current
+register state (retro.chips.vic.dma), and the IRQ output, low while a bit latched in $D019 is
+enabled in $D01A [Bauer 3.12]. `irq_next` is the machine cycle at which the next enabled source can
+latch (the raster compare, or the first collision while its register is zero), so the CPU asks the
+device only when a poll reaches it.
 """
 
 from __future__ import annotations
@@ -29,6 +35,7 @@ from retro.chips.vic.constants import (
     IRQ_SPRITE_BACKGROUND,
     IRQ_SPRITE_SPRITE,
     MIRROR_SIZE,
+    RASTER_IRQ_LINE0_DELAY,
     REG_CONTROL1,
     REG_IRQ_ENABLE,
     REG_IRQ_LATCH,
@@ -42,6 +49,7 @@ from retro.chips.vic.constants import (
     UNUSED_READ,
     Y_COMPARE_MASK,
 )
+from retro.chips.vic.dma import DMA_REGISTERS, bus_schedule
 from retro.chips.vic.model import (
     COLLISION_REGISTERS,
     FrameCollisions,
@@ -50,10 +58,23 @@ from retro.chips.vic.model import (
     irq_register,
     raster_irq_time,
 )
+from retro.cpu.bus import NEVER
 
 SCHEDULE_CACHE_SIZE = 256
 _COLLISION_SET = frozenset(COLLISION_REGISTERS)
 _READ_ONLY = frozenset({REG_SPRITE_SPRITE, REG_SPRITE_BACKGROUND, REG_LIGHTPEN_X, REG_LIGHTPEN_Y})
+_DMA_SET = frozenset(DMA_REGISTERS)
+
+
+def _next_event(times: np.ndarray, after: int, frame_cycles: int) -> int | None:
+    """Device time of the first event at or after `after`, events repeating every frame."""
+    if times.size == 0:
+        return None
+    within = after % frame_cycles
+    i = int(np.searchsorted(times, within))
+    if i < times.size:
+        return after + int(times[i]) - within
+    return after + frame_cycles - within + int(times[0])
 
 
 def _bits_between(times: np.ndarray, bits: np.ndarray, lo: int, hi: int, frame_cycles: int) -> int:
@@ -85,6 +106,24 @@ def _time_between(t: int | None, lo: int, hi: int, frame_cycles: int) -> bool:
 class VicDevice:
     """A VIC-II whose frame starts (line 0, cycle 1) at machine cycle `start_cycle`."""
 
+    drives_cpu_lines = True
+    nmi_next = NEVER  # the VIC-II has no NMI output
+
+    @classmethod
+    def at_beam(cls, state: VicState, cycle: int, line: int = 0, line_cycle: int = 1) -> "VicDevice":
+        """A device whose beam is at `line`, cycle `line_cycle` (1-based) at machine cycle `cycle`.
+
+        Nothing is taken to have happened earlier in that frame (no raster compare, no collision).
+        """
+        video = state.video
+        if not 0 <= line < video.lines or not 1 <= line_cycle <= video.cycles_per_line:
+            raise ValueError(f"no line {line}, cycle {line_cycle} on the {video.chip}")
+        offset = line * video.cycles_per_line + line_cycle - 1
+        device = cls(state, start_cycle=cycle - offset)
+        device.synced = offset
+        device._refresh_irq_next()
+        return device
+
     def __init__(self, state: VicState, start_cycle: int = 0) -> None:
         self.state = state
         self.video = state.video
@@ -96,6 +135,9 @@ class VicDevice:
         self.synced = 0  # device time up to which (exclusive) events have been applied
         self._schedules: dict[bytes, FrameCollisions] = {}
         self._schedule = self._schedule_for(state)
+        self._bus = bus_schedule(self.video, self.registers)
+        self.irq_next = NEVER
+        self._refresh_irq_next()
 
     # ---- catching up -------------------------------------------------------------------------
 
@@ -126,6 +168,45 @@ class VicDevice:
         if _time_between(raster_irq_time(self.video, self.registers), lo, until, frame_cycles):
             self.irq_latch |= IRQ_RASTER
         self.synced = until
+        self._refresh_irq_next()
+
+    # ---- the CPU's lines ---------------------------------------------------------------------
+
+    def _refresh_irq_next(self) -> None:
+        enabled = self.registers[REG_IRQ_ENABLE] & IRQ_SOURCES
+        if self.irq_latch & enabled:
+            self.irq_next = -NEVER  # low now
+            return
+        frame_cycles = self.video.frame_cycles
+        after = self.synced
+        candidates = []
+        raster = raster_irq_time(self.video, self.registers)
+        if enabled & IRQ_RASTER and raster is not None:
+            candidates.append(after + (raster - after) % frame_cycles)
+        events = self._schedule
+        if enabled & IRQ_SPRITE_SPRITE and not self.sprite_sprite:
+            candidates.append(_next_event(events.ss_times, after, frame_cycles))
+        if enabled & IRQ_SPRITE_BACKGROUND and not self.sprite_background:
+            candidates.append(_next_event(events.sb_times, after, frame_cycles))
+        found = [c for c in candidates if c is not None]
+        self.irq_next = self.start_cycle + min(found) if found else NEVER
+
+    def irq_low(self, cycle: int) -> bool:
+        self._advance(self.time(cycle) + 1)
+        return bool(self.irq_latch & self.registers[REG_IRQ_ENABLE] & IRQ_SOURCES)
+
+    def nmi_edge(self, cycle: int) -> bool:
+        return False
+
+    def ba_wait(self, cycle: int) -> int:
+        t = cycle - self.start_cycle
+        return self._bus.wait[t % self.video.frame_cycles] if t >= 0 else 0
+
+    def ba_free(self, cycle: int) -> int:
+        t = cycle - self.start_cycle
+        if t < 0:
+            return -t + self._bus.free[0]
+        return self._bus.free[t % self.video.frame_cycles]
 
     def time(self, cycle: int) -> int:
         return cycle - self.start_cycle
@@ -142,9 +223,11 @@ class VicDevice:
         register = address % MIRROR_SIZE
         if register == REG_SPRITE_SPRITE:
             value, self.sprite_sprite = self.sprite_sprite, 0
+            self._refresh_irq_next()
             return value
         if register == REG_SPRITE_BACKGROUND:
             value, self.sprite_background = self.sprite_background, 0
+            self._refresh_irq_next()
             return value
         return self._value(register, t)
 
@@ -152,7 +235,9 @@ class VicDevice:
         if register >= REGISTER_COUNT:
             return UNUSED_READ
         if register in (REG_CONTROL1, REG_RASTER):
-            _, line, _ = position(self.video, max(t, 0))
+            _, line, cycle = position(self.video, max(t, 0))
+            if line == 0 and cycle <= RASTER_IRQ_LINE0_DELAY:
+                line = self.video.lines - 1  # the counter reaches 0 a cycle late (why line 0's IRQ is late)
             if register == REG_RASTER:
                 return line & Y_COMPARE_MASK
             return (self.registers[REG_CONTROL1] & ~CONTROL1_RST8) | (CONTROL1_RST8 if line > Y_COMPARE_MASK else 0)
@@ -168,12 +253,18 @@ class VicDevice:
             return
         if register == REG_IRQ_LATCH:
             self.irq_latch &= ~value & IRQ_SOURCES
+            self._refresh_irq_next()
             return
         old = self.registers[register]
         self.registers[register] = value & 0xFF
-        if register in _COLLISION_SET and old != value:
+        if old == value:
+            return
+        if register in _COLLISION_SET:
             self.state = self.state.with_registers(self.registers)
             self._schedule = self._schedule_for(self.state)
+        if register in _DMA_SET:
+            self._bus = bus_schedule(self.video, self.registers)
+        self._refresh_irq_next()
 
     def peek(self, address: int) -> int:
         """The value a read would return at the last synchronised cycle, without clearing anything."""

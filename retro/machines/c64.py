@@ -1,0 +1,131 @@
+"""A C64 as far as timing needs one: the 6510, the VIC-II driving BA and IRQ, and the raster budget.
+
+No CIA, SID, KERNAL or disk. A scene may ask for the KERNAL's IRQ entry so that a program can hook
+the `$0314` vector as it would on a real C64: then the ROM's entry and exit code (a fact of the
+machine: `$FF48`-`$FF5A` and `$EA81`-`$EA86` of the KERNAL, as listed in S. Leemon, *Mapping the
+Commodore 64*, and every KERNAL disassembly) is placed in RAM and `$FFFE/$FFFF` points at it, so the
+handler is reached 29 cycles after the interrupt sequence, as on the real machine.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, replace
+
+from retro.chips.vic.beam import position
+from retro.chips.vic.device import VicDevice
+from retro.errors import InputError
+
+IRQ_VECTOR_HARDWARE = "$fffe"  # the program puts its handler's address at $FFFE/$FFFF in RAM
+IRQ_VECTOR_KERNAL = "$0314"  # the program puts it at $0314/$0315; the KERNAL entry saves A, X, Y first
+IRQ_VECTOR_MODES = (IRQ_VECTOR_HARDWARE, IRQ_VECTOR_KERNAL)
+CPU_IRQ_VECTOR = 0xFFFE
+KERNAL_IRQ_ENTRY = 0xFF48
+# PHA / TXA / PHA / TYA / PHA / TSX / LDA $0104,X / AND #$10 / BEQ +3 / JMP ($0316) / JMP ($0314)
+KERNAL_IRQ_ENTRY_CODE = bytes([0x48, 0x8A, 0x48, 0x98, 0x48, 0xBA, 0xBD, 0x04, 0x01, 0x29, 0x10,
+                               0xF0, 0x03, 0x6C, 0x16, 0x03, 0x6C, 0x14, 0x03])
+KERNAL_IRQ_EXIT = 0xEA81
+KERNAL_IRQ_EXIT_CODE = bytes([0x68, 0xA8, 0x68, 0xAA, 0x68, 0x40])  # PLA / TAY / PLA / TAX / PLA / RTI
+
+
+def install_kernal_irq_entry(machine) -> None:
+    """Put the KERNAL's IRQ entry and exit in RAM and point the CPU's IRQ vector at the entry."""
+    machine.bus.load(KERNAL_IRQ_ENTRY, KERNAL_IRQ_ENTRY_CODE)
+    machine.bus.load(KERNAL_IRQ_EXIT, KERNAL_IRQ_EXIT_CODE)
+    machine.bus.load(CPU_IRQ_VECTOR, bytes([KERNAL_IRQ_ENTRY & 0xFF, KERNAL_IRQ_ENTRY >> 8]))
+
+
+@dataclass(frozen=True)
+class RasterBudget:
+    """Where on the beam a routine ran: first and last cycle as (raster line, 1-based cycle in line).
+
+    `cycles` counts every cycle from the first instruction through the RTS, `stolen` those in which
+    the VIC-II held the CPU (Bad Lines, sprite DMA); `lines` is cycles / cycles per line, and
+    `frames` how many frame ends the routine ran across (0: it ended in the frame it began in).
+    """
+
+    chip: str
+    start_line: int
+    start_cycle: int
+    end_line: int
+    end_cycle: int
+    cycles: int
+    stolen: int
+    lines: float
+    frames: int
+
+    def ends_before(self, line: int) -> bool:
+        """Whether the routine's last cycle is in the frame it started in and above `line`."""
+        return self.frames == 0 and self.end_line < line
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def raster_budget(device: VicDevice, start: int, cycles: int, stolen: int) -> RasterBudget:
+    """The raster budget of a routine that began at machine cycle `start` and took `cycles` cycles."""
+    if cycles < 1:
+        raise ValueError("a routine takes at least one cycle")
+    video = device.video
+    first_frame, start_line, start_cycle = position(video, device.time(start))
+    last_frame, end_line, end_cycle = position(video, device.time(start + cycles - 1))
+    return RasterBudget(chip=video.chip, start_line=start_line, start_cycle=start_cycle, end_line=end_line,
+                        end_cycle=end_cycle, cycles=cycles, stolen=stolen,
+                        lines=round(cycles / video.cycles_per_line, 2), frames=last_frame - first_frame)
+
+
+def call_budget(machine, result) -> RasterBudget | None:
+    """The raster budget of the `Machine.call` that just returned `result`, or None without a VIC-II.
+
+    The call ended at the machine's clock now, so it began `result.cycles` earlier.
+    """
+    device = machine.mpu.lines
+    if not isinstance(device, VicDevice):
+        return None
+    return raster_budget(device, machine.cycle - result.cycles, result.cycles, result.stolen)
+
+
+OPCODE_RTI = 0x40
+
+
+def interrupt_budgets(machine, result) -> list[RasterBudget]:
+    """The raster budget of every interrupt in the traced `Machine.call` that just returned `result`.
+
+    Each runs from the first cycle of its 7-cycle interrupt sequence through the RTI that returns
+    from it (nested interrupts counted inside the outer one). Empty without a VIC-II or a trace.
+    """
+    device = machine.mpu.lines
+    if not isinstance(device, VicDevice) or not result.trace:
+        return []
+    budgets = []
+    at = machine.cycle - result.cycles
+    opened: list[tuple[int, int]] = []  # (first cycle, stolen so far) of interrupts not yet returned from
+    stolen = 0
+    for entry in result.trace:
+        if entry.mode == "int":
+            opened.append((at, stolen))
+        at += entry.cycles
+        stolen += entry.stolen
+        if entry.opcode == OPCODE_RTI and opened:
+            first, stolen_before = opened.pop()
+            if not opened:
+                budgets.append(raster_budget(device, first, at - first, stolen - stolen_before))
+    return budgets
+
+
+def call_at_line(scene, program, entry, line: int, cycle: int = 1, **call_args):
+    """Call `entry` of `program` on a fresh C64 with `scene`'s VIC-II, the beam at (line, cycle).
+
+    Returns (CallResult, RasterBudget): what `retro cycles SPEC --scene S --at-line L` needs per call
+    (`call_args` go to Machine.call: a=, x=, y=, p=, memory=, budget=, trace=).
+    """
+    from retro.cpu.machine import Machine
+
+    video = scene.state.video
+    if not 0 <= line < video.lines or not 1 <= cycle <= video.cycles_per_line:
+        raise InputError(f"--at-line: the {video.chip} has lines 0-{video.lines - 1} and cycles "
+                         f"1-{video.cycles_per_line}, got line {line} cycle {cycle}")
+    machine = Machine(scene.cpu_variant)
+    replace(scene, start_line=line, start_cycle=cycle).attach(machine)
+    machine.load(program)
+    result = machine.call(entry, **call_args)
+    return result, call_budget(machine, result)
