@@ -29,7 +29,7 @@ from retro.cpu.timing import model_cycles
 from retro.errors import InputError, RunError
 from retro.routines import cases as case_sets
 from retro.routines.registry import select
-from retro.routines.runner import RoutineRunner, Size, describe_value
+from retro.routines.runner import RasterStart, RoutineRunner, Size, describe_value
 from retro.routines.spec import Routine, load_spec
 
 EXAMPLES_KEPT = 5
@@ -64,6 +64,9 @@ class ChunkResult:
     max_case: tuple | None = None
     cycles_sum: int = 0
     cycles_count: int = 0
+    cpu_min: int | None = None  # cycles the CPU ran (stalls excluded): what the static bounds bound
+    cpu_max: int | None = None
+    stolen_max: int = 0  # with a scene: the most cycles one call lost to Bad Lines and sprite DMA
     examples: list[str] = field(default_factory=list)
     outside_examples: list[str] = field(default_factory=list)
     failure: Failure | None = None
@@ -86,6 +89,10 @@ class ChunkResult:
                 self.cycles_max, self.max_case = other.cycles_max, other.max_case
         self.cycles_sum += other.cycles_sum
         self.cycles_count += other.cycles_count
+        if other.cpu_min is not None:
+            self.cpu_min = other.cpu_min if self.cpu_min is None else min(self.cpu_min, other.cpu_min)
+            self.cpu_max = other.cpu_max if self.cpu_max is None else max(self.cpu_max, other.cpu_max)
+        self.stolen_max = max(self.stolen_max, other.stolen_max)
         self.examples = (self.examples + other.examples)[:EXAMPLES_KEPT]
         self.outside_examples = (self.outside_examples + other.outside_examples)[:EXAMPLES_KEPT]
         self.failure = self.failure or other.failure
@@ -108,6 +115,7 @@ class RoutineCheck:
     budget_violations: list[str] = field(default_factory=list)
     parts: list[PartRun] = field(default_factory=list)
     trace: list[str] = field(default_factory=list)  # the first failing case's instructions
+    start: RasterStart | None = None  # with --scene: the beam position every call started at
 
     @property
     def mismatches(self) -> int:
@@ -121,7 +129,7 @@ class RoutineCheck:
 
     @property
     def worst_reached(self) -> bool:
-        return self.static is not None and self.totals.cycles_max == self.static.worst
+        return self.static is not None and self.totals.cpu_max == self.static.worst
 
     def domain_report(self) -> list[str]:
         t = self.totals
@@ -220,16 +228,37 @@ def routine_of(key: str) -> Routine:
     return _BUILT[key] if key.startswith(_BUILT_PREFIX) else load_spec(key)
 
 
-def runner_for(spec: str, seed: int) -> RoutineRunner:
-    key = (str(spec), seed)
+@dataclass(frozen=True)
+class SceneStart:
+    """`--scene S --at-line L --at-cycle C`, as plain data that crosses to worker processes."""
+
+    scene: str
+    line: int | None = None  # None: the scene's own [cpu] start_line / start_cycle
+    cycle: int | None = None
+
+    def raster_start(self) -> RasterStart:
+        from retro.scenes import load_scene
+
+        scene = load_scene(self.scene)
+        line = scene.start_line if self.line is None else self.line
+        cycle = scene.start_cycle if self.cycle is None else self.cycle
+        video = scene.state.video
+        if not 0 <= line < video.lines or not 1 <= cycle <= video.cycles_per_line:
+            raise InputError(f"--at-line/--at-cycle: the {video.chip} has lines 0-{video.lines - 1} and cycles "
+                             f"1-{video.cycles_per_line}, got line {line} cycle {cycle}")
+        return RasterStart(scene, line, cycle)
+
+
+def runner_for(spec: str, seed: int, start: SceneStart | None = None) -> RoutineRunner:
+    key = (str(spec), seed, start)
     if key not in _RUNNERS:
-        _RUNNERS[key] = RoutineRunner(routine_of(str(spec)), seed)
+        _RUNNERS[key] = RoutineRunner(routine_of(str(spec)), seed, start.raster_start() if start else None)
     return _RUNNERS[key]
 
 
-def check_chunk(spec: str, seed: int, chunk: list[tuple]) -> ChunkResult:
+def check_chunk(spec: str, seed: int, chunk: list[tuple], start: SceneStart | None = None) -> ChunkResult:
     """Run cases of one routine; a pure function of its arguments (used in worker processes)."""
-    runner = runner_for(spec, seed)
+    runner = runner_for(spec, seed, start)
     routine = runner.routine
     name = routine.name
     read = runner.machine.memory.__getitem__
@@ -252,13 +281,14 @@ def check_chunk(spec: str, seed: int, chunk: list[tuple]) -> ChunkResult:
                 raise
             expected = None  # a reference may refuse inputs outside the domain: no answer to compare
         out.cases += 1
+        cpu_cycles = cycles - runner.last_stolen  # the timing model and the static bounds know no stalls
         modelled = model_cycles(read, steps)
-        if modelled != cycles:
+        if modelled != cpu_cycles:
             out.cycle_mismatches += 1
             out.failure = out.failure or Failure(case, "cycles", answer, expected,
-                                                 f"measured {cycles} cycles, the timing model says {modelled}")
+                                                 f"measured {cpu_cycles} cycles, the timing model says {modelled}")
             if len(out.examples) < EXAMPLES_KEPT:
-                out.examples.append(f"{name}({describe_case(routine, case)}): measured {cycles} cycles, "
+                out.examples.append(f"{name}({describe_case(routine, case)}): measured {cpu_cycles} cycles, "
                                     f"the timing model says {modelled}")
         for text in broken:
             out.constraint_cases[text] = out.constraint_cases.get(text, 0) + 1
@@ -285,6 +315,9 @@ def check_chunk(spec: str, seed: int, chunk: list[tuple]) -> ChunkResult:
             out.cycles_max, out.max_case = cycles, case
         out.cycles_sum += cycles
         out.cycles_count += 1
+        out.cpu_min = cpu_cycles if out.cpu_min is None else min(out.cpu_min, cpu_cycles)
+        out.cpu_max = cpu_cycles if out.cpu_max is None else max(out.cpu_max, cpu_cycles)
+        out.stolen_max = max(out.stolen_max, runner.last_stolen)
     return out
 
 
@@ -323,8 +356,8 @@ def _chunks(parts: list[case_sets.Part]) -> Iterator[list[tuple]]:
 
 
 def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | None = None,
-                  random_count: int | None = None, jobs: int = 1,
-                  progress: Callable[[str], None] | None = None) -> RoutineCheck:
+                  random_count: int | None = None, jobs: int = 1, progress: Callable[[str], None] | None = None,
+                  start: SceneStart | None = None) -> RoutineCheck:
     """Check one routine: a spec path, or a Routine built in Python (then in this process only)."""
     if isinstance(spec, Routine):
         jobs = 1
@@ -334,7 +367,7 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     parts = case_sets.plan(routine, exhaustive=exhaustive, seed=seed, random=random_count)
     known = sum(p.count for p in parts if p.count is not None)
     unknown = any(p.count is None for p in parts)
-    runner = runner_for(spec, seed)  # loads and validates in this process before any worker starts
+    runner = runner_for(spec, seed, start)  # loads and validates in this process before any worker starts
     totals = ChunkResult()
     done = 0
     shown = [time.monotonic()]
@@ -355,7 +388,7 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         pending: set[Future] = set()
         try:
             for chunk in chunk_iter:
-                pending.add(pool.submit(check_chunk, spec, seed, chunk))
+                pending.add(pool.submit(check_chunk, spec, seed, chunk, start))
                 if len(pending) >= 2 * jobs:  # bounded: cases are made as workers take them
                     finished, pending = wait(pending, return_when=FIRST_COMPLETED)
                     for future in finished:
@@ -368,7 +401,7 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
             pool.shutdown(wait=True, cancel_futures=True)
     else:
         for chunk in chunk_iter:
-            report(check_chunk(spec, seed, chunk))
+            report(check_chunk(spec, seed, chunk, start))
             if totals.run_errors:
                 break
     part_runs = [PartRun(p.name, p.count if p.count is not None else 0, p.total) for p in parts]
@@ -379,10 +412,10 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     static = static_bounds(routine, runner)
     violations = []
     t = totals
-    if static is not None and t.cycles_count and t.cycles_min < static.best:
-        violations.append(f"{routine.name}: measured minimum {t.cycles_min} is below the static best case {static.best}")
-    if static is not None and t.cycles_count and t.cycles_max > static.worst:
-        violations.append(f"{routine.name}: measured maximum {t.cycles_max} is above the static worst case {static.worst}")
+    if static is not None and t.cycles_count and t.cpu_min < static.best:
+        violations.append(f"{routine.name}: measured minimum {t.cpu_min} is below the static best case {static.best}")
+    if static is not None and t.cycles_count and t.cpu_max > static.worst:
+        violations.append(f"{routine.name}: measured maximum {t.cpu_max} is above the static worst case {static.worst}")
     budget_violations = []
     if routine.budget is not None:
         if t.cycles_count and t.cycles_max > routine.budget:
@@ -391,15 +424,16 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         if static is not None and static.worst > routine.budget:
             budget_violations.append(f"{routine.name}: the static worst case {static.worst} cycles is over the budget "
                                      f"of {routine.budget}")
-    check = RoutineCheck(routine, runner.size(), static, totals, violations, budget_violations, part_runs)
+    check = RoutineCheck(routine, runner.size(), static, totals, violations, budget_violations, part_runs,
+                         start=runner.start)
     if totals.failure is not None:
-        check.trace = failure_trace(spec, seed, totals.failure.case)
+        check.trace = failure_trace(spec, seed, totals.failure.case, start)
     return check
 
 
-def failure_trace(spec: str, seed: int, case: tuple) -> list[str]:
+def failure_trace(spec: str, seed: int, case: tuple, start: SceneStart | None = None) -> list[str]:
     """The instructions of one case, run again on a fresh machine with the trace on."""
-    runner = RoutineRunner(routine_of(spec), seed)
+    runner = RoutineRunner(routine_of(spec), seed, start.raster_start() if start else None)
     try:
         result = runner.traced(case)
     except RunError as exc:
@@ -422,13 +456,13 @@ def default_jobs() -> int:
 
 def run_checks(names: list[str] | None, *, exhaustive: bool = False, seed: int | None = None,
                random_count: int | None = None, jobs: int | None = None,
-               progress: Callable[[str], None] | None = None) -> list[RoutineCheck]:
+               progress: Callable[[str], None] | None = None, start: SceneStart | None = None) -> list[RoutineCheck]:
     """Check the named routines (built-in names or spec paths; all built-ins when none are named);
     every name is loaded and validated before any work starts."""
     specs = select(names)
     workers = default_jobs() if jobs is None else jobs
     return [check_routine(spec, exhaustive=exhaustive, seed=seed, random_count=random_count, jobs=workers,
-                          progress=progress) for spec in specs]
+                          progress=progress, start=start) for spec in specs]
 
 
 # ---- reports -------------------------------------------------------------------------------------------
@@ -455,7 +489,26 @@ def cycle_figures(check: RoutineCheck) -> dict:
             "min_inputs": inputs_by_name(routine, t.min_case) if t.min_case is not None else None,
             "max_inputs": inputs_by_name(routine, t.max_case) if t.max_case is not None else None,
             "budget": routine.budget,
-            "raster": raster_figures(routine.cpu, t.cycles_min, check.mean if t.cycles_count else None, t.cycles_max)}
+            "raster": {**raster_figures(routine.cpu, t.cycles_min, check.mean if t.cycles_count else None,
+                                        t.cycles_max), **scene_raster(check)}}
+
+
+def scene_raster(check: RoutineCheck) -> dict:
+    """With --scene: the calls on the scene's timeline from the start line ({"scene": {...}}), stalls
+    included: lines taken, the most cycles stolen, and where the slowest call ended."""
+    start = check.start
+    t = check.totals
+    if start is None or not t.cycles_count:
+        return {}
+    video = start.scene.state.video
+    per_line = video.cycles_per_line
+    last = start.line * per_line + start.cycle - 1 + t.cycles_max - 1
+    frames, within = divmod(last, video.frame_cycles)
+    end_line, end_cycle = divmod(within, per_line)
+    return {"scene": {"chip": video.chip, "start_line": start.line, "start_cycle": start.cycle,
+                      "min_lines": round(t.cycles_min / per_line, 3), "mean_lines": round(check.mean / per_line, 3),
+                      "max_lines": round(t.cycles_max / per_line, 3), "stolen_max": t.stolen_max,
+                      "slowest_end_line": end_line, "slowest_end_cycle": end_cycle + 1, "frames_crossed": frames}}
 
 
 def check_record(check: RoutineCheck) -> dict:
@@ -514,7 +567,13 @@ def format_check(check: RoutineCheck) -> list[str]:
         lines.append(f"  slowest: {describe_case(routine, t.max_case)}")
         raster = format_raster(routine.cpu, raster_figures(routine.cpu, t.cycles_min, check.mean, t.cycles_max))
         if raster:
-            lines.append(f"  raster: {raster}")
+            lines.append(f"  raster (CPU never stalled): {raster}")
+        scene = scene_raster(check).get("scene")
+        if scene:
+            lines.append(f"  on the scene from line {scene['start_line']} cycle {scene['start_cycle']} ({scene['chip']}): "
+                         f"{scene['min_lines']:.2f}-{scene['max_lines']:.2f} lines, up to {scene['stolen_max']} cycles "
+                         f"stolen; the slowest ends at line {scene['slowest_end_line']} cycle {scene['slowest_end_cycle']}"
+                         + (f" {scene['frames_crossed']} frame(s) later" if scene["frames_crossed"] else ""))
     if routine.budget is not None:
         lines.append(f"  budget: {routine.budget} cycles: {'broken' if check.budget_violations else 'kept'}")
     lines += [f"  {line}" for line in check.domain_report()[1:]] if routine.domain else []

@@ -46,7 +46,8 @@ def format_cost_table(checks: list[RoutineCheck]) -> list[str]:
     for check in checks:
         r = cost_row(check)
         static = f"{r['static_min']}-{r['static_max']}" if check.static else "off"
-        lines_at_most = next(iter(r["raster"].values()), {}).get("max_lines")
+        timelines = r["raster"]
+        lines_at_most = timelines.get("scene", next(iter(timelines.values()), {})).get("max_lines")
         rows.append((r["routine"], str(r["code_bytes"]), str(r["table_bytes"]), str(r["min"]), f"{r['mean']:.2f}",
                      str(r["max"]), static, "yes" if check.worst_reached else "no",
                      "-" if lines_at_most is None else f"{lines_at_most:.2f}", str(r["cases"]), str(r["mismatches"]),
@@ -54,7 +55,8 @@ def format_cost_table(checks: list[RoutineCheck]) -> list[str]:
     widths = [max(len(h), *(len(row[i]) for row in rows)) for i, h in enumerate(header)]
     lines = ["  ".join(h.ljust(w) for h, w in zip(header, widths)).rstrip()]
     lines += ["  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip() for row in rows]
-    lines.append("max lines: raster lines of the slowest case on a C64 PAL (6510 routines) or an NTSC NES (2A03)")
+    lines.append("max lines: raster lines of the slowest case: on the --scene from its start line when given, "
+                 "else on a C64 PAL (6510 routines) or an NTSC NES (2A03) with the CPU never stalled")
     lines.append("cycles: from the routine's first instruction through its RTS (the caller's JSR, 6, not included); "
                  "bytes of tables exclude storage the caller fills")
     return lines

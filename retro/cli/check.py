@@ -6,7 +6,8 @@ import argparse
 import json
 import sys
 
-from retro.analysis.check import check_record, format_check, run_checks
+from retro.analysis.check import SceneStart, check_record, format_check, run_checks
+from retro.errors import InputError
 from retro.numbers import parse_int
 
 ROUTINES_HELP = ("built-in routine names (aabb8 aabb_sprite circle mul8 tile tile_box pixel; all when none is "
@@ -23,6 +24,11 @@ def add_case_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--random", dest="random_count", metavar="N",
                    help="random cases per routine (default: the spec's count, at most 2,000 without --exhaustive)")
     p.add_argument("--jobs", metavar="N", help="worker processes (default: up to 2)")
+    p.add_argument("--scene", metavar="SCENE.toml", help="run every call on a C64 with this VIC-II scene: the CPU "
+                   "stalls on Bad Lines and sprite DMA, and the report gives raster lines from the start line")
+    p.add_argument("--at-line", metavar="L", help="with --scene: the raster line each call starts at "
+                   "(default: the scene's [cpu] start_line)")
+    p.add_argument("--at-cycle", metavar="C", help="with --scene: the cycle in that line (default: the scene's)")
     p.add_argument("--json", action="store_true", help="print a JSON list, one object per routine")
 
 
@@ -32,7 +38,16 @@ def case_options(args: argparse.Namespace) -> dict:
             "random_count": None if args.random_count is None else parse_int(args.random_count, field="--random",
                                                                              lo=0, hi=MAX_RANDOM),
             "jobs": None if args.jobs is None else parse_int(args.jobs, field="--jobs", lo=1, hi=64),
-            "progress": progress}
+            "progress": progress, "start": scene_start(args)}
+
+
+def scene_start(args: argparse.Namespace) -> SceneStart | None:
+    if args.scene is None:
+        if args.at_line is not None or args.at_cycle is not None:
+            raise InputError("--at-line and --at-cycle go with --scene")
+        return None
+    return SceneStart(args.scene, None if args.at_line is None else parse_int(args.at_line, field="--at-line", lo=0, hi=1000),
+                      None if args.at_cycle is None else parse_int(args.at_cycle, field="--at-cycle", lo=1, hi=100))
 
 
 def progress(message: str) -> None:

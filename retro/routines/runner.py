@@ -89,15 +89,35 @@ def memory_values(routine: Routine, seed: int) -> dict[str, tuple[int, ...]]:
     return out
 
 
+@dataclass(frozen=True)
+class RasterStart:
+    """Run every call with a VIC-II scene on the bus and the beam at this line and cycle (the CPU
+    then stalls on Bad Lines and sprite DMA as on a real C64)."""
+
+    scene: object  # a VicScene (retro.scenes.vic)
+    line: int
+    cycle: int = 1
+
+
 class RoutineRunner:
-    def __init__(self, routine: Routine, seed: int = 0) -> None:
+    def __init__(self, routine: Routine, seed: int = 0, start: RasterStart | None = None) -> None:
         from retro.loaders import load_program
 
         self.routine = routine
         self.seed = seed
+        self.start = start
         self.program = load_program(routine.program_file, symbols=routine.symbols_file, load=routine.load)
         self.machine = Machine(routine.cpu)
+        self.vic = None
+        if start is not None:
+            if getattr(start.scene, "cpu_variant", None) != routine.cpu:
+                raise InputError(f"--scene: a {start.scene.cpu_variant} scene cannot run the {routine.cpu} routine "
+                                 f"{routine.name}")
+            if not hasattr(start.scene.state, "video") or not hasattr(start.scene, "start_line"):
+                raise InputError("--at-line needs a VIC-II scene (chip = \"vic-ii\")")
+            self.vic = start.scene.attach(self.machine)
         self.machine.load(self.program)
+        self.last_stolen = 0  # cycles of the last call in which the VIC-II held the CPU
         self.entry = self.machine.resolve(routine.entry, "program.entry")
         self.memory_values = memory_values(routine, seed)
         memory = self.machine.memory
@@ -155,9 +175,18 @@ class RoutineRunner:
     def run(self, case: Sequence, record: list | None = None) -> tuple[tuple, int]:
         """(outputs in the spec's order, cycles) of one call."""
         writes, registers, p = self.inputs_for_call(case)
+        if self.vic is not None:
+            self._restart_beam()
+            stolen = self.machine.mpu.stolen
         cycles, a, x, y, p = self.machine.call_fast(self.entry, writes, **registers, p=p, budget=self.limit,
                                                     record=record, pointer_pcs=self.pointer_pcs)
+        if self.vic is not None:
+            self.last_stolen = self.machine.mpu.stolen - stolen
         return self.outputs(a, x, y, p), cycles
+
+    def _restart_beam(self) -> None:
+        self.vic.restart(self.machine.cycle, self.start.line, self.start.cycle)
+        self.machine.mpu.ba_high_until = -1  # the CPU's note of how long BA stays high was for the old beam
 
     def answer(self, case: Sequence) -> int:
         """The first output of one call (the hit flag or value of a single-output routine)."""
@@ -192,6 +221,8 @@ class RoutineRunner:
     def traced(self, case: Sequence) -> CallResult:
         """The same call with the instruction trace (for the report of a failing case)."""
         writes, registers, p = self.inputs_for_call(case)
+        if self.vic is not None:
+            self._restart_beam()
         return self.machine.call(self.entry, **registers, p=p, memory={address: [v] for address, v in writes},
                                  budget=self.limit, trace=True)
 

@@ -185,3 +185,29 @@ def test_a_runaway_routine_stops_the_check_with_its_inputs(tmp_path, capsys):
     code, (record,) = _check_json(capsys, str(tmp_path / "spin.toml"))
     assert code == 1 and record["run_errors"] == 1
     assert record["first_failure"]["inputs"] == {"a": 7} and "cycle budget of 1000" in record["first_failure"]["message"]
+
+
+def test_a_spec_on_a_scene_counts_bad_line_stalls_from_the_start_line(tmp_path, capsys):
+    # 30 NOPs (2 read cycles each) and an RTS: 66 cycles. With the screen on ($D011 = $1B: YSCROLL 3)
+    # line 51 is a Bad Line: BA is low from cycle 12 (3 cycles before the c-accesses of cycles
+    # 15-54, Bauer 3.6.3), and the CPU, reading in every cycle, stops from cycle 12 through 54:
+    # 43 cycles stolen, 109 in all, ending at line 52 cycle 46 (51*63 + 108 = 52*63 + 45).
+    # Started at line 50 cycle 1 the same call ends at line 51 cycle 3, before BA falls.
+    (tmp_path / "nops.s").write_text("        .org $c000\nnops:\n" + "        nop\n" * 30 + "        rts\n")
+    (tmp_path / "ref.py").write_text("def same(a):\n    return a\n")
+    (tmp_path / "nops.toml").write_text('[program]\nfile = "nops.s"\nentry = "nops"\n[inputs]\na = "A"\n'
+                                        '[outputs]\nresult = "A"\n[reference]\nfunction = "ref.py:same"\n'
+                                        '[cases]\nexhaustive = ["a"]\n')
+    (tmp_path / "screen.toml").write_text('chip = "vic-ii"\nvideo = "pal"\n[registers]\n"$d011" = 0x1b\n')
+    spec, scene = str(tmp_path / "nops.toml"), str(tmp_path / "screen.toml")
+    code, (record,) = _check_json(capsys, spec, "--scene", scene, "--at-line", "51")
+    assert code == 0 and record["mismatches"] == 0
+    assert (record["min"], record["max"], record["static_max"]) == (109, 109, 66)
+    on_scene = record["raster"]["scene"]
+    assert on_scene["stolen_max"] == 43 and on_scene["max_lines"] == round(109 / 63, 3)
+    assert (on_scene["slowest_end_line"], on_scene["slowest_end_cycle"]) == (52, 46)
+    code, (record,) = _check_json(capsys, spec, "--scene", scene, "--at-line", "50", "--at-cycle", "1")
+    assert record["max"] == 66 and record["raster"]["scene"]["stolen_max"] == 0
+    assert (record["raster"]["scene"]["slowest_end_line"], record["raster"]["scene"]["slowest_end_cycle"]) == (51, 3)
+    assert main(["cycles", spec, "--at-line", "50"]) == 2
+    assert "--at-line and --at-cycle go with --scene" in capsys.readouterr().err

@@ -124,6 +124,15 @@ class VicDevice:
         device._refresh_irq_next()
         return device
 
+    def restart(self, cycle: int, line: int, line_cycle: int = 1) -> None:
+        """Back to the scene's registers with the beam at `line`, `line_cycle` at machine cycle `cycle`,
+        as `at_beam` makes it (for runs of many calls that each start at the same raster position).
+        The bus keeps this object, so its state is replaced in place; the collision cache is kept."""
+        schedules = self._schedules
+        fresh = type(self).at_beam(self.state, cycle, line, line_cycle)
+        self.__dict__.update(fresh.__dict__)
+        self._schedules.update(schedules)
+
     def __init__(self, state: VicState, start_cycle: int = 0) -> None:
         self.state = state
         self.video = state.video
