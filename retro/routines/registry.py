@@ -16,10 +16,8 @@ SPEC_SUFFIX = ".toml"
 
 
 def builtin_names() -> list[str]:
-    """The built-in routines, in the order `retro check` runs them (docs/routines.md's order)."""
-    names = sorted(p.stem for p in ASM_DIR.glob(f"*{SPEC_SUFFIX}"))
-    preferred = ["aabb8", "aabb_sprite", "circle", "mul8", "tile", "tile_box", "pixel"]
-    return [n for n in preferred if n in names] + [n for n in names if n not in preferred]
+    """The built-in routines (every spec in asm/), in the order `retro check` runs them."""
+    return sorted(p.stem for p in ASM_DIR.glob(f"*{SPEC_SUFFIX}"))
 
 
 def is_spec_path(text: str) -> bool:
