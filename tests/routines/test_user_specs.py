@@ -211,3 +211,24 @@ def test_a_spec_on_a_scene_counts_bad_line_stalls_from_the_start_line(tmp_path, 
     assert (record["raster"]["scene"]["slowest_end_line"], record["raster"]["scene"]["slowest_end_cycle"]) == (51, 3)
     assert main(["cycles", spec, "--at-line", "50"]) == 2
     assert "--at-line and --at-cycle go with --scene" in capsys.readouterr().err
+
+
+def test_cycle_model_disagreements_are_counted_and_fail(monkeypatch, capsys):
+    import retro.analysis.check as check
+
+    monkeypatch.setattr(check, "model_cycles", lambda read, steps: 1)  # a timing model that disagrees
+    code, (record,) = _check_json(capsys, str(SPECS / "boxhit_xa.toml"), "--random", "10")
+    assert code == 1 and record["cycle_mismatches"] == record["cases"] > 0
+    assert record["first_failure"]["kind"] == "cycles" and "the timing model says 1" in record["first_failure"]["message"]
+
+
+def test_measured_cycles_outside_the_static_bounds_fail(monkeypatch, capsys):
+    import retro.analysis.check as check
+    from retro.cpu.flow import Bounds
+
+    monkeypatch.setattr(check, "analyse", lambda *args, **kwargs: Bounds(best=FASTEST + 1, worst=SLOWEST - 1,
+                                                                          instructions=1))
+    code, (record,) = _check_json(capsys, str(SPECS / "boxhit_xa.toml"), "--random", "10")
+    assert code == 1 and len(record["bounds_violations"]) == 2
+    assert "below the static best case 25" in record["bounds_violations"][0]
+    assert "above the static worst case 74" in record["bounds_violations"][1]
