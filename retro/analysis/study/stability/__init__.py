@@ -1,0 +1,1 @@
+"""`retro stability`: where collision methods break (tunnelling, wrap, ranges, edges, latch pitfalls)."""
