@@ -8,6 +8,7 @@ folder, so nothing can be read from the repository by accident.
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -20,9 +21,14 @@ def _run(command: list[str], cwd: Path, env: dict | None = None) -> subprocess.C
 
 
 def test_wheel_runs_demo_and_check(tmp_path):
+    # a clean copy: an earlier build's build/ folder could otherwise supply files the build forgets
+    source = tmp_path / "source"
+    shutil.copytree(ROOT, source, ignore=shutil.ignore_patterns(".git", ".venv", "v", "build", "*.egg-info",
+                                                                 "__pycache__", ".pytest_cache", ".hypothesis",
+                                                                 "retro-out", "out"))
     wheels = tmp_path / "wheels"
     built = _run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(wheels),
-                  str(ROOT)], cwd=tmp_path)
+                  str(source)], cwd=tmp_path)
     assert built.returncode == 0, built.stderr[-2000:]
     (wheel,) = wheels.glob("retro-*.whl")
     target = tmp_path / "site"
