@@ -29,9 +29,11 @@ from retro.program import ADDRESS_LIMIT, Program
 _OPHIS_DRIVER = "import sys; from Ophis.Main import run_ophis; sys.exit(run_ophis(sys.argv[1:]))"
 _ERROR_LINE = re.compile(r"^(?P<file>.+?):(?P<line>\d+): (?P<message>.+)$")
 _MAP_LINE = re.compile(r"^\$(?P<address>[0-9A-Fa-f]+)\s*\|\s*(?P<name>\S+)\s*\|")
-_LISTING_ADDRESS = re.compile(r"^\s*(?P<address>[0-9A-Fa-f]{4})\s")
+_LISTING_ADDRESS = re.compile(r"^\s*(?P<address>[0-9A-Fa-f]{4,})\s")
 _TABLES_REQUEST = re.compile(r"^[ \t]*;[ \t]*retro-tables:(?P<names>.*)$", re.MULTILINE)
 ASSEMBLER_TIMEOUT_SECONDS = 60
+ASSEMBLER_MEMORY_BYTES = 2 << 30  # an `.incbin "/dev/zero"` stops here, not when the machine's memory runs out
+MAX_SOURCE_BYTES = 16 << 20
 _STDIN = "-"  # Ophis's name for standard input
 ANONYMOUS_LABEL = "*"  # Ophis's `*` labels, reached by +/- references only
 
@@ -59,11 +61,34 @@ def _check_tables(source_text: str, shown: str, known: dict) -> list[str]:
     return names
 
 
-def assemble_file(path: str | Path) -> Program:
-    """Assemble a source file (and the tables it requests)."""
+def assemble_file(path: str | Path, data: bytes | None = None) -> Program:
+    """Assemble a source file (and the tables it requests). A file that is not a regular file (a
+    FIFO, a device) is read once (or its bytes are given as `data`, already read) and handed to
+    Ophis as text, its includes relative to its folder."""
     source_path = Path(path)
+    if source_path.exists() and not source_path.is_file() and not source_path.is_dir():
+        text = _decode(source_path, data) if data is not None else _read_once(source_path)
+        return _assemble(_STDIN, str(source_path), text, cwd=source_path.parent)
     text = read_text(source_path, "source file")
     return _assemble_cached(str(source_path.resolve()), str(source_path), _fingerprint(source_path, text))
+
+
+def _read_once(path: Path) -> str:
+    try:
+        with open(path, "rb") as stream:
+            data = stream.read(MAX_SOURCE_BYTES + 1)
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read source file: {exc.strerror or exc}") from None
+    if len(data) > MAX_SOURCE_BYTES:
+        raise InputError(f"{path}: a source of more than {MAX_SOURCE_BYTES >> 20} MiB")
+    return _decode(path, data)
+
+
+def _decode(path: Path, data: bytes) -> str:
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{path}: source file is not UTF-8 text (byte {exc.start})") from None
 
 
 def assemble_text(text: str, name: str = "<source>") -> Program:
@@ -89,7 +114,13 @@ def _assemble_cached(resolved: str, shown: str, fingerprint: str) -> Program:
     return _assemble(resolved, shown, Path(resolved).read_text())
 
 
-def _assemble(resolved: str, shown: str, text: str) -> Program:
+def _limit_memory() -> None:  # runs in the assembler's process, before Ophis starts
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_AS, (ASSEMBLER_MEMORY_BYTES, ASSEMBLER_MEMORY_BYTES))
+
+
+def _assemble(resolved: str, shown: str, text: str, cwd: Path | None = None) -> Program:
     from retro import (
         tables,  # tables are pure generators; imported late to keep start-up light
     )
@@ -106,7 +137,7 @@ def _assemble(resolved: str, shown: str, text: str) -> Program:
                    "-o", str(out / "out.bin"), "-l", str(out / "out.lst"), "-m", str(out / "out.map"), *infiles]
         try:
             done = subprocess.run(command, capture_output=True, text=True, timeout=ASSEMBLER_TIMEOUT_SECONDS,
-                                  input=text if resolved == _STDIN else None)
+                                  input=text if resolved == _STDIN else None, cwd=cwd, preexec_fn=_limit_memory)
         except subprocess.TimeoutExpired:
             raise InputError(f"{shown}: the assembler did not finish in {ASSEMBLER_TIMEOUT_SECONDS} s") from None
         if done.returncode != 0:
@@ -115,6 +146,8 @@ def _assemble(resolved: str, shown: str, text: str) -> Program:
         listing = (out / "out.lst").read_text()
         symbols = _parse_map((out / "out.map").read_text())
     origin = _origin(listing)
+    if origin > ADDRESS_LIMIT:
+        raise InputError(f"{shown}: the code starts at ${origin:X}, above ${ADDRESS_LIMIT:04X}")
     if origin + len(code) > ADDRESS_LIMIT + 1:  # the PRG could not be loaded, nor the code run
         raise InputError(f"{shown}: {len(code)} bytes at ${origin:04X} run past ${ADDRESS_LIMIT:04X}")
     return Program(code=code, origin=origin, symbols=symbols, listing=listing, source=shown)
@@ -129,6 +162,12 @@ def _first_error(output: str, resolved: str, shown: str) -> str:
                 file = shown
             return f"{file}:{match.group('line')}: {match.group('message')}"
     lines = [line for line in output.splitlines() if line.strip() and "error" not in line.lower()[:8]]
+    if any(line.startswith("Traceback") for line in lines):  # Ophis itself crashed: its last line says why
+        if "MemoryError" in lines[-1]:
+            return f"{shown}: the assembler ran out of memory (over {ASSEMBLER_MEMORY_BYTES >> 30} GiB: an .incbin of a device?)"
+        if "RecursionError" in lines[-1]:
+            return f"{shown}: the assembler recursed too deeply (a file that includes itself?)"
+        return f"{shown}: the assembler failed on this source: {lines[-1].strip()[:200]}"
     return f"{shown}: assembly failed: {lines[0].strip() if lines else 'no message from Ophis'}"
 
 

@@ -4,32 +4,78 @@ from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Iterable
 from pathlib import Path
 
 from retro.errors import InputError
 
+MAX_INPUT_BYTES = 64 << 20  # no file a user gives retro (program, symbols, sprites, scenes) is near this
 
-def write_atomic(path: str | os.PathLike, data: bytes | str) -> Path:
-    """Write data to a temp file beside path, then rename it over path."""
-    target = Path(path)
-    payload = data.encode() if isinstance(data, str) else bytes(data)
-    directory = target.parent if str(target.parent) else Path(".")
+
+def write_atomic(path: str | os.PathLike, data: bytes | str, inputs: Iterable[str | os.PathLike] = ()) -> Path:
+    """Write data to a temp file beside path, then rename it over path: all or nothing."""
+    return next(iter(write_all_atomic({path: data}, inputs=inputs)))
+
+
+def write_all_atomic(outputs: dict, inputs: Iterable[str | os.PathLike] = ()) -> list[Path]:
+    """Write every output or none: each to a temp file beside it first, then all renamed into place.
+
+    Refused before anything is written: an output that is one of the `inputs`, one that is not a
+    regular file (a device, a FIFO, a folder: `--png /dev/stdout` is not replaced by a file), and the
+    same output twice. A symlink to a regular file is written through (the link stays a link). Temp
+    files are removed whatever stops the write, Ctrl-C included.
+    """
+    targets = [_checked_target(Path(path)) for path in outputs]
+    if len(set(targets)) != len(targets):
+        raise InputError("the same output file is named twice")
+    protected = {_resolved(Path(p)) for p in inputs}
+    for given, target in zip(outputs, targets):
+        if target in protected:
+            raise InputError(f"{given}: is an input of this command: refusing to write over it")
+    temps: list[str] = []
     try:
-        directory.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
-    except OSError as exc:
-        raise InputError(f"{target}: cannot write: {exc.strerror or exc}") from None
+        for target, data in zip(targets, outputs.values()):
+            payload = data.encode() if isinstance(data, str) else bytes(data)
+            directory = target.parent
+            try:
+                directory.mkdir(parents=True, exist_ok=True)
+                fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
+            except OSError as exc:
+                raise InputError(f"{target}: cannot write: {exc.strerror or exc}") from None
+            temps.append(tmp)
+            try:
+                with os.fdopen(fd, "wb") as fh:
+                    fh.write(payload)
+                os.chmod(tmp, _mode_for(target))  # mkstemp makes the file private (0600); a plain write would not
+            except OSError as exc:
+                raise InputError(f"{target}: cannot write: {exc.strerror or exc}") from None
+        for target, tmp in zip(targets, temps):
+            try:
+                os.replace(tmp, target)
+            except OSError as exc:
+                raise InputError(f"{target}: cannot write: {exc.strerror or exc}") from None
+        temps.clear()
+    finally:
+        for tmp in temps:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+    return targets
+
+
+def _resolved(path: Path) -> Path:
     try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(payload)
-        os.chmod(tmp, _mode_for(target))  # mkstemp makes the file private (0600); a plain write would not
-        os.replace(tmp, target)
-    except OSError as exc:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise InputError(f"{target}: cannot write: {exc.strerror or exc}") from None
+        return path.resolve()
+    except (OSError, RuntimeError):  # a symlink loop
+        return path.absolute()
+
+
+def _checked_target(path: Path) -> Path:
+    target = _resolved(path)
+    if target.exists() and not target.is_file():
+        kind = "a folder" if target.is_dir() else "not a regular file"
+        raise InputError(f"{path}: is {kind}: give a file name to write")
     return target
 
 
@@ -43,9 +89,16 @@ def _mode_for(target: Path) -> int:
         return 0o666 & ~umask
 
 
-def read_bytes(path: str | os.PathLike, what: str = "file") -> bytes:
+def read_bytes(path: str | os.PathLike, what: str = "file", limit: int = MAX_INPUT_BYTES) -> bytes:
+    """The file's bytes, read once (a FIFO works); more than `limit` bytes is an error, not a hang."""
+    if Path(path).is_dir():
+        raise InputError(f"{path}: {what} is a folder, not a file")
     try:
-        return Path(path).read_bytes()
+        with open(path, "rb") as stream:
+            data = stream.read(limit + 1)
+        if len(data) > limit:
+            raise InputError(f"{path}: {what} is larger than {limit >> 20} MiB")
+        return data
     except FileNotFoundError:
         raise InputError(f"{path}: {what} not found") from None
     except OSError as exc:

@@ -9,6 +9,7 @@ from retro.errors import InputError
 _NUMBER = re.compile(r"^(?P<sign>-)?(?:\$(?P<hex>[0-9a-fA-F]+)|0[xX](?P<hex0x>[0-9a-fA-F]+)"
                      r"|%(?P<binary>[01]+)|0[bB](?P<binary0b>[01]+)|(?P<decimal>[0-9]+))$")
 _BASES = {"hex": 16, "hex0x": 16, "binary": 2, "binary0b": 2, "decimal": 10}
+MAX_DIGITS = 80  # no number retro takes needs more; Python refuses int() of 4,300+ decimal digits
 
 
 def parse_int(text: str | int, *, field: str = "value", lo: int | None = None, hi: int | None = None) -> int:
@@ -18,6 +19,8 @@ def parse_int(text: str | int, *, field: str = "value", lo: int | None = None, h
     if isinstance(text, int):
         value = text
     else:
+        if len(str(text)) > MAX_DIGITS:
+            raise InputError(f"{field}: not a number: {str(text)[:20]!r}... ({len(str(text))} characters)")
         match = _NUMBER.match(str(text).strip().replace("_", ""))
         if not match:
             raise InputError(f"{field}: not a number: {text!r} (use $C000, 0xc000, %1010 or 49152)")

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from retro.assembler import assemble_file
-from retro.fileio import read_bytes, write_atomic
+from retro.fileio import read_bytes, write_all_atomic
 from retro.loaders import refuse_foreign_source
 from retro.program import format_vice_labels, prg_bytes
 
@@ -21,17 +21,17 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run_asm(args: argparse.Namespace) -> int:
-    refuse_foreign_source(args.source, read_bytes(args.source, "source file"))
-    program = assemble_file(args.source)
+    data = read_bytes(args.source, "source file")  # once: the source may be a FIFO
+    refuse_foreign_source(args.source, data)
+    program = assemble_file(args.source, data=data)
     output = Path(args.output) if args.output else Path(args.source).with_suffix(".prg")
-    write_atomic(output, prg_bytes(program))
-    written = [str(output)]
+    outputs = {output: prg_bytes(program)}
     if args.labels:
-        write_atomic(args.labels, format_vice_labels(program.symbols))
-        written.append(args.labels)
+        outputs[Path(args.labels)] = format_vice_labels(program.symbols)
     if args.listing:
-        write_atomic(args.listing, program.listing)
-        written.append(args.listing)
+        outputs[Path(args.listing)] = program.listing
+    write_all_atomic(outputs, inputs=[args.source])
+    written = [str(path) for path in outputs]
     span = f"${program.origin:04X}-${program.end - 1:04X}" if program.code else f"${program.origin:04X}"
     print(f"{len(program.code)} bytes at {span}, {len(program.symbols)} labels -> {', '.join(written)}")
     return 0

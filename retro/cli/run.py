@@ -6,7 +6,7 @@ import argparse
 import json
 
 from retro.app.run import SETTABLE_FLAGS, run_routine
-from retro.cpu.machine import DEFAULT_BUDGET, JSR_CYCLES
+from retro.cpu.machine import DEFAULT_BUDGET, MAX_BUDGET, JSR_CYCLES
 from retro.machines.c64 import call_budget
 from retro.numbers import parse_int
 
@@ -20,15 +20,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--labels", metavar="F", help="symbol file of a .prg, .bin or .nes, in any supported format "
                                                    "(docs/symbols.md)")
     p.add_argument("--load", metavar="ADDR", help="load address of a raw binary")
-    p.add_argument("--entry", required=True, metavar="LABEL|ADDR")
-    p.add_argument("--a", default="0", metavar="V")
-    p.add_argument("--x", default="0", metavar="V")
-    p.add_argument("--y", default="0", metavar="V")
+    p.add_argument("--entry", required=True, metavar="LABEL|ADDR", help="where the routine starts (called as by JSR)")
+    p.add_argument("--a", default="0", metavar="V", help="A on entry (default 0)")
+    p.add_argument("--x", default="0", metavar="V", help="X on entry (default 0)")
+    p.add_argument("--y", default="0", metavar="V", help="Y on entry (default 0)")
     for flag in SETTABLE_FLAGS:
         p.add_argument(f"--{flag}", metavar="0|1", help=f"{flag.upper()} flag on entry")
-    p.add_argument("--set", dest="sets", action="append", default=[], metavar="TARGET=V")
-    p.add_argument("--peek", dest="peeks", action="append", default=[], metavar="TARGET[:N]")
-    p.add_argument("--budget", default=str(DEFAULT_BUDGET), metavar="CYCLES")
+    p.add_argument("--set", dest="sets", action="append", default=[], metavar="TARGET=V",
+                   help="store bytes before the call: a label or address = V[,V...] (repeatable)")
+    p.add_argument("--peek", dest="peeks", action="append", default=[], metavar="TARGET[:N]",
+                   help="show N bytes (default 1) at a label or address after the call (repeatable)")
+    p.add_argument("--budget", default=str(DEFAULT_BUDGET), metavar="CYCLES",
+                   help=f"stop the routine after this many cycles (default {DEFAULT_BUDGET:,}, at most {MAX_BUDGET:,})")
     p.add_argument("--scene", metavar="SCENE.toml", help="attach a VIC-II or NES PPU scene to the machine")
     output = p.add_mutually_exclusive_group()  # the JSON object's keys are fixed: no room for a trace
     output.add_argument("--trace", action="store_true", help="print every instruction executed")
@@ -43,7 +46,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         args.program, args.entry, labels=args.labels, load=args.load,
         a=parse_int(args.a, field="--a", lo=0, hi=0xFF), x=parse_int(args.x, field="--x", lo=0, hi=0xFF),
         y=parse_int(args.y, field="--y", lo=0, hi=0xFF), flags=flags, sets=args.sets, peeks=args.peeks,
-        budget=parse_int(args.budget, field="--budget", lo=1), scene=args.scene, trace=args.trace)
+        budget=parse_int(args.budget, field="--budget", lo=1, hi=MAX_BUDGET), scene=args.scene, trace=args.trace)
     r = report.result
     if args.json:
         budget = call_budget(report.machine, r)

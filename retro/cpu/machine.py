@@ -29,6 +29,8 @@ from retro.numbers import parse_int
 from retro.program import Program, ambiguity_message
 
 DEFAULT_BUDGET = 5_000_000  # cycles; about five seconds of C64 time, a few seconds on the host
+MAX_BUDGET = 100_000_000  # cycles; about 100 s of C64 time, a minute or two on the host
+MAX_TRACE = 200_000  # instructions a trace keeps (about 30 MB); a longer traced run is stopped
 RETURN_TRAP = 0x0000  # the routine "returns" here: RTS to $0000 with the stack back where it started
 CALL_STACK_TOP = 0xFF
 DEFAULT_FLAGS = FLAG_U | FLAG_I
@@ -157,8 +159,8 @@ class Machine:
         for name, value in (("a", a), ("x", x), ("y", y), ("p", p)):
             if not 0 <= value <= 0xFF:
                 raise InputError(f"{name}: {value} is not a byte (0-255)")
-        if budget < 1:
-            raise InputError(f"budget: {budget} is not a positive number of cycles")
+        if not 1 <= budget <= MAX_BUDGET:
+            raise InputError(f"budget: {budget} is not a number of cycles in 1..{MAX_BUDGET:,}")
         for target, values in (memory or {}).items():
             self.poke(target, values)
         entries: list[TraceEntry] | None = [] if trace else None
@@ -263,6 +265,9 @@ class Machine:
                 return mpu.run_until(stop_pc, stop_sp, limit)
             count = 0
             while not (mpu.pc == stop_pc and (stop_sp < 0 or mpu.sp == stop_sp)) and mpu.processorCycles < limit:
+                if len(entries) >= MAX_TRACE:
+                    raise RunError(f"the trace is longer than {MAX_TRACE:,} instructions (at PC ${mpu.pc:04X}): "
+                                   "give a smaller budget, or run without the trace")
                 if mpu.pending_interrupt is None:
                     mpu.recent[count & RECENT_MASK] = mpu.pc
                     count += 1

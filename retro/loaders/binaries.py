@@ -161,6 +161,6 @@ def load_program(path: str | Path, *, symbols: str | Path | None = None, load: i
         if symbols:
             raise InputError(f"{symbols}: --labels goes with a .prg, a raw binary or a .nes image; "
                              f"a source's labels come from the assembler")
-        return assemble_file(path)
+        return assemble_file(path, data=data)
     raise InputError(f"{source}: a binary file without a load address: pass --load ADDR for a raw binary, "
                      f"or name a C64 program .prg (2-byte load address first)")
