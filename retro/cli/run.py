@@ -55,12 +55,16 @@ def cmd_run(args: argparse.Namespace) -> int:
                           **({"raster": budget.as_dict()} if budget else {})}))
         return 0
     if r.trace:
+        print("address  instruction    cycles  total  read       notes")
+        total = 0
         for e in r.trace:
+            total += e.cycles
             notes = " ".join(n for n, on in (("taken", e.branch_taken), ("page+1", e.page_crossed)) if on)
             if e.stolen:
                 notes = f"{notes} stolen {e.stolen}".strip()
             text = e.mnemonic if e.mode == "int" else report.machine.disassemble_at(e.address)
-            print(f"${e.address:04X}  {text:<14} {e.cycles}  {notes}".rstrip())
+            read = f"${e.read:02X}@${e.operand:04X}" if e.read is not None else ""
+            print(f"${e.address:04X}    {text:<14} {e.cycles:>6}  {total:>5}  {read:<10} {notes}".rstrip())
     print(f"A=${r.a:02X} X=${r.x:02X} Y=${r.y:02X} S=${r.s:02X} P=${r.p:02X}")
     print(STATUS_BITS_HEADER)
     print(" ".join(str(r.p >> bit & 1) for bit in range(7, -1, -1)))

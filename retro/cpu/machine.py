@@ -38,6 +38,8 @@ RECENT_SHOWN = 8  # instructions listed in a failure message
 NO_ADDRESS = -1  # a stop address the PC never equals
 ANY_STACK = -1  # stop at the address whatever the stack pointer
 JSR_CYCLES = 6  # the caller's JSR, excluded from every reported count
+LOADS = frozenset({"LDA", "LDX", "LDY", "LAX"})
+STORES = frozenset({"STA", "STX", "STY", "SAX", "SHA", "SHX", "SHY", "TAS"})
 
 
 @dataclass(frozen=True)
@@ -50,6 +52,8 @@ class TraceEntry:
     page_crossed: bool
     branch_taken: bool
     stolen: int = 0  # cycles of `cycles` the CPU stood still (BA low: Bad Line, sprite DMA)
+    operand: int | None = None  # the memory address the instruction used (None: none)
+    read: int | None = None  # the value it read there (loads: what reached the register)
 
 
 @dataclass
@@ -277,10 +281,35 @@ class Machine:
         except CpuHalt as halt:
             raise RunError(f"{halt}; last instructions: {self._describe_recent(mpu.executed)}") from None
 
+    def _operand_address(self, pc: int, mode: str) -> int | None:
+        """The effective address of the instruction at pc, from the registers before it runs."""
+        memory = self.mpu.memory
+        mpu = self.mpu
+        lo = memory[(pc + 1) & 0xFFFF]
+        word = lo | memory[(pc + 2) & 0xFFFF] << 8
+        if mode == "zpg":
+            return lo
+        if mode in ("zpx", "zpy"):
+            return (lo + (mpu.x if mode == "zpx" else mpu.y)) & 0xFF
+        if mode == "abs":
+            return word
+        if mode in ("abx", "aby"):
+            return (word + (mpu.x if mode == "abx" else mpu.y)) & 0xFFFF
+        if mode == "inx":
+            pointer = (lo + mpu.x) & 0xFF
+            return memory[pointer] | memory[(pointer + 1) & 0xFF] << 8
+        if mode == "iny":
+            return ((memory[lo] | memory[(lo + 1) & 0xFF] << 8) + mpu.y) & 0xFFFF
+        return None
+
     def _traced_step(self) -> TraceEntry:
         mpu = self.mpu
         address = mpu.pc
         opcode = mpu.memory[address]
+        mnemonic, mode = mpu.disassemble[opcode]
+        operand = self._operand_address(address, mode) if mnemonic not in ("JMP", "JSR") else None
+        reads = operand is not None and mnemonic not in STORES
+        before_value = self.bus.peek(operand) if reads and mnemonic not in LOADS else None
         before = mpu.processorCycles
         if mpu.lines is None:
             mpu.step()
@@ -294,12 +323,14 @@ class Machine:
                                   cycles=mpu.processorCycles - before, page_crossed=False, branch_taken=False,
                                   stolen=stolen)
         cycles = mpu.processorCycles - before
-        mnemonic, mode = mpu.disassemble[opcode]
         extra = cycles - stolen - mpu.cycletime[opcode]
         is_branch = mode == "rel"
+        value = before_value
+        if reads and mnemonic in LOADS:  # what the load put in its register is what it read
+            value = {"LDA": mpu.a, "LDX": mpu.x, "LDY": mpu.y, "LAX": mpu.a}[mnemonic]
         return TraceEntry(address=address, opcode=opcode, mnemonic=mnemonic, mode=mode, cycles=cycles,
                           page_crossed=(extra == 2) if is_branch else extra == 1,
-                          branch_taken=is_branch and extra >= 1, stolen=stolen)
+                          branch_taken=is_branch and extra >= 1, stolen=stolen, operand=operand, read=value)
 
     def _over_budget(self, budget: int, count: int) -> None:
         raise RunError(f"cycle budget of {budget} cycles used up at PC ${self.mpu.pc:04X} after {count} "

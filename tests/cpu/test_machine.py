@@ -390,3 +390,25 @@ def test_nes_nmi_at_vblank_when_2000_bit_7_is_set():
         at += entry.cycles
     assert at == 27406
     assert [e.mnemonic for e in result.trace].count("NMI") == 1
+
+
+def test_trace_shows_the_address_and_value_each_read_used():
+    from retro.assembler import assemble_text
+
+    program = assemble_text("""
+        .org $c000
+    start:
+        ldx #2
+        lda table,x     ; reads table+2
+        cmp $10         ; reads zero page $10
+        sta $11         ; a store: no value read
+        rts
+    table: .byte 7, 8, 9
+    """)
+    machine = Machine()
+    machine.load(program)
+    result = machine.call("start", memory={0x10: [42]}, trace=True)
+    table = program.symbols["table"]
+    reads = [(e.mnemonic, e.operand, e.read) for e in result.trace]
+    assert reads == [("LDX", None, None), ("LDA", table + 2, 9), ("CMP", 0x10, 42), ("STA", 0x11, None),
+                     ("RTS", None, None)]
