@@ -20,7 +20,7 @@ from retro.analysis.cost import COST_FIELDS
 from retro.cli import main
 
 SPECS = Path(__file__).resolve().parents[1] / "data" / "specs"
-ASSEMBLERS = ["acme", "64tass", "ca65", "kick", "dasm", "xa"]
+ASSEMBLERS = ["acme", "64tass", "ca65", "kick", "dasm", "xa", "nes"]
 FASTEST, SLOWEST = 24, 75
 
 
@@ -36,6 +36,10 @@ def test_each_assemblers_build_is_checked(assembler, capsys):
     assert record["min"] == FASTEST and record["max"] == SLOWEST
     assert (record["static_min"], record["static_max"]) == (FASTEST, SLOWEST)
     assert record["budget"] == 80
+    # an iNES image runs on the 2A03 and is shown in NES raster lines (341 dots / 3 per CPU cycle)
+    assert record["cpu"] == ("2a03" if assembler == "nes" else "6510")
+    timeline = record["raster"]["nes_ntsc" if assembler == "nes" else "c64_pal"]
+    assert timeline["max_lines"] == round(SLOWEST / (341 / 3 if assembler == "nes" else 63), 3)
     assert set(record["min_inputs"]) == {"ax", "ay", "aw", "ah", "bx", "by", "bw", "bh"}
     # the exhaustive part: every pair of the two left edges (0..255 for ACME, 0..63 in the others)
     exhaustive = next(part for part in record["coverage"] if part["part"] == "exhaustive")
