@@ -25,7 +25,7 @@ def _accuracy(text: str) -> float:
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("advise", help="the cheapest collision method (6502 cycles) that meets an accuracy target "
                                       "on a VIC-II scene's sprites")
-    p.add_argument("scene", metavar="SCENE.toml")
+    p.add_argument("scene", metavar="SCENE.toml", help="a VIC-II scene whose enabled sprites are the objects to test")
     p.add_argument("--accuracy", default=str(DEFAULT_ACCURACY), metavar="A",
                    help=f"required share of cases decided correctly, 0-1 or a percentage (default: {DEFAULT_ACCURACY})")
     p.add_argument("--workers", default="2", metavar="N", help="processes to use (default: 2)")

@@ -13,7 +13,7 @@ from retro.program import format_vice_labels, prg_bytes
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("asm", help="assemble a 6502 source (Ophis syntax) into a PRG and a VICE label file")
-    p.add_argument("source", metavar="FILE.s")
+    p.add_argument("source", metavar="FILE.s", help="a 6502 source in Ophis syntax")
     p.add_argument("-o", "--output", metavar="OUT.prg", help="PRG to write (default: FILE.prg)")
     p.add_argument("--labels", metavar="OUT.lbl", help="VICE label file to write")
     p.add_argument("--list", dest="listing", metavar="OUT.lst", help="listing to write")

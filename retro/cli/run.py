@@ -16,7 +16,8 @@ STATUS_BITS_HEADER = "N V - B D I Z C"
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("run", help="call a 6502 routine in the emulator and report registers, cycles and memory")
-    p.add_argument("program", metavar="FILE.s|FILE.prg|FILE.bin|FILE.nes")
+    p.add_argument("program", metavar="FILE.s|FILE.prg|FILE.bin|FILE.nes",
+                   help="an Ophis source, a C64 .prg, a raw binary (with --load) or an iNES image (NROM)")
     p.add_argument("--labels", metavar="F", help="symbol file of a .prg, .bin or .nes, in any supported format "
                                                    "(docs/symbols.md)")
     p.add_argument("--load", metavar="ADDR", help="load address of a raw binary")
