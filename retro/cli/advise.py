@@ -28,13 +28,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("scene", metavar="SCENE.toml", help="a VIC-II scene whose enabled sprites are the objects to test")
     p.add_argument("--accuracy", default=str(DEFAULT_ACCURACY), metavar="A",
                    help=f"required share of cases decided correctly, 0-1 or a percentage (default: {DEFAULT_ACCURACY})")
-    p.add_argument("--workers", default="2", metavar="N", help="processes to use (default: 2)")
+    p.add_argument("--jobs", default="2", metavar="N", help="worker processes (default: 2)")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     p.set_defaults(func=cmd_advise)
 
 
 def cmd_advise(args: argparse.Namespace) -> int:
-    advice = advise(args.scene, _accuracy(args.accuracy), workers=parse_int(args.workers, field="--workers", lo=1, hi=64),
+    advice = advise(args.scene, _accuracy(args.accuracy), workers=parse_int(args.jobs, field="--jobs", lo=1, hi=64),
                     progress=quiet if args.quiet else stderr_progress)
     for line in advice_lines(advice):
         print(line)

@@ -19,7 +19,7 @@ def run_cli(*args: str) -> subprocess.CompletedProcess:
     (["advise", "examples/vic_two_balls.toml", "--accuracy", "1.5"], "--accuracy"),
     (["advise", "examples/vic_two_balls.toml", "--accuracy", "most"], "--accuracy"),
     (["advise", "examples/nes_sprite0.toml"], "chip"),
-    (["chart", "--workers", "0"], "--workers"),
+    (["chart", "--jobs", "0"], "--jobs"),
 ])
 def test_bad_input_is_one_line_and_exit_2(args, field, capsys):
     assert main(args) == 2
@@ -44,7 +44,7 @@ x = 130
 y = 100
 file = "{SPRITES_DIR / 'bar.spr'}"
 """)
-    done = run_cli("advise", str(scene), "--accuracy", "0.9", "--quiet", "--workers", "1")
+    done = run_cli("advise", str(scene), "--accuracy", "0.9", "--quiet", "--jobs", "1")
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
     advice = next(line for line in lines if line.startswith("advice:"))
@@ -54,7 +54,7 @@ file = "{SPRITES_DIR / 'bar.spr'}"
 
 
 def test_advise_many_sprites_excludes_the_latch():
-    done = run_cli("advise", "examples/vic_two_balls.toml", "--accuracy", "99%", "--quiet", "--workers", "1")
+    done = run_cli("advise", "examples/vic_two_balls.toml", "--accuracy", "99%", "--quiet", "--jobs", "1")
     assert done.returncode == 0, done.stderr
     assert "cannot say which pair" in done.stdout
     advice = next(line for line in done.stdout.splitlines() if line.startswith("advice:"))
