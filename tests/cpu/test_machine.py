@@ -412,3 +412,25 @@ def test_trace_shows_the_address_and_value_each_read_used():
     reads = [(e.mnemonic, e.operand, e.read) for e in result.trace]
     assert reads == [("LDX", None, None), ("LDA", table + 2, 9), ("CMP", 0x10, 42), ("STA", 0x11, None),
                      ("RTS", None, None)]
+
+
+def test_a_call_starts_with_interrupts_disabled():
+    from retro.assembler import assemble_text
+
+    program = assemble_text("        .org $c000\nstart:  php\n        pla\n        rts\n")
+    machine = Machine()
+    machine.load(program)
+    # PHP pushes P with B and bit 5 set; I is set on entry (docs/specs.md): $30 | $04
+    assert machine.call("start").a == 0x34
+    assert machine.call("start", p=0x20).a == 0x30
+
+
+def test_run_reports_cycles_without_the_6_cycle_jsr(tmp_path, capsys):
+    from retro.cli import main
+
+    source = tmp_path / "php.s"
+    source.write_text("        .org $c000\nstart:  php\n        pla\n        rts\n")
+    assert main(["run", str(source), "--entry", "start"]) == 0
+    out = capsys.readouterr().out
+    assert "13 cycles, 3 instructions" in out  # PHP 3 + PLA 4 + RTS 6
+    assert "the caller's JSR, 6 cycles, is not included" in out

@@ -236,3 +236,14 @@ def test_measured_cycles_outside_the_static_bounds_fail(monkeypatch, capsys):
     assert code == 1 and len(record["bounds_violations"]) == 2
     assert "below the static best case 25" in record["bounds_violations"][0]
     assert "above the static worst case 74" in record["bounds_violations"][1]
+
+
+def test_the_first_run_failure_stops_the_check(tmp_path, capsys):
+    (tmp_path / "brk.s").write_text("        .org $c000\nbrk_it: brk\n")
+    (tmp_path / "ref.py").write_text("def f(a):\n    return a\n")
+    (tmp_path / "brk.toml").write_text('[program]\nfile = "brk.s"\nentry = "brk_it"\n[inputs]\na = "A"\n'
+                                       '[outputs]\nr = "A"\n[reference]\nfunction = "ref.py:f"\n'
+                                       '[cases]\nexhaustive = ["a"]\n[cycles]\nstatic = false\n')
+    code, (record,) = _check_json(capsys, str(tmp_path / "brk.toml"))
+    assert code == 1 and record["run_errors"] == 1 and record["cases"] == 1  # every case would BRK: stop at one
+    assert "BRK" in record["first_failure"]["message"]

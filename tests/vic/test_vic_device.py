@@ -313,3 +313,33 @@ def test_unused_bits_of_every_register_read_1():
     for register in (0x15, 0x16, 0x17, 0x18, 0x1A, 0x1B, 0x1C, 0x1D, 0x20, 0x21, 0x25, 0x27, 0x2E):
         assert vic.read(0xD000 + register, 10) == unused.get(register, 0), hex(register)
     assert vic.read(0xD019, 10) == 0x70 | 0x01  # bits 4-6; raster compare line 0 passed at cycle 2
+
+
+GFX_MEMORY = {"screen": {"fill": 32, "cells": [{"col": c, "row": 0, "value": 0xA0} for c in range(7, 15)]},
+              "charset": {"160": [0xFF] * 8}}  # solid characters under the sprites' one pixel (above)
+PAL_FRAME = 312 * PAL_LINE
+IRQ_SPRITE_BACKGROUND_BIT = 0x02
+
+
+def test_d01f_clears_on_read_and_d019_bit1_latches_only_from_zero():
+    vic = VicDevice(scene(sprite(0, 86, 0x34, ONE_PIXEL), sprite(1, 86, 0x34, ONE_PIXEL), memory=GFX_MEMORY).state)
+    t = VICE_READ_TIME
+    assert vic.read(0xD019, t) & IRQ_SPRITE_BACKGROUND_BIT  # latched when $D01F went from 0 to non-zero
+    vic.write(0xD019, IRQ_SPRITE_BACKGROUND_BIT, t + 1)  # acknowledged; $D01F is not read
+    assert vic.read(0xD019, t + PAL_FRAME) & IRQ_SPRITE_BACKGROUND_BIT == 0  # $D01F still non-zero: no latch
+    assert vic.read(0xD01F, t + PAL_FRAME + 1) == 0b11
+    assert vic.read(0xD01F, t + PAL_FRAME + 2) == 0  # cleared by the read
+    assert vic.read(0xD019, t + 2 * PAL_FRAME) & IRQ_SPRITE_BACKGROUND_BIT  # from zero again: latched
+    assert vic.read(0xD01F, t + 2 * PAL_FRAME + 1) == 0b11
+
+
+def test_a_register_write_takes_effect_in_the_next_cycle():
+    # The first common pixel of the two sprites is drawn in cycle OVERLAP_TIME (above). Moving
+    # sprite 0 away by a write in that very cycle is too late (the cycle still drew with the old X);
+    # a write one cycle earlier is in time.
+    vic = device()
+    vic.write(0xD000, 200, OVERLAP_TIME)
+    assert vic.read(0xD01E, OVERLAP_TIME + 1) == 0b11
+    vic = device()
+    vic.write(0xD000, 200, OVERLAP_TIME - 1)
+    assert vic.read(0xD01E, OVERLAP_TIME + 1) == 0
