@@ -118,10 +118,12 @@ def run_mutant(mutant: Mutant, tree: Path) -> tuple[str, float]:
     path.write_text(original.replace(mutant.old, mutant.new))
     started = time.monotonic()
     try:
-        env = {**os.environ, "PYTHONPATH": str(tree), "PYTHONDONTWRITEBYTECODE": "1"}
+        env = {**os.environ, "PYTHONPATH": str(tree), "PYTHONDONTWRITEBYTECODE": "1",
+               "RETRO_CPU_VECTORS": os.environ.get("RETRO_CPU_VECTORS", str(ROOT.parent / "shared" / "cpu-vectors"))}
         done = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", *mutant.tests],
                               cwd=tree, env=env, capture_output=True, text=True, timeout=TIMEOUT_SECONDS)
-        verdict = "killed" if done.returncode != 0 else "SURVIVED"
+        failed = [line.split(" ", 2)[1] for line in done.stdout.splitlines() if line.startswith(("FAILED ", "ERROR "))]
+        verdict = (f"killed by {failed[0].split('::')[-1][:60]}" if failed else "killed") if done.returncode else "SURVIVED"
     except subprocess.TimeoutExpired:
         verdict = "killed (timeout)"
     finally:
