@@ -557,8 +557,9 @@ def format_check(check: RoutineCheck) -> list[str]:
     verdict = "OK" if not check.mismatches else f"{check.mismatches} MISMATCH(ES)"
     static = (f"static {check.static.best}-{check.static.worst}, worst case "
               f"{'reached' if check.worst_reached else 'not reached'}" if check.static else "static analysis off")
-    lines = [f"{routine.name}: {t.cases} cases, {verdict}; cycles {t.cycles_min}-{t.cycles_max} "
-             f"(mean {check.mean:.2f}), {static}; timing model equal on "
+    cost = (f"cycles {t.cycles_min}-{t.cycles_max} (mean {check.mean:.2f})" if t.cycles_count
+            else "no case inside the domain")
+    lines = [f"{routine.name}: {t.cases} cases, {verdict}; {cost}, {static}; timing model equal on "
              f"{t.cases - t.cycle_mismatches - t.run_errors} of {t.cases} calls"]
     if check.parts:
         lines.append(f"  cases: {format_coverage(check)}")

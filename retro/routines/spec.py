@@ -39,6 +39,7 @@ from retro.routines.where import Condition, parse_where
 BYTE_VALUES = 256
 MAX_EXHAUSTIVE = 1 << 32  # cases in an exhaustive set
 MAX_RANDOM = 10 ** 9
+DEFAULT_RANDOM = 10_000  # random cases when a spec does not say (2,000 of them without --exhaustive)
 MAX_TABLE = 0x10000
 MAX_SPEC_BYTES = 1 << 20  # a spec file is a page of TOML, never megabytes
 MAX_LOOP_BOUND = 1 << 20
@@ -322,7 +323,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
             raise r.fail("cases.exhaustive", f"unknown input {n!r} (inputs: {', '.join(names)})")
     if len(set(exhaustive)) != len(exhaustive):
         raise r.fail("cases.exhaustive", "an input is named twice")
-    random_count = r.number(cases_doc.get("random", 0), "cases.random", 0, MAX_RANDOM)
+    random_count = r.number(cases_doc.get("random", DEFAULT_RANDOM), "cases.random", 0, MAX_RANDOM)
     seed = r.number(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1)
     where = cases_doc.get("where")
     domain = parse_where(where, names, f"{r.source}: cases.where") if where is not None else ()
@@ -354,6 +355,8 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
         random=random_count, seed=seed, domain=domain, boundary=generators.get("boundary"),
         sweep=generators.get("sweep"), random_generator=generators.get("random_generator"), budget=budget,
         loop_bounds=loop_bounds, limit=limit, static=static, summary=summary)
+    if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep):
+        raise r.fail("cases", "no cases: give random = N, exhaustive = [...], boundary or sweep")
     if routine.exhaustive_count() > MAX_EXHAUSTIVE:
         raise r.fail("cases.exhaustive", f"{routine.exhaustive_count():,} cases is more than 2^32: "
                                          "narrow the inputs' values or sweep fewer inputs")

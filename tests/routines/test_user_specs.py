@@ -136,6 +136,7 @@ BAD_SPECS = [
     ({'boxhit_refs.py:boxhit': 'boxhit_refs.py:nothing'}, "reference.function: boxhit_refs.py has no function"),
     ({'max = 80': 'max = 80\n[cycles.extra]'}, "cycles.extra: unknown key"),
     ({'[inputs]': '[inputs\n'}, "not valid TOML"),
+    ({'exhaustive = ["ax", "bx"]': 'exhaustive = []', 'random = 3000': 'random = 0'}, "cases: no cases"),
 ]
 
 
