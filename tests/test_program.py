@@ -5,14 +5,18 @@ from __future__ import annotations
 import pytest
 
 from retro.errors import InputError
-from retro.program import (
-    Program,
-    format_vice_labels,
-    load_prg_file,
-    parse_prg,
-    parse_vice_labels,
-    prg_bytes,
-)
+from retro.loaders import load_program, parse_symbols, symbol_tables
+from retro.program import Program, format_vice_labels, parse_prg, prg_bytes
+
+
+def parse_vice_labels(text: str, source: str = "labels") -> dict[str, int]:
+    symbols, ambiguous = symbol_tables(parse_symbols(text, source))
+    assert not ambiguous
+    return symbols
+
+
+def load_prg_file(path, labels=None) -> Program:
+    return load_program(path, symbols=labels)
 
 
 def test_prg_round_trip_and_header_is_little_endian():
@@ -64,7 +68,7 @@ def test_malformed_label_file_names_file_and_line(tmp_path):
 
 
 def test_label_address_above_ffff():
-    with pytest.raises(InputError, match="lbl:2: address \\$10000"):
+    with pytest.raises(InputError, match="lbl:2: value \\$10000 of .far. is above \\$FFFF"):
         parse_vice_labels("al C:c000 .ok\nal 010000 .far\n", source="lbl")
 
 
