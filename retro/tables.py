@@ -162,3 +162,11 @@ table("pixel_mask_b")(lambda: [0] * 64)
 
 # Tables that are storage the caller fills, not lookup tables (reported apart from table bytes).
 STORAGE_TABLES = frozenset({"tile_props", "pixel_mask_a", "pixel_mask_b"})
+
+
+# ---- circle_r (radius sum precomputed) ------------------------------------------------------------
+# R^2 - 1 for R = 1..255 (entry 0 is outside the routine's domain, R >= 1): read with the carry
+# set it gives R^2 - 1 - dx^2, the "< R^2" test as a borrow.
+_CIRCLE_R_SQUARE_MINUS_1 = [0] + [r * r - 1 for r in range(1, 256)]
+table("circle_rm1_lo")(lambda: _lo(_CIRCLE_R_SQUARE_MINUS_1))
+table("circle_rm1_hi")(lambda: _hi(_CIRCLE_R_SQUARE_MINUS_1))

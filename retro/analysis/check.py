@@ -357,14 +357,15 @@ def _chunks(parts: list[case_sets.Part]) -> Iterator[list[tuple]]:
 
 def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | None = None,
                   random_count: int | None = None, jobs: int = 1, progress: Callable[[str], None] | None = None,
-                  start: SceneStart | None = None) -> RoutineCheck:
+                  start: SceneStart | None = None, bounded_product: int = case_sets.BOUNDED_PRODUCT) -> RoutineCheck:
     """Check one routine: a spec path, or a Routine built in Python (then in this process only)."""
     if isinstance(spec, Routine):
         jobs = 1
     spec = routine_key(spec)
     routine = routine_of(spec)
     seed = routine.seed if seed is None else seed
-    parts = case_sets.plan(routine, exhaustive=exhaustive, seed=seed, random=random_count)
+    parts = case_sets.plan(routine, exhaustive=exhaustive, seed=seed, random=random_count,
+                           bounded_product=bounded_product)
     known = sum(p.count for p in parts if p.count is not None)
     unknown = any(p.count is None for p in parts)
     runner = runner_for(spec, seed, start)  # loads and validates in this process before any worker starts
@@ -456,13 +457,14 @@ def default_jobs() -> int:
 
 def run_checks(names: list[str] | None, *, exhaustive: bool = False, seed: int | None = None,
                random_count: int | None = None, jobs: int | None = None,
-               progress: Callable[[str], None] | None = None, start: SceneStart | None = None) -> list[RoutineCheck]:
+               progress: Callable[[str], None] | None = None, start: SceneStart | None = None,
+               bounded_product: int = case_sets.BOUNDED_PRODUCT) -> list[RoutineCheck]:
     """Check the named routines (built-in names or spec paths; all built-ins when none are named);
     every name is loaded and validated before any work starts."""
     specs = select(names)
     workers = default_jobs() if jobs is None else jobs
     return [check_routine(spec, exhaustive=exhaustive, seed=seed, random_count=random_count, jobs=workers,
-                          progress=progress, start=start) for spec in specs]
+                          progress=progress, start=start, bounded_product=bounded_product) for spec in specs]
 
 
 # ---- reports -------------------------------------------------------------------------------------------

@@ -307,3 +307,70 @@ def pixel_sweep(seed: int = 0) -> Iterable[tuple]:
         for dx in range(BYTE):
             for dy in range(BYTE):
                 yield (dx, dy, *masks[pair])
+
+
+# ---- circle_r ------------------------------------------------------------------------------------
+
+def circle_r_sweep() -> Iterable[tuple]:
+    """Every pair of 8-bit deltas (both signs) at the radius sums just below and at their distance
+    (where those are 1..255): the only places the answer can flip."""
+    for dx in range(-255, 256):
+        for dy in range(-255, 256):
+            distance_ceiling = math.isqrt(dx * dx + dy * dy - 1) + 1 if dx or dy else 0
+            x1, x2 = (dx, 0) if dx >= 0 else (0, -dx)
+            y1, y2 = (dy, 0) if dy >= 0 else (0, -dy)
+            for radius in (distance_ceiling, distance_ceiling + 1):
+                if 1 <= radius <= 255:
+                    yield (x1, y1, radius, x2, y2)
+
+
+def circle_r_boundary() -> list[tuple]:
+    """Coincident centres (R = 0 is outside the domain: two points never overlap), byte ends, tangency."""
+    out = []
+    for dx, dy in ((0, 0), (3, 4), (-3, -4), (255, 0), (-255, 0), (0, 255), (0, -255), (180, -180), (1, 1)):
+        distance = math.isqrt(dx * dx + dy * dy)
+        for radius in {0, 1, distance, distance + 1, 254, 255}:
+            if 0 <= radius <= 255:
+                x1, x2 = (dx, 0) if dx >= 0 else (0, -dx)
+                y1, y2 = (dy, 0) if dy >= 0 else (0, -dy)
+                out.append((x1, y1, radius, x2, y2))
+    return out
+
+
+# ---- aabb_edges and sprite_edges: edges as their prepare routines make them -----------------------
+
+def _boxes(rng: np.random.Generator, n: int, limit: int) -> tuple[np.ndarray, np.ndarray]:
+    """Starts and sizes (size >= 1, start + size <= limit); half the sizes small, as sprites are."""
+    size = np.where(rng.random(n) < 0.5, rng.integers(1, 48, size=n), rng.integers(1, limit, size=n))
+    start = (rng.random(n) * (limit - size + 1)).astype(np.int64)
+    return start, size
+
+
+def _near(rng: np.random.Generator, start: np.ndarray, size: np.ndarray, limit: int) -> np.ndarray:
+    """B's start near A's (half the cases), so hits, misses and touching are all common."""
+    near = np.clip(start + rng.integers(-48, 48, size=len(start)), 0, limit - 1)
+    return np.where(rng.random(len(start)) < 0.5, near, rng.integers(0, limit, size=len(start)))
+
+
+def aabb_edges_random(rng: np.random.Generator, n: int) -> list[tuple]:
+    ax, aw = _boxes(rng, n, 256)
+    ay, ah = _boxes(rng, n, 256)
+    bw = np.where(rng.random(n) < 0.5, rng.integers(1, 48, size=n), rng.integers(1, 256, size=n))
+    bh = np.where(rng.random(n) < 0.5, rng.integers(1, 48, size=n), rng.integers(1, 256, size=n))
+    bx = np.minimum(_near(rng, ax, aw, 256), 255 - bw)
+    by = np.minimum(_near(rng, ay, ah, 256), 255 - bh)
+    columns = (ax, ay, ax + aw - 1, ay + ah - 1, bx, bx + bw, by, by + bh)
+    return [tuple(int(v) for v in row) for row in zip(*columns)]
+
+
+def sprite_edges_random(rng: np.random.Generator, n: int) -> list[tuple]:
+    a_left, a_width = _boxes(rng, n, 512 + 48)
+    b_left = _near(rng, a_left, a_width, 512 + 48)
+    b_width = np.where(rng.random(n) < 0.5, rng.integers(1, 48, size=n), rng.integers(1, 256, size=n))
+    a_top, a_height = _boxes(rng, n, 256)
+    b_height = np.where(rng.random(n) < 0.5, rng.integers(1, 48, size=n), rng.integers(1, 256, size=n))
+    b_top = np.minimum(_near(rng, a_top, a_height, 256), 255 - b_height)
+    a_right, b_right = a_left + a_width, b_left + b_width
+    columns = (a_left & 0xFF, a_top, a_top + a_height - 1, a_left >> 8, a_right & 0xFF, a_right >> 8,
+               b_left & 0xFF, b_left >> 8, b_right & 0xFF, b_right >> 8, b_top, b_top + b_height)
+    return [tuple(int(v) for v in row) for row in zip(*columns)]

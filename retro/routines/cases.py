@@ -46,8 +46,10 @@ def random_count(routine: Routine, exhaustive: bool, override: int | None) -> in
     return routine.random if exhaustive else min(routine.random, RANDOM_BOUNDED)
 
 
-def plan(routine: Routine, *, exhaustive: bool, seed: int | None = None, random: int | None = None) -> list[Part]:
-    """The parts of a check, each with its case count and a lazy iterable of cases."""
+def plan(routine: Routine, *, exhaustive: bool, seed: int | None = None, random: int | None = None,
+         bounded_product: int = BOUNDED_PRODUCT) -> list[Part]:
+    """The parts of a check, each with its case count and a lazy iterable of cases. Without
+    `exhaustive`, an exhaustive set larger than `bounded_product` is sampled."""
     seed = routine.seed if seed is None else seed
     parts = []
     if routine.boundary is not None:
@@ -56,10 +58,11 @@ def plan(routine: Routine, *, exhaustive: bool, seed: int | None = None, random:
         parts.append(Part("boundary", len(made), len(made), made))
     if routine.exhaustive:
         total = routine.exhaustive_count()
-        if exhaustive or total <= BOUNDED_PRODUCT:
+        if exhaustive or total <= bounded_product:
             parts.append(Part("exhaustive", total, total, _product(routine, seed, None)))
         else:
-            parts.append(Part("exhaustive", BOUNDED_SAMPLE, total, _product(routine, seed, BOUNDED_SAMPLE)))
+            sample = min(BOUNDED_SAMPLE, bounded_product)
+            parts.append(Part("exhaustive", sample, total, _product(routine, seed, sample)))
     if exhaustive and routine.sweep is not None:
         parts.append(Part("sweep", None, 0, _lazy_sweep(routine, seed)))
     count = random_count(routine, exhaustive, random)

@@ -114,3 +114,51 @@ def pixel(dx: int, dy: int, mask_a, mask_b) -> bool:
         return False
     canvas[oy + dy:oy + dy + b.shape[0], ox + dx:ox + dx + b.shape[1]] = b
     return bool((canvas[oy:oy + height, ox:ox + width] & a).any())
+
+
+# ---- routines in the conventions games use: edges prepared once per object ------------------------
+
+def aabb_edges(a_left, a_top, a_right1, a_bottom1, b_left, b_right, b_top, b_bottom):
+    """Box A's columns a_left..a_right1 and rows a_top..a_bottom1 (inclusive) share a pixel with box B's
+    columns b_left..b_right-1 and rows b_top..b_bottom-1."""
+    return _result(_intervals_share_a_pixel(a_left, np.asarray(a_right1, dtype=np.int64) - a_left + 1, b_left,
+                                            np.asarray(b_right, dtype=np.int64) - b_left)
+                   & _intervals_share_a_pixel(a_top, np.asarray(a_bottom1, dtype=np.int64) - a_top + 1, b_top,
+                                              np.asarray(b_bottom, dtype=np.int64) - b_top))
+
+
+def box_edges(px, py, pw, ph) -> dict:
+    """The six edges aabb_edges_prepare makes of a box at (px, py) of size pw x ph."""
+    return {"left": px, "top": py, "right1": px + pw - 1, "right": px + pw, "bottom1": py + ph - 1,
+            "bottom": py + ph}
+
+
+def circle_r(x1, y1, radius_sum, x2, y2):
+    """Circles with centres (x1, y1), (x2, y2) and radii summing to radius_sum overlap (tangent: no)."""
+    x1, y1, radius_sum, x2, y2 = (np.asarray(v, dtype=np.int64) for v in (x1, y1, radius_sum, x2, y2))
+    return _result((x1 - x2) ** 2 + (y1 - y2) ** 2 < radius_sum ** 2)
+
+
+def radius_sum(r1, r2):
+    return r1 + r2
+
+
+def sprite_edges(a_left, a_top, a_bottom1, a_left_hi, a_right, a_right_hi, b_left, b_left_hi, b_right,
+                 b_right_hi, b_top, b_bottom):
+    """Hitbox A (columns a_left + 256 a_left_hi .. a_right + 256 a_right_hi - 1, rows a_top..a_bottom1)
+    shares a pixel with hitbox B (columns b_left.. b_right - 1, rows b_top .. b_bottom - 1)."""
+    a0 = np.asarray(a_left, dtype=np.int64) + HIGH_BIT_WEIGHT * np.asarray(a_left_hi, dtype=np.int64)
+    a1 = np.asarray(a_right, dtype=np.int64) + HIGH_BIT_WEIGHT * np.asarray(a_right_hi, dtype=np.int64)
+    b0 = np.asarray(b_left, dtype=np.int64) + HIGH_BIT_WEIGHT * np.asarray(b_left_hi, dtype=np.int64)
+    b1 = np.asarray(b_right, dtype=np.int64) + HIGH_BIT_WEIGHT * np.asarray(b_right_hi, dtype=np.int64)
+    return _result(_intervals_share_a_pixel(a0, a1 - a0, b0, b1 - b0)
+                   & _intervals_share_a_pixel(a_top, np.asarray(a_bottom1, dtype=np.int64) - a_top + 1, b_top,
+                                              np.asarray(b_bottom, dtype=np.int64) - b_top))
+
+
+def sprite_hitbox_edges(sx, sxh, sy, ox, oy, w, h) -> dict:
+    """The edges sprite_edges_prepare makes: left and right (exclusive) as 16-bit, top, bottom, bottom - 1."""
+    left = sx + HIGH_BIT_WEIGHT * sxh + ox
+    top = sy + oy
+    return {"left": left & 0xFF, "left_hi": left >> 8, "right": (left + w) & 0xFF, "right_hi": (left + w) >> 8,
+            "top": top, "bottom": top + h, "bottom1": top + h - 1}

@@ -35,34 +35,55 @@ class Size:
     storage_bytes: int
 
 
-def program_size(program: Program, source_text: str | None) -> Size:
-    """Bytes of code and of generated tables. A program without `; retro-tables:` is all code."""
+def routine_code(read, entries: list[int], within: tuple[int, int]) -> dict[int, int]:
+    """{address: length} of every instruction reachable from the entries (following branches, JMP and
+    JSR into the program), as the static analysis decodes them."""
+    from retro.cpu.flow import decode
+    from retro.cpu.timing import timing_of
+
+    found: dict[int, int] = {}
+    pending = list(entries)
+    while pending:
+        entry = pending.pop()
+        if entry in found:
+            continue
+        callees: list[int] = []
+
+        def note_call(pc: int, target: int) -> tuple[int, int]:
+            if within[0] <= target < within[1]:
+                callees.append(target)
+            return (0, 0)
+        try:
+            nodes = decode(read, entry, note_call)
+        except (InputError, KeyError, ValueError):  # code the decoder does not follow: count none of it
+            continue
+        for pc in nodes:
+            found[pc] = timing_of(read(pc)).length
+        pending.extend(callees)
+    return found
+
+
+def program_size(program: Program, source_text: str | None, entries: list[int], read) -> Size:
+    """The routine's bytes: its reachable instructions (the entry's and init's, with their subroutines)
+    and the generated tables they name (by address, or by `#>table` for pointers set up at init)."""
+    within = (program.origin, program.end)
+    code = routine_code(read, entries, within)
     names = requested_tables(source_text) if source_text else []
-    starts = [program.symbols[n] for n in names if n in program.symbols]
-    if not starts:
-        return Size(code_bytes=len(program.code), table_bytes=0, storage_bytes=0)
-    tables_start = min(starts)
-    code_end = program.origin
-    for line in program.listing.splitlines():  # instructions, not the page-alignment padding
-        parts = line.split()
-        if len(parts) >= 2 and len(parts[0]) == 4:
-            try:
-                address = int(parts[0], 16)
-                count = sum(1 for p in parts[1:4] if len(p) == 2 and int(p, 16) >= 0)
-            except ValueError:
-                continue
-            if address < tables_start and count and _looks_like_instruction(line):
-                code_end = max(code_end, address + count)
-    lookup = sum(len(GENERATORS[n]()) for n in names if n not in STORAGE_TABLES)
-    storage = sum(len(GENERATORS[n]()) for n in names if n in STORAGE_TABLES)
-    return Size(code_bytes=code_end - program.origin, table_bytes=lookup, storage_bytes=storage)
+    spans = {n: (program.symbols[n], program.symbols[n] + len(GENERATORS[n]())) for n in names if n in program.symbols}
+    used = set()
+    for pc, length in code.items():
+        operand = read((pc + 1) & 0xFFFF) | (read((pc + 2) & 0xFFFF) << 8 if length == 3 else 0)
+        for name, (first, end) in spans.items():
+            if length == 3 and first <= operand < end:
+                used.add(name)
+            elif length == 2 and read(pc) == IMMEDIATE_LOAD_A and operand == first >> 8:
+                used.add(name)  # lda #>table: a pointer's high byte, as set up by an init routine
+    lookup = sum(len(GENERATORS[n]()) for n in used if n not in STORAGE_TABLES)
+    storage = sum(len(GENERATORS[n]()) for n in used if n in STORAGE_TABLES)
+    return Size(code_bytes=sum(code.values()), table_bytes=lookup, storage_bytes=storage)
 
 
-def _looks_like_instruction(line: str) -> bool:
-    """An Ophis listing line of an instruction: address, 1-3 bytes, then an upper-case mnemonic."""
-    import re
-
-    return re.match(r"^\s*[0-9A-Fa-f]{4}  (?:[0-9A-Fa-f]{2} ){1,3}\s*[A-Z]{3}\b", line) is not None
+IMMEDIATE_LOAD_A = 0xA9
 
 
 def memory_values(routine: Routine, seed: int) -> dict[str, tuple[int, ...]]:
@@ -124,6 +145,7 @@ class RoutineRunner:
         for block in routine.memory:
             data = self.memory_values[block.name]
             memory[block.address:block.address + len(data)] = list(data)
+        self.code_image = bytes(self.machine.memory)  # before init and the cases patch anything
         if routine.init is not None:
             self.machine.call_fast(self.machine.resolve(routine.init, "program.init"), budget=self.limit)
         # (indirect),Y instructions: the timing model needs their pointer. Every byte of the program
@@ -230,7 +252,8 @@ class RoutineRunner:
         """Bytes of code, lookup tables and caller-filled storage of the routine's program."""
         source = self.routine.program_file
         text = read_text(source, "source file") if source.suffix.lower() in (".s", ".asm", ".oph") else None
-        return program_size(self.program, text)
+        entries = [self.entry] + ([self.machine.resolve(self.routine.init)] if self.routine.init else [])
+        return program_size(self.program, text, entries, self.code_image.__getitem__)
 
 
 def describe_value(port: Port, value) -> str:
