@@ -9,15 +9,16 @@ import sys
 from retro.analysis.check import SceneStart, check_record, format_check, run_checks
 from retro.errors import InputError
 from retro.numbers import parse_int
+from retro.routines.registry import builtin_names
 
-ROUTINES_HELP = ("built-in routine names (aabb8 aabb_sprite circle mul8 tile tile_box pixel; all when none is "
-                 "given) or routine spec files (NAME.toml, docs/specs.md)")
 MAX_RANDOM = 10 ** 9
 
 
 def add_case_options(p: argparse.ArgumentParser) -> None:
     """Options `retro check` and `retro cycles` share."""
-    p.add_argument("routines", nargs="*", metavar="ROUTINE|SPEC.toml", help=ROUTINES_HELP)
+    p.add_argument("routines", nargs="*", metavar="ROUTINE|SPEC.toml",
+                   help=f"built-in routine names ({' '.join(builtin_names())}; all when none is given) or routine "
+                        "spec files (NAME.toml, docs/specs.md)")
     p.add_argument("--exhaustive", action="store_true",
                    help="the full run: every exhaustive set and sweep, and each spec's full random count (minutes)")
     p.add_argument("--seed", help="seed of the random cases and of random memory (default: the spec's, 0)")
