@@ -29,12 +29,14 @@ def read_toml(path: str | Path) -> dict:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{path}: not valid TOML: {exc}") from None
+    except RecursionError:  # tomllib recurses per nesting level
+        raise InputError(f"{path}: not valid TOML: nested too deeply") from None
 
 
 def load_scene(path: str | Path):
     doc = read_toml(path)
     chip = doc.get("chip")
-    if chip not in CHIP_MODULES:
+    if not isinstance(chip, str) or chip not in CHIP_MODULES:
         raise InputError(f"{path}: chip: expected one of {', '.join(repr(c) for c in CHIP_MODULES)}, got {chip!r}")
     module = importlib.import_module(CHIP_MODULES[chip])
     return module.parse(doc, source=str(path))

@@ -132,12 +132,12 @@ class NesScene:
 def parse(doc: dict, source: str) -> NesScene:
     _known_keys(doc, TOP_KEYS, source, "")
     video_name = doc.get("video", "ntsc")
-    if video_name not in VIDEO_STANDARDS:
+    if not isinstance(video_name, str) or video_name not in VIDEO_STANDARDS:
         raise InputError(f"{source}: video: expected one of {', '.join(repr(v) for v in VIDEO_STANDARDS)}, got {video_name!r}")
     ppu = _table(doc.get("ppu", {}), source, "ppu")
     _known_keys(ppu, PPU_KEYS, source, "ppu.")
     mirroring = ppu.get("mirroring", "horizontal")
-    if mirroring not in MIRRORING:
+    if not isinstance(mirroring, str) or mirroring not in MIRRORING:
         raise InputError(f"{source}: ppu.mirroring: expected one of {', '.join(repr(m) for m in MIRRORING)}, got {mirroring!r}")
     return NesScene(
         source=source, video=VIDEO_STANDARDS[video_name],

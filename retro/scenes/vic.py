@@ -285,7 +285,7 @@ def parse(doc: dict, source: str) -> VicScene:
     where = _Where(source)
     where.table(doc, "", TOP_KEYS)
     video = doc.get("video", "pal")
-    if video not in VIDEOS:
+    if not isinstance(video, str) or video not in VIDEOS:
         raise where.error("video", f"expected \"pal\" (6569) or \"ntsc\" (6567R8), got {video!r}")
     registers = bytearray(REGISTER_COUNT)
     table = doc.get("registers", {})
