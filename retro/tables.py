@@ -85,7 +85,7 @@ table("circle_dyn_hi")(lambda: _hi(_CIRCLE_DYN))
 
 
 def _screen():
-    from retro.routines import (
+    from retro.chips.vic import (
         screen,  # plain constants; imported here to keep this module light
     )
     return screen

@@ -20,7 +20,7 @@ import numpy as np
 
 from retro.chips.vic.constants import SPRITE_HEIGHT, SPRITE_WIDTH
 from retro.routines import reference
-from retro.routines.screen import SPRITE_ROW_BYTES
+from retro.chips.vic.screen import SPRITE_ROW_BYTES
 
 BYTE = 256
 MASK_BYTES = SPRITE_HEIGHT * SPRITE_ROW_BYTES

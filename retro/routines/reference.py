@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from retro.chips.vic.constants import SPRITE_HEIGHT
-from retro.routines.screen import (
+from retro.chips.vic.screen import (
     CELL_PIXELS,
     COLUMNS,
     ROWS,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from retro.routines import reference
-from retro.routines.screen import SCREEN_BASE, cell_of, row_address
+from retro.chips.vic.screen import SCREEN_BASE, cell_of, row_address
 
 
 def test_aabb8_touching_boxes_do_not_overlap():

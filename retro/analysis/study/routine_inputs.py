@@ -127,7 +127,7 @@ class _TileBoxSession(Session):
     MARK = 1
 
     def __init__(self, pair: Pair, adapter: "Issue5Adapter") -> None:
-        from retro.routines import screen
+        from retro.chips.vic import screen
 
         self.pair, self.screen = pair, screen
         props = [0] * 256
