@@ -32,4 +32,5 @@ def describe(result: SpriteZeroHit) -> str:
     if not result.hit:
         return f"no sprite-zero hit: {result.reason}"
     return (f"sprite-zero hit at pixel x={result.x}, line {result.line}: $2002 bit 6 set at line {result.line} "
-            f"dot {result.dot}, {result.dots_after_vblank} PPU dots after the vblank flag (line 241 dot 1)")
+            f"dot {result.dot}, {result.dots_after_vblank} PPU dots ({result.cpu_cycles_after_vblank:g} CPU cycles) "
+            f"after the vblank flag (line 241 dot 1)")

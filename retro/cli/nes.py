@@ -12,7 +12,7 @@ from retro.numbers import parse_int
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("nes", help="predict the NES sprite-zero hit ($2002 bit 6) of a scene: pixel, line, dot")
     p.add_argument("scene", metavar="SCENE.toml")
-    p.add_argument("--json", action="store_true", help="print one JSON object: hit, line, dot, x, dots_after_vblank")
+    p.add_argument("--json", action="store_true", help="print one JSON object: hit, line, dot, x, dots_after_vblank, cpu_cycles_after_vblank")
     p.add_argument("--png", metavar="OUT.png", help="write a picture of the frame and sprite 0")
     p.add_argument("--scale", default="2", metavar="K", help=f"integer picture scale 1-{MAX_SCALE} (default 2)")
     p.set_defaults(func=cmd_nes)

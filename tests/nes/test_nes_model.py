@@ -30,6 +30,7 @@ def test_pal_counts_312_lines():
     result = sprite_zero_hit(make_state(cells=BG_TILE_AT_120_128, video=PAL))
     # (312 - 241 + 120) * 341 + 128 = 191 * 341 + 128 = 65131 + 128
     assert result.dots_after_vblank == 65259
+    assert result.cpu_cycles_after_vblank == 65259 * 5 / 16  # PAL: 3.2 dots a CPU cycle -> 20393.4375
 
 
 def test_sprite_is_drawn_from_y_plus_one():

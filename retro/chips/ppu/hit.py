@@ -48,10 +48,13 @@ class SpriteZeroHit:
     dot: int | None = None                # PPU dot of that line at which bit 6 is set (x + 1)
     dots_after_vblank: int | None = None  # dots from the preceding vblank flag to that dot
     reason: str = ""                      # why there is no hit (empty when there is one)
+    # the same span in CPU cycles of the scene's standard (3 dots a cycle on NTSC, 3.2 on PAL): what a
+    # `bit $2002` loop started at the vblank flag waits; fractional where the ratio makes it so
+    cpu_cycles_after_vblank: float | None = None
 
     def as_json(self) -> dict:
         return {"hit": self.hit, "line": self.line, "dot": self.dot, "x": self.x,
-                "dots_after_vblank": self.dots_after_vblank}
+                "dots_after_vblank": self.dots_after_vblank, "cpu_cycles_after_vblank": self.cpu_cycles_after_vblank}
 
 
 def hit_dot(x: int) -> int:
@@ -61,6 +64,14 @@ def hit_dot(x: int) -> int:
 def dots_after_vblank(line: int, dot: int, video: VideoStandard) -> int:
     """Dots from line 241 dot 1 of the preceding frame to (line, dot) of this one, full pre-render line."""
     return (video.lines_per_frame - VBLANK_LINE + line) * DOTS_PER_LINE + dot - VBLANK_DOT
+
+
+CPU_CYCLE_DIGITS = 4
+
+
+def cpu_cycles(dots: int, video: VideoStandard) -> float:
+    """PPU dots as CPU cycles of that standard (exact to 4 decimals: the ratios are 3 and 16/5)."""
+    return round(float(dots / video.dots_per_cpu_cycle), CPU_CYCLE_DIGITS)
 
 
 def rendering_enabled_for_hits(mask: int) -> bool:
@@ -96,7 +107,8 @@ def sprite_zero_hit(state: PpuState) -> SpriteZeroHit:
     line, x = int(lines[0]), int(xs[0])
     dot = hit_dot(x)
     return SpriteZeroHit(hit=True, x=x, line=line, dot=dot,
-                         dots_after_vblank=dots_after_vblank(line, dot, state.video))
+                         dots_after_vblank=dots_after_vblank(line, dot, state.video),
+                         cpu_cycles_after_vblank=cpu_cycles(dots_after_vblank(line, dot, state.video), state.video))
 
 
 def _no_hit_reason(state: PpuState) -> str:
