@@ -8,6 +8,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from retro.chips.vic.constants import (
     IRQ_ANY,
     IRQ_RASTER,
@@ -30,10 +32,11 @@ class VicRun:
     scene: VicScene
     report: LatchReport
     png: Path | None = None
+    pixels: bool = False  # list every overlap pixel in the answers
 
 
 def run_scene(path: str | Path, frames: int = 1, png: str | Path | None = None, scale: int = 2,
-              palette_name: str = C64_DEFAULT_PALETTE) -> VicRun:
+              palette_name: str = C64_DEFAULT_PALETTE, pixels: bool = False) -> VicRun:
     """Load a scene, compute the latches after `frames` frames, optionally write the overlap PNG."""
     if not 1 <= frames <= MAX_FRAMES:
         raise InputError(f"--frames: {frames} is out of range 1..{MAX_FRAMES}")
@@ -47,17 +50,61 @@ def run_scene(path: str | Path, frames: int = 1, png: str | Path | None = None, 
         from retro.render.vic_image import overlap_image
 
         written = save_png(overlap_image(scene.state, report.collisions, scale, palette_name), png)
-    return VicRun(scene, report, written)
+    return VicRun(scene, report, written, pixels)
 
 
 def _first(position: tuple[int, int] | None) -> dict | None:
     return None if position is None else {"line": position[0], "x": position[1]}
 
 
+def _box(lines, xs) -> dict:
+    return {"line_min": int(lines.min()), "line_max": int(lines.max()), "x_min": int(xs.min()), "x_max": int(xs.max())}
+
+
+def overlap_pairs(run: VicRun) -> list[dict]:
+    """Each pair of sprites whose opaque pixels meet: how many places they share and where (raster
+    lines and X coordinates). A place where three sprites meet counts for each of their pairs."""
+    c = run.report.collisions
+    lines, xs = c.ss_pixels
+    if not lines.size:
+        return []
+    places = lines * c.video.x_positions + xs
+    unique, inverse = np.unique(places, return_inverse=True)
+    together = np.zeros(unique.size, np.uint8)
+    np.bitwise_or.at(together, inverse, c.ss_pixel_bits)
+    place_lines, place_xs = unique // c.video.x_positions, unique % c.video.x_positions
+    out = []
+    for a, b in run.report.pairs:
+        both = (together >> a & 1).astype(bool) & (together >> b & 1).astype(bool)
+        out.append({"sprites": [a, b], "pixels": int(both.sum()), "box": _box(place_lines[both], place_xs[both]),
+                    **({"at": _pixel_list(place_lines[both], place_xs[both])} if run.pixels else {})})
+    return out
+
+
+def background_overlaps(run: VicRun) -> list[dict]:
+    """Each sprite whose opaque pixels meet foreground graphics: how many, and where."""
+    c = run.report.collisions
+    lines, xs = c.sb_pixels
+    out = []
+    for n in range(SPRITE_COUNT):
+        mine = c.sb_pixel_bits == (1 << n)
+        if mine.any():
+            out.append({"sprite": n, "pixels": int(mine.sum()), "box": _box(lines[mine], xs[mine]),
+                        **({"at": _pixel_list(lines[mine], xs[mine])} if run.pixels else {})})
+    return out
+
+
+def _pixel_list(lines, xs) -> list[list[int]]:
+    """[[raster line, X], ...] in beam order."""
+    order = np.lexsort((xs, lines))
+    return [[int(lines[i]), int(xs[i])] for i in order]
+
+
 def report_json(run: VicRun) -> dict:
     r = run.report
     return {"d01e": r.d01e, "d01f": r.d01f, "d019": r.d019,
-            "first": {"d01e": _first(r.first_d01e), "d01f": _first(r.first_d01f)}}
+            "first": {"d01e": _first(r.first_d01e), "d01f": _first(r.first_d01f)},
+            "pairs": overlap_pairs(run), "background": background_overlaps(run)}
 
 
 def _sprites(bits: int) -> str:
@@ -75,13 +122,24 @@ def report_lines(run: VicRun) -> list[str]:
     d019_sources = [name for bit, name in ((IRQ_SPRITE_SPRITE, "sprite-sprite"),
                                            (IRQ_SPRITE_BACKGROUND, "sprite-background"),
                                            (IRQ_RASTER, "raster compare")) if r.d019 & bit]
-    pairs = ", ".join(f"{a}+{b}" for a, b in r.pairs) or "none"
+    pairs = ", ".join(f"{p['sprites'][0]}+{p['sprites'][1]} ({p['pixels']} px, lines {p['box']['line_min']}-"
+                      f"{p['box']['line_max']}, X {p['box']['x_min']}-{p['box']['x_max']})"
+                      for p in overlap_pairs(run)) or "none"
+    background = ", ".join(f"{b['sprite']} ({b['pixels']} px)" for b in background_overlaps(run)) or "none"
     lines = [f"{run.scene.source}: {video.name.upper()} ({video.chip}), after {r.frames} frame(s)",
              f"$D01E = ${r.d01e:02X} %{r.d01e:08b}  sprite-sprite: {_sprites(r.d01e)}{_where(r.first_d01e)}",
              f"$D01F = ${r.d01f:02X} %{r.d01f:08b}  sprite-background: {_sprites(r.d01f)}{_where(r.first_d01f)}",
              f"$D019 = ${r.d019:02X} %{r.d019:08b}  latched: {', '.join(d019_sources) or 'nothing'}"
              f"{'; IRQ line active (bit 7)' if r.d019 & IRQ_ANY else ''}",
-             f"overlapping sprite pairs (not visible to a program): {pairs}"]
+             f"overlapping sprite pairs (not visible to a program): {pairs}",
+             f"sprites over foreground graphics: {background}"]
+    if run.pixels:
+        for p in overlap_pairs(run):
+            lines.append(f"pixels of {p['sprites'][0]}+{p['sprites'][1]} (line, X): "
+                         + " ".join(f"{line},{x}" for line, x in p["at"]))
+        for b in background_overlaps(run):
+            lines.append(f"pixels of {b['sprite']} over graphics (line, X): "
+                         + " ".join(f"{line},{x}" for line, x in b["at"]))
     if run.png is not None:
         lines.append(f"wrote {run.png}")
     return lines

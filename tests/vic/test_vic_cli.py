@@ -25,7 +25,7 @@ def write_scene(tmp_path: Path, body: str, name: str = "scene.toml") -> Path:
 def test_json_output_has_the_exact_keys(capsys):
     assert main(["vic", str(ROOT / "examples" / "vic_text_collision.toml"), "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert set(out) == {"d01e", "d01f", "d019", "first"}
+    assert set(out) == {"d01e", "d01f", "d019", "first", "pairs", "background"}
     assert set(out["first"]) == {"d01e", "d01f"}
     # by hand (see the scene's comments): the ship's pixel at X 107 meets glyph 1's row 0 (%00011000,
     # pixel 3 of column 10 at X 104) on line 48+3+8*5 = 91; sprites 0 and 2 hit text, nothing overlaps.
@@ -119,3 +119,22 @@ def test_run_with_a_scene_attaches_the_vic(tmp_path, capsys, video, cycles_per_l
     assert main(["run", str(source), "--entry", "start", "--scene", str(scene), "--json"]) == 0
     read_at = 2 + outer * (2 + (5 * inner - 1) + 2 + 3) - 1 + 3
     assert json.loads(capsys.readouterr().out)["a"] == read_at // cycles_per_line
+
+
+def test_pairs_and_background_answers(tmp_path, capsys):
+    # two full 24 x 21 sprites at X 100 and 110, Y 100: shown on lines 101-121 (a sprite's first row
+    # is on line Y + 1), they share X 110-123 on each: 14 x 21 = 294 places
+    body = ('[registers]\n"$d015" = 3\n'
+            '[[sprite]]\nindex = 0\nx = 100\ny = 100\nrows = [' + ", ".join(['"' + "#" * 24 + '"'] * 21) + ']\n'
+            '[[sprite]]\nindex = 1\nx = 110\ny = 100\nrows = [' + ", ".join(['"' + "#" * 24 + '"'] * 21) + ']\n')
+    path = tmp_path / "pair.toml"
+    path.write_text('chip = "vic-ii"\nvideo = "pal"\n' + body)
+    assert main(["vic", str(path), "--json", "--pixels"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    (pair,) = out["pairs"]
+    assert pair["sprites"] == [0, 1] and pair["pixels"] == 14 * 21
+    assert pair["box"] == {"line_min": 101, "line_max": 121, "x_min": 110, "x_max": 123}
+    assert len(pair["at"]) == 294 and pair["at"][0] == [101, 110] and pair["at"][-1] == [121, 123]
+    assert out["background"] == []
+    assert main(["vic", str(path)]) == 0
+    assert "0+1 (294 px, lines 101-121, X 110-123)" in capsys.readouterr().out

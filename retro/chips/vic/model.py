@@ -120,6 +120,8 @@ class FrameCollisions:
     first_ss: tuple[int, int] | None
     first_sb: tuple[int, int] | None
     pairs: tuple[tuple[int, int], ...]
+    ss_pixel_bits: np.ndarray = field(default_factory=lambda: np.zeros(0, np.uint8))  # sprites at each ss pixel
+    sb_pixel_bits: np.ndarray = field(default_factory=lambda: np.zeros(0, np.uint8))  # the sprite at each sb pixel
 
     @property
     def d01e(self) -> int:
@@ -267,7 +269,7 @@ def frame_collisions(state: VicState) -> FrameCollisions:
     ss_times, ss_merged, first_ss = _events(video, ssl, ssx, ssb)
     sb_times, sb_merged, first_sb = _events(video, sbl, sbx, sbb)
     return FrameCollisions(video, ss_times, ss_merged, sb_times, sb_merged, (ssl, ssx), (sbl, sbx),
-                           first_ss, first_sb, _pairs(ssb) if ssb.size else ())
+                           first_ss, first_sb, _pairs(ssb) if ssb.size else (), ssb, sbb)
 
 
 def raster_compare_line(registers: bytes) -> int:
