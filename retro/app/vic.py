@@ -5,7 +5,7 @@ The CLI and the demo call these; they only parse arguments and print.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -15,16 +15,21 @@ from retro.chips.vic.constants import (
     IRQ_RASTER,
     IRQ_SPRITE_BACKGROUND,
     IRQ_SPRITE_SPRITE,
+    REG_SPRITE_X0,
+    REG_SPRITE_X_MSB,
+    REG_SPRITE_Y0,
     SPRITE_COUNT,
+    X_BITS_MASK,
+    Y_COMPARE_MASK,
 )
-from retro.chips.vic.model import LatchReport, run_frames
+from retro.chips.vic.model import LatchReport, frame_collisions, run_frames
 from retro.errors import InputError
 from retro.render.palette import C64_DEFAULT_PALETTE
 from retro.scenes.vic import VicScene, load
 
 DEMO_SCENE = "vic_two_balls.toml"
 MAX_SCALE = 8
-MAX_FRAMES = 1_000_000
+MAX_FRAMES = 10_000  # each moving frame is a full collision pass (about a millisecond)
 
 
 @dataclass
@@ -33,6 +38,7 @@ class VicRun:
     report: LatchReport
     png: Path | None = None
     pixels: bool = False  # list every overlap pixel in the answers
+    per_frame: list[dict] | None = None  # with moving sprites and --frames N: what each frame showed
 
 
 def run_scene(path: str | Path, frames: int = 1, png: str | Path | None = None, scale: int = 2,
@@ -43,14 +49,52 @@ def run_scene(path: str | Path, frames: int = 1, png: str | Path | None = None, 
     if not 1 <= scale <= MAX_SCALE:
         raise InputError(f"--scale: {scale} is out of range 1..{MAX_SCALE}")
     scene = load(path)
-    report = run_frames(scene.state, frames)
+    per_frame = None
+    if frames > 1 and any(spec.velocity != (0, 0) for spec in scene.sprites):
+        per_frame, state = moving_frames(scene, frames)
+        report = run_frames(state, 1)
+        report = replace(report, frames=frames)
+    else:
+        report = run_frames(scene.state, frames)
     written = None
     if png is not None:
         from retro.render.images import save_png
         from retro.render.vic_image import overlap_image
 
         written = save_png(overlap_image(scene.state, report.collisions, scale, palette_name), png)
-    return VicRun(scene, report, written, pixels)
+    return VicRun(scene, report, written, pixels, per_frame)
+
+
+def moved_registers(scene: VicScene, frame: int) -> bytes:
+    """The scene's registers with every sprite moved by `frame` times its velocity (X wraps at 512,
+    Y at 256: the registers' widths)."""
+    registers = bytearray(scene.registers)
+    for spec in scene.sprites:
+        dx, dy = spec.velocity
+        if not (dx or dy):
+            continue
+        n, bit = spec.index, 1 << spec.index
+        x = (registers[REG_SPRITE_X0 + 2 * n] | ((registers[REG_SPRITE_X_MSB] >> n) & 1) << 8) + frame * dx
+        x %= X_BITS_MASK + 1
+        registers[REG_SPRITE_X0 + 2 * n] = x & 0xFF
+        registers[REG_SPRITE_X_MSB] = (registers[REG_SPRITE_X_MSB] & ~bit) | (bit if x >> 8 else 0)
+        registers[REG_SPRITE_Y0 + 2 * n] = (registers[REG_SPRITE_Y0 + 2 * n] + frame * dy) & Y_COMPARE_MASK
+    return bytes(registers)
+
+
+def moving_frames(scene: VicScene, frames: int) -> tuple[list[dict], object]:
+    """Frame by frame, sprites moved by their velocity: what a program that reads $D01E and $D01F
+    once per frame, after the frame is drawn (clearing them), sees, and where each was first set.
+    Returns the records and the last frame's state."""
+    records = []
+    state = scene.state
+    for frame in range(frames):
+        state = scene.state.with_registers(moved_registers(scene, frame))
+        events = frame_collisions(state)
+        records.append({"frame": frame, "d01e": events.d01e, "d01f": events.d01f,
+                        "first": {"d01e": _first(events.first_ss), "d01f": _first(events.first_sb)},
+                        "pairs": [list(p) for p in events.pairs]})
+    return records, state
 
 
 def _first(position: tuple[int, int] | None) -> dict | None:
@@ -102,9 +146,12 @@ def _pixel_list(lines, xs) -> list[list[int]]:
 
 def report_json(run: VicRun) -> dict:
     r = run.report
-    return {"d01e": r.d01e, "d01f": r.d01f, "d019": r.d019,
-            "first": {"d01e": _first(r.first_d01e), "d01f": _first(r.first_d01f)},
-            "pairs": overlap_pairs(run), "background": background_overlaps(run)}
+    out = {"d01e": r.d01e, "d01f": r.d01f, "d019": r.d019,
+           "first": {"d01e": _first(r.first_d01e), "d01f": _first(r.first_d01f)},
+           "pairs": overlap_pairs(run), "background": background_overlaps(run)}
+    if run.per_frame is not None:
+        out["frames"] = run.per_frame
+    return out
 
 
 def _sprites(bits: int) -> str:
@@ -140,6 +187,15 @@ def report_lines(run: VicRun) -> list[str]:
         for b in background_overlaps(run):
             lines.append(f"pixels of {b['sprite']} over graphics (line, X): "
                          + " ".join(f"{line},{x}" for line, x in b["at"]))
+    if run.per_frame is not None:
+        hits = [f for f in run.per_frame if f["d01e"] or f["d01f"]]
+        lines.append(f"moving sprites, {len(run.per_frame)} frames read once each (clear on read): "
+                     f"{len(hits)} frame(s) with a collision" + (f", the first in frame {hits[0]['frame']}" if hits else ""))
+        for f in hits[:20]:
+            lines.append(f"  frame {f['frame']}: $D01E = ${f['d01e']:02X}, $D01F = ${f['d01f']:02X}"
+                         + (f", pairs {', '.join(f'{a}+{b}' for a, b in f['pairs'])}" if f["pairs"] else ""))
+        if len(hits) > 20:
+            lines.append(f"  ... {len(hits) - 20} more (--json lists every frame)")
     if run.png is not None:
         lines.append(f"wrote {run.png}")
     return lines

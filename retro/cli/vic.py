@@ -13,7 +13,8 @@ from retro.render.palette import C64_DEFAULT_PALETTE
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("vic", help="predict the VIC-II collision registers for a scene; draw the overlaps")
     p.add_argument("scene", metavar="SCENE.toml", help="a VIC-II scene file (docs/vic.md)")
-    p.add_argument("--frames", default="1", metavar="N", help="frames to run (default 1)")
+    p.add_argument("--frames", default="1", metavar="N", help="frames to run (default 1, at most 10,000): sprites with a "
+                   "velocity move each frame, and each frame's latches are reported as a program reading them once a frame sees them")
     p.add_argument("--json", action="store_true", help="print one JSON object: d01e, d01f, d019, first, pairs, "
                    "background")
     p.add_argument("--pixels", action="store_true", help="list every overlap pixel (raster line, X) of each pair "

@@ -49,7 +49,8 @@ from retro.sprites import parse_hex, parse_rows, read_png, read_spr
 TOP_KEYS = {"chip", "video", "registers", "sprite", "memory", "cpu"}
 CPU_KEYS = {"start_line", "start_cycle", "irq_vector"}  # where the beam is when the routine starts
 SPRITE_KEYS = {"index", "x", "y", "enabled", "multicolor", "expand_x", "expand_y", "behind", "color", "data",
-               "rows", "file", "frame"}
+               "rows", "file", "frame", "velocity"}
+MAX_SPEED = 255  # pixels a frame, either axis: faster than anything on screen
 MEMORY_KEYS = {"screen", "color", "charset", "bitmap", "idle"}
 FILL_KEYS = {"fill", "cells"}
 SCREEN_CELL_KEYS = {"col", "row", "value"}
@@ -64,6 +65,7 @@ class SpriteSpec:
     index: int
     data: bytes  # 63 bytes
     source: str  # "data", "rows", "file NAME"
+    velocity: tuple[int, int] = (0, 0)  # X and Y added every frame (`retro vic --frames N`)
 
 
 @dataclass(frozen=True, eq=False)
@@ -177,6 +179,12 @@ def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: _Where) 
         registers[register] = (registers[register] & ~bit) | (bit if on else 0)
     if "color" in entry:
         registers[REG_SPRITE_COLOR0 + n] = where.number(entry["color"], f"{name}.color", 0, COLOR_MASK)
+    velocity = (0, 0)
+    if "velocity" in entry:
+        value = entry["velocity"]
+        if not isinstance(value, list) or len(value) != 2:
+            raise where.error(f"{name}.velocity", "expected [dx, dy]: pixels added to X and Y every frame")
+        velocity = tuple(where.number(v, f"{name}.velocity", -MAX_SPEED, MAX_SPEED) for v in value)
     multicolor = bool(registers[REG_SPRITE_MULTICOLOR] & bit)
     given = [k for k in ("data", "rows", "file") if k in entry]
     if len(given) != 1:
@@ -208,7 +216,7 @@ def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: _Where) 
         if message.startswith(kind) or message.startswith("rows["):
             raise InputError(f"{where.source}: {name}.{message}") from None
         raise InputError(f"{where.source}: {name}: {message}") from None
-    return SpriteSpec(n, data[:SPRITE_BYTES], source)
+    return SpriteSpec(n, data[:SPRITE_BYTES], source, velocity)
 
 
 def _fill_cells(spec, name: str, where: _Where, hi: int) -> np.ndarray:

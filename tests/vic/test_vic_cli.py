@@ -138,3 +138,23 @@ def test_pairs_and_background_answers(tmp_path, capsys):
     assert out["background"] == []
     assert main(["vic", str(path)]) == 0
     assert "0+1 (294 px, lines 101-121, X 110-123)" in capsys.readouterr().out
+
+
+def test_frames_move_sprites_by_their_velocity(tmp_path, capsys):
+    # sprite 0's top row (X 100-123) moves 4 pixels right a frame towards sprite 1's (X 160-183), both
+    # on line 101: frame f covers 100 + 4f .. 123 + 4f, so they meet from frame 10 (X 140-163) on,
+    # first at X 160; read once a frame (clearing), $D01E is $03 in frames 10-19 and 0 before
+    top_row = ", ".join(['"' + "#" * 24 + '"'] + ['"' + "." * 24 + '"'] * 20)
+    path = tmp_path / "move.toml"
+    path.write_text('chip = "vic-ii"\nvideo = "pal"\n'
+                    f'[[sprite]]\nindex = 0\nx = 100\ny = 100\nvelocity = [4, 0]\nrows = [{top_row}]\n'
+                    f'[[sprite]]\nindex = 1\nx = 160\ny = 100\nrows = [{top_row}]\n')
+    assert main(["vic", str(path), "--frames", "20", "--json"]) == 0
+    frames = json.loads(capsys.readouterr().out)["frames"]
+    assert [f["frame"] for f in frames if f["d01e"]] == list(range(10, 20))
+    assert all(f["d01e"] == 0b11 for f in frames[10:]) and frames[9]["d01e"] == 0
+    assert frames[10]["first"]["d01e"] == {"line": 101, "x": 160} and frames[10]["pairs"] == [[0, 1]]
+    bad = tmp_path / "bad.toml"
+    bad.write_text(path.read_text().replace("velocity = [4, 0]", "velocity = 4"))
+    assert main(["vic", str(bad), "--frames", "2"]) == 2
+    assert "sprite[0].velocity: expected [dx, dy]" in capsys.readouterr().err
