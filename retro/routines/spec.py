@@ -610,6 +610,9 @@ def _module_cached(path: str, mtime: float):
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module  # pickling and dataclasses look modules up by name
+    folder = str(Path(path).parent)
+    if folder not in sys.path:  # the user's module may import its neighbours, as a script would
+        sys.path.append(folder)
     spec.loader.exec_module(module)
     return module
 

@@ -249,3 +249,13 @@ def test_the_first_run_failure_stops_the_check(tmp_path, capsys):
     code, (record,) = _check_json(capsys, str(tmp_path / "brk.toml"))
     assert code == 1 and record["run_errors"] == 1 and record["cases"] == 1  # every case would BRK: stop at one
     assert "BRK" in record["first_failure"]["message"]
+
+
+def test_a_reference_may_import_its_neighbours(tmp_path, capsys):
+    spec = _variant(tmp_path, {"boxhit_refs.py:boxhit": "uses_helper.py:boxhit"})
+    (tmp_path / "box_maths.py").write_text("def overlap(a, aw, b, bw):\n    return max(a, b) < min(a + aw, b + bw)\n")
+    (tmp_path / "uses_helper.py").write_text(
+        "from box_maths import overlap\n\n"
+        "def boxhit(ax, ay, aw, ah, bx, by, bw, bh):\n    return overlap(ax, aw, bx, bw) and overlap(ay, ah, by, bh)\n")
+    code, (record,) = _check_json(capsys, str(spec), "--random", "50")
+    assert code == 0 and record["mismatches"] == 0
