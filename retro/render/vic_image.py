@@ -30,8 +30,10 @@ from retro.chips.vic.graphics import colours, foreground_at
 from retro.chips.vic.model import FrameCollisions, VicState, placement, sprite_rows
 from retro.render.images import (
     LABEL_COLOUR,
+    LABEL_SIZE,
     PANEL_BACKGROUND,
     from_rgb_array,
+    label_font,
     side_by_side,
     upscale,
 )
@@ -46,6 +48,14 @@ ZOOM_MAX_BOX = (96, 72)  # a wider spread of overlaps zooms on the first one ins
 ZOOM_MAX_SCALE = 16
 ZOOM_MIN_BOX = (40, 30)  # show some context around a tiny overlap
 LEGEND_HEIGHT = 22
+MARKER_COLOUR = (255, 220, 0)  # yellow rings at the first pixel that latches $D01E / $D01F
+MARKER_RADIUS = 4
+ZOOM_PANELS = 4  # zooms at most: one per colliding pair, then per sprite over graphics
+ZOOM_MIN_HEIGHT = 240
+RULER = 26  # pixels of ruler above and left of a zoom
+RULER_STEP = 8  # ruler ticks every 8 X coordinates and 8 lines (a character cell)
+RULER_LABEL_SIZE = 10
+RULER_LABEL_ROOM = 26  # pixels a ruler number needs
 
 
 def frame_order(state: VicState) -> tuple[np.ndarray, np.ndarray]:
@@ -132,39 +142,124 @@ def _zoom_box(state: VicState, collisions: FrameCollisions) -> tuple[int, int, i
     return (int(left) - ZOOM_MARGIN, int(top) - ZOOM_MARGIN, int(right) + ZOOM_MARGIN, int(bottom) + ZOOM_MARGIN)
 
 
-def _legend(width: int, palette_name: str) -> Image.Image:
+def _legend(width: int, palette_name: str, collisions: FrameCollisions) -> Image.Image:
     legend = Image.new("RGB", (width, LEGEND_HEIGHT), PANEL_BACKGROUND)
     draw = ImageDraw.Draw(legend)
     x = 8
-    for colour, text in ((SPRITE_SPRITE_HIGHLIGHT, "sprite-sprite overlap ($D01E)"),
-                         (SPRITE_BACKGROUND_HIGHLIGHT, "sprite-background overlap ($D01F)")):
+    for colour, text in ((SPRITE_SPRITE_HIGHLIGHT, f"sprite-sprite overlap ($D01E = ${collisions.d01e:02X})"),
+                         (SPRITE_BACKGROUND_HIGHLIGHT, f"sprite-background overlap ($D01F = ${collisions.d01f:02X})"),
+                         (MARKER_COLOUR, "first pixel that latches each")):
         draw.rectangle((x, 5, x + 11, 16), fill=colour)
-        draw.text((x + 16, 5), text, fill=LABEL_COLOUR)
-        x += 16 + int(draw.textlength(text)) + 20
-    draw.text((x, 5), f"palette {palette_name}; dimmed: blanking (off-screen)", fill=LABEL_COLOUR)
+        draw.text((x + 16, 5), text, fill=LABEL_COLOUR, font=label_font())
+        x += 16 + int(draw.textlength(text, font=label_font())) + 20
+    draw.text((x, 5), f"palette {palette_name}; dimmed: blanking (off-screen); numbers: sprites", fill=LABEL_COLOUR,
+              font=label_font())
     return legend
+
+
+def _annotate_frame(panel: Image.Image, state: VicState, collisions: FrameCollisions, scale: int) -> None:
+    """Sprite numbers at each sprite's top-left; a ring and a label at each latch's first pixel."""
+    draw = ImageDraw.Draw(panel)
+    font = label_font()
+    for n in range(SPRITE_COUNT):
+        place = placement(state, n)
+        if place is None or place.lines.size == 0:
+            continue
+        rows, cols = _image_position(state, place.lines[:1], place.xs[:1])
+        x, y = int(cols[0]) * scale, int(rows[0]) * scale
+        box = draw.textbbox((x + 1, y - LABEL_SIZE - 2), str(n), font=font)
+        draw.rectangle(box, fill=PANEL_BACKGROUND)
+        draw.text((x + 1, y - LABEL_SIZE - 2), str(n), fill=LABEL_COLOUR, font=font)
+    for first, name in ((collisions.first_ss, "$D01E"), (collisions.first_sb, "$D01F")):
+        if first is None:
+            continue
+        rows, cols = _image_position(state, np.array([first[0]]), np.array([first[1]]))
+        cx, cy = int(cols[0]) * scale + scale // 2, int(rows[0]) * scale + scale // 2
+        radius = MARKER_RADIUS + scale
+        draw.ellipse((cx - radius, cy - radius, cx + radius, cy + radius), outline=MARKER_COLOUR, width=2)
+        text = f"{name} first: line {first[0]}, X {first[1]}"
+        draw.text((cx + radius + 3, cy - LABEL_SIZE // 2), text, fill=MARKER_COLOUR, font=font)
+
+
+def _zoom(frame: Image.Image, state: VicState, rows: np.ndarray, cols: np.ndarray, height: int,
+          title: str) -> tuple[Image.Image, str]:
+    """A zoom on the image pixels (rows, cols), with rulers every 8 X coordinates and 8 lines. Pixels
+    spread wider than ZOOM_MAX_BOX (a pair meeting in two places) zoom on the part around the first."""
+    first = int(np.argmin(rows * frame.width + cols))
+    near = (np.abs(rows - rows[first]) <= ZOOM_MAX_BOX[1]) & (np.abs(cols - cols[first]) <= ZOOM_MAX_BOX[0])
+    rows, cols = rows[near], cols[near]
+    top, bottom, left, right = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
+    pad_w = max(0, (ZOOM_MIN_BOX[0] - (right - left)) // 2)
+    pad_h = max(0, (ZOOM_MIN_BOX[1] - (bottom - top)) // 2)
+    left, right = max(0, left - pad_w - ZOOM_MARGIN), min(frame.width, right + pad_w + ZOOM_MARGIN)
+    top, bottom = max(0, top - pad_h - ZOOM_MARGIN), min(frame.height, bottom + pad_h + ZOOM_MARGIN)
+    crop = frame.crop((int(left), int(top), int(right), int(bottom)))
+    zoom_scale = max(1, min(ZOOM_MAX_SCALE, height // max(1, crop.height), max(1, 480 // max(1, crop.width))))
+    zoomed = upscale(crop, zoom_scale)
+    ruled = Image.new("RGB", (zoomed.width + RULER, zoomed.height + RULER), PANEL_BACKGROUND)
+    ruled.paste(zoomed, (RULER, RULER))
+    draw = ImageDraw.Draw(ruled)
+    lines, xs = frame_order(state)
+    font = label_font(RULER_LABEL_SIZE)
+    # label every tick that leaves room for its number (at small zooms every 2nd, 4th ... tick)
+    every = RULER_STEP * max(1, -(-RULER_LABEL_ROOM // (RULER_STEP * zoom_scale)))
+    for col in range(int(left), int(right)):
+        if xs[col] % RULER_STEP == 0:
+            x = RULER + (col - int(left)) * zoom_scale
+            draw.line((x, RULER - 4, x, RULER - 1), fill=LABEL_COLOUR)
+            if xs[col] % every == 0:
+                draw.text((x + 2, 1), str(int(xs[col])), fill=LABEL_COLOUR, font=font)
+    for row in range(int(top), int(bottom)):
+        if lines[row] % RULER_STEP == 0:
+            y = RULER + (row - int(top)) * zoom_scale
+            draw.line((RULER - 4, y, RULER - 1, y), fill=LABEL_COLOUR)
+            if lines[row] % every == 0:
+                draw.text((1, y + 1), str(int(lines[row])), fill=LABEL_COLOUR, font=font)
+    return ruled, (f"{title} x{zoom_scale}: lines {lines[int(top)]}-{lines[int(bottom) - 1]}, "
+                   f"X {xs[int(left)]}-{xs[int(right) - 1]}")
+
+
+def _zoom_sets(state: VicState, collisions: FrameCollisions) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """(title, image rows, image cols) of each colliding pair, of each sprite over graphics, or of
+    all sprites when nothing collides."""
+    sets = []
+    ss_lines, ss_xs = collisions.ss_pixels
+    for a, b in collisions.pairs[:ZOOM_PANELS]:
+        both = ((collisions.ss_pixel_bits >> a) & 1).astype(bool) & ((collisions.ss_pixel_bits >> b) & 1).astype(bool)
+        if both.any():
+            sets.append((f"sprites {a}+{b}", *_image_position(state, ss_lines[both], ss_xs[both])))
+    sb_lines, sb_xs = collisions.sb_pixels
+    for n in range(SPRITE_COUNT):
+        mine = collisions.sb_pixel_bits == (1 << n)
+        if mine.any() and len(sets) < ZOOM_PANELS:
+            sets.append((f"sprite {n} over graphics", *_image_position(state, sb_lines[mine], sb_xs[mine])))
+    if not sets:
+        box = _zoom_box(state, collisions)
+        if box is not None:
+            left, top, right, bottom = box
+            sets.append(("sprites (no collision)", np.array([top + ZOOM_MARGIN, bottom - ZOOM_MARGIN - 1]),
+                         np.array([left + ZOOM_MARGIN, right - ZOOM_MARGIN - 1])))
+    return sets
 
 
 def overlap_image(state: VicState, collisions: FrameCollisions, scale: int = 2,
                   palette_name: str = C64_DEFAULT_PALETTE) -> Image.Image:
-    """The frame at an integer scale beside a zoom on the overlaps, with a legend underneath."""
+    """The frame at an integer scale (sprite numbers, first-latch markers) beside a zoom with rulers on
+    each colliding pair and each sprite over graphics, with a legend (register values) underneath."""
     video = state.video
     frame = from_rgb_array(frame_rgb(state, collisions, palette_name))
-    panels = [upscale(frame, scale)]
+    full = upscale(frame, scale)
+    _annotate_frame(full, state, collisions, scale)
+    panels = [full]
     titles = [f"{video.name.upper()} {video.chip}, full frame x{scale} (lines from {video.first_visible_line}, "
               f"X from ${video.first_visible_x:X})"]
-    box = _zoom_box(state, collisions)
-    if box is not None:
-        left, top, right, bottom = box
-        crop = frame.crop((max(0, left), max(0, top), min(frame.width, right), min(frame.height, bottom)))
-        zoom_scale = max(1, min(ZOOM_MAX_SCALE, panels[0].height // max(1, crop.height),
-                                max(1, 640 // max(1, crop.width))))
-        panels.append(upscale(crop, zoom_scale))
-        lines, xs = frame_order(state)
-        titles.append(f"zoom x{zoom_scale}: lines {lines[max(0, top)]}-{lines[min(frame.height, bottom) - 1]}, "
-                      f"X {xs[max(0, left)]}-{xs[min(frame.width, right) - 1]}")
+    zoom_height = max(ZOOM_MIN_HEIGHT, full.height // max(1, min(2, len(_zoom_sets(state, collisions)))))
+    for title, rows, cols in _zoom_sets(state, collisions):
+        panel, text = _zoom(frame, state, rows, cols, zoom_height, title)
+        panels.append(panel)
+        titles.append(text)
     sheet = side_by_side(panels, titles)
-    legend = _legend(sheet.width, palette_name)
+    legend = _legend(sheet.width, palette_name, collisions)
     out = Image.new("RGB", (sheet.width, sheet.height + legend.height), PANEL_BACKGROUND)
     out.paste(sheet, (0, 0))
     out.paste(legend, (0, sheet.height))

@@ -158,3 +158,14 @@ def test_frames_move_sprites_by_their_velocity(tmp_path, capsys):
     bad.write_text(path.read_text().replace("velocity = [4, 0]", "velocity = 4"))
     assert main(["vic", str(bad), "--frames", "2"]) == 2
     assert "sprite[0].velocity: expected [dx, dy]" in capsys.readouterr().err
+
+
+def test_the_image_zooms_on_each_colliding_pair():
+    from retro.render.vic_image import _zoom_sets
+    from retro.scenes.vic import load
+
+    scene = load(ROOT / "examples" / "vic_two_balls.toml")
+    from retro.chips.vic.model import frame_collisions
+
+    collisions = frame_collisions(scene.state)
+    assert [title for title, _, _ in _zoom_sets(scene.state, collisions)] == ["sprites 0+1", "sprites 2+3"]
