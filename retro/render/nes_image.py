@@ -23,7 +23,15 @@ from retro.chips.ppu.constants import (
 from retro.chips.ppu.hit import SpriteZeroHit
 from retro.chips.ppu.pixels import background_frame, sprite_values
 from retro.chips.ppu.state import PpuState
-from retro.render.images import from_rgb_array, side_by_side, upscale, zoom
+from retro.render.images import (
+    LABEL_COLOUR,
+    PANEL_BACKGROUND,
+    from_rgb_array,
+    label_font,
+    side_by_side,
+    upscale,
+    zoom,
+)
 from retro.render.palette import palette
 
 # 2C02 colour numbers used for the picture.
@@ -35,6 +43,8 @@ SHADE_WEIGHT = 0.45
 MARK_RGB = (255, 230, 0)
 ZOOM_MARGIN = 4
 ZOOM_PIXELS = 12                                # each pixel of the zoom panel becomes this many x scale
+LEGEND_HEIGHT = 22
+SWATCH = 11
 
 
 def frame_rgb(state: PpuState) -> np.ndarray:
@@ -81,4 +91,28 @@ def sprite_zero_image(state: PpuState, result: SpriteZeroHit, scale: int = 2) ->
         title = f"hit at x={result.x}, line {result.line}: bit 6 set at dot {result.dot}"
     else:
         title = f"no hit: {result.reason}"
-    return side_by_side([big, panel], [title, f"sprite 0 at x={left}, lines {top}-{top + height - 1} (zoom)"])
+    sheet = side_by_side([big, panel], [title, f"sprite 0 at x={left}, lines {top}-{top + height - 1} (zoom)"])
+    legend = _legend(sheet.width)
+    out = Image.new("RGB", (sheet.width, sheet.height + legend.height), PANEL_BACKGROUND)
+    out.paste(sheet, (0, 0))
+    out.paste(legend, (0, sheet.height))
+    return out
+
+
+def _legend(width: int) -> Image.Image:
+    """What each colour means: background shades, sprite 0, both opaque, the hit, the columns that
+    cannot hit."""
+    nes = palette("nes")
+    shade = tuple(int(v) for v in (np.array(nes[BACKGROUND_COLOURS[0]]) * (1 - SHADE_WEIGHT) + SHADE_RGB * SHADE_WEIGHT))
+    items = [(nes[BACKGROUND_COLOURS[3]], "background (pattern 1-3)"), (nes[SPRITE_COLOURS[3]], "sprite 0 (pattern 1-3: darker to lighter)"),
+             (nes[OVERLAP_COLOUR], "both opaque (may hit)"), (MARK_RGB, "the hit pixel"),
+             (shade, "columns that cannot hit (x = 255; x < 8 when clipped)")]
+    legend = Image.new("RGB", (width, LEGEND_HEIGHT), PANEL_BACKGROUND)
+    draw = ImageDraw.Draw(legend)
+    font = label_font()
+    x = 8
+    for colour, text in items:
+        draw.rectangle((x, 5, x + SWATCH, 5 + SWATCH), fill=tuple(colour))
+        draw.text((x + SWATCH + 5, 5), text, fill=LABEL_COLOUR, font=font)
+        x += SWATCH + 5 + int(draw.textlength(text, font=font)) + 16
+    return legend
