@@ -28,6 +28,7 @@ from retro.chips.vic.constants import (
 )
 from retro.errors import InputError
 from retro.fileio import read_bytes, write_atomic
+from retro.loaders.gfx_spritepad import looks_like_spd, parse_spd
 
 HIRES_ROW_CHARS = {".": 0, "#": 1}
 MULTICOLOR_ROW_CHARS = {".": 0, "1": 1, "2": 2, "3": 3}
@@ -114,8 +115,15 @@ def format_rows(data: bytes, multicolor: bool = False) -> list[str]:
 
 
 def read_spr(path: str | Path, frame: int = 0, field: str = "file") -> bytes:
-    """Frame N of a raw .spr file (64-byte blocks; a lone 63-byte sprite is accepted) -> 63 bytes."""
+    """Frame N of a raw .spr file (64-byte blocks; a lone 63-byte sprite is accepted) or of a
+    SpritePad .spd file (detected by content) -> 63 bytes."""
     raw = read_bytes(path, "sprite file")
+    if looks_like_spd(raw):
+        sprites = parse_spd(raw, str(path)).sprites
+        if not 0 <= frame < len(sprites):
+            raise InputError(f"{path}: frame: {frame} is outside 0..{len(sprites) - 1} "
+                             f"({len(sprites)} sprites in the SpritePad file)")
+        return sprites[frame].data
     if len(raw) == SPRITE_BYTES:
         frames = 1
     elif raw and len(raw) % SPRITE_BLOCK == 0:
@@ -136,12 +144,16 @@ def read_png(path: str | Path, multicolor: bool = False) -> bytes:
     """A 24x21 PNG -> 63 bytes (see the module docstring for the colour rules)."""
     raw = read_bytes(path, "sprite PNG")
     try:
-        image = Image.open(io.BytesIO(raw)).convert("RGBA")
+        image = Image.open(io.BytesIO(raw))  # reads the header only: the size is known before decoding
     except Exception:  # Pillow raises several types for bad files
         raise InputError(f"{path}: not a readable PNG image") from None
     if image.size != (SPRITE_WIDTH, SPRITE_HEIGHT):
         raise InputError(f"{path}: a sprite PNG must be {SPRITE_WIDTH}x{SPRITE_HEIGHT} pixels, "
                          f"got {image.width}x{image.height}")
+    try:
+        image = image.convert("RGBA")
+    except Exception:  # a valid header over damaged pixel data
+        raise InputError(f"{path}: not a readable PNG image") from None
     rgba = np.asarray(image)
     empty = (rgba[..., 3] == 0) | np.all(rgba[..., :3] == TRANSPARENT_PREVIEW, axis=-1)
     if not multicolor:

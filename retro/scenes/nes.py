@@ -15,7 +15,7 @@ Format (see docs/nes.md):
     tile = 3
     attr = 0x00
     x = 128
-    [chr]                              # file = "game.chr" (8 KiB, relative to the scene) and/or tiles
+    [chr]                              # file = "game.chr" (8 KiB, 4 KiB + table = 0/1, or a .nes; relative to the scene) and/or tiles
     tiles = { "0:3" = ["33333333", ...] }   # "table:index": 8 rows of 8 values 0-3 ('.' = 0), or 16 bytes
     [[nametable]]                      # 32x30 tiles; index 0-3; anything not given is tile 0
     index = 0
@@ -53,6 +53,7 @@ from retro.chips.ppu.device import PpuDevice, attach_ppu
 from retro.chips.ppu.state import PpuState
 from retro.errors import InputError
 from retro.fileio import read_bytes
+from retro.loaders.gfx_chr import chr_from_bytes
 from retro.numbers import parse_int
 from retro.scenes import earlier_spelling
 
@@ -62,7 +63,7 @@ PIXEL_DIGITS = {".": 0, "0": 0, "1": 1, "2": 2, "3": 3}
 TOP_KEYS = {"chip", "video", "ppu", "oam", "chr", "nametable"}
 PPU_KEYS = {"ctrl", "mask", "scroll_x", "scroll_y", "mirroring"}
 OAM_KEYS = {"y", "tile", "attr", "x"}
-CHR_KEYS = {"file", "tiles"}
+CHR_KEYS = {"file", "table", "tiles"}
 NAMETABLE_KEYS = {"index", "fill", "cells"}
 CELL_KEYS = {"col", "row", "tile"}
 
@@ -223,9 +224,13 @@ def _parse_chr(value, source: str) -> bytes:
             content = read_bytes(path, "CHR file")
         except InputError as exc:
             raise _fail(source, "chr.file", str(exc)) from None
-        if len(content) != CHR_SIZE:
-            raise _fail(source, "chr.file", f"{path} is {len(content)} bytes, expected {CHR_SIZE} (8 KiB)")
-        data[:] = content
+        at = _int(table.get("table", 0), source, "chr.table", 0, 1)
+        try:
+            data[:] = chr_from_bytes(content, str(path), at)
+        except InputError as exc:
+            raise _fail(source, "chr.file", str(exc)) from None
+    elif "table" in table:
+        raise _fail(source, "chr.table", "places a 4 KiB chr.file; give the file too")
     tiles = _table(table.get("tiles", {}), source, "chr.tiles")
     spelled: dict[int, str] = {}
     for key, rows in tiles.items():

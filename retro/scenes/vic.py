@@ -14,7 +14,6 @@ import numpy as np
 from retro.chips.vic.constants import (
     BITMAP_BYTES,
     CHAR_HEIGHT,
-    CHARSET_BYTES,
     COLOR_MASK,
     READ_ONLY_LATCHES,
     REG_IRQ_LATCH,
@@ -44,6 +43,7 @@ from retro.errors import InputError
 from retro.fileio import read_bytes
 from retro.numbers import parse_int
 from retro.scenes import earlier_spelling
+from retro.loaders.gfx_charset import charset_from_bytes
 from retro.sprites import parse_hex, parse_rows, read_png, read_spr
 
 TOP_KEYS = {"chip", "video", "registers", "sprite", "memory", "cpu"}
@@ -262,7 +262,12 @@ def _memory(doc, where: _Where) -> VicMemory:
         if not isinstance(table, dict):
             raise where.error("memory.charset", "expected a table of glyphs by code (\"1\" = [8 bytes]) or file =")
         if "file" in table:
-            charset = _file_bytes(table["file"], "memory.charset.file", CHARSET_BYTES, where)
+            path = where.file(table["file"], "memory.charset.file", "file")
+            try:
+                glyphs = charset_from_bytes(read_bytes(path), repr(table["file"]))
+            except InputError as exc:
+                raise where.error("memory.charset.file", str(exc)) from None
+            charset = np.frombuffer(glyphs, dtype=np.uint8).copy()
         spelled: dict[int, str] = {}
         for key, glyph in table.items():
             if key == "file":

@@ -117,10 +117,10 @@ def test_bad_scene_one_line_error_names_file_and_field(tmp_path, capsys, edit, f
     assert err.count("\n") == 1 and str(path) in err and field in err, err
 
 
-def test_chr_file_must_be_8_kib(tmp_path):
-    (tmp_path / "short.chr").write_bytes(bytes(4096))
+def test_chr_file_must_be_4_or_8_kib(tmp_path):
+    (tmp_path / "short.chr").write_bytes(bytes(4000))
     text = SCENE.replace('tiles = { "0:3"', 'file = "short.chr"\ntiles = { "0:3"')
-    with pytest.raises(InputError, match=r"scene.toml: chr.file: .*4096 bytes, expected 8192"):
+    with pytest.raises(InputError, match=r"scene.toml: chr.file: .*4000 bytes: a CHR file is 4 KiB"):
         load_scene(write(tmp_path, text))
 
 
