@@ -1,21 +1,44 @@
-"""`retro chart [--out DIR] [--reduced] [--jobs N]`: speed against accuracy of every method."""
+"""`retro chart [--out DIR] [--reduced] [--method FILE.toml ...] [--sprites FILE ...] [--samples N]`:
+speed against accuracy of every collision method."""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
 
-from retro.analysis.study.chart_run import run_chart, summary_lines
+from retro.analysis.study.chart_run import AUTO, REDUCED_COST_SAMPLES, run_chart, summary_lines
 from retro.analysis.study.evaluate import quiet, stderr_progress
+from retro.analysis.study.methods import with_user_methods
 from retro.numbers import parse_int
 
 DEFAULT_OUT = "retro-out/chart"
+MAX_SAMPLES = 1_000_000
+
+
+def add_method_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--method", action="append", default=[], metavar="FILE.toml",
+                   help="a method of your own: a routine spec plus a hitbox rule (docs/methods.md); repeatable")
+
+
+def samples_option(text: str) -> int | None | str:
+    if text == "auto":
+        return AUTO
+    if text == "all":
+        return None
+    return parse_int(text, field="--samples", lo=1, hi=MAX_SAMPLES)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("chart", help="chart 6502 cycles against accuracy for every collision method (PNG, CSV, Markdown)")
     p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR", help=f"output folder (default: {DEFAULT_OUT})")
     p.add_argument("--reduced", action="store_true", help="a small corpus (3 shapes) and fewer cycle samples: seconds")
+    add_method_option(p)
+    p.add_argument("--sprites", action="append", default=[], metavar="FILE",
+                   help="add a file's sprites to the corpus (.spr/raw frames, SpritePad .spd, a 24x21 PNG, or a "
+                        "VIC-II scene's enabled sprites); repeatable")
+    p.add_argument("--samples", default="auto", metavar="N",
+                   help=f"cases per pair whose cycles are measured: a number, or `all` (default: all; "
+                        f"{REDUCED_COST_SAMPLES} with --reduced)")
     p.add_argument("--jobs", default="2", metavar="N", help="worker processes (default: 2)")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     p.set_defaults(func=cmd_chart)
@@ -23,8 +46,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def cmd_chart(args: argparse.Namespace) -> int:
     workers = parse_int(args.jobs, field="--jobs", lo=1, hi=64)
+    samples = samples_option(args.samples)
+    methods = with_user_methods(args.method)
     output = run_chart(Path(args.out), reduced=args.reduced, workers=workers,
-                       progress=quiet if args.quiet else stderr_progress)
+                       progress=quiet if args.quiet else stderr_progress, cost_samples=samples, methods=methods,
+                       sprite_files=tuple(args.sprites))
     for line in summary_lines(output):
         print(line)
     return 0

@@ -48,9 +48,11 @@ file = "{SPRITES_DIR / 'bar.spr'}"
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
     advice = next(line for line in lines if line.startswith("advice:"))
-    # Two sprites: the latch is exact and the cheapest measured method.
+    # Two sprites: the latch is exact and the cheapest measured method; then the tight box tested from
+    # prepared edges (aabb_edges), whose preparation per object is named beside it.
     assert "VIC-II latch" in advice
-    assert any(line.startswith("runner-up: tight hitbox AABB") for line in lines), lines
+    assert any(line.startswith("runner-up: tight hitbox, prepared edges") for line in lines), lines
+    assert any("aabb_edges_prepare once per object" in line for line in lines), lines
 
 
 def test_advise_many_sprites_excludes_the_latch():

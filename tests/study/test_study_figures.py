@@ -83,6 +83,7 @@ def test_measured_routines_agree_with_the_study_verdicts(sprite_shapes):
 
 @pytest.mark.parametrize("length,thickness", [(4, 1), (4, 8), (2, 3)])
 def test_tunnelling_matches_the_closed_form(length, thickness):
+    from retro.analysis.study.methods import PIXEL
     from retro.analysis.study.stability.tunnelling import (
         miss_rate_from_hits,
         static_hits_by_dx,
@@ -94,7 +95,7 @@ def test_tunnelling_matches_the_closed_form(length, thickness):
     mask[9:11, 3:3 + length] = True
     mover = Shape(name="mover", mask=mask)
     obstacle = wall(thickness)
-    dxs, hits = static_hits_by_dx("pixel", mover, obstacle)
+    dxs, hits = static_hits_by_dx(PIXEL, mover, obstacle)
     for v in range(1, 30):
         expected = max(0.0, 1 - (thickness + length - 1) / v)
         assert miss_rate_from_hits(dxs, hits, v) == pytest.approx(expected)

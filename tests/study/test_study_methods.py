@@ -29,7 +29,7 @@ def test_pixel_perfect_and_latch_have_zero_error(table):
             assert c.tp == p.colliding
 
 
-@pytest.mark.parametrize("key", ["box", "tight", "sat", "circle", "tile"])
+@pytest.mark.parametrize("key", ["box", "tight", "tight_edges", "sprite_edges", "sat", "circle", "circle_r", "tile"])
 def test_enclosing_methods_never_miss(table, key):
     """Boxes, hulls, enclosing circles and the cells they touch all contain every opaque pixel."""
     for p in table.pairs:
@@ -118,4 +118,4 @@ def test_confusion_counts_by_hand():
 
 
 def test_every_method_is_listed_once():
-    assert len({m.key for m in METHODS}) == len(METHODS) == 7
+    assert len({m.key for m in METHODS}) == len(METHODS) == 10

@@ -6,9 +6,10 @@ boxes meet); identical shape pairs are evaluated once and weighted by how many s
 stand for. Accuracy is pooled over those cases (the counting rules of accuracy.py). Cycles are
 measured in the emulator on the same pairs.
 
-A method qualifies when its accuracy is at least the target and it has a 6502 cost. The hardware
-latch qualifies only with exactly two enabled sprites: with more, its bits cannot say which pair
-collided (see the stability study's latch pitfalls). SAT has no 6502 routine and is listed only.
+A method qualifies when its accuracy is at least the target, it has a 6502 cost and it can serve
+the scene (`Method.advice_note`: the hardware latch only with exactly two enabled sprites, since with
+more its bits cannot say which pair collided; see the stability study's latch pitfalls). SAT has no
+6502 routine and is listed only. A user's methods (`--method FILE.toml`) are compared alongside.
 """
 
 from __future__ import annotations
@@ -17,13 +18,11 @@ import math
 from dataclasses import dataclass
 from itertools import combinations
 
-import numpy as np
-
 from retro.analysis.study.accuracy import Confusion, pooled
 from retro.analysis.study.corpus import Shape
 from retro.analysis.study.costs import CycleStats
 from retro.analysis.study.evaluate import Progress, evaluate, quiet
-from retro.analysis.study.methods import METHODS
+from retro.analysis.study.methods import METHODS, Method
 from retro.errors import InputError
 
 ADVICE_COST_SAMPLES = 48
@@ -52,39 +51,10 @@ class Advice:
 
 
 def scene_shapes(path: str) -> list[tuple[int, Shape]]:
-    """(sprite index, shape) for each enabled sprite of a VIC-II scene."""
-    from retro.chips.vic.constants import (
-        REG_SPRITE_ENABLE,
-        REG_SPRITE_EXPAND_X,
-        REG_SPRITE_EXPAND_Y,
-        REG_SPRITE_MULTICOLOR,
-        SPRITE_BYTES,
-        SPRITE_COUNT,
-    )
-    from retro.scenes import load_scene
-    from retro.sprites import opaque_mask
+    """(sprite index, shape) for each enabled sprite of a VIC-II scene (at least two)."""
+    from retro.analysis.study.sprites_io import scene_shapes as shapes_of_scene
 
-    scene = load_scene(path)
-    state = getattr(scene, "state", None)
-    if state is None or not hasattr(state, "sprite_data"):
-        raise InputError(f"{path}: chip: `retro advise` needs a VIC-II scene (chip = \"vic-ii\")")
-    shapes = []
-    for n in range(SPRITE_COUNT):
-        if not state.sprite_flag(REG_SPRITE_ENABLE, n):
-            continue
-        data = bytes(state.sprite_data[n][:SPRITE_BYTES])
-        multicolor = state.sprite_flag(REG_SPRITE_MULTICOLOR, n)
-        ex, ey = state.sprite_flag(REG_SPRITE_EXPAND_X, n), state.sprite_flag(REG_SPRITE_EXPAND_Y, n)
-        mask = opaque_mask(data, multicolor)
-        if not mask.any():
-            continue  # a fully transparent sprite never collides: nothing to choose a method for
-        mask = np.repeat(np.repeat(mask, 2 if ey else 1, axis=0), 2 if ex else 1, axis=1)
-        shapes.append((n, Shape(name=f"sprite{n}", mask=mask, multicolor=multicolor, source=f"{path} sprite {n}",
-                                data=data, expand_x=ex, expand_y=ey)))
-    if len(shapes) < 2:
-        raise InputError(f"{path}: sprite: need at least two enabled sprites with opaque pixels to advise on "
-                         f"(found {len(shapes)})")
-    return shapes
+    return shapes_of_scene(path, minimum=2)
 
 
 def _shape_key(shape: Shape) -> tuple:
@@ -92,7 +62,7 @@ def _shape_key(shape: Shape) -> tuple:
 
 
 def advise(path: str, target: float, workers: int | None = None, progress: Progress = quiet,
-           samples: int = ADVICE_COST_SAMPLES) -> Advice:
+           samples: int = ADVICE_COST_SAMPLES, methods: tuple[Method, ...] = METHODS) -> Advice:
     if not 0 < target <= 1:
         raise InputError(f"--accuracy: {target} is outside (0, 1] (e.g. 0.99 for 99%)")
     from retro.analysis.study.cost_runs import measure_costs
@@ -106,21 +76,25 @@ def advise(path: str, target: float, workers: int | None = None, progress: Progr
         weights[key] = weights.get(key, 0) + 1
         jobs.setdefault(key, (a, b))
     keys = list(jobs)
-    table = evaluate([], METHODS, workers=workers, progress=progress, pair_list=[jobs[k] for k in keys])
-    costs = measure_costs([], samples=samples, workers=workers, progress=progress, pair_list=[jobs[k] for k in keys])
+    table = evaluate([], methods, workers=workers, progress=progress, pair_list=[jobs[k] for k in keys])
+    costs = measure_costs([], samples=samples, workers=workers, progress=progress, pair_list=[jobs[k] for k in keys],
+                          methods=methods)
     sprite_count = len(indexed)
     figures = []
-    for m in METHODS:
+    for m in methods:
         counts = pooled([_scaled(p.counts[m.key], weights[k]) for p, k in zip(table.pairs, keys)])
         cycles = costs[m.key].overall if m.key in costs else CycleStats.of([])
         note = ""
         qualifies = counts.accuracy >= target
+        unusable = m.advice_note(sprite_count)
         if m.host_only or cycles.samples == 0:
             qualifies, note = False, costs[m.key].counted if m.key in costs else "no 6502 cost"
-        elif m.key == "latch" and sprite_count != 2:
-            qualifies, note = False, (f"{sprite_count} sprites: $D01E's bits cannot say which pair collided")
+        elif unusable:
+            qualifies, note = False, unusable
         elif not qualifies:
             note = "below the target"
+        elif m.prepare:
+            note = f"per test; {m.prepare} once per object besides"
         figures.append(MethodFigures(m.key, m.label, counts, cycles, qualifies, note))
     figures.sort(key=lambda f: (math.isnan(f.cycles.mean), f.cycles.mean if not math.isnan(f.cycles.mean) else 0))
     eligible = [f for f in figures if f.qualifies]

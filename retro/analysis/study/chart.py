@@ -16,12 +16,22 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 
-from retro.analysis.study.report import ALL, HARDWARE, FigureRow  # noqa: E402
+from retro.analysis.study.report import ALL, FigureRow  # noqa: E402
 
-COLOURS = {"box": "#1f77b4", "tight": "#2ca02c", "circle": "#ff7f0e", "tile": "#8c564b",
-           "pixel": "#d62728", "latch": "#17becf", "sat": "#9467bd"}
-MARKERS = {"box": "s", "tight": "D", "circle": "o", "tile": "P", "pixel": "*", "latch": "^", "sat": "X"}
 GREY = "#b0b0b0"
+Styles = dict[str, tuple[str, str]]  # method key -> (colour, marker), from the method objects
+
+
+def styles_of(methods) -> Styles:
+    return {m.key: (m.colour, m.marker) for m in methods}
+
+
+def _colour(styles: Styles, key: str) -> str:
+    return styles.get(key, ("black", "o"))[0]
+
+
+def _marker(styles: Styles, key: str) -> str:
+    return styles.get(key, ("black", "o"))[1]
 
 
 def _png(fig) -> bytes:
@@ -39,17 +49,18 @@ def _x_limits(rows: list[FigureRow]) -> tuple[float, float]:
     return min(lows) / 1.5, max(highs) * 1.5
 
 
-def _draw_panel(ax, rows: list[FigureRow], xlim: tuple[float, float], labels: bool, title: str) -> None:
+def _draw_panel(ax, rows: list[FigureRow], styles: Styles, xlim: tuple[float, float], labels: bool,
+                title: str) -> None:
     measured = [r for r in rows if not math.isnan(r.cycles_mean)]
     accuracies = [r.accuracy for r in rows if not math.isnan(r.accuracy)]
     y_low = max(0.0, min(accuracies) - 0.06) if accuracies else 0.0
     for r in measured:
-        hardware = r.method in HARDWARE
+        hardware = r.hardware
         lit = r.pareto_software or hardware
-        colour = COLOURS.get(r.method, "black") if lit else GREY
+        colour = _colour(styles, r.method) if lit else GREY
         ax.errorbar([r.cycles_mean], [r.accuracy],
                     xerr=[[r.cycles_mean - r.cycles_min], [r.cycles_max - r.cycles_mean]],
-                    fmt=MARKERS.get(r.method, "o"), color=colour, ecolor=colour, elinewidth=1.2, capsize=3,
+                    fmt=_marker(styles, r.method), color=colour, ecolor=colour, elinewidth=1.2, capsize=3,
                     markersize=9 if labels else 6, markeredgecolor="black" if lit else GREY,
                     markerfacecolor="none" if hardware else colour, markeredgewidth=1.6 if hardware else 1.0,
                     zorder=3 if lit else 2)
@@ -60,10 +71,10 @@ def _draw_panel(ax, rows: list[FigureRow], xlim: tuple[float, float], labels: bo
         ax.step(xs, ys, where="post", color="black", linewidth=0.8, alpha=0.5, zorder=1)
     for r in rows:
         if math.isnan(r.cycles_mean) and not math.isnan(r.accuracy):
-            ax.axhline(r.accuracy, color=COLOURS.get(r.method, "black"), linestyle="--", linewidth=1.2)
+            ax.axhline(r.accuracy, color=_colour(styles, r.method), linestyle="--", linewidth=1.2)
             text = f"{r.label}: {100 * r.accuracy:.1f}% (host only, no 6502 routine)" if labels else f"{r.method} (host)"
             ax.text(xlim[1] / 1.08, r.accuracy, text, fontsize=8.5 if labels else 6.5,
-                    color=COLOURS.get(r.method, "black"), va="top", ha="right")
+                    color=_colour(styles, r.method), va="top", ha="right")
     ax.set_xscale("log")
     ax.set_xlim(*xlim)
     ax.set_ylim(y_low, 1.0 + (1.0 - y_low) * 0.06)
@@ -95,9 +106,9 @@ def _place_labels(ax, rows: list[FigureRow]) -> None:
         taken.append(Bbox.from_extents(px - 8, py - 8, px + 8, py + 8))
     for r in sorted(rows, key=lambda r: (-r.pareto_software, r.cycles_mean)):
         text = f"{r.label}\n{r.cycles_mean:.0f} cycles, {100 * r.accuracy:.1f}%"
-        if r.method in HARDWARE:
+        if r.hardware:
             text += "\n(hardware: not which pair, not when)"
-        lit = r.pareto_software or r.method in HARDWARE
+        lit = r.pareto_software or r.hardware
         for dx, dy, align in _LABEL_SLOTS:
             note = ax.annotate(text, (r.cycles_mean, r.accuracy), textcoords="offset points", xytext=(dx, dy),
                                ha=align, fontsize=8.5, color="black" if lit else "#707070",
@@ -113,50 +124,68 @@ def _place_labels(ax, rows: list[FigureRow]) -> None:
         taken.append(box)
 
 
-def overall_chart(rows: list[FigureRow], note: str = "") -> bytes:
+def overall_chart(rows: list[FigureRow], styles: Styles, note: str = "") -> bytes:
+    return _png(overall_figure(rows, styles, note))
+
+
+def overall_figure(rows: list[FigureRow], styles: Styles, note: str = ""):
     """One large panel for the pooled corpus, every point labelled. The front is that of the software
     methods; the hardware latch (hollow marker) is drawn in colour beside it for reference."""
     chosen = [r for r in rows if r.scope == ALL]
     fig, ax = plt.subplots(figsize=(10, 6.5))
-    fig.subplots_adjust(left=0.08, right=0.82, bottom=0.12, top=0.94)  # fixed before labels are placed
-    _draw_panel(ax, chosen, _x_limits(chosen), labels=True,
+    fig.subplots_adjust(left=0.08, right=0.80, bottom=0.12, top=0.94)  # fixed before labels are placed
+    _draw_panel(ax, chosen, styles, _x_limits(chosen), labels=True,
                 title=f"Speed against accuracy, all pairs pooled ({chosen[0].cases if chosen else 0} cases)")
     ax.set_xlabel("6502 cycles per test (mean; bar = min to max over the corpus inputs), log scale")
     ax.set_ylabel("accuracy (share of cases decided correctly)")
-    _legend(fig)
+    _legend(fig, styles, list(dict.fromkeys(r.method for r in chosen)))
     if note:
-        fig.text(0.01, 0.01, note, fontsize=8, color="#555555")
-    return _png(fig)
+        fig.text(0.01, 0.01, note, fontsize=8, color="#555555", wrap=True)
+    return fig
 
 
-def _legend(fig, below: bool = False) -> None:
+LEGEND_COLUMNS = 6  # below a grid: rows of at most this many entries, so none is cut off
+
+
+def _legend(fig, styles: Styles, keys: list[str], below: bool = False) -> int:
+    """The legend; returns its number of rows (below a grid)."""
     from matplotlib.lines import Line2D
 
-    handles = [Line2D([], [], marker=MARKERS[k], color=COLOURS[k], linestyle="", markersize=8, markeredgecolor="black",
-                      label=k) for k in COLOURS]
+    handles = [Line2D([], [], marker=_marker(styles, k), color=_colour(styles, k), linestyle="", markersize=8,
+                      markeredgecolor="black", label=k) for k in keys]
     handles.append(Line2D([], [], marker="o", color=GREY, linestyle="", markersize=8, label="dominated (grey)"))
     handles.append(Line2D([], [], color="black", alpha=0.5, label="Pareto front\n(software methods)"))
     if below:
-        fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=9, frameon=False)
-    else:
-        fig.legend(handles=handles, loc="upper right", fontsize=8.5, frameon=True, title="method", title_fontsize=9)
+        columns = min(len(handles), LEGEND_COLUMNS)
+        fig.legend(handles=handles, loc="lower center", ncol=columns, fontsize=9, frameon=False)
+        return math.ceil(len(handles) / columns)
+    fig.legend(handles=handles, loc="upper right", fontsize=8.5, frameon=True, title="method", title_fontsize=9)
+    return 1
 
 
-def pairs_chart(rows: list[FigureRow], columns: int = 6) -> bytes:
+def pairs_chart(rows: list[FigureRow], styles: Styles, columns: int = 6) -> bytes:
+    return _png(pairs_figure(rows, styles, columns))
+
+
+def pairs_figure(rows: list[FigureRow], styles: Styles, columns: int = 6):
     """A faceted grid, one small panel per shape pair, sharing the x range."""
     scopes = [s for s in dict.fromkeys(r.scope for r in rows) if s != ALL]
     count = max(1, len(scopes))
     columns = min(columns, count)
     lines = math.ceil(count / columns)
-    fig, axes = plt.subplots(lines, columns, figsize=(2.5 * columns + 0.6, 2.2 * lines + 1.2), squeeze=False)
+    keys = list(dict.fromkeys(r.method for r in rows))
+    legend_rows = math.ceil((len(keys) + 2) / LEGEND_COLUMNS)
+    fig, axes = plt.subplots(lines, columns, figsize=(max(2.5 * columns + 0.6, 11), 2.2 * lines + 1.0 + 0.3 * legend_rows),
+                             squeeze=False)
     xlim = _x_limits([r for r in rows if r.scope != ALL])
     for i, scope in enumerate(scopes):
         ax = axes[i // columns][i % columns]
-        _draw_panel(ax, [r for r in rows if r.scope == scope], xlim, labels=False, title=scope)
+        _draw_panel(ax, [r for r in rows if r.scope == scope], styles, xlim, labels=False, title=scope)
     for j in range(len(scopes), lines * columns):
         axes[j // columns][j % columns].axis("off")
-    fig.supxlabel("6502 cycles per test (mean, bar = min-max; log scale)", fontsize=10, y=0.035)
+    _legend(fig, styles, keys, below=True)
+    bottom = (0.35 + 0.3 * legend_rows) / fig.get_figheight()  # inches of legend, as a share of the figure
+    fig.supxlabel("6502 cycles per test (mean, bar = min-max; log scale)", fontsize=10, y=bottom)
     fig.supylabel("accuracy", fontsize=10)
-    _legend(fig, below=True)
-    fig.tight_layout(rect=(0, 0.05, 1, 1))
-    return _png(fig)
+    fig.tight_layout(rect=(0, bottom + 0.02, 1, 1))
+    return fig

@@ -10,14 +10,17 @@ from pathlib import Path
 from retro.analysis.study import report
 from retro.analysis.study.corpus import DEFAULT_SHAPES, REDUCED_SHAPES, load_shapes
 from retro.analysis.study.evaluate import Progress, evaluate, quiet
-from retro.analysis.study.methods import METHODS
+from retro.analysis.study.methods import METHODS, Method
 from retro.fileio import output_folder, write_atomic
 
-# Cases per pair whose 6502 cycles are measured: a deterministic, evenly spread sample of the
-# pair's offsets (every k-th case in row-major order). The full corpus is ~54,000 cases per method;
-# measuring them all in py65 would take hours for the pixel routine.
-FULL_COST_SAMPLES = 192
+# Cases per pair whose 6502 cycles are measured. The full run measures every case of every pair
+# (69,372 calls per routine on the default corpus: about 20 s of py65 for all the routines on two
+# cores, benchmarks/study_speed.py); a method whose calls are costly to set up caps its own sample
+# (Method.max_cost_samples: the latch needs a VIC-II frame per call). The reduced run takes an evenly
+# spread sample of each pair's offsets (every k-th case in row-major order).
+FULL_COST_SAMPLES: int | None = None  # every case
 REDUCED_COST_SAMPLES = 24
+AUTO = "auto"
 
 CSV_NAME = "study.csv"
 MARKDOWN_NAME = "study.md"
@@ -33,33 +36,48 @@ class ChartOutput:
 
 
 def run_chart(out_dir: Path, reduced: bool = False, workers: int | None = None, progress: Progress = quiet,
-              shape_names: tuple[str, ...] | None = None, cost_samples: int | None = None) -> ChartOutput:
+              shape_names: tuple[str, ...] | None = None, cost_samples: int | None | str = AUTO,
+              methods: tuple[Method, ...] = METHODS, sprite_files: tuple[str, ...] = ()) -> ChartOutput:
+    """The study on the corpus (the named shapes from sprites/, then every sprite of `sprite_files`)
+    for the given methods. `cost_samples`: cases per pair whose cycles are measured (None: every
+    case; AUTO: every case, or REDUCED_COST_SAMPLES with `reduced`)."""
     from retro.analysis.study.cost_runs import measure_costs
+    from retro.analysis.study.sprites_io import load_sprite_files
 
-    output_folder(out_dir)
-    start = time.perf_counter()
     names = shape_names or (REDUCED_SHAPES if reduced else DEFAULT_SHAPES)
     shapes = load_shapes(names)
-    table = evaluate(shapes, METHODS, workers=workers, progress=progress)
-    samples = cost_samples or (REDUCED_COST_SAMPLES if reduced else FULL_COST_SAMPLES)
-    costs = measure_costs(shapes, samples=samples, workers=workers, progress=progress)
+    shapes += load_sprite_files(sprite_files, taken={s.name for s in shapes})  # checked before any output
+    output_folder(out_dir)
+    start = time.perf_counter()
+    table = evaluate(shapes, methods, workers=workers, progress=progress)
+    samples = (REDUCED_COST_SAMPLES if reduced else FULL_COST_SAMPLES) if cost_samples == AUTO else cost_samples
+    costs = measure_costs(shapes, samples=samples, workers=workers, progress=progress, methods=methods)
     rows = report.figure_rows(table, costs)
-    note = (f"corpus: {', '.join(names)} ({len(table.pairs)} pairs, {table.cases} cases); "
-            f"cycles measured in py65 on {samples} evenly spread cases per pair")
+    shown = ", ".join(s.name for s in shapes)
+    measured = "every case" if samples is None else f"{samples} evenly spread cases per pair"
+    capped = [f"{m.key} {m.max_cost_samples}" for m in methods if m.max_cost_samples is not None and not m.host_only
+              and (samples is None or m.max_cost_samples < samples)]
+    note = (f"corpus: {shown} ({len(table.pairs)} pairs, {table.cases} cases); cycles measured in py65 on "
+            f"{measured}" + (f" (at most: {', '.join(capped)} per pair)" if capped else ""))
     files = [
         write_atomic(out_dir / CSV_NAME, report.rows_to_csv(rows)),
-        write_atomic(out_dir / MARKDOWN_NAME, markdown_report(rows, note, costs)),
+        write_atomic(out_dir / MARKDOWN_NAME, markdown_report(rows, note, costs, methods)),
     ]
-    from retro.analysis.study.chart import overall_chart, pairs_chart
+    from retro.analysis.study.chart import overall_chart, pairs_chart, styles_of
 
-    files.append(write_atomic(out_dir / OVERALL_PNG, overall_chart(rows, note)))
-    files.append(write_atomic(out_dir / PAIRS_PNG, pairs_chart(rows)))
+    styles = styles_of(methods)
+    files.append(write_atomic(out_dir / OVERALL_PNG, overall_chart(rows, styles, note)))
+    files.append(write_atomic(out_dir / PAIRS_PNG, pairs_chart(rows, styles)))
     return ChartOutput(rows=rows, files=files, seconds=time.perf_counter() - start)
 
 
-def markdown_report(rows: list[report.FigureRow], note: str, costs: dict) -> str:
-    counted = "\n".join(f"- **{key}** ({cost.routine or 'no routine'}): {cost.counted}" for key, cost in costs.items())
+def markdown_report(rows: list[report.FigureRow], note: str, costs: dict, methods: tuple[Method, ...] = METHODS) -> str:
+    counted = "\n".join(f"- **{key}** ({cost.routine or 'no routine'}"
+                        + (f", prepared by {cost.prepare}" if cost.prepare else "") + f"): {cost.counted}"
+                        for key, cost in costs.items())
+    rules = "\n".join(f"| {m.key} | {m.label} | {m.rule} | {m.origin} |" for m in methods)
     return (f"# Speed against accuracy\n\n{note}.\n\n## All pairs pooled\n\n" + report.markdown_table(rows)
+            + "\n## The methods\n\n| key | label | rule | defined in |\n|---|---|---|---|\n" + rules + "\n"
             + "\n## What each cycle figure counts\n\n" + counted + "\n"
             + "\n## Accuracy per pair (* = on that pair's software Pareto front)\n\n" + report.markdown_pairs(rows))
 
@@ -71,7 +89,7 @@ def summary_lines(output: ChartOutput) -> list[str]:
             continue
         cycles = "host only" if r.host_only else (
             "not measured" if math.isnan(r.cycles_mean) else f"{r.cycles_mean:6.1f} cycles")
-        lines.append(f"{r.label:<24} {cycles:>14}  accuracy {100 * r.accuracy:6.2f}%  "
+        lines.append(f"{r.label:<34} {cycles:>14}  accuracy {100 * r.accuracy:6.2f}%  "
                      f"FP {100 * r.fp_rate:5.1f}%  FN {100 * r.fn_rate:4.1f}%"
                      + ("  software Pareto front" if r.pareto_software else ""))
     lines.append(f"wrote {', '.join(p.name for p in output.files)} in {output.seconds:.1f} s")

@@ -108,6 +108,19 @@ def make_pair(a: Shape, b: Shape) -> Pair:
     return Pair(a=a, b=b, dx=dx, dy=dy, overlap=overlap_counts(a.mask, b.mask).ravel())
 
 
+def pair_at(a: Shape, b: Shape, offsets: list[tuple[int, int]]) -> Pair:
+    """A pair with the given offsets only (they may lie where the sprite boxes do not meet: their
+    overlap is 0 there), for the scenarios of the stability study."""
+    counts = overlap_counts(a.mask, b.mask)
+    dx = np.array([o[0] for o in offsets], dtype=np.int64)
+    dy = np.array([o[1] for o in offsets], dtype=np.int64)
+    row, col = dy + b.height - 1, dx + b.width - 1
+    inside = (row >= 0) & (row < counts.shape[0]) & (col >= 0) & (col < counts.shape[1])
+    overlap = np.zeros(dx.shape, dtype=counts.dtype)
+    overlap[inside] = counts[row[inside], col[inside]]
+    return Pair(a=a, b=b, dx=dx, dy=dy, overlap=overlap)
+
+
 def make_pairs(shapes: list[Shape]) -> list[Pair]:
     """Every unordered pair of the shapes, each shape also paired with itself (two bullets meet too)."""
     return [make_pair(a, b) for a, b in combinations_with_replacement(shapes, 2)]

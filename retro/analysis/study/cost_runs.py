@@ -1,10 +1,11 @@
 """Measure each method's 6502 cost in the emulator: cycles per test on the corpus inputs, bytes.
 
-For every pair, an evenly spread sample of its cases is turned into the inputs of the method's
-routine (per the calling conventions in the asm/ headers, see routine_inputs.py), the routine is
-called in py65, and its cycles (first instruction through RTS, the caller's JSR excluded) are
-recorded. Every call's answer is compared with the study's verdict for that case: a mismatch means
-the study does not model the routine it charges for, and is an error, not a statistic.
+For every pair, the method's routine is called in py65 on the pair's cases (every case, or an
+evenly spread sample), with the inputs the method makes of each case (`Method.case_maker`, passed
+through the routine's spec), and its cycles (first instruction through RTS, the caller's JSR
+excluded) are recorded. Every call's answer is compared with the method's verdict for that case: a
+mismatch means the study does not model the routine it charges for, and is an error, not a
+statistic. The verdict is computed on the measured cases only.
 """
 
 from __future__ import annotations
@@ -16,59 +17,81 @@ from retro.analysis.study.corpus import Pair, Shape, make_pair
 from retro.analysis.study.costs import CycleStats, MethodCost
 from retro.analysis.study.evaluate import Progress, default_workers, quiet
 from retro.analysis.study.host_timing import host_microseconds
-from retro.analysis.study.methods import METHODS
-from retro.analysis.study.routine_inputs import ADAPTERS, Adapter
+from retro.analysis.study.methods import METHODS, Method, sub_pair
 from retro.errors import RunError
 
+HOST_SAMPLES = 48  # cases per pair timed on the host (a secondary figure)
 
-def sample_indices(pair: Pair, samples: int) -> list[int]:
-    """`samples` case indices spread evenly over the pair's cases (all of them if fewer)."""
-    if samples >= pair.cases:
+
+def sample_indices(pair: Pair, samples: int | None) -> list[int]:
+    """`samples` case indices spread evenly over the pair's cases (all of them if None or fewer)."""
+    if samples is None or samples >= pair.cases:
         return list(range(pair.cases))
     return [round(i * (pair.cases - 1) / (samples - 1)) for i in range(samples)] if samples > 1 else [0]
 
 
-def _measure_pair(adapter_key: str, a: Shape, b: Shape, samples: int) -> tuple[str, list[int]]:
-    adapter = ADAPTERS[adapter_key]
+def method_samples(method: Method, samples: int | None) -> int | None:
+    """The cases per pair measured for a method: the run's figure, capped by the method's own."""
+    cap = method.max_cost_samples
+    if cap is None:
+        return samples
+    return cap if samples is None else min(samples, cap)
+
+
+def _measure_pair(method: Method, a: Shape, b: Shape, samples: int | None) -> tuple[str, list[int]]:
     pair = make_pair(a, b)
-    session = adapter.session(pair)
+    indices = sample_indices(pair, method_samples(method, samples))
+    session = method.session(pair)
+    verdict = None if method.averaged else method.verdict(sub_pair(pair, indices)) > 0
     cycles = []
-    for index in sample_indices(pair, samples):
-        answer, expected, spent = session.run(index)
+    for k, index in enumerate(indices):
+        answer, spent = session.run(index)
+        expected = session.expected(index) if verdict is None else bool(verdict[k])
         if answer != expected:
-            raise RunError(f"{adapter.routine}: on {pair.name} at offset ({int(pair.dx[index])}, {int(pair.dy[index])}) "
-                           f"the routine says {answer}, the study's {adapter_key} method says {expected}")
+            raise RunError(f"{method.routine}: on {pair.name} at offset ({int(pair.dx[index])}, {int(pair.dy[index])}) "
+                           f"the routine says {answer}, the rule of method {method.key} says {expected}")
         cycles.append(spent)
     return pair.name, cycles
 
 
-def measure_costs(shapes: list[Shape], samples: int, workers: int | None = None, progress: Progress = quiet,
-                  pair_list: list[tuple[Shape, Shape]] | None = None) -> dict[str, MethodCost]:
-    """MethodCost for every method; a method whose routine is missing gets no cycles and says so."""
+def measure_costs(shapes: list[Shape], samples: int | None, workers: int | None = None, progress: Progress = quiet,
+                  pair_list: list[tuple[Shape, Shape]] | None = None,
+                  methods: tuple[Method, ...] = METHODS) -> dict[str, MethodCost]:
+    """MethodCost for every method; a host-only method gets no cycles and says so. `samples`: cases
+    measured per pair (None: every case)."""
     jobs = pair_list if pair_list is not None else list(combinations_with_replacement(shapes, 2))
     workers = default_workers() if workers is None else workers
-    costs: dict[str, MethodCost] = {}
     pairs = [make_pair(a, b) for a, b in jobs]
-    for m in METHODS:
-        adapter: Adapter | None = ADAPTERS.get(m.key)
-        host = host_microseconds(m.key, pairs, max(4, samples // 4))
-        if m.host_only or adapter is None:
-            why = "host-only: no 6502 routine exists for it"
-            costs[m.key] = MethodCost(key=m.key, routine="", overall=CycleStats.of([]), host_us=host, counted=why)
+    measured = [m for m in methods if not m.host_only]
+    tasks = [(m, a, b) for m in measured for a, b in jobs]
+    if workers > 1 and len(tasks) > 1:
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            futures = [pool.submit(_measure_pair, m, a, b, samples) for m, a, b in tasks]
+            results = []
+            for (m, _, _), future in zip(tasks, futures):
+                results.append(future.result())
+                if len(results) % len(jobs) == 0:
+                    progress(f"cost: {m.key} ({m.routine}) measured on {len(jobs)} pairs")
+    else:
+        results = []
+        for m, a, b in tasks:
+            results.append(_measure_pair(m, a, b, samples))
+            if len(results) % len(jobs) == 0:
+                progress(f"cost: {m.key} ({m.routine}) measured on {len(jobs)} pairs")
+    by_method = {m.key: results[i * len(jobs):(i + 1) * len(jobs)] for i, m in enumerate(measured)}
+    costs: dict[str, MethodCost] = {}
+    for m in methods:
+        host = host_microseconds(m, pairs, HOST_SAMPLES if samples is None else max(4, samples // 4))
+        if m.host_only:
+            costs[m.key] = MethodCost(key=m.key, routine="", overall=CycleStats.of([]), host_us=host, counted=m.counted)
             continue
         per_pair: dict[str, CycleStats] = {}
         every: list[int] = []
-        if workers > 1 and len(jobs) > 1:
-            with ProcessPoolExecutor(max_workers=workers) as pool:
-                futures = [pool.submit(_measure_pair, m.key, a, b, samples) for a, b in jobs]
-                results = [f.result() for f in futures]
-        else:
-            results = [_measure_pair(m.key, a, b, samples) for a, b in jobs]
-        for name, cycles in results:
+        for name, cycles in by_method[m.key]:
             per_pair[name] = CycleStats.of(cycles)
             every += cycles
-        code, tables = adapter.size()
-        costs[m.key] = MethodCost(key=m.key, routine=adapter.routine, overall=CycleStats.of(every), per_pair=per_pair,
-                                  code_bytes=code, table_bytes=tables, host_us=host, counted=adapter.counted)
-        progress(f"cost: {m.key} ({adapter.routine}) {len(every)} calls, mean {sum(every) / len(every):.1f} cycles")
+        code, tables = m.size()
+        costs[m.key] = MethodCost(key=m.key, routine=m.routine, overall=CycleStats.of(every), per_pair=per_pair,
+                                  code_bytes=code, table_bytes=tables, host_us=host, counted=m.counted,
+                                  prepare=m.prepare)
     return costs

@@ -36,6 +36,7 @@ class MethodCost:
     table_bytes: int | None = None
     host_us: float = math.nan  # microseconds per test of the Python reference on this host
     counted: str = ""  # what the cycle figure covers
+    prepare: str | None = None  # the once-per-object preparation routine (its cost is not in these cycles)
 
     def cycles_for(self, pair: str | None) -> CycleStats:
         if pair is None:

@@ -44,10 +44,9 @@ class AccuracyTable:
         return sum(p.cases for p in self.pairs)
 
 
-def _evaluate_pair(a: Shape, b: Shape, keys: tuple[str, ...]) -> PairResult:
+def _evaluate_pair(a: Shape, b: Shape, methods: tuple[Method, ...]) -> PairResult:
     pair = make_pair(a, b)
-    by_key = {m.key: m for m in METHODS}
-    counts = {key: confusion(by_key[key].verdict(pair), pair.truth) for key in keys}
+    counts = {m.key: confusion(m.verdict(pair), pair.truth) for m in methods}
     return PairResult(pair=pair.name, cases=pair.cases, colliding=int(pair.truth.sum()), counts=counts)
 
 
@@ -61,16 +60,16 @@ def evaluate(shapes: list[Shape], methods: tuple[Method, ...] = METHODS, workers
     from itertools import combinations_with_replacement
 
     jobs = pair_list if pair_list is not None else list(combinations_with_replacement(shapes, 2))
-    keys = tuple(m.key for m in methods)
+    methods = tuple(methods)
     workers = default_workers() if workers is None else workers
     results: list[PairResult] = []
     if workers <= 1 or len(jobs) <= 1:
         for i, (a, b) in enumerate(jobs, 1):
-            results.append(_evaluate_pair(a, b, keys))
+            results.append(_evaluate_pair(a, b, methods))
             progress(f"accuracy: pair {i}/{len(jobs)} {a.name}+{b.name}")
     else:
         with ProcessPoolExecutor(max_workers=workers) as pool:
-            futures = [pool.submit(_evaluate_pair, a, b, keys) for a, b in jobs]
+            futures = [pool.submit(_evaluate_pair, a, b, methods) for a, b in jobs]
             for i, future in enumerate(futures, 1):
                 results.append(future.result())
                 progress(f"accuracy: pair {i}/{len(jobs)} {results[-1].pair}")

@@ -13,8 +13,6 @@ from retro.analysis.study.evaluate import AccuracyTable
 from retro.analysis.study.pareto import pareto_front
 
 ALL = "ALL"
-HARDWARE = ("latch",)  # methods that need the VIC-II's collision hardware (not on the NES, not for
-# more objects than sprites): the software front leaves them out
 
 
 @dataclass(frozen=True)
@@ -39,6 +37,7 @@ class FigureRow:
     table_bytes: int | None
     host_us: float
     host_only: bool
+    hardware: bool  # needs the VIC-II's collision hardware (not on the NES, not past 8 sprites)
     pareto: bool  # on the (cycles, accuracy) Pareto front of its scope, all methods
     pareto_software: bool  # on the front of the software methods (the hardware latch left out)
 
@@ -58,9 +57,10 @@ def _rows_for_scope(scope: str, cases: int, colliding: int, counts: dict[str, Co
             cycles_min=stats.min if has_cycles else None, cycles_max=stats.max if has_cycles else None,
             cycle_samples=stats.samples if has_cycles else 0,
             code_bytes=cost.code_bytes if cost else None, table_bytes=cost.table_bytes if cost else None,
-            host_us=cost.host_us if cost else math.nan, host_only=m.host_only, pareto=False, pareto_software=False))
+            host_us=cost.host_us if cost else math.nan, host_only=m.host_only, hardware=m.hardware, pareto=False,
+            pareto_software=False))
     front = pareto_front([(r.cycles_mean, r.accuracy) for r in rows])
-    software = pareto_front([(math.nan, 0.0) if r.method in HARDWARE else (r.cycles_mean, r.accuracy) for r in rows])
+    software = pareto_front([(math.nan, 0.0) if r.hardware else (r.cycles_mean, r.accuracy) for r in rows])
     return [FigureRow(**{**asdict(r), "pareto": on, "pareto_software": soft})
             for r, on, soft in zip(rows, front, software)]
 
@@ -100,7 +100,7 @@ def rows_to_csv(rows: list[FigureRow]) -> str:
 
 _INT_OR_NONE = {"cycles_min", "cycles_max", "code_bytes", "table_bytes"}
 _INT = {"cases", "colliding", "cycle_samples"}
-_BOOL = {"host_only", "pareto", "pareto_software"}
+_BOOL = {"host_only", "hardware", "pareto", "pareto_software"}
 _STR = {"scope", "method", "label"}
 
 
@@ -153,7 +153,7 @@ def markdown_table(rows: list[FigureRow], scope: str = ALL) -> str:
         host = "n/a" if math.isnan(r.host_us) else f"{r.host_us:.1f}"
         lines.append(f"| {r.label} | {_cycles(r)} | {_bytes(r)} | {_pct(r.fp_rate)} | {_pct(r.fn_rate)} | "
                      f"{_pct(r.accuracy, 2)} | {host} | {'yes' if r.pareto else 'no'} / "
-                     f"{'yes' if r.pareto_software else ('-' if r.method in HARDWARE else 'no')} |")
+                     f"{'yes' if r.pareto_software else ('-' if r.hardware else 'no')} |")
     return "\n".join(lines) + "\n"
 
 

@@ -7,37 +7,62 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from retro.analysis.study.chart import COLOURS, MARKERS, _png  # noqa: E402
-from retro.analysis.study.stability.tunnelling import SWEPT, TunnelRow  # noqa: E402
+import math  # noqa: E402
 
-LABELS = {"box": "sprite box AABB", "tight": "tight hitbox AABB", "circle": "fitted circle",
-          "pixel": "pixel-perfect / latch", SWEPT: "swept tight box (retro.geometry)"}
+from retro.analysis.study.chart import _png  # noqa: E402
+from retro.analysis.study.stability.tunnelling import GROUP, SWEPT, TunnelRow  # noqa: E402
+
+SWEPT_LABEL = "swept tight box (retro.geometry)"
+LEGEND_COLUMNS = 2
 
 
-def tunnelling_chart(rows: list[TunnelRow], mover: str) -> bytes:
+def group_label(key: str, methods) -> str:
+    """The label of a tunnelling line: its methods' labels (or the swept reference's)."""
+    if key == SWEPT:
+        return SWEPT_LABEL
+    labels = {m.key: m.label for m in methods}
+    first, *others = key.split(GROUP)
+    return labels.get(first, first) + (f" (and {', '.join(others)})" if others else "")
+
+
+def tunnelling_chart(rows: list[TunnelRow], mover: str, methods) -> bytes:
+    return _png(tunnelling_figure(rows, mover, methods))
+
+
+def tunnelling_figure(rows: list[TunnelRow], mover: str, methods):
+    """One panel per wall thickness: miss rate against speed, one line per method group."""
+    by_key = {m.key: m for m in methods}
     thicknesses = sorted({r.thickness for r in rows})
-    methods = list(dict.fromkeys(r.method for r in rows))
-    fig, axes = plt.subplots(1, len(thicknesses), figsize=(3.6 * len(thicknesses) + 1.5, 3.9), sharey=True, squeeze=False)
+    groups = list(dict.fromkeys(r.method for r in rows))
+    legend_rows = math.ceil(len(groups) / LEGEND_COLUMNS)
+    height = 3.6 + 0.25 * legend_rows
+    fig, axes = plt.subplots(1, len(thicknesses), figsize=(3.6 * len(thicknesses) + 1.5, height), sharey=True,
+                             squeeze=False)
     for ax, t in zip(axes[0], thicknesses):
-        for key in methods:
+        for key in groups:
+            first = by_key.get(key.split(GROUP)[0])
             chosen = sorted((r for r in rows if r.method == key and r.thickness == t), key=lambda r: r.speed)
             ax.plot([r.speed for r in chosen], [100 * r.miss_rate for r in chosen],
-                    color="black" if key == SWEPT else COLOURS.get(key, "black"),
-                    linestyle="--" if key == SWEPT else "-", marker=MARKERS.get(key, None), markevery=4,
-                    markersize=5, linewidth=2.4 if key == SWEPT else 1.5, label=LABELS.get(key, key))
+                    color="black" if first is None else first.colour,
+                    linestyle="--" if key == SWEPT else "-", marker=None if first is None else first.marker,
+                    markevery=4, markersize=5, linewidth=2.4 if key == SWEPT else 1.5, label=group_label(key, methods))
         ax.set_title(f"obstacle {t} px thick", fontsize=10)
         ax.set_xlabel("speed (pixels per frame)")
         ax.grid(True, alpha=0.3)
         ax.set_ylim(-3, 100)
     axes[0][0].set_ylabel("crossings missed (% of start phases)")
     handles, labels = axes[0][0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=len(methods), fontsize=8.5, frameon=False)
+    fig.legend(handles, labels, loc="lower center", ncol=min(len(groups), LEGEND_COLUMNS), fontsize=8.5, frameon=False)
     fig.suptitle(f"Tunnelling: a {mover} crossing a wall at v px/frame, tested once per frame", fontsize=11)
-    fig.tight_layout(rect=(0, 0.08, 1, 1))
-    return _png(fig)
+    fig.tight_layout(rect=(0, (0.3 * legend_rows + 0.2) / height, 1, 1))
+    return fig
 
 
 def wrap_chart(maps: dict, rows: list) -> bytes:
+    return _png(wrap_figure(maps, rows))
+
+
+def wrap_figure(maps: dict, rows: list):
     """One map per (video, software test): for every pair of X registers, whether the software box
     test and the VIC-II agree."""
     from matplotlib.colors import ListedColormap
@@ -67,4 +92,4 @@ def wrap_chart(maps: dict, rows: list) -> bytes:
     fig.suptitle("Coordinate wrap: box test on sprite X registers against the VIC-II (two full 24x21 sprites)",
                  fontsize=10.5)
     fig.tight_layout(rect=(0, 0.07, 1, 1))
-    return _png(fig)
+    return fig

@@ -55,7 +55,7 @@ WRAP_W = 24  # full sprite width
 def wrap_routine_rows(reduced: bool = False) -> list[WrapRoutineRow]:
     """aabb8 with boxes reaching past 255 (x + w > 255), and aabb_sprite with X across 255/256,
     against the plain-integer overlap of the same boxes. Every pair of positions in the window."""
-    from retro.analysis.study.routine_inputs import routine_runner
+    from retro.analysis.study.methods.base import routine_runner
 
     step = 3 if reduced else 1
     aabb8 = routine_runner("aabb8")

@@ -39,7 +39,29 @@ def _md_table(header: list[str], body: list[list[object]]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = quiet) -> StabilityOutput:
+def _verdict_text(hit: float | None) -> str:
+    if hit is None:
+        return ""
+    if hit in (0.0, 1.0):
+        return "hit" if hit else "no"
+    return f"hit in {100 * hit:.1f}% of alignments"
+
+
+def edges_markdown(rows: list) -> str:
+    """Two tables (boxes, circles; the swept cases with the boxes): a row per test, a column per
+    case; a test with no answer on any of a table's cases is left out of it."""
+    by = {(r.case, r.test): r.hit for r in rows}
+    cases = list(dict.fromkeys(r.case for r in rows))
+    tests = list(dict.fromkeys(r.test for r in rows))
+    out = []
+    for chosen in ([c for c in cases if not c.startswith("circle")], [c for c in cases if c.startswith("circle")]):
+        used = [t for t in tests if any((c, t) in by for c in chosen)]
+        out.append(_md_table(["test"] + chosen, [[t] + [_verdict_text(by.get((c, t))) for c in chosen] for t in used]))
+    return "\n".join(out)
+
+
+def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = quiet,
+                  methods: tuple | None = None) -> StabilityOutput:
     from retro.analysis.study.stability import (
         charts,
         edges,
@@ -49,6 +71,9 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
         wrap,
     )
 
+    from retro.analysis.study.methods import METHODS
+
+    methods = METHODS if methods is None else tuple(methods)
     output_folder(out_dir)
     start = time.perf_counter()
     files: list[Path] = []
@@ -59,20 +84,21 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
     mover = load_shapes(["bullet"])[0]
     speeds = REDUCED_SPEEDS if reduced else FULL_SPEEDS
     progress("stability: tunnelling")
-    tunnel = tunnelling.tunnelling_table(mover, speeds=speeds)
+    tunnel = tunnelling.tunnelling_table(mover, speeds=speeds, methods=methods)
     files.append(write_atomic(out_dir / "tunnelling.csv", _csv(tunnel)))
-    files.append(write_atomic(out_dir / "tunnelling.png", charts.tunnelling_chart(tunnel, "4x4 bullet sprite")))
-    methods = list(dict.fromkeys(r.method for r in tunnel))
-    body = [[charts.LABELS.get(m, m)] + [tunnelling.safe_speed(tunnel, m, t) for t in tunnelling.THICKNESSES]
-            for m in methods]
+    files.append(write_atomic(out_dir / "tunnelling.png", charts.tunnelling_chart(tunnel, "4x4 bullet sprite", methods)))
+    groups = list(dict.fromkeys(r.method for r in tunnel))
+    body = [[charts.group_label(g, methods)] + [tunnelling.safe_speed(tunnel, g, t) for t in tunnelling.THICKNESSES]
+            for g in groups]
     md.append("## Tunnelling\n\nHighest speed (px/frame, tested up to "
               f"{max(speeds)}) at which a 4x4 bullet never passes through a wall of the given thickness "
               "unseen (every start phase tried):\n\n")
     md.append(_md_table(["method"] + [f"wall {t} px" for t in tunnelling.THICKNESSES], body))
     md.append("\n![tunnelling](tunnelling.png)\n\n")
-    pixel_safe = tunnelling.safe_speed(tunnel, "pixel", 1)
-    summary.append(f"tunnelling: pixel-exact static tests miss a 1 px wall above {pixel_safe} px/frame; "
-                   f"the swept test never misses (up to {max(speeds)})")
+    thinnest = min(tunnelling.THICKNESSES)
+    summary.append(f"tunnelling (highest speed with no miss, {thinnest} px wall, px/frame): "
+                   + "; ".join(f"{charts.group_label(g, methods)} {tunnelling.safe_speed(tunnel, g, thinnest)}"
+                               for g in groups))
 
     # Coordinate wrap
     progress("stability: coordinate wrap")
@@ -108,14 +134,10 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
 
     # Edge conventions
     progress("stability: edge conventions")
-    edge_rows = edges.edge_table()
+    edge_rows = edges.edge_table(methods)
     files.append(write_atomic(out_dir / "edges.csv", _csv(edge_rows)))
-    tests = list(dict.fromkeys(r.test for r in edge_rows))
-    cases = list(dict.fromkeys(r.case for r in edge_rows))
-    by = {(r.case, r.test): r.hit for r in edge_rows}
     md.append("## Edge conventions\n\n")
-    md.append(_md_table(["case"] + tests, [[c] + [{True: "hit", False: "no", None: ""}[by.get((c, t))]
-                                                  for t in tests] for c in cases]))
+    md.append(edges_markdown(edge_rows))
     md.append("\n")
 
     # Latch pitfalls

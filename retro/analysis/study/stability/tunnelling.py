@@ -6,8 +6,11 @@ x_k = x_0 + k*v; every start phase x_0 mod v (0 .. v-1) is taken once, so a miss
 not sampled. The mover crosses the wall completely, so the correct answer is always "collided":
 a static method misses when none of the frame positions is one where it reports a hit.
 
-The swept test beside them is retro.geometry.swept_aabb on the tight hitboxes, frame by frame (the
-box moving by v over each frame).
+Every method whose verdict is a 0/1 answer takes part (an averaged method, the tile cells, has no
+single answer per position). Methods that give the same answer at every position of every crossing
+(the tight box through aabb8, aabb_edges or sprite_edges; pixel-perfect and the latch) are one line,
+named by all of them. The swept test beside them is retro.geometry.swept_aabb on the tight hitboxes,
+frame by frame (the box moving by v over each frame).
 
 Reference: a mover of length L through a wall of thickness T overlaps it at T + L - 1 integer
 positions, so a pixel-exact static test misses a share max(0, 1 - (T + L - 1) / v) of the phases.
@@ -21,10 +24,10 @@ import numpy as np
 
 from retro.analysis.study.corpus import Shape, make_pair
 from retro.analysis.study.fits import tight_box
-from retro.analysis.study.methods import method
+from retro.analysis.study.methods import METHODS, Method, sub_pair
 
-STATIC_METHODS = ("box", "tight", "circle", "pixel")
 SWEPT = "swept"
+GROUP = "/"  # joins the keys of methods that answer alike on every crossing
 SPEEDS = tuple(range(1, 41))
 THICKNESSES = (1, 2, 4, 8)
 WALL_HEIGHT = 21
@@ -45,14 +48,13 @@ def _row_offset(mover: Shape, obstacle: Shape) -> int:
     return (oy0 + oy1) // 2 - (my0 + my1) // 2
 
 
-def static_hits_by_dx(method_key: str, mover: Shape, obstacle: Shape) -> tuple[np.ndarray, np.ndarray]:
+def static_hits_by_dx(method: Method, mover: Shape, obstacle: Shape) -> tuple[np.ndarray, np.ndarray]:
     """(dx values, verdict) of a static method along the mover's line through the obstacle; the
-    obstacle is shape a at the origin, the mover shape b at (dx, dy)."""
+    obstacle is shape a at the origin, the mover shape b at (dx, dy). Only the line's cases are
+    evaluated."""
     pair = make_pair(obstacle, mover)
-    dy = _row_offset(mover, obstacle)
-    on_line = pair.dy == dy
-    verdict = method(method_key).verdict(pair)
-    return pair.dx[on_line], verdict[on_line] > 0
+    line = sub_pair(pair, np.flatnonzero(pair.dy == _row_offset(mover, obstacle)))
+    return line.dx, method.verdict(line) > 0
 
 
 def miss_rate_from_hits(dxs: np.ndarray, hits: np.ndarray, speed: int) -> float:
@@ -94,14 +96,26 @@ class TunnelRow:
     miss_rate: float
 
 
-def tunnelling_table(mover: Shape, speeds: tuple[int, ...] = SPEEDS,
-                     thicknesses: tuple[int, ...] = THICKNESSES) -> list[TunnelRow]:
+def tunnelling_methods(methods: tuple[Method, ...]) -> tuple[Method, ...]:
+    return tuple(m for m in methods if not m.averaged)
+
+
+def tunnelling_table(mover: Shape, speeds: tuple[int, ...] = SPEEDS, thicknesses: tuple[int, ...] = THICKNESSES,
+                     methods: tuple[Method, ...] = METHODS) -> list[TunnelRow]:
+    """Rows per (method group, thickness, speed); a group's key is its methods' keys joined by GROUP."""
+    walls = [wall(t) for t in thicknesses]
+    hits: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {}
+    for m in tunnelling_methods(methods):
+        hits[m.key] = [static_hits_by_dx(m, mover, obstacle) for obstacle in walls]
+    groups: dict[tuple, list[str]] = {}
+    for key, lines in hits.items():
+        signature = tuple((dxs[h].tobytes(), dxs.tobytes()) for dxs, h in lines)
+        groups.setdefault(signature, []).append(key)
     rows = []
-    for t in thicknesses:
-        obstacle = wall(t)
-        for key in STATIC_METHODS:
-            dxs, hits = static_hits_by_dx(key, mover, obstacle)
-            rows += [TunnelRow(key, t, v, miss_rate_from_hits(dxs, hits, v)) for v in speeds]
+    for i, (t, obstacle) in enumerate(zip(thicknesses, walls)):
+        for keys in groups.values():
+            dxs, h = hits[keys[0]][i]
+            rows += [TunnelRow(GROUP.join(keys), t, v, miss_rate_from_hits(dxs, h, v)) for v in speeds]
         rows += [TunnelRow(SWEPT, t, v, swept_miss_rate(mover, obstacle, v)) for v in speeds]
     return rows
 

@@ -1,0 +1,398 @@
+"""A user's method from a TOML file: a routine spec plus a hitbox rule (docs/methods.md).
+
+    name = "shrunk"                 # the method's key in the CSV (default: the file's stem)
+    label = "tight box, 1 px in"    # the chart's label (default: the name)
+    routine = "aabb8"               # a built-in routine or a spec file (relative to this file); none: host only
+    prepare = "aabb_edges_prepare"  # optional: the once-per-object preparation routine
+    hit = "hit"                     # optional: the routine's output that answers (default: its first)
+
+    [hitbox]
+    shape = "box"                   # box | circle | mask | function
+    fit = "tight"                   # box: "tight" (bounds of the opaque pixels) or "full" (the sprite box)
+    inset = 1                       # box: pixels off every side, or [left, top, right, bottom]; circle: off r
+    touching = false                # box, circle: whether touching boxes / tangent circles collide
+    function = "rule.py:hit"        # function: FILE.py:NAME, hit(a, b, dx, dy) -> one verdict per offset
+
+    [inputs]                        # each routine input as an expression over the case
+    ax = "a_x"
+    bx = "b_x"
+    ...
+
+Every error is one line naming the file and the field. The routine's answer is checked against the
+hitbox rule on every measured case (a mismatch stops the run), so the rule is what the chart's
+accuracy counts and the routine is what its cycles count.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+import sys
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from retro.analysis.study.corpus import Pair, Shape
+from retro.analysis.study.fits import Box, Circle, fitted_circle, full_box, tight_box
+from retro.analysis.study.methods.base import ORIGIN, Method
+from retro.errors import InputError, RunError
+from retro.fileio import read_bytes
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+MAX_METHOD_BYTES = 1 << 16
+TOP_KEYS = {"name", "label", "routine", "prepare", "hit", "colour", "marker", "hitbox", "inputs"}
+SHAPE_KEYS = {"box": {"shape", "fit", "inset", "touching"}, "circle": {"shape", "inset", "touching"},
+              "mask": {"shape"}, "function": {"shape", "function"}}
+FITS = {"tight": tight_box, "full": full_box}
+NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]{0,31}$")
+MAX_INSET = 24
+
+# What an input expression may name: the offset, and per sprite (a_ and b_) its sprite box's position,
+# the method's box, the method's circle and the opacity mask, in screen coordinates with sprite a at
+# (ORIGIN, ORIGIN). For a circle, mask or function rule the box is the tight box; for a box, mask or
+# function rule the circle is the fitted circle (strict).
+PER_SPRITE = ("sx", "sy", "x", "y", "w", "h", "right", "right1", "bottom", "bottom1", "cx", "cy", "r", "mask")
+NAMES = ("dx", "dy") + tuple(f"{s}_{n}" for s in "ab" for n in PER_SPRITE)
+DEFAULT_COLOURS = ("#e377c2", "#7f7f7f", "#bcbd22", "#393b79", "#637939", "#843c39", "#7b4173")
+DEFAULT_MARKERS = ("v", "<", ">", "p", "8", "H", "1")
+
+
+def _fail(path: str, key: str, message: str) -> InputError:
+    return InputError(f"{path}: {key}: {message}")
+
+
+@dataclass(frozen=True)
+class Hitbox:
+    shape: str
+    fit: str = "tight"
+    inset: tuple[int, int, int, int] = (0, 0, 0, 0)  # left, top, right, bottom (a circle uses the first)
+    touching: bool = False
+    function: object = None  # the user's function for shape = "function"
+    function_text: str = ""
+
+
+@dataclass(frozen=True, kw_only=True)
+class UserMethod(Method):
+    path: str
+    hitbox: Hitbox
+    inputs: tuple = ()  # (input name, expression text, compiled function), in the routine's input order
+    input_bits: tuple = ()  # per input: bits of a number, or -size for a table of that many bytes
+    domain: tuple = field(default=(), repr=False)  # the routine's `where` conditions
+
+    def __reduce__(self):  # workers re-read the file: the user's function is not picklable
+        return load_method_file, (self.path,)
+
+    # ---- the hitbox rule ------------------------------------------------------------------------
+
+    def box(self, shape: Shape) -> Box:
+        x0, y0, x1, y1 = FITS[self.hitbox.fit](shape.mask)
+        left, top, right, bottom = self.hitbox.inset
+        box = (x0 + left, y0 + top, x1 - right, y1 - bottom)
+        if box[0] >= box[2] or box[1] >= box[3]:
+            raise InputError(f"{self.path}: hitbox.inset: {list(self.hitbox.inset)} leaves no box of sprite "
+                             f"{shape.name} ({x1 - x0}x{y1 - y0})")
+        return box
+
+    def circle(self, shape: Shape) -> Circle:
+        c = fitted_circle(shape.mask, self.hitbox.touching)
+        r = c.r - self.hitbox.inset[0]
+        if r < 0:
+            raise InputError(f"{self.path}: hitbox.inset: {self.hitbox.inset[0]} is more than the radius {c.r} "
+                             f"of sprite {shape.name}")
+        return Circle(c.cx, c.cy, r)
+
+    def verdict(self, pair: Pair) -> np.ndarray:
+        shape, touching = self.hitbox.shape, self.hitbox.touching
+        if shape == "box":
+            (ax0, ay0, ax1, ay1), (bx0, by0, bx1, by1) = self.box(pair.a), self.box(pair.b)
+            dx, dy = pair.dx, pair.dy
+            if touching:
+                hit = (ax0 <= bx1 + dx) & (bx0 + dx <= ax1) & (ay0 <= by1 + dy) & (by0 + dy <= ay1)
+            else:
+                hit = (ax0 < bx1 + dx) & (bx0 + dx < ax1) & (ay0 < by1 + dy) & (by0 + dy < ay1)
+            return hit.astype(float)
+        if shape == "circle":
+            ca, cb = self.circle(pair.a), self.circle(pair.b)
+            ddx, ddy = cb.cx + pair.dx - ca.cx, cb.cy + pair.dy - ca.cy
+            d2, reach = ddx * ddx + ddy * ddy, (ca.r + cb.r) ** 2
+            return (d2 <= reach if touching else d2 < reach).astype(float)
+        if shape == "mask":
+            return (pair.overlap > 0).astype(float)
+        return self._function_verdict(pair)
+
+    def _function_verdict(self, pair: Pair) -> np.ndarray:
+        key = f"{self.path}: hitbox.function: {self.hitbox.function_text}"
+        try:
+            result = self.hitbox.function(pair.a.mask.copy(), pair.b.mask.copy(), pair.dx.copy(), pair.dy.copy())
+            out = np.asarray(result, dtype=float)
+        except Exception as exc:  # the user's code: one line, whatever it raised
+            raise RunError(f"{key} failed on {pair.name}: {type(exc).__name__}: {exc}") from None
+        if out.shape != pair.dx.shape:
+            raise RunError(f"{key} returned shape {out.shape} for {pair.dx.size} offsets (one verdict per offset)")
+        if out.size and (np.isnan(out).any() or out.min() < 0 or out.max() > 1):
+            raise RunError(f"{key} returned values outside [0, 1] (True/False or a share of hits)")
+        return out
+
+    # ---- the routine's inputs -------------------------------------------------------------------
+
+    def _sprite_values(self, shape: Shape, sx: int, sy: int) -> list:
+        from retro.analysis.study.methods.pixel import opacity_bytes
+
+        x0, y0, x1, y1 = self.box(shape) if self.hitbox.shape == "box" else tight_box(shape.mask)
+        c = self.circle(shape) if self.hitbox.shape == "circle" else fitted_circle(shape.mask)
+        mask = opacity_bytes(shape) if shape.mask.shape == (21, 24) else ()
+        return [sx, sy, sx + x0, sy + y0, x1 - x0, y1 - y0, sx + x1, sx + x1 - 1, sy + y1, sy + y1 - 1,
+                sx + c.cx, sy + c.cy, c.r, mask]
+
+    def case_maker(self, pair: Pair):
+        a = self._sprite_values(pair.a, ORIGIN, ORIGIN)
+        b0 = self._sprite_values(pair.b, 0, 0)
+        moved_x = {0, 2, 6, 7, 10}  # b's values that move with dx (sx, x, right, right1, cx) ...
+        moved_y = {1, 3, 8, 9, 11}  # ... and with dy
+        dxs, dys = pair.dx.tolist(), pair.dy.tolist()
+
+        def case(i: int) -> tuple:
+            dx, dy = dxs[i], dys[i]
+            b = [v + ORIGIN + dx if k in moved_x else v + ORIGIN + dy if k in moved_y else v for k, v in enumerate(b0)]
+            values = (dx, dy, *a, *b)
+            out = []
+            for (name, _, compiled), bits in zip(self.inputs, self.input_bits):
+                try:
+                    value = compiled(*values)
+                except Exception as exc:
+                    raise RunError(f"{self.path}: inputs.{name}: {type(exc).__name__}: {exc} on {pair.name} at "
+                                   f"offset ({dx}, {dy})") from None
+                out.append(_checked(value, bits, f"{self.path}: inputs.{name}", f"on {pair.name} at offset ({dx}, {dy})"))
+            case_values = tuple(out)
+            for condition in self.domain:
+                if not condition.test(*case_values):
+                    raise RunError(f"{self.path}: inputs: on {pair.name} at offset ({dx}, {dy}) the case is outside "
+                                   f"the routine's domain ({condition.text})")
+            return case_values
+        return case
+
+    def session(self, pair: Pair):
+        if self.routine is None:
+            raise RunError(f"{self.path}: routine: none given, the method is host only")
+        return super().session(pair)
+
+
+def _checked(value, bits: int, field_name: str, where: str):
+    if bits < 0:  # a table input of -bits bytes
+        if not isinstance(value, (tuple, list)) or len(value) != -bits:
+            raise RunError(f"{field_name}: expected {-bits} bytes (e.g. a_mask) {where}")
+        return tuple(int(v) for v in value)
+    if isinstance(value, bool):
+        value = int(value)
+    if not isinstance(value, int) or not 0 <= value < 1 << bits:
+        raise RunError(f"{field_name}: {value!r} does not fit the input's {bits} bits {where} (use & 255, >> 8)")
+    return value
+
+
+# ---- reading the file ------------------------------------------------------------------------------
+
+def _load_function(path: Path, shown: str, text) -> object:
+    key = "hitbox.function"
+    if not isinstance(text, str) or ":" not in text:
+        raise _fail(shown, key, "expected FILE.py:NAME (relative to the method file)")
+    file_text, _, name = text.rpartition(":")
+    if not file_text.endswith(".py") or not name.isidentifier():
+        raise _fail(shown, key, f"{text!r}: expected FILE.py:NAME (relative to the method file)")
+    file = (path.parent / file_text).resolve()
+    if not file.is_file():
+        raise _fail(shown, key, f"{file_text}: file not found")
+    try:
+        module = _module(str(file), file.stat().st_mtime)
+    except Exception as exc:  # the user's module failed to import: one line, whatever it raised
+        raise _fail(shown, key, f"{file.name} failed to import: {type(exc).__name__}: {exc}") from None
+    function = getattr(module, name, None)
+    if not callable(function):
+        raise _fail(shown, key, f"{file_text} has no function {name!r}")
+    return function
+
+
+@lru_cache(maxsize=32)
+def _module(path: str, mtime: float):
+    name = f"retro_method_{abs(hash((path, mtime))):x}"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    folder = str(Path(path).parent)
+    if folder not in sys.path:  # the user's module may import its neighbours, as a script would
+        sys.path.append(folder)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _int_list(shown: str, key: str, value, count: int, lo: int, hi: int) -> tuple[int, ...]:
+    values = [value] * count if isinstance(value, int) and not isinstance(value, bool) else value
+    if not isinstance(values, list) or len(values) != count or not all(
+            isinstance(v, int) and not isinstance(v, bool) for v in values):
+        raise _fail(shown, key, f"expected a whole number or a list of {count}, got {value!r}")
+    for v in values:
+        if not lo <= v <= hi:
+            raise _fail(shown, key, f"{v} is outside {lo}..{hi}")
+    return tuple(values)
+
+
+def _hitbox(path: Path, shown: str, doc) -> Hitbox:
+    if not isinstance(doc, dict):
+        raise _fail(shown, "hitbox", "expected a table: [hitbox] shape = \"box\" (or circle, mask, function)")
+    shape = doc.get("shape")
+    if shape not in SHAPE_KEYS:
+        raise _fail(shown, "hitbox.shape", f"expected one of box, circle, mask, function, got {shape!r}")
+    for key in doc:
+        if key not in SHAPE_KEYS[shape]:
+            raise _fail(shown, f"hitbox.{key}", f"unknown for shape {shape!r} (known: "
+                                                f"{', '.join(sorted(SHAPE_KEYS[shape]))})")
+    fit = doc.get("fit", "tight")
+    if fit not in FITS:
+        raise _fail(shown, "hitbox.fit", f"expected \"tight\" or \"full\", got {fit!r}")
+    touching = doc.get("touching", False)
+    if not isinstance(touching, bool):
+        raise _fail(shown, "hitbox.touching", f"expected true or false, got {touching!r}")
+    if shape == "circle":
+        radius_inset = doc.get("inset", 0)
+        if not isinstance(radius_inset, int) or isinstance(radius_inset, bool):
+            raise _fail(shown, "hitbox.inset", f"a circle's inset is one whole number (pixels off the radius), "
+                                               f"got {radius_inset!r}")
+        inset = _int_list(shown, "hitbox.inset", radius_inset, 4, -MAX_INSET, MAX_INSET)
+    else:
+        inset = _int_list(shown, "hitbox.inset", doc.get("inset", 0), 4, -MAX_INSET, MAX_INSET)
+    function, text = None, ""
+    if shape == "function":
+        if "function" not in doc:
+            raise _fail(shown, "hitbox.function", "missing: FILE.py:NAME, hit(a, b, dx, dy) -> a verdict per offset")
+        text = doc["function"]
+        function = _load_function(path, shown, text)
+    return Hitbox(shape=shape, fit=fit, inset=inset, touching=touching, function=function, function_text=text)
+
+
+def _string(shown: str, doc: dict, key: str, default: str | None = None) -> str | None:
+    value = doc.get(key, default)
+    if value is not None and (not isinstance(value, str) or not value.strip() or len(value) > 200):
+        raise _fail(shown, key, f"expected a non-empty string of at most 200 characters, got {value!r}")
+    return value
+
+
+def _spec_name(path: Path, shown: str, key: str, text: str | None) -> str | None:
+    """A built-in routine's name as given; a spec path made relative to the method file; checked."""
+    if text is None:
+        return None
+    from retro.analysis.study.methods.base import routine_spec
+    from retro.routines.registry import is_spec_path
+
+    name = str((path.parent / text).resolve()) if is_spec_path(text) else text
+    try:
+        routine_spec(name)
+    except InputError as exc:
+        raise _fail(shown, key, str(exc)) from None
+    return name
+
+
+def _inputs(shown: str, doc, routine) -> tuple[tuple, tuple]:
+    from retro.routines.where import parse_where
+
+    if not isinstance(doc, dict):
+        raise _fail(shown, "inputs", f"expected a table of the routine's inputs ({', '.join(routine.input_names)}), "
+                                     "each an expression such as \"a_x\" or \"b_x & 255\"")
+    for name in doc:
+        if name not in routine.input_names:
+            raise _fail(shown, f"inputs.{name}", f"routine {routine.name} has no input {name!r} "
+                                                 f"(its inputs: {', '.join(routine.input_names)})")
+    compiled, bits = [], []
+    for port in routine.inputs:
+        if port.name not in doc:
+            raise _fail(shown, f"inputs.{port.name}", f"missing: routine {routine.name} needs it "
+                                                      f"(names: dx, dy, a_x, b_right1, a_mask, ... see docs/methods.md)")
+        text = doc[port.name]
+        if isinstance(text, int) and not isinstance(text, bool):
+            text = str(text)
+        if not isinstance(text, str):
+            raise _fail(shown, f"inputs.{port.name}", f"expected an expression as a string, got {text!r}")
+        terms = parse_where(text, NAMES, f"{shown}: inputs.{port.name}")
+        if len(terms) != 1:
+            raise _fail(shown, f"inputs.{port.name}", "one value, not a condition joined by `and`")
+        compiled.append((port.name, text, terms[0].test))
+        bits.append(-len(port.places) if port.table else port.bits)
+    return tuple(compiled), tuple(bits)
+
+
+def load_method_file(path_text: str, index: int = 0) -> UserMethod:
+    """Read and check a method file; `index` picks a default colour and marker."""
+    path = Path(path_text)
+    shown = str(path_text)
+    raw = read_bytes(path, "method file", limit=MAX_METHOD_BYTES)
+    try:
+        doc = tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{shown}: not UTF-8 text (byte {exc.start})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{shown}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise InputError(f"{shown}: not valid TOML: nested too deeply") from None
+    for key in doc:
+        if key not in TOP_KEYS:
+            raise _fail(shown, key, f"unknown key (known: {', '.join(sorted(TOP_KEYS))})")
+    name = _string(shown, doc, "name", path.stem)
+    if not NAME.match(name):
+        raise _fail(shown, "name", f"{name!r}: a letter, then letters, digits, _ or - (at most 32)")
+    label = _string(shown, doc, "label", name)
+    if "hitbox" not in doc:
+        raise _fail(shown, "hitbox", "missing: [hitbox] shape = \"box\" (or circle, mask, function)")
+    hitbox = _hitbox(path, shown, doc["hitbox"])
+    routine_name = _spec_name(path, shown, "routine", _string(shown, doc, "routine"))
+    prepare = _spec_name(path, shown, "prepare", _string(shown, doc, "prepare"))
+    inputs, bits, domain, hit = (), (), (), 0
+    if routine_name is None:
+        for key in ("inputs", "hit", "prepare"):
+            if key in doc:
+                raise _fail(shown, key, "needs a routine (routine = \"aabb8\" or a spec file)")
+    else:
+        from retro.analysis.study.methods.base import routine_spec
+
+        routine = routine_spec(routine_name)
+        if "inputs" not in doc:
+            raise _fail(shown, "inputs", f"missing: the routine's inputs {', '.join(routine.input_names)} as "
+                                         "expressions over the case (docs/methods.md)")
+        inputs, bits = _inputs(shown, doc["inputs"], routine)
+        domain = routine.domain
+        hit_name = _string(shown, doc, "hit", routine.output_names[0])
+        if hit_name not in routine.output_names:
+            raise _fail(shown, "hit", f"routine {routine.name} has no output {hit_name!r} "
+                                      f"(its outputs: {', '.join(routine.output_names)})")
+        hit = routine.output_names.index(hit_name)
+    colour = _string(shown, doc, "colour", DEFAULT_COLOURS[index % len(DEFAULT_COLOURS)])
+    marker = _string(shown, doc, "marker", DEFAULT_MARKERS[index % len(DEFAULT_MARKERS)])
+    from matplotlib.colors import is_color_like
+    from matplotlib.lines import Line2D
+
+    if not is_color_like(colour):
+        raise _fail(shown, "colour", f"{colour!r} is not a colour (e.g. \"#e377c2\" or \"purple\")")
+    if marker not in Line2D.markers:
+        raise _fail(shown, "marker", f"{marker!r} is not a matplotlib marker (e.g. \"v\", \"p\", \"h\")")
+    rule = _describe(hitbox)
+    counted = (f"{Path(routine_name).name if routine_name else ''} called through its spec with the inputs of "
+               f"{path.name}" if routine_name else "host only: no routine given")
+    return UserMethod(key=name, label=label, rule=rule, colour=colour, marker=marker, routine=routine_name,
+                      prepare=prepare, hit_output=hit, counted=counted, origin=shown, path=shown, hitbox=hitbox,
+                      inputs=inputs, input_bits=bits, domain=domain)
+
+
+def _describe(h: Hitbox) -> str:
+    touching = "touching counts as a hit" if h.touching else "touching is no hit"
+    if h.shape == "box":
+        inset = "" if not any(h.inset) else f", inset {list(h.inset)} (left, top, right, bottom)"
+        return f"the {h.fit} boxes{inset} overlap ({touching})"
+    if h.shape == "circle":
+        inset = "" if not h.inset[0] else f", radius {-h.inset[0]:+d}"
+        return f"the fitted circles{inset}: squared centre distance against (r1+r2)^2 ({touching})"
+    if h.shape == "mask":
+        return "the opacity masks share a pixel (exact)"
+    return f"the function {h.function_text} (hit(a, b, dx, dy))"
+
