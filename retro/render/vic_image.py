@@ -19,7 +19,6 @@ from retro.chips.vic.constants import (
     REG_CONTROL2,
     REG_SPRITE_COLOR0,
     REG_SPRITE_EXPAND_X,
-    REG_SPRITE_EXPAND_Y,
     REG_SPRITE_MC0,
     REG_SPRITE_MC1,
     REG_SPRITE_MULTICOLOR,
@@ -27,7 +26,7 @@ from retro.chips.vic.constants import (
     SPRITE_COUNT,
 )
 from retro.chips.vic.graphics import colours, foreground_at
-from retro.chips.vic.model import FrameCollisions, VicState, placement, sprite_rows
+from retro.chips.vic.model import FrameCollisions, VicState, placement
 from retro.render.images import (
     LABEL_COLOUR,
     LABEL_SIZE,
@@ -98,14 +97,12 @@ def frame_rgb(state: VicState, collisions: FrameCollisions, palette_name: str = 
         place = placement(state, n)
         if place is None or place.lines.size == 0:
             continue
-        rows = sprite_rows(video, state.sprite_y(n), state.sprite_flag(REG_SPRITE_EXPAND_Y, n))
-        sprite_numbers = _sprite_colour_numbers(state, n)[rows[place.lines]]
+        sprite_numbers = _sprite_colour_numbers(state, n)[place.rows, place.cols]  # opaque pixels only
         rr, cc = _image_position(state, place.lines, place.xs)
-        target = numbers[rr[:, None], cc[None, :]]
         show = sprite_numbers >= 0
         if state.sprite_flag(REG_SPRITE_PRIORITY, n):
-            show &= ~fg[rr[:, None], cc[None, :]]
-        numbers[rr[:, None], cc[None, :]] = np.where(show, sprite_numbers, target)
+            show &= ~fg[rr, cc]
+        numbers[rr[show], cc[show]] = sprite_numbers[show]
     rgb = rgb_table[numbers]
     for (pl, px), colour in ((collisions.sb_pixels, SPRITE_BACKGROUND_HIGHLIGHT),
                              (collisions.ss_pixels, SPRITE_SPRITE_HIGHLIGHT)):
@@ -126,8 +123,8 @@ def _zoom_box(state: VicState, collisions: FrameCollisions) -> tuple[int, int, i
         places = [p for p in (placement(state, n) for n in range(SPRITE_COUNT)) if p is not None and p.lines.size]
         if not places:
             return None
-        lines = np.concatenate([np.repeat(p.lines, p.xs.size) for p in places])
-        xs = np.concatenate([np.tile(p.xs, p.lines.size) for p in places])
+        lines = np.concatenate([p.lines for p in places])
+        xs = np.concatenate([p.xs for p in places])
     rows, cols = _image_position(state, lines, xs)
     top, bottom, left, right = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
     if right - left > ZOOM_MAX_BOX[0] or bottom - top > ZOOM_MAX_BOX[1]:
@@ -165,7 +162,7 @@ def _annotate_frame(panel: Image.Image, state: VicState, collisions: FrameCollis
         place = placement(state, n)
         if place is None or place.lines.size == 0:
             continue
-        rows, cols = _image_position(state, place.lines[:1], place.xs[:1])
+        rows, cols = _image_position(state, place.lines.min(keepdims=True), np.array([place.x]))
         x, y = int(cols[0]) * scale, int(rows[0]) * scale
         box = draw.textbbox((x + 1, y - LABEL_SIZE - 2), str(n), font=font)
         draw.rectangle(box, fill=PANEL_BACKGROUND)

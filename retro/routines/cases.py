@@ -15,7 +15,7 @@ widths (one-line error naming the function and the case).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from itertools import islice
 
@@ -32,12 +32,33 @@ RANDOM_BLOCK = 1_000_000  # a random generator is called once per block of this 
 EXHAUSTIVE_RNG_OFFSET = 2  # the non-swept inputs of the exhaustive part draw from seed + 2
 
 
+Columns = list  # one numpy array per input, in input order: (n,) int64, or (n, size) for a table
+
+
 @dataclass(frozen=True)
 class Part:
     name: str  # "boundary", "exhaustive", "sweep", "random"
     count: int | None  # None when a sweep function does not say
     total: int  # cases of the full space this part stands for (exhaustive: the whole product)
-    cases: Iterable[tuple]
+    blocks: Callable[[], Iterator[Columns]]  # a fresh iterator of column blocks of at most CHUNK cases
+
+    @property
+    def cases(self) -> Iterator[tuple]:
+        """The part's cases one by one (for the scalar engine), in the same order as its blocks."""
+        for block in self.blocks():
+            yield from columns_to_cases(block)
+
+
+def columns_to_cases(block: Columns) -> list[tuple]:
+    return list(zip(*(c.tolist() if c.ndim == 1 else [tuple(row) for row in c.tolist()] for c in block)))
+
+
+def cases_to_columns(routine: Routine, cases: list[tuple]) -> Columns:
+    columns = []
+    for index, port in enumerate(routine.inputs):
+        column = np.asarray([case[index] for case in cases], dtype=np.int64)
+        columns.append(column.reshape(len(cases), len(port.places)) if port.table else column)
+    return columns
 
 
 def random_count(routine: Routine, exhaustive: bool, override: int | None) -> int:
@@ -55,19 +76,19 @@ def plan(routine: Routine, *, exhaustive: bool, seed: int | None = None, random:
     if routine.boundary is not None:
         made = list(_checked(routine, "cases.boundary",
                              call_with(routine.boundary, {"seed": seed, "rng": np.random.default_rng(seed)})))
-        parts.append(Part("boundary", len(made), len(made), made))
+        parts.append(Part("boundary", len(made), len(made), lambda: _blocks_of(routine, made)))
     if routine.exhaustive:
         total = routine.exhaustive_count()
         if exhaustive or total <= bounded_product:
-            parts.append(Part("exhaustive", total, total, _product(routine, seed, None)))
+            parts.append(Part("exhaustive", total, total, lambda: _product(routine, seed, None)))
         else:
             sample = min(BOUNDED_SAMPLE, bounded_product)
-            parts.append(Part("exhaustive", sample, total, _product(routine, seed, sample)))
+            parts.append(Part("exhaustive", sample, total, lambda: _product(routine, seed, sample)))
     if exhaustive and routine.sweep is not None:
-        parts.append(Part("sweep", None, 0, _lazy_sweep(routine, seed)))
+        parts.append(Part("sweep", None, 0, lambda: _blocks_of(routine, _lazy_sweep(routine, seed))))
     count = random_count(routine, exhaustive, random)
     if count:
-        parts.append(Part("random", count, count, _random(routine, seed, count)))
+        parts.append(Part("random", count, count, lambda: _random(routine, seed, count)))
     return parts
 
 
@@ -80,10 +101,33 @@ def chunks(cases: Iterable[tuple], size: int = CHUNK) -> Iterator[list[tuple]]:
         yield chunk
 
 
+def batches(parts: list[Part], size: int) -> Iterator[Columns]:
+    """The parts' cases as column blocks of `size` cases (the last one shorter), in case order."""
+    held: list[Columns] = []
+    count = 0
+    for part in parts:
+        for block in part.blocks():
+            held.append(block)
+            count += len(block[0])
+            while count >= size:
+                joined = [np.concatenate(column) for column in zip(*held)]
+                yield [c[:size] for c in joined]
+                rest = [c[size:] for c in joined]
+                count -= size
+                held = [rest] if count else []
+    if count:
+        yield [np.concatenate(column) for column in zip(*held)]
+
+
+def _blocks_of(routine: Routine, cases: Iterable[tuple]) -> Iterator[Columns]:
+    for chunk in chunks(cases):
+        yield cases_to_columns(routine, chunk)
+
+
 # ---- exhaustive product ----------------------------------------------------------------------------
 
-def _product(routine: Routine, seed: int, sample: int | None) -> Iterator[tuple]:
-    """Every combination (mixed-radix counting over the swept inputs' values), in chunks; or a seeded
+def _product(routine: Routine, seed: int, sample: int | None) -> Iterator[Columns]:
+    """Every combination (mixed-radix counting over the swept inputs' values), in blocks; or a seeded
     sample of `sample` distinct combinations."""
     swept = [i for i, port in enumerate(routine.inputs) if port.name in routine.exhaustive]
     radices = [routine.inputs[i].count for i in swept]
@@ -106,49 +150,46 @@ def _product(routine: Routine, seed: int, sample: int | None) -> Iterator[tuple]
         for i, port in enumerate(routine.inputs):
             if columns[i] is None:
                 columns[i] = _random_column(port, rng, n)
-        yield from zip(*columns)
+        yield columns
 
 
-def _digit_values(port: Port, digit: np.ndarray) -> list:
+def _digit_values(port: Port, digit: np.ndarray) -> np.ndarray:
     values = port.values
     if not port.table:
         if values.listed is None:
-            return (digit.astype(np.int64) + values.lo).tolist()
-        return np.asarray(values.listed, dtype=np.int64)[digit.astype(np.int64)].tolist()
+            return digit.astype(np.int64) + values.lo
+        return np.asarray(values.listed, dtype=np.int64)[digit.astype(np.int64)]
     size = len(port.places)
     out = np.empty((len(digit), size), dtype=np.int64)
     rest = digit.copy()
     for byte in range(size):  # the first byte varies fastest
         out[:, byte] = rest % np.uint64(values.count)
         rest //= np.uint64(values.count)
-    mapped = out + values.lo if values.listed is None else np.asarray(values.listed, dtype=np.int64)[out]
-    return [tuple(row) for row in mapped.tolist()]
+    return out + values.lo if values.listed is None else np.asarray(values.listed, dtype=np.int64)[out]
 
 
-def _random_column(port: Port, rng: np.random.Generator, n: int) -> list:
+def _random_column(port: Port, rng: np.random.Generator, n: int) -> np.ndarray:
     values = port.values
     shape = (n, len(port.places)) if port.table else (n,)
     if values.listed is not None:
-        drawn = np.asarray(values.listed, dtype=np.int64)[rng.integers(0, len(values.listed), size=shape)]
-    else:
-        drawn = rng.integers(values.lo, values.hi + 1, size=shape, dtype=np.int64)
-    return [tuple(row) for row in drawn.tolist()] if port.table else drawn.tolist()
+        return np.asarray(values.listed, dtype=np.int64)[rng.integers(0, len(values.listed), size=shape)]
+    return rng.integers(values.lo, values.hi + 1, size=shape, dtype=np.int64)
 
 
 # ---- random ------------------------------------------------------------------------------------------
 
-def _random(routine: Routine, seed: int, count: int) -> Iterator[tuple]:
+def _random(routine: Routine, seed: int, count: int) -> Iterator[Columns]:
     rng = np.random.default_rng(seed)
     done = 0
     while done < count:
         n = min(RANDOM_BLOCK, count - done)
         if routine.random_generator is not None:
             made = call_with(routine.random_generator, {"rng": rng, "count": n, "n": n, "seed": seed})
-            yield from _checked(routine, "cases.random_generator", made, expected=n)
+            yield from _blocks_of(routine, _checked(routine, "cases.random_generator", made, expected=n))
         else:
             for start in range(0, n, CHUNK):
                 m = min(CHUNK, n - start)
-                yield from zip(*(_random_column(port, rng, m) for port in routine.inputs))
+                yield [_random_column(port, rng, m) for port in routine.inputs]
         done += n
 
 

@@ -5,8 +5,13 @@ flags, memory; numbers little-endian, tables as bytes), calls the routine with `
 and returns (outputs, cycles): the outputs as a tuple in the spec's order. With `record`, the
 executed path is appended for the independent timing model (retro.cpu.timing).
 
-Memory persists between calls: every input is written before each call, the `[memory]` blocks once
-after loading (then `init` runs). A routine must not depend on what it wrote in an earlier call.
+`run_batch(columns)` runs many cases at once on the batched core (retro.cpu.batch): every lane starts
+from the memory as it stood after `init`, with its inputs in place.
+
+Memory on the scalar path persists between calls: every input is written before each call, and so
+are the output places in memory (restored to their value after `init`, so an output a routine writes
+only on some paths reads the same on both engines); the `[memory]` blocks once after loading (then
+`init` runs). A routine must not depend on anything else it wrote in an earlier call.
 """
 
 from __future__ import annotations
@@ -17,7 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from retro.assembler import requested_tables
-from retro.cpu.machine import DEFAULT_BUDGET, DEFAULT_FLAGS, CallResult, Machine
+from retro.cpu.batch import BatchCpu, LaneMemoryFull
+from retro.cpu.machine import CALL_STACK_TOP, DEFAULT_BUDGET, DEFAULT_FLAGS, RETURN_TRAP, CallResult, Machine
+from retro.cpu.mpu import FLAG_B, FLAG_U
 from retro.cpu.timing import OPCODES
 from retro.errors import InputError
 from retro.fileio import read_text
@@ -111,6 +118,19 @@ def memory_values(routine: Routine, seed: int) -> dict[str, tuple[int, ...]]:
 
 
 @dataclass(frozen=True)
+class BatchOutcome:
+    """What a batch of calls did: per output an array (n,) or (n, bytes), cycles, and per case the
+    retro.cpu.batch.LaneError that stopped it (0: returned)."""
+
+    outputs: list
+    cycles: np.ndarray
+    error: np.ndarray
+
+    def case_outputs(self, i: int) -> tuple:
+        return tuple(tuple(o[i].tolist()) if o.ndim == 2 else int(o[i]) for o in self.outputs)
+
+
+@dataclass(frozen=True)
 class RasterStart:
     """Run every call with a VIC-II scene on the bus and the beam at this line and cycle (the CPU
     then stalls on Bad Lines and sprite DMA as on a real C64)."""
@@ -148,6 +168,7 @@ class RoutineRunner:
         self.code_image = bytes(self.machine.memory)  # before init and the cases patch anything
         if routine.init is not None:
             self.machine.call_fast(self.machine.resolve(routine.init, "program.init"), budget=self.limit)
+        self.call_image = bytearray(self.machine.memory)  # what every call starts from (the batch's image)
         # (indirect),Y instructions: the timing model needs their pointer. Every byte of the program
         # that could be such an opcode is listed; a data byte in the set only costs a lookup.
         indirect_y = {opcode for opcode, op in OPCODES.items() if op.mode == "iny"}
@@ -179,10 +200,14 @@ class RoutineRunner:
         for _, bit in self.flag_inputs:
             forced |= bit
         self.base_flags = DEFAULT_FLAGS & ~forced
+        self.output_addresses = tuple(sorted({place.address for port in self.routine.outputs for place in port.places
+                                              if place.kind == "memory"}))
 
     def inputs_for_call(self, case: Sequence) -> tuple[list[tuple[int, int]], dict[str, int], int]:
         """(memory writes, register values, P) that put the case where the spec says."""
-        writes = [(address, (case[index] >> shift) & 0xFF) for index, address, shift in self.byte_inputs]
+        image = self.call_image
+        writes = [(address, image[address]) for address in self.output_addresses]
+        writes += [(address, (case[index] >> shift) & 0xFF) for index, address, shift in self.byte_inputs]
         for index, addresses in self.table_inputs:
             writes.extend(zip(addresses, case[index]))
         registers = {"a": 0, "x": 0, "y": 0}
@@ -221,7 +246,62 @@ class RoutineRunner:
             raise InputError(f"{self.routine.spec_path}: no memory block {name!r}")
         data = tuple(int(v) for v in values)
         self.machine.memory[block.address:block.address + len(data)] = list(data)
+        self.call_image[block.address:block.address + len(data)] = bytes(data)
         self.memory_values[name] = data
+
+    @property
+    def batchable(self) -> bool:
+        """Whether the batched core can run this routine (it has no chips: not with a scene)."""
+        return self.vic is None
+
+    def run_batch(self, columns: list) -> "BatchOutcome":
+        """Run every case of a column block (one array per input) on the batched core."""
+        n = len(columns[0])
+        try:
+            return self._run_lanes(columns, n)
+        except LaneMemoryFull:
+            if n <= 1:
+                raise
+            half = n // 2
+            first = self.run_batch([c[:half] for c in columns])
+            second = self.run_batch([c[half:] for c in columns])
+            return BatchOutcome([np.concatenate(pair) for pair in zip(first.outputs, second.outputs)],
+                                np.concatenate([first.cycles, second.cycles]),
+                                np.concatenate([first.error, second.error]))
+
+    def _run_lanes(self, columns: list, n: int) -> "BatchOutcome":
+        image = bytearray(self.call_image)
+        stack = 0x100 | CALL_STACK_TOP
+        back = (RETURN_TRAP - 1) & 0xFFFF  # the return address a JSR from the trap would push
+        image[stack], image[stack - 1] = back >> 8, back & 0xFF
+        cpu = BatchCpu(self.routine.cpu, image, n)
+        registers = {"a": cpu.a, "x": cpu.x, "y": cpu.y}
+        for index, register, shift in self.register_inputs:
+            registers[register] |= ((columns[index] >> shift) & 0xFF).astype(np.int32)
+        cpu.p[:] = (self.base_flags | FLAG_U) & ~FLAG_B  # as Machine sets P
+        for index, bit in self.flag_inputs:
+            cpu.p |= np.where(columns[index] != 0, bit, 0).astype(np.int32)
+        for index, address, shift in self.byte_inputs:
+            cpu.memory.fill(address, (columns[index] >> shift) & 0xFF)
+        for index, addresses in self.table_inputs:
+            for byte, address in enumerate(addresses):
+                cpu.memory.fill(address, columns[index][:, byte])
+        cpu.sp[:] = CALL_STACK_TOP - 2
+        cpu.call(self.entry, self.limit, RETURN_TRAP, CALL_STACK_TOP)
+        lanes = {"a": cpu.a, "x": cpu.x, "y": cpu.y}
+        outputs = []
+        for port in self.routine.outputs:
+            if port.flag:
+                outputs.append(((cpu.p & port.places[0].bit) != 0).astype(np.int64))
+            elif port.table:
+                outputs.append(np.stack([cpu.read(place.address) for place in port.places], axis=1).astype(np.int64))
+            else:
+                value = np.zeros(n, dtype=np.int64)
+                for shift, place in enumerate(port.places):
+                    byte = lanes[place.register] if place.kind == "register" else cpu.read(place.address)
+                    value |= byte.astype(np.int64) << (8 * shift)
+                outputs.append(value)
+        return BatchOutcome(outputs, cpu.cycles, cpu.error)
 
     def outputs(self, a: int, x: int, y: int, p: int) -> tuple:
         registers = {"a": a, "x": x, "y": y}

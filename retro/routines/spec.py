@@ -51,7 +51,7 @@ TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "refere
 PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "init", "load"}
 PORT_KEYS = {"at", "size", "values", "table"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
-REFERENCE_KEYS = {"function"}
+REFERENCE_KEYS = {"function", "arrays"}
 CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator"}
 CYCLES_KEYS = {"max", "loops", "limit", "static"}
 
@@ -153,6 +153,7 @@ class Routine:
     reference: Callable
     reference_name: str
     reference_memory: tuple[str, ...]  # memory blocks the reference takes by name
+    reference_arrays: bool = False  # the reference takes numpy arrays (one element per case) and answers so
     exhaustive: tuple[str, ...] = ()
     random: int = 0
     seed: int = 0
@@ -312,6 +313,10 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     reference_name = r.string(reference_doc, "function", "reference.function", required=True)
     reference = load_function(reference_name, base, r, "reference.function")
     reference_memory = _reference_signature(r, reference, reference_name, inputs, memory)
+    reference_arrays = reference_doc.get("arrays", False)
+    if not isinstance(reference_arrays, bool):
+        raise r.fail("reference.arrays", "expected true (the function takes numpy arrays, one element per case) "
+                     "or false")
 
     cases_doc = r.table(doc, "cases", CASES_KEYS)
     names = tuple(p.name for p in inputs)
@@ -326,7 +331,8 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     random_count = r.number(cases_doc.get("random", DEFAULT_RANDOM), "cases.random", 0, MAX_RANDOM)
     seed = r.number(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1)
     where = cases_doc.get("where")
-    domain = parse_where(where, names, f"{r.source}: cases.where") if where is not None else ()
+    tables = frozenset(p.name for p in inputs if p.table)
+    domain = parse_where(where, names, f"{r.source}: cases.where", tables) if where is not None else ()
     generators = {key: load_function(r.string(cases_doc, key, f"cases.{key}"), base, r, f"cases.{key}")
                   for key in ("boundary", "sweep", "random_generator") if key in cases_doc}
 
@@ -351,7 +357,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     routine = Routine(
         name=name, spec_path=path, program_file=program_file, symbols_file=symbols_file, load=load, entry=entry,
         cpu=cpu, init=init, inputs=inputs, outputs=outputs, memory=memory, reference=reference,
-        reference_name=reference_name, reference_memory=reference_memory, exhaustive=tuple(exhaustive),
+        reference_name=reference_name, reference_memory=reference_memory, reference_arrays=reference_arrays, exhaustive=tuple(exhaustive),
         random=random_count, seed=seed, domain=domain, boundary=generators.get("boundary"),
         sweep=generators.get("sweep"), random_generator=generators.get("random_generator"), budget=budget,
         loop_bounds=loop_bounds, limit=limit, static=static, summary=summary)

@@ -17,13 +17,19 @@ sprite_data = st.one_of(st.binary(min_size=63, max_size=63),
                         st.sampled_from([b"\xff" * 63, bytes(range(63)), b"\x18" * 63]))
 
 
+# X where no sprite's row meets any sprite's own fetch (the sprite gap, test_sprite_gap.py): a row
+# (48 X expanded) starting here ends before the first halt (X $163 PAL, $16B NTSC), or starts after
+# the last sprite's fetch (sprite 7 resumes at X $1DF). Only there does the sprite number not matter.
+GAP_FREE_X = st.one_of(st.integers(0, 0x12C), st.integers(0x1E0, 511))
+
+
 @st.composite
-def sprites(draw, count=st.integers(0, 8)):
+def sprites(draw, count=st.integers(0, 8), xs=st.integers(0, 511)):
     n = draw(count)
     indices = draw(st.permutations(range(8)))[:n]
     out = []
     for index in indices:
-        out.append({"index": index, "x": draw(st.integers(0, 511)), "y": draw(st.integers(0, 255)),
+        out.append({"index": index, "x": draw(xs), "y": draw(st.integers(0, 255)),
                     "multicolor": draw(st.booleans()), "expand_x": draw(st.booleans()),
                     "expand_y": draw(st.booleans()), "behind": draw(st.booleans()),
                     "data": draw(sprite_data).hex()})
@@ -50,7 +56,7 @@ def test_a_lone_sprite_never_sets_d01e(scene):
 
 
 @SETTINGS
-@given(scenes(sprites(st.integers(2, 5))), st.permutations(range(8)))
+@given(scenes(sprites(st.integers(2, 5), GAP_FREE_X)), st.permutations(range(8)))
 def test_relabelling_sprites_permutes_the_bits(scene, permutation):
     state = scene.state
     regs = bytearray(state.registers)

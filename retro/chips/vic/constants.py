@@ -119,10 +119,25 @@ class Video:
     # last cycle fall in the next line) [Bauer 3.6.3 timing diagrams; the 6567R8 has two idle
     # cycles more before sprite 0's p-access than the 6569 (the "N" in his diagrams)].
     sprite0_dma_cycle: int
+    # The sprite gap (see SPRITE_HALT_PIXEL below): the cycle of sprite 0's p-access as its pixel
+    # sequencer sees it (sprite n: + 2n; the next cycle holds its other s-accesses), the cycle whose
+    # pixel SPRITE_PENDING_PIXEL copies the display flags to the sequencer, and the cycle that draws
+    # the X coordinates of the cycle before it again (0: none). [VICE viciisc/vicii-chip-model.c
+    # cycle_tab_pal / cycle_tab_ntsc; checked against the real-hardware dumps of VICE-testprogs
+    # VICII/spritegap. On the 6567R8 those dumps put sprite 0's p-access in cycle 59, as VICE does,
+    # where sprite0_dma_cycle (read from Bauer's diagram, used for BA) says 60: docs/vic.md.]
+    sprite0_pointer_cycle: int = 0
+    display_check_cycle: int = 0
+    repeated_x_cycle: int = 0
 
     @property
     def frame_cycles(self) -> int:
         return self.lines * self.cycles_per_line
+
+    @property
+    def line_slots(self) -> int:
+        """Pixel positions the sprite sequencer steps through in one raster line (8 per cycle)."""
+        return self.cycles_per_line * PIXELS_PER_CYCLE
 
 
 PIXELS_PER_CYCLE = 8
@@ -137,13 +152,36 @@ PIXELS_PER_CYCLE = 8
 COLLISION_LATCH_DELAY = 4
 PAL = Video("pal", "6569", lines=312, cycles_per_line=63, x_positions=0x1F8, first_x=0x194,
             first_visible_line=16, visible_lines=284, first_visible_x=0x1E0, visible_pixels=403,
-            sprite0_dma_cycle=58)
-# 65 cycles draw 520 pixels but only 512 X coordinates exist: the model gives the 65th cycle no
-# X coordinate (see docs/vic.md, timing model).
+            sprite0_dma_cycle=58, sprite0_pointer_cycle=58, display_check_cycle=58)
+# 65 cycles draw 520 pixels but only 512 X coordinates exist. For collision times the model gives
+# the 65th cycle no X coordinate (see docs/vic.md, timing model); the sprite sequencer draws X
+# $180-$187 twice, in cycles 62 and 63 (VICE cycle_tab_ntsc; the spritegap dumps of a 6567R8 show
+# sprite 0 at X $187 and sprite 1 at $188 not meeting).
 NTSC = Video("ntsc", "6567R8", lines=263, cycles_per_line=65, x_positions=0x200, first_x=0x19C,
              first_visible_line=41, visible_lines=235, first_visible_x=0x1E9, visible_pixels=418,
-             sprite0_dma_cycle=60)
+             sprite0_dma_cycle=60, sprite0_pointer_cycle=59, display_check_cycle=59, repeated_x_cycle=63)
 VIDEOS = {"pal": PAL, "ntsc": NTSC}
+
+# ---- the sprite gap: each sprite's pixel sequencer around its own fetches -------------------------
+# [VICE viciisc/vicii-draw-cycle.c draw_sprites8, checked against the real-hardware results of the
+# VICE test programs VICII/spritegap/spritegap2 and spritegap3 (dumps from 6569R1, 6569R3, 8565R2
+# and 6567R8 machines): tests/vic/test_sprite_gap.py replays them.]
+# The sequencer steps through 8 positions per cycle; cycle 1's first position draws X
+# first_x - COLLISION_LATCH_DELAY (the sprite X compare runs 4 X behind Bauer's counter: VICE draws
+# the X of each cycle's first phase rounded down to 8, the same 4 the collision latch measurements
+# give). Pixel p of the cycle of sprite n's p-access (sprite0_pointer_cycle + 2n, counted on into
+# the next line) halts that sprite's shift register: it repeats the pixel it showed last; pixel
+# SPRITE_DROP_PIXEL of the next cycle drops the rest of the row, pixel SPRITE_LOAD_PIXEL loads the
+# row just fetched, and from pixel SPRITE_RESUME_PIXEL on the sprite may start again. A sprite whose
+# X falls while it is halted never starts. The sequencer starts a sprite at its X only while its
+# copy of the display flag is set; that copy is taken at pixel SPRITE_PENDING_PIXEL of
+# display_check_cycle, so the last row of a sprite whose X comes after that point in the line is
+# never shown, and one whose X comes after its own load shows each row in the line it is fetched.
+SPRITE_HALT_PIXEL = 3
+SPRITE_DROP_PIXEL = 2
+SPRITE_LOAD_PIXEL = 4
+SPRITE_RESUME_PIXEL = 7
+SPRITE_PENDING_PIXEL = 4
 
 # Raster compare [Bauer 3.12]: the IRQ for line 0 comes one cycle later than for the other lines.
 RASTER_IRQ_LINE0_DELAY = 1

@@ -91,13 +91,19 @@ class UserMethod(Method):
     # ---- the hitbox rule ------------------------------------------------------------------------
 
     def box(self, shape: Shape) -> Box:
+        """The hitbox: the fitted box with the inset taken off each side; on an axis where that
+        leaves no pixel, the box keeps the middle pixel of the fitted box (rounded down)."""
         x0, y0, x1, y1 = FITS[self.hitbox.fit](shape.mask)
         left, top, right, bottom = self.hitbox.inset
-        box = (x0 + left, y0 + top, x1 - right, y1 - bottom)
-        if box[0] >= box[2] or box[1] >= box[3]:
-            raise InputError(f"{self.path}: hitbox.inset: {list(self.hitbox.inset)} leaves no box of sprite "
-                             f"{shape.name} ({x1 - x0}x{y1 - y0})")
-        return box
+
+        def side(lo: int, hi: int, cut_lo: int, cut_hi: int) -> tuple[int, int]:
+            if lo + cut_lo < hi - cut_hi:
+                return lo + cut_lo, hi - cut_hi
+            middle = (lo + hi - 1) // 2
+            return middle, middle + 1
+
+        (bx0, bx1), (by0, by1) = side(x0, x1, left, right), side(y0, y1, top, bottom)
+        return bx0, by0, bx1, by1
 
     def circle(self, shape: Shape) -> Circle:
         c = fitted_circle(shape.mask, self.hitbox.touching)
