@@ -90,7 +90,9 @@ def _draw_panel(ax, rows: list[FigureRow], styles: Styles, xlim: tuple[float, fl
 
 
 # Label positions tried in turn (offset in points, horizontal alignment) until one overlaps nothing.
-_LABEL_SLOTS = ((9, -16, "left"), (9, 5, "left"), (-9, 5, "right"), (-9, -16, "right"), (9, -30, "left"), (9, 18, "left"))
+_LABEL_SLOTS = ((9, -16, "left"), (9, 5, "left"), (-9, 5, "right"), (-9, -16, "right"), (9, -30, "left"),
+                (9, 18, "left"), (-9, -30, "right"), (-9, 18, "right"), (9, -44, "left"), (9, 32, "left"),
+                (-9, -44, "right"), (-9, 32, "right"), (9, -58, "left"), (-9, -58, "right"))
 
 
 def _place_labels(ax, rows: list[FigureRow]) -> None:
@@ -100,7 +102,8 @@ def _place_labels(ax, rows: list[FigureRow]) -> None:
     renderer = fig.canvas.get_renderer()
     from matplotlib.transforms import Bbox
 
-    taken = []
+    area = ax.get_window_extent(renderer)
+    taken = [t.get_window_extent(renderer) for t in ax.texts]  # the host-only methods' line labels
     for r in rows:  # keep labels off every marker
         px, py = ax.transData.transform((r.cycles_mean, r.accuracy))
         taken.append(Bbox.from_extents(px - 8, py - 8, px + 8, py + 8))
@@ -114,7 +117,8 @@ def _place_labels(ax, rows: list[FigureRow]) -> None:
                                ha=align, fontsize=8.5, color="black" if lit else "#707070",
                                bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8), zorder=4)
             box = note.get_window_extent(renderer)
-            if not any(box.overlaps(other) for other in taken):
+            inside = area.x0 <= box.x0 and box.x1 <= area.x1 and area.y0 <= box.y0 and box.y1 <= area.y1
+            if inside and not any(box.overlaps(other) for other in taken):
                 break
             note.remove()
         else:
