@@ -57,7 +57,8 @@ PAGES = MEMORY_SIZE // PAGE_SIZE
 STACK_PAGE = 0x100
 BYTE = 0xFF
 WORD = 0xFFFF
-MAX_PRIVATE_BYTES = 512 << 20  # per-lane page copies a batch may hold before it must be split
+MAX_PRIVATE_BYTES = 512 << 20  # per-lane bytes a batch may hold before it must be split
+DENSE_AFTER = 24  # a page with more per-lane bytes than this is held as one block
 NZ = FLAG_N | FLAG_Z
 NVZC = FLAG_N | FLAG_V | FLAG_Z | FLAG_C
 
@@ -77,7 +78,11 @@ class LaneMemoryFull(Exception):
 
 
 class LaneMemory:
-    """A shared 64 KiB image and, per page that differs between lanes, a (lanes x 256) copy."""
+    """A shared 64 KiB image and, per address that differs between lanes, a row of one value per lane.
+
+    Rows are int32 (registers' type, so arithmetic never wraps early) and made on first write. A page
+    that gets more than DENSE_AFTER rows (a table the routine writes) becomes one (256 x lanes) block,
+    its rows views into it, so accesses with per-lane addresses stay one gather."""
 
     def __init__(self, image, lanes: int, limit: int = MAX_PRIVATE_BYTES) -> None:
         self.shared = np.frombuffer(bytes(image), dtype=np.uint8).copy()
@@ -85,57 +90,99 @@ class LaneMemory:
             raise InputError(f"a memory image is {MEMORY_SIZE} bytes, got {len(self.shared)}")
         self.lanes = lanes
         self.limit = limit
-        self.private: dict[int, np.ndarray] = {}
-        self.is_private = np.zeros(PAGES, dtype=bool)
+        self.rows: dict[int, np.ndarray] = {}
+        self.page_rows: dict[int, list[int]] = {}  # sparse pages: their addresses with rows
+        self.dense: dict[int, np.ndarray] = {}
+        self.is_private = np.zeros(PAGES, dtype=bool)  # the page has rows (sparse or dense)
+        self.all_lanes = np.arange(lanes)
 
-    def page(self, page: int) -> np.ndarray:
-        """The per-lane copy of a page (made from the shared image on first use)."""
-        store = self.private.get(page)
-        if store is None:
-            if (len(self.private) + 1) * self.lanes * PAGE_SIZE > self.limit:
-                raise LaneMemoryFull(f"{self.lanes} lanes with {len(self.private) + 1} private pages")
-            base = page * PAGE_SIZE
-            store = np.tile(self.shared[base:base + PAGE_SIZE], (self.lanes, 1))
-            self.private[page] = store
-            self.is_private[page] = True
-        return store
+    def _held(self) -> int:
+        return (len(self.rows) + (PAGE_SIZE - 1) * len(self.dense)) * self.lanes * 4
 
-    def read(self, idx: np.ndarray, address):
-        """The byte at address (an int, or an array aligned with idx) for the lanes idx."""
-        if isinstance(address, (int, np.integer)):
-            address = int(address)
+    def row(self, address: int) -> np.ndarray:
+        """The per-lane row of an address (made from the shared image on first use)."""
+        row = self.rows.get(address)
+        if row is None:
+            if self._held() + self.lanes * 4 > self.limit:
+                raise LaneMemoryFull(f"{self.lanes} lanes with {len(self.rows) + 1} private bytes")
+            row = np.full(self.lanes, self.shared[address], dtype=np.int32)
+            self.rows[address] = row
             page = address >> 8
-            if self.is_private[page]:
-                return self.private[page][idx, address & BYTE].astype(np.int32)
-            return int(self.shared[address])
+            self.is_private[page] = True
+            listed = self.page_rows.setdefault(page, [])
+            listed.append(address)
+            if len(listed) > DENSE_AFTER:
+                self._densify(page)
+                row = self.rows[address]
+        return row
+
+    def _densify(self, page: int) -> None:
+        if self._held() + PAGE_SIZE * self.lanes * 4 > self.limit:
+            raise LaneMemoryFull(f"{self.lanes} lanes with a page of per-lane bytes more")
+        base = page * PAGE_SIZE
+        block = np.repeat(self.shared[base:base + PAGE_SIZE].astype(np.int32)[:, None], self.lanes, axis=1)
+        for address in self.page_rows.pop(page, []):
+            block[address & BYTE] = self.rows[address]
+        for offset in range(PAGE_SIZE):
+            self.rows[base + offset] = block[offset]
+        self.dense[page] = block
+        self.is_private[page] = True
+
+    def lanes_of(self, idx) -> np.ndarray:
+        return self.all_lanes[idx] if isinstance(idx, slice) else idx
+
+    def read(self, idx, address):
+        """The byte at address (an int, or an array aligned with idx) for the lanes idx (an index
+        array or slice(None) for every lane)."""
+        if isinstance(address, (int, np.integer)):
+            row = self.rows.get(int(address))
+            return int(self.shared[address]) if row is None else row[idx]
         values = self.shared[address].astype(np.int32)
-        if self.private:
+        if self.rows:
             pages = address >> 8
-            for page, store in self.private.items():
+            lanes = None
+            for page in np.flatnonzero(self.is_private).tolist():
                 hit = pages == page
-                if hit.any():
-                    values[hit] = store[idx[hit], address[hit] & BYTE]
+                if not hit.any():
+                    continue
+                lanes = self.lanes_of(idx) if lanes is None else lanes
+                block = self.dense.get(page)
+                if block is not None:
+                    values[hit] = block[address[hit] & BYTE, lanes[hit]]
+                    continue
+                for row_address in self.page_rows[page]:
+                    at = hit & (address == row_address)
+                    if at.any():
+                        values[at] = self.rows[row_address][lanes[at]]
         return values
 
-    def write(self, idx: np.ndarray, address, value) -> None:
+    def write(self, idx, address, value) -> None:
         """Store value (an int or an array aligned with idx) at address for the lanes idx."""
         if isinstance(address, (int, np.integer)):
-            address = int(address)
-            self.page(address >> 8)[idx, address & BYTE] = value
+            self.row(int(address))[idx] = value
             return
-        pages = address >> 8
-        first, last = int(pages.min()), int(pages.max())
-        if first == last:
-            self.page(first)[idx, address & BYTE] = value
-            return
+        lanes = self.lanes_of(idx)
         array = not isinstance(value, (int, np.integer))
-        for page in np.unique(pages).tolist():
-            hit = pages == page
-            self.page(page)[idx[hit], address[hit] & BYTE] = value[hit] if array else value
+        targets = np.unique(address)
+        if len(targets) == 1:
+            self.row(int(targets[0]))[lanes] = value
+            return
+        for page in np.unique(targets >> 8).tolist():
+            in_page = targets[(targets >> 8) == page]
+            if page not in self.dense and len(in_page) + len(self.page_rows.get(page, ())) > DENSE_AFTER:
+                self._densify(page)
+            block = self.dense.get(page)
+            if block is not None:
+                hit = (address >> 8) == page
+                block[address[hit] & BYTE, lanes[hit]] = value[hit] if array else value
+                continue
+            for target in in_page.tolist():
+                at = address == target
+                self.row(target)[lanes[at]] = value[at] if array else value
 
     def fill(self, address: int, values) -> None:
         """Per-lane values (an array of one byte per lane) at one address, for every lane."""
-        self.page(address >> 8)[:, address & BYTE] = values
+        self.row(address)[:] = values
 
 
 def _signed(offset):
@@ -182,30 +229,37 @@ class BatchCpu:
     def call(self, entry: int, budget: int, return_pc: int, return_sp: int) -> None:
         """Run every lane from entry until it stands at return_pc with S = return_sp (the caller has
         pushed the return address and set S), or stops with an error. Cycles count from entry."""
-        pending: dict[int, list[np.ndarray]] = {entry: [np.arange(self.lanes)]}
+        every = slice(None)
+        pending: dict[int, list] = {entry: [every]}
+        lanes_of = self.memory.lanes_of
         while pending:
             pc = min(pending)
             parts = pending.pop(pc)
-            idx = parts[0] if len(parts) == 1 else np.concatenate(parts)
+            idx = parts[0] if len(parts) == 1 else np.concatenate([lanes_of(part) for part in parts])
+            if not isinstance(idx, slice) and len(idx) == self.lanes:
+                idx = every  # every lane: slices index without copying
             if pc == return_pc:
                 home = self.sp[idx] == return_sp
                 if home.any():
-                    self.pc[idx[home]] = pc
-                    late = idx[home][self.cycles[idx[home]] > budget]
-                    self._stop(late, pc, LaneError.BUDGET)
-                    idx = idx[~home]
+                    lanes = lanes_of(idx)
+                    done = lanes[home]
+                    self.pc[done] = pc
+                    self._stop(done[self.cycles[done] > budget], pc, LaneError.BUDGET)
+                    idx = lanes[~home]
                     if not len(idx):
                         continue
             spent = self.cycles[idx] >= budget
             if spent.any():
-                self._stop(idx[spent], pc, LaneError.BUDGET)
-                idx = idx[~spent]
+                lanes = lanes_of(idx)
+                self._stop(lanes[spent], pc, LaneError.BUDGET)
+                idx = lanes[~spent]
                 if not len(idx):
                     continue
             for target, lanes in self._run_at(idx, pc):
                 if isinstance(target, int):
                     pending.setdefault(target, []).append(lanes)
                 else:
+                    lanes = lanes_of(lanes)
                     order = np.argsort(target, kind="stable")
                     ordered = target[order]
                     starts = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]])
@@ -214,13 +268,12 @@ class BatchCpu:
 
     def step(self) -> None:
         """Run one instruction on every lane from its own PC (for single-step test vectors)."""
-        idx = np.arange(self.lanes)
         pc = _uniform(self.pc)
-        for target, lanes in self._run_at(idx, pc):
+        for target, lanes in self._run_at(slice(None), pc):
             self.pc[lanes] = target
 
-    def _stop(self, idx: np.ndarray, pc, kind: LaneError) -> None:
-        if len(idx):
+    def _stop(self, idx, pc, kind: LaneError) -> None:
+        if isinstance(idx, slice) or len(idx):
             self.error[idx] = kind
             self.error_pc[idx] = pc
 
@@ -238,9 +291,10 @@ class BatchCpu:
         if isinstance(opcodes, int):
             yield from self._dispatch(opcodes, idx, pc, lo, hi)
             return
+        lanes = memory.lanes_of(idx)
         for opcode in np.unique(opcodes).tolist():
             hit = opcodes == opcode
-            yield from self._dispatch(opcode, idx[hit], _uniform(pc if isinstance(pc, int) else pc[hit]),
+            yield from self._dispatch(opcode, lanes[hit], _uniform(pc if isinstance(pc, int) else pc[hit]),
                                       _uniform(lo if isinstance(lo, int) else lo[hit]),
                                       _uniform(hi if isinstance(hi, int) else hi[hit]))
 
@@ -260,9 +314,8 @@ class BatchCpu:
 
     def read(self, address: int) -> np.ndarray:
         """Every lane's byte at address."""
-        idx = np.arange(self.lanes)
-        value = self.memory.read(idx, address)
-        return np.full(self.lanes, value, dtype=np.int32) if isinstance(value, int) else value
+        value = self.memory.read(slice(None), address)
+        return np.full(self.lanes, value, dtype=np.int32) if isinstance(value, int) else value.copy()
 
     def push(self, idx, value) -> None:
         sp = self.sp[idx]
@@ -596,7 +649,8 @@ def _make_branch(opcode: int, cycles: int) -> Handler:
                 return target
             if not taken.any():
                 return following
-            return [(target, idx[taken]), (following, idx[~taken])]
+            lanes = cpu.memory.lanes_of(idx)
+            return [(target, lanes[taken]), (following, lanes[~taken])]
         return np.where(taken, target, following)
     return handler
 

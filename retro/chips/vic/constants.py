@@ -126,8 +126,8 @@ class Video:
     # cycle_tab_pal / cycle_tab_ntsc; checked against the real-hardware dumps of VICE-testprogs
     # VICII/spritegap. On the 6567R8 those dumps put sprite 0's p-access in cycle 59, as VICE does,
     # where sprite0_dma_cycle (read from Bauer's diagram, used for BA) says 60: docs/vic.md.]
-    sprite0_pointer_cycle: int = 0
-    display_check_cycle: int = 0
+    sprite0_pointer_cycle: int
+    display_check_cycle: int
     repeated_x_cycle: int = 0
 
     @property
@@ -169,14 +169,15 @@ VIDEOS = {"pal": PAL, "ntsc": NTSC}
 # The sequencer steps through 8 positions per cycle; cycle 1's first position draws X
 # first_x - COLLISION_LATCH_DELAY (the sprite X compare runs 4 X behind Bauer's counter: VICE draws
 # the X of each cycle's first phase rounded down to 8, the same 4 the collision latch measurements
-# give). Pixel p of the cycle of sprite n's p-access (sprite0_pointer_cycle + 2n, counted on into
-# the next line) halts that sprite's shift register: it repeats the pixel it showed last; pixel
-# SPRITE_DROP_PIXEL of the next cycle drops the rest of the row, pixel SPRITE_LOAD_PIXEL loads the
-# row just fetched, and from pixel SPRITE_RESUME_PIXEL on the sprite may start again. A sprite whose
-# X falls while it is halted never starts. The sequencer starts a sprite at its X only while its
-# copy of the display flag is set; that copy is taken at pixel SPRITE_PENDING_PIXEL of
-# display_check_cycle, so the last row of a sprite whose X comes after that point in the line is
-# never shown, and one whose X comes after its own load shows each row in the line it is fetched.
+# give). Pixel SPRITE_HALT_PIXEL of the cycle of sprite n's p-access (sprite0_pointer_cycle + 2n,
+# counted on into the next line) halts that sprite's shift register: it repeats the pixel it showed
+# last; pixel SPRITE_DROP_PIXEL of the next cycle drops the rest of the row, pixel SPRITE_LOAD_PIXEL
+# loads the row just fetched (anywhere inside the halt gives the same pixels), and from pixel
+# SPRITE_RESUME_PIXEL on the sprite may start again. A sprite whose X falls while it is halted
+# never starts. The sequencer starts a sprite at its X only while its copy of the display flag is
+# set; that copy is taken at pixel SPRITE_PENDING_PIXEL of display_check_cycle, so the last row of a
+# sprite whose X comes after that point in the line (and before its own load) is never shown, and
+# one whose X comes after its own load shows each row in the line it is fetched.
 SPRITE_HALT_PIXEL = 3
 SPRITE_DROP_PIXEL = 2
 SPRITE_LOAD_PIXEL = 4
