@@ -60,7 +60,7 @@ def _rows_for_scope(scope: str, cases: int, colliding: int, counts: dict[str, Co
             host_us=cost.host_us if cost else math.nan, host_only=m.host_only, hardware=m.hardware, pareto=False,
             pareto_software=False))
     front = pareto_front([(r.cycles_mean, r.accuracy) for r in rows])
-    software = pareto_front([(math.nan, 0.0) if False else (r.cycles_mean, r.accuracy) for r in rows])
+    software = pareto_front([(math.nan, 0.0) if r.hardware else (r.cycles_mean, r.accuracy) for r in rows])
     return [FigureRow(**{**asdict(r), "pareto": on, "pareto_software": soft})
             for r, on, soft in zip(rows, front, software)]
 
