@@ -78,7 +78,8 @@ def pixel_hits(mask_a: np.ndarray, mask_b: np.ndarray, offsets: Offsets) -> list
 
 
 def cells(x0: int, y0: int, x1: int, y1: int) -> set[tuple[int, int]]:
-    return {(x // 8, y // 8) for x in range(x0, x1) for y in range(y0, y1)}
+    """The 8x8 cells (column, row) that the pixels x0..x1-1, y0..y1-1 fall in."""
+    return {(cx, cy) for cx in range(x0 // 8, (x1 - 1) // 8 + 1) for cy in range(y0 // 8, (y1 - 1) // 8 + 1)}
 
 
 def tile_shares(a: tuple, b: tuple, offsets: Offsets) -> list[float]:
