@@ -10,6 +10,12 @@ cycle budget (`[cycles] max`) when it has one.
 Cases are made lazily (retro.routines.cases) and run in chunks over worker processes (`jobs`);
 the first run failure (BRK, JAM, a runaway past `[cycles] limit`) stops the check and is reported
 with its inputs.
+
+Two engines run the calls: `Machine` (scalar, the reference, with the timing model on every call)
+and the batched core (retro.cpu.batch: 65,536 cases at a time with numpy). `engine="auto"` takes the
+batched core from AUTO_BATCH_CASES planned cases on; then the first AGREEMENT_PER_PART cases of every
+part also run on `Machine` with the timing model, and the two engines must agree call for call
+(outputs and cycles): a disagreement is a mismatch of kind "engine".
 """
 
 from __future__ import annotations
@@ -20,6 +26,7 @@ import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
+from itertools import islice
 
 import numpy as np
 
@@ -29,10 +36,15 @@ from retro.cpu.timing import model_cycles
 from retro.errors import InputError, RunError
 from retro.routines import cases as case_sets
 from retro.routines.registry import select
-from retro.routines.runner import RasterStart, RoutineRunner, Size, describe_value
+from retro.cpu.batch import LaneError
+from retro.routines.runner import BatchOutcome, RasterStart, RoutineRunner, Size, describe_value
 from retro.routines.spec import Routine, load_spec
 
 EXAMPLES_KEPT = 5
+ENGINES = ("auto", "scalar", "batch")
+BATCH_LANES = 65_536  # cases the batched core runs at once (memory stays bounded: see LaneMemory)
+AUTO_BATCH_CASES = 20_000  # planned cases from which engine="auto" takes the batched core
+AGREEMENT_PER_PART = 2_000  # cases of each part also run on Machine when the batched core runs the check
 TRACE_SHOWN = 400  # instructions of the first failing case's trace in the report
 PROGRESS_SECONDS = 1.0  # at most one progress line a second
 
@@ -67,6 +79,8 @@ class ChunkResult:
     cpu_min: int | None = None  # cycles the CPU ran (stalls excluded): what the static bounds bound
     cpu_max: int | None = None
     stolen_max: int = 0  # with a scene: the most cycles one call lost to Bad Lines and sprite DMA
+    engine_cases: int = 0  # calls run on both engines and compared
+    engine_mismatches: int = 0
     examples: list[str] = field(default_factory=list)
     outside_examples: list[str] = field(default_factory=list)
     failure: Failure | None = None
@@ -93,6 +107,8 @@ class ChunkResult:
             self.cpu_min = other.cpu_min if self.cpu_min is None else min(self.cpu_min, other.cpu_min)
             self.cpu_max = other.cpu_max if self.cpu_max is None else max(self.cpu_max, other.cpu_max)
         self.stolen_max = max(self.stolen_max, other.stolen_max)
+        self.engine_cases += other.engine_cases
+        self.engine_mismatches += other.engine_mismatches
         self.examples = (self.examples + other.examples)[:EXAMPLES_KEPT]
         self.outside_examples = (self.outside_examples + other.outside_examples)[:EXAMPLES_KEPT]
         self.failure = self.failure or other.failure
@@ -116,12 +132,17 @@ class RoutineCheck:
     parts: list[PartRun] = field(default_factory=list)
     trace: list[str] = field(default_factory=list)  # the first failing case's instructions
     start: RasterStart | None = None  # with --scene: the beam position every call started at
+    engine: str = "scalar"  # which engine ran the cases: "scalar" (Machine) or "batch"
+    agreement: ChunkResult | None = None  # with the batched core: the cases also run on Machine
 
     @property
     def mismatches(self) -> int:
         t = self.totals
-        return (t.result_mismatches + t.cycle_mismatches + t.run_errors + len(self.bounds_violations)
-                + len(self.budget_violations))
+        found = (t.result_mismatches + t.cycle_mismatches + t.run_errors + len(self.bounds_violations)
+                 + len(self.budget_violations))
+        if self.agreement is not None:  # its result mismatches and run errors are among the batch's own
+            found += self.agreement.engine_mismatches + self.agreement.cycle_mismatches
+        return found
 
     @property
     def mean(self) -> float:
@@ -256,14 +277,16 @@ def runner_for(spec: str, seed: int, start: SceneStart | None = None) -> Routine
     return _RUNNERS[key]
 
 
-def check_chunk(spec: str, seed: int, chunk: list[tuple], start: SceneStart | None = None) -> ChunkResult:
-    """Run cases of one routine; a pure function of its arguments (used in worker processes)."""
+def check_chunk(spec: str, seed: int, chunk: list[tuple], start: SceneStart | None = None,
+                against: BatchOutcome | None = None) -> ChunkResult:
+    """Run cases of one routine; a pure function of its arguments (used in worker processes). With
+    `against` (the batched core's outcome for the same cases), every call is also compared with it."""
     runner = runner_for(spec, seed, start)
     routine = runner.routine
     name = routine.name
     read = runner.machine.memory.__getitem__
     out = ChunkResult()
-    for case in chunk:
+    for i, case in enumerate(chunk):
         steps: list = []
         try:
             answer, cycles = runner.run(case, steps)
@@ -272,7 +295,11 @@ def check_chunk(spec: str, seed: int, chunk: list[tuple], start: SceneStart | No
             out.run_errors += 1
             out.examples.append(f"{name}({describe_case(routine, case)}): {exc}")
             out.failure = out.failure or Failure(case, "run", message=str(exc))
+            if against is not None:
+                _compare_engines(out, routine, case, against, i, None, None)
             break  # a broken routine stops the check: the next case could run away as well
+        if against is not None:
+            _compare_engines(out, routine, case, against, i, answer, cycles)
         broken = [c.text for c in routine.domain if not c.test(*case)]
         try:
             expected = expected_outputs(routine, case, runner.memory_values)
@@ -321,6 +348,186 @@ def check_chunk(spec: str, seed: int, chunk: list[tuple], start: SceneStart | No
     return out
 
 
+def _compare_engines(out: ChunkResult, routine: Routine, case: tuple, batch: BatchOutcome, i: int,
+                     answer: tuple | None, cycles: int | None) -> None:
+    """Count one call run on both engines; a difference is an engine mismatch (answer None: Machine
+    stopped the call with a run error)."""
+    out.engine_cases += 1
+    stopped = bool(batch.error[i])
+    if answer is None and stopped:
+        return
+    if answer is not None and not stopped and batch.case_outputs(i) == answer and int(batch.cycles[i]) == cycles:
+        return
+    out.engine_mismatches += 1
+    if answer is None:
+        text = "Machine stopped the call, the batched core returned"
+    elif stopped:
+        text = f"the batched core stopped the call ({LaneError(int(batch.error[i])).name}), Machine returned"
+    else:
+        text = (f"Machine: {describe_outputs(routine, answer)} in {cycles} cycles; batched core: "
+                f"{describe_outputs(routine, batch.case_outputs(i))} in {int(batch.cycles[i])} cycles")
+    message = f"the engines disagree: {text}"
+    out.failure = out.failure or Failure(case, "engine", answer, None, message)
+    if len(out.examples) < EXAMPLES_KEPT:
+        out.examples.append(f"{routine.name}({describe_case(routine, case)}): {message}")
+
+
+def agreement_chunk(spec: str, seed: int, chunk: list[tuple]) -> ChunkResult:
+    """Cases run on both engines: Machine's full check (timing model included) and the comparison."""
+    runner = runner_for(spec, seed, None)
+    outcome = runner.run_batch(case_sets.cases_to_columns(runner.routine, chunk))
+    return check_chunk(spec, seed, chunk, None, outcome)
+
+
+def expected_columns(routine: Routine, columns: list, cases: list[tuple] | None, memory: dict) -> list[np.ndarray]:
+    """The reference's answers for a block of cases, one array per output (a table: (n, bytes))."""
+    n = len(columns[0])
+    if routine.reference_arrays:
+        arguments = dict(zip(routine.input_names, columns))
+        arguments.update({name: memory[name] for name in routine.reference_memory})
+        where = f"{routine.spec_path}: reference {routine.reference_name} (arrays = true)"
+        try:
+            with np.errstate(all="ignore"):
+                value = routine.reference(**arguments)
+        except Exception as exc:  # the user's reference: whatever it raises is reported in one line
+            raise InputError(f"{where} raised {type(exc).__name__}: {str(exc)[:200]}") from None
+        if isinstance(value, dict):
+            if set(value) != set(routine.output_names):
+                raise InputError(f"{where} returned keys {sorted(value)} for the outputs {list(routine.output_names)}")
+            values = [value[name] for name in routine.output_names]
+        elif len(routine.outputs) == 1:
+            values = [value]
+        else:
+            values = list(value) if isinstance(value, (tuple, list)) else []
+            if len(values) != len(routine.outputs):
+                raise InputError(f"{where}: with {len(routine.outputs)} outputs it must return a dict or a tuple of "
+                                 f"{len(routine.outputs)} arrays")
+        out = []
+        for port, item in zip(routine.outputs, values):
+            array = np.asarray(item)
+            if array.dtype == bool:
+                array = array.astype(np.int64)
+            shape = (n, len(port.places)) if port.table else (n,)
+            if array.shape != shape and array.ndim == 0:
+                array = np.broadcast_to(array, shape)
+            if array.shape != shape or not np.issubdtype(array.dtype, np.integer):
+                raise InputError(f"{where} returned {array.dtype} of shape {array.shape} for {port.name}: expected "
+                                 f"whole numbers of shape {shape}")
+            limit = 1 << port.bits
+            if array.size and (array.min() < 0 or array.max() >= limit):
+                raise InputError(f"{where} returned a value outside 0..{limit - 1} for {port.name}")
+            out.append(array.astype(np.int64))
+        return out
+    cases = cases if cases is not None else case_sets.columns_to_cases(columns)
+    answers = [expected_outputs(routine, case, memory) for case in cases]
+    return [np.asarray([a[k] for a in answers], dtype=np.int64).reshape((n, len(port.places)) if port.table else (n,))
+            for k, port in enumerate(routine.outputs)]
+
+
+def _expected_inside(routine: Routine, columns: list, inside: np.ndarray, memory: dict):
+    """Expected outputs case by case where the reference answers (it must, inside the domain);
+    -> (arrays, answerable)."""
+    n = len(columns[0])
+    cases = case_sets.columns_to_cases(columns)
+    answers, answerable = [], np.zeros(n, dtype=bool)
+    blank = tuple(tuple(0 for _ in p.places) if p.table else 0 for p in routine.outputs)
+    for i, case in enumerate(cases):
+        try:
+            answers.append(expected_outputs(routine, case, memory))
+            answerable[i] = True
+        except InputError:
+            if inside[i]:
+                raise
+            answers.append(blank)
+    arrays = [np.asarray([a[k] for a in answers], dtype=np.int64).reshape((n, len(p.places)) if p.table else (n,))
+              for k, p in enumerate(routine.outputs)]
+    return arrays, answerable
+
+
+def check_batch(spec: str, seed: int, columns: list) -> ChunkResult:
+    """`check_chunk` for a column block on the batched core (used in worker processes)."""
+    runner = runner_for(spec, seed, None)
+    routine = runner.routine
+    name = routine.name
+    out = ChunkResult()
+    outcome = runner.run_batch(columns)
+    stopped = np.flatnonzero(outcome.error)
+    n = len(columns[0]) if not len(stopped) else int(stopped[0])
+    full = columns
+    columns = [c[:n] for c in columns]
+    cases = case_sets.columns_to_cases(columns) if not routine.reference_arrays or routine.domain else None
+    inside = np.ones(n, dtype=bool)
+    broken_by: list[np.ndarray] = []
+    for condition in routine.domain:
+        broken = ~condition.over(columns, cases)
+        broken_by.append(broken)
+        inside &= ~broken
+        out.constraint_cases[condition.text] = int(broken.sum())
+    if n:
+        try:
+            expected = expected_columns(routine, columns, cases, runner.memory_values)
+            answerable = np.ones(n, dtype=bool)
+        except InputError:
+            if inside.all():
+                raise
+            # a reference may refuse inputs outside the domain: ask it case by case for those inside
+            expected, answerable = _expected_inside(routine, columns, inside, runner.memory_values)
+        got = [o[:n] for o in outcome.outputs]
+        equal = np.ones(n, dtype=bool)
+        for g, e in zip(got, expected):
+            equal &= (g == e).all(axis=1) if g.ndim == 2 else g == e
+        wrong_inside = np.flatnonzero(inside & ~equal)
+        wrong_outside = ~inside & ~equal & answerable
+        out.cases = n
+        out.result_mismatches = len(wrong_inside)
+        out.outside = int((~inside).sum())
+        out.outside_wrong = int(wrong_outside.sum())
+        for condition, broken in zip(routine.domain, broken_by):
+            out.constraint_wrong[condition.text] = int((broken & wrong_outside).sum())
+        case_at = (lambda i: cases[i]) if cases is not None else (
+            lambda i: case_sets.columns_to_cases([c[i:i + 1] for c in columns])[0])
+
+        def outputs_at(arrays, i):
+            return tuple(tuple(a[i].tolist()) if a.ndim == 2 else int(a[i]) for a in arrays)
+        for i in wrong_inside[:EXAMPLES_KEPT].tolist():
+            out.examples.append(f"{name}({describe_case(routine, case_at(i))}): returned "
+                                f"{describe_outputs(routine, outputs_at(got, i))}, reference "
+                                f"{describe_outputs(routine, outputs_at(expected, i))}")
+        if len(wrong_inside):
+            first = int(wrong_inside[0])
+            out.failure = Failure(case_at(first), "result", outputs_at(got, first), outputs_at(expected, first))
+        for i in np.flatnonzero(wrong_outside)[:EXAMPLES_KEPT].tolist():
+            broken = [c.text for c, b in zip(routine.domain, broken_by) if b[i]]
+            out.outside_examples.append(
+                f"{name}({describe_case(routine, case_at(i))}): returned {describe_outputs(routine, outputs_at(got, i))}, "
+                f"reference {describe_outputs(routine, outputs_at(expected, i))} (outside: {', '.join(broken)})")
+        cycles = outcome.cycles[:n][inside]
+        if len(cycles):
+            positions = np.flatnonzero(inside)
+            low, high = int(np.argmin(cycles)), int(np.argmax(cycles))
+            out.cycles_min, out.min_case = int(cycles[low]), case_at(int(positions[low]))
+            out.cycles_max, out.max_case = int(cycles[high]), case_at(int(positions[high]))
+            out.cycles_sum = int(cycles.sum())
+            out.cycles_count = len(cycles)
+            out.cpu_min, out.cpu_max = out.cycles_min, out.cycles_max
+    if len(stopped):  # the first call that did not return stops the check, as on Machine
+        case = case_sets.columns_to_cases([c[n:n + 1] for c in full])[0]
+        out.cases += 1
+        out.run_errors += 1
+        try:
+            runner.run(case)
+            message = (f"the engines disagree: the batched core stopped the call "
+                       f"({LaneError(int(outcome.error[n])).name}), Machine returned")
+            kind = "engine"
+            out.engine_cases += 1
+            out.engine_mismatches += 1
+        except RunError as exc:
+            message, kind = str(exc), "run"
+        out.examples.append(f"{name}({describe_case(routine, case)}): {message}")
+        out.failure = out.failure or Failure(case, kind, message=message)
+    return out
+
+
 # ---- static bounds -------------------------------------------------------------------------------------
 
 def static_bounds(routine: Routine, runner: RoutineRunner | None = None) -> Bounds | None:
@@ -350,6 +557,33 @@ def _ignore_interrupt() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C goes to the parent, which stops the pool
 
 
+def _run_work(work: Iterator[tuple], jobs: int, report: Callable[[ChunkResult], None],
+              stop: Callable[[], int]) -> None:
+    """Run (function, arguments) items in order, over `jobs` worker processes when more than one,
+    with at most 2 * jobs items in flight; stop early once `stop()` is true (a run error)."""
+    if jobs <= 1:
+        for function, arguments in work:
+            report(function(*arguments))
+            if stop():
+                return
+        return
+    pool = ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_interrupt)
+    pending: set[Future] = set()
+    try:
+        for function, arguments in work:
+            pending.add(pool.submit(function, *arguments))
+            if len(pending) >= 2 * jobs:  # bounded: cases are made as workers take them
+                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+                for future in finished:
+                    report(future.result())
+            if stop():
+                break
+        for future in pending:
+            report(future.result())
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
 def _chunks(parts: list[case_sets.Part]) -> Iterator[list[tuple]]:
     for part in parts:
         yield from case_sets.chunks(part.cases)
@@ -357,8 +591,13 @@ def _chunks(parts: list[case_sets.Part]) -> Iterator[list[tuple]]:
 
 def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | None = None,
                   random_count: int | None = None, jobs: int = 1, progress: Callable[[str], None] | None = None,
-                  start: SceneStart | None = None, bounded_product: int = case_sets.BOUNDED_PRODUCT) -> RoutineCheck:
-    """Check one routine: a spec path, or a Routine built in Python (then in this process only)."""
+                  start: SceneStart | None = None, bounded_product: int = case_sets.BOUNDED_PRODUCT,
+                  engine: str = "auto") -> RoutineCheck:
+    """Check one routine: a spec path, or a Routine built in Python (then in this process only).
+    `engine`: "scalar" (Machine), "batch" (the batched core, checked against Machine on the first
+    AGREEMENT_PER_PART cases of each part) or "auto" (batch from AUTO_BATCH_CASES planned cases)."""
+    if engine not in ENGINES:
+        raise InputError(f"--engine: {engine!r} is not one of {', '.join(ENGINES)}")
     if isinstance(spec, Routine):
         jobs = 1
     spec = routine_key(spec)
@@ -369,6 +608,10 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     known = sum(p.count for p in parts if p.count is not None)
     unknown = any(p.count is None for p in parts)
     runner = runner_for(spec, seed, start)  # loads and validates in this process before any worker starts
+    if engine == "batch" and not runner.batchable:
+        raise InputError("--engine batch: with --scene the calls run on Machine (the batched core models no chips); "
+                         "use --engine scalar or auto")
+    batched = runner.batchable and (engine == "batch" or (engine == "auto" and (unknown or known >= AUTO_BATCH_CASES)))
     totals = ChunkResult()
     done = 0
     shown = [time.monotonic()]
@@ -383,28 +626,18 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
             progress(f"check {routine.name}: {done:,} cases of {known:,} and the sweep" if unknown else
                      f"check {routine.name}: {done:,}/{known:,} cases")
 
-    chunk_iter = _chunks(parts)
-    if jobs > 1 and (known > case_sets.CHUNK or unknown):
-        pool = ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_interrupt)
-        pending: set[Future] = set()
-        try:
-            for chunk in chunk_iter:
-                pending.add(pool.submit(check_chunk, spec, seed, chunk, start))
-                if len(pending) >= 2 * jobs:  # bounded: cases are made as workers take them
-                    finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                    for future in finished:
-                        report(future.result())
-                if totals.run_errors:
+    agreement = None
+    if batched:
+        agreement = ChunkResult()
+        for part in parts:  # Machine first: the reference engine's verdict on a prefix of every part
+            for chunk in case_sets.chunks(islice(part.cases, AGREEMENT_PER_PART)):
+                agreement.merge(agreement_chunk(spec, seed, chunk))
+                if agreement.run_errors:
                     break
-            for future in pending:
-                report(future.result())
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
+        work = ((check_batch, (spec, seed, block)) for block in case_sets.batches(parts, BATCH_LANES))
     else:
-        for chunk in chunk_iter:
-            report(check_chunk(spec, seed, chunk, start))
-            if totals.run_errors:
-                break
+        work = ((check_chunk, (spec, seed, chunk, start)) for chunk in _chunks(parts))
+    _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
     part_runs = [PartRun(p.name, p.count if p.count is not None else 0, p.total) for p in parts]
     if unknown:  # the sweep's count is whatever was left after the counted parts
         counted = sum(p.cases for p in part_runs if p.name != "sweep")
@@ -426,7 +659,9 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
             budget_violations.append(f"{routine.name}: the static worst case {static.worst} cycles is over the budget "
                                      f"of {routine.budget}")
     check = RoutineCheck(routine, runner.size(), static, totals, violations, budget_violations, part_runs,
-                         start=runner.start)
+                         start=runner.start, engine="batch" if batched else "scalar", agreement=agreement)
+    if agreement is not None and agreement.failure is not None and totals.failure is None:
+        totals.failure = agreement.failure  # the timing model or the engines disagreed on a call
     if totals.failure is not None:
         check.trace = failure_trace(spec, seed, totals.failure.case, start)
     return check
@@ -458,13 +693,14 @@ def default_jobs() -> int:
 def run_checks(names: list[str] | None, *, exhaustive: bool = False, seed: int | None = None,
                random_count: int | None = None, jobs: int | None = None,
                progress: Callable[[str], None] | None = None, start: SceneStart | None = None,
-               bounded_product: int = case_sets.BOUNDED_PRODUCT) -> list[RoutineCheck]:
+               bounded_product: int = case_sets.BOUNDED_PRODUCT, engine: str = "auto") -> list[RoutineCheck]:
     """Check the named routines (built-in names or spec paths; all built-ins when none are named);
     every name is loaded and validated before any work starts."""
     specs = select(names)
     workers = default_jobs() if jobs is None else jobs
     return [check_routine(spec, exhaustive=exhaustive, seed=seed, random_count=random_count, jobs=workers,
-                          progress=progress, start=start, bounded_product=bounded_product) for spec in specs]
+                          progress=progress, start=start, bounded_product=bounded_product, engine=engine)
+            for spec in specs]
 
 
 # ---- reports -------------------------------------------------------------------------------------------
@@ -518,14 +754,19 @@ def check_record(check: RoutineCheck) -> dict:
     t = check.totals
     record = {"routine": check.routine.name, "spec": str(check.routine.spec_path), "cpu": check.routine.cpu,
               "cases": t.cases, "mismatches": check.mismatches,
-              "result_mismatches": t.result_mismatches, "cycle_mismatches": t.cycle_mismatches,
+              "result_mismatches": t.result_mismatches,
+              "cycle_mismatches": t.cycle_mismatches + (check.agreement.cycle_mismatches if check.agreement else 0),
               "run_errors": t.run_errors, "bounds_violations": check.bounds_violations,
               "budget_violations": check.budget_violations,
               "outside_domain": t.outside, "outside_domain_wrong": t.outside_wrong,
               "domain": [{"condition": c.text, "cases": t.constraint_cases.get(c.text, 0),
                           "wrong": t.constraint_wrong.get(c.text, 0)} for c in check.routine.domain],
               **cycle_figures(check), "worst_reached": check.worst_reached, "coverage": coverage(check),
-              "examples": t.examples, "outside_examples": t.outside_examples, "first_failure": None}
+              "examples": t.examples, "outside_examples": t.outside_examples, "engine": check.engine,
+              "engine_agreement": None if check.agreement is None else {
+                  "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
+                  "timing_model_mismatches": check.agreement.cycle_mismatches},
+              "first_failure": None}
     failure = t.failure
     if failure is not None:
         routine = check.routine
@@ -561,8 +802,14 @@ def format_check(check: RoutineCheck) -> list[str]:
               f"{'reached' if check.worst_reached else 'not reached'}" if check.static else "static analysis off")
     cost = (f"cycles {t.cycles_min}-{t.cycles_max} (mean {check.mean:.2f})" if t.cycles_count
             else "no case inside the domain")
-    lines = [f"{routine.name}: {t.cases} cases, {verdict}; {cost}, {static}; timing model equal on "
-             f"{t.cases - t.cycle_mismatches - t.run_errors} of {t.cases} calls"]
+    if check.agreement is None:
+        checked = f"timing model equal on {t.cases - t.cycle_mismatches - t.run_errors} of {t.cases} calls"
+    else:
+        a = check.agreement
+        checked = (f"batched core; on {a.engine_cases} of the calls Machine agrees on "
+                   f"{a.engine_cases - a.engine_mismatches} and the timing model on "
+                   f"{a.cases - a.cycle_mismatches - a.run_errors}")
+    lines = [f"{routine.name}: {t.cases} cases, {verdict}; {cost}, {static}; {checked}"]
     if check.parts:
         lines.append(f"  cases: {format_coverage(check)}")
     if t.cycles_count:

@@ -6,7 +6,7 @@ import argparse
 import json
 import sys
 
-from retro.analysis.check import SceneStart, check_record, format_check, run_checks
+from retro.analysis.check import ENGINES, SceneStart, check_record, format_check, run_checks
 from retro.errors import InputError
 from retro.numbers import parse_int
 from retro.routines.registry import builtin_names
@@ -30,6 +30,10 @@ def add_case_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--at-line", metavar="L", help="with --scene: the raster line each call starts at "
                    "(default: the scene's [cpu] start_line)")
     p.add_argument("--at-cycle", metavar="C", help="with --scene: the cycle in that line (default: the scene's)")
+    p.add_argument("--engine", choices=ENGINES, default="auto",
+                   help="which engine runs the calls: scalar (Machine, the reference; the timing model checks every "
+                        "call), batch (the numpy batched core, checked against Machine on the first 2,000 cases of each "
+                        "part) or auto (batch from 20,000 cases; default)")
     p.add_argument("--json", action="store_true", help="print a JSON list, one object per routine")
 
 
@@ -39,7 +43,7 @@ def case_options(args: argparse.Namespace) -> dict:
             "random_count": None if args.random_count is None else parse_int(args.random_count, field="--random",
                                                                              lo=0, hi=MAX_RANDOM),
             "jobs": None if args.jobs is None else parse_int(args.jobs, field="--jobs", lo=1, hi=64),
-            "progress": progress, "start": scene_start(args)}
+            "progress": progress, "start": scene_start(args), "engine": args.engine}
 
 
 def scene_start(args: argparse.Namespace) -> SceneStart | None:
