@@ -40,6 +40,8 @@ def method_samples(method: Method, samples: int | None) -> int | None:
 
 def _measure_pair(method: Method, a: Shape, b: Shape, samples: int | None) -> tuple[str, list[int]]:
     pair = make_pair(a, b)
+    if method.unmeasurable(pair):
+        return pair.name, []
     indices = sample_indices(pair, method_samples(method, samples))
     session = method.session(pair)
     verdict = None if method.averaged else method.verdict(sub_pair(pair, indices)) > 0
@@ -87,11 +89,15 @@ def measure_costs(shapes: list[Shape], samples: int | None, workers: int | None 
             continue
         per_pair: dict[str, CycleStats] = {}
         every: list[int] = []
-        for name, cycles in by_method[m.key]:
+        skipped = []
+        for (name, cycles), (a, b) in zip(by_method[m.key], jobs):
             per_pair[name] = CycleStats.of(cycles)
             every += cycles
+            if not cycles:
+                skipped.append(f"{name} ({m.unmeasurable(make_pair(a, b))})")
         code, tables = m.size()
+        counted = m.counted + (f"; not measured on {', '.join(skipped)}" if skipped else "")
         costs[m.key] = MethodCost(key=m.key, routine=m.routine, overall=CycleStats.of(every), per_pair=per_pair,
-                                  code_bytes=code, table_bytes=tables, host_us=host, counted=m.counted,
+                                  code_bytes=code, table_bytes=tables, host_us=host, counted=counted,
                                   prepare=m.prepare)
     return costs

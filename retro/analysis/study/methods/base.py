@@ -119,6 +119,10 @@ class Method:
     def session(self, pair: Pair) -> Session:
         return RoutineSession(self, pair)
 
+    def unmeasurable(self, pair: Pair) -> str:
+        """Why the routine cannot take this pair ("" when it can): its cycles are then not measured."""
+        return ""
+
     def size(self) -> tuple[int, int]:
         """(bytes of code, bytes of lookup tables) of the routine, as `retro cycles` counts them."""
         size = routine_runner(self.routine).size()

@@ -47,6 +47,12 @@ class PixelMethod(Method):
         out[inside] = grid[row[inside], col[inside]]
         return out
 
+    def unmeasurable(self, pair: Pair) -> str:
+        sizes = {pair.a.mask.shape, pair.b.mask.shape}
+        if sizes != {(21, 24)}:
+            return "asm/pixel.s takes unexpanded 24x21 sprites"
+        return ""
+
     def case_maker(self, pair: Pair):
         masks = opacity_bytes(pair.a), opacity_bytes(pair.b)
         dxs, dys = pair.dx.tolist(), pair.dy.tolist()

@@ -183,6 +183,11 @@ class UserMethod(Method):
             return case_values
         return case
 
+    def unmeasurable(self, pair: Pair) -> str:
+        if any(bits < 0 for bits in self.input_bits) and {pair.a.mask.shape, pair.b.mask.shape} != {(21, 24)}:
+            return "its 63-byte mask inputs need unexpanded 24x21 sprites"
+        return ""
+
     def session(self, pair: Pair):
         if self.routine is None:
             raise RunError(f"{self.path}: routine: none given, the method is host only")
