@@ -9,7 +9,7 @@ A `Method` holds
   method is meant to be used with values prepared once per object, the preparation routine
   (`prepare`);
 - how a case (a shape pair and an offset) becomes the routine's **inputs**: `case_maker(pair)`
-  returns a function from case index to the routine's logical case (the spec's input order); the
+  returns a function from case index to the routine's inputs by name (the spec's input names); the
   spec alone knows where each value goes;
 - its **host timing**: `host_calls(pair, indices)`, one zero-argument call per case running the
   method's Python reference;
@@ -34,7 +34,7 @@ from retro.analysis.study.corpus import Pair
 
 ORIGIN = 64  # shape a's sprite box sits at (64, 64): every coordinate of the corpus stays in 0..255
 
-Case = tuple  # a routine's logical case: its inputs in the spec's order
+Case = dict  # a routine's inputs by the spec's input names
 
 
 def sub_pair(pair: Pair, indices) -> Pair:
@@ -75,12 +75,21 @@ class RoutineSession(Session):
     """The usual session: the method's case maker gives the logical case, the spec's runner calls."""
 
     def __init__(self, method: "Method", pair: Pair) -> None:
+        from retro.errors import InputError
+
         self.case = method.case_maker(pair)
         self.runner = routine_runner(method.routine)
         self.hit = method.hit_output
+        self.names = self.runner.routine.input_names
+        if pair.cases:
+            given = set(self.case(0))
+            if given != set(self.names):
+                raise InputError(f"{self.runner.routine.spec_path}: inputs: method {method.key} gives "
+                                 f"{', '.join(sorted(given))}; the routine takes {', '.join(self.names)}")
 
     def run(self, index: int) -> tuple[bool, int]:
-        outputs, cycles = self.runner.run(self.case(index))
+        case = self.case(index)
+        outputs, cycles = self.runner.run(tuple(case[name] for name in self.names))
         return bool(outputs[self.hit]), cycles
 
 
@@ -113,7 +122,7 @@ class Method:
     # ---- the 6502 routine -----------------------------------------------------------------------
 
     def case_maker(self, pair: Pair) -> Callable[[int], Case]:
-        """Case index -> the routine's logical case (the spec's input order)."""
+        """Case index -> the routine's inputs by name (the spec's input names)."""
         raise NotImplementedError(f"{self.key}: no routine inputs")
 
     def session(self, pair: Pair) -> Session:

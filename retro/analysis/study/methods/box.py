@@ -41,9 +41,8 @@ class BoxMethod(Method):
     def case_maker(self, pair: Pair):
         (ax0, ay0, ax1, ay1), (bx0, by0, bx1, by1) = self.boxes(pair)
         dxs, dys = pair.dx.tolist(), pair.dy.tolist()
-        # aabb8's logical case: (ax, ay, aw, ah, bx, by, bw, bh)
-        return lambda i: (ORIGIN + ax0, ORIGIN + ay0, ax1 - ax0, ay1 - ay0,
-                          ORIGIN + dxs[i] + bx0, ORIGIN + dys[i] + by0, bx1 - bx0, by1 - by0)
+        return lambda i: dict(ax=ORIGIN + ax0, ay=ORIGIN + ay0, aw=ax1 - ax0, ah=ay1 - ay0,  # asm/aabb8.toml
+                              bx=ORIGIN + dxs[i] + bx0, by=ORIGIN + dys[i] + by0, bw=bx1 - bx0, bh=by1 - by0)
 
     def host_calls(self, pair: Pair, indices: list[int]):
         from retro.geometry.aabb import aabb_overlap
@@ -61,9 +60,9 @@ class EdgesBoxMethod(BoxMethod):
         (ax0, ay0, ax1, ay1), (bx0, by0, bx1, by1) = self.boxes(pair)
         dxs, dys = pair.dx.tolist(), pair.dy.tolist()
         left, top = ORIGIN + ax0, ORIGIN + ay0
-        # aabb_edges' logical case: (a_left, a_top, a_right1, a_bottom1, b_left, b_right, b_top, b_bottom)
-        return lambda i: (left, top, ORIGIN + ax1 - 1, ORIGIN + ay1 - 1,
-                          ORIGIN + dxs[i] + bx0, ORIGIN + dxs[i] + bx1, ORIGIN + dys[i] + by0, ORIGIN + dys[i] + by1)
+        return lambda i: dict(a_left=left, a_top=top, a_right1=ORIGIN + ax1 - 1, a_bottom1=ORIGIN + ay1 - 1,
+                              b_left=ORIGIN + dxs[i] + bx0, b_right=ORIGIN + dxs[i] + bx1,  # asm/aabb_edges.toml
+                              b_top=ORIGIN + dys[i] + by0, b_bottom=ORIGIN + dys[i] + by1)
 
 
 BOX = BoxMethod(

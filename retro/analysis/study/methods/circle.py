@@ -38,8 +38,8 @@ class CircleMethod(Method):
     def case_maker(self, pair: Pair):
         ca, cb = self.circles(pair)
         dxs, dys = pair.dx.tolist(), pair.dy.tolist()
-        # circle's logical case: (x1, y1, r1, x2, y2, r2)
-        return lambda i: (ORIGIN + ca.cx, ORIGIN + ca.cy, ca.r, ORIGIN + dxs[i] + cb.cx, ORIGIN + dys[i] + cb.cy, cb.r)
+        return lambda i: dict(x1=ORIGIN + ca.cx, y1=ORIGIN + ca.cy, r1=ca.r,  # asm/circle.toml
+                              x2=ORIGIN + dxs[i] + cb.cx, y2=ORIGIN + dys[i] + cb.cy, r2=cb.r)
 
     def host_calls(self, pair: Pair, indices: list[int]):
         from retro.geometry.circle import circle_overlap
@@ -54,8 +54,8 @@ class RadiusSumCircleMethod(CircleMethod):
     def case_maker(self, pair: Pair):
         ca, cb = self.circles(pair)
         dxs, dys = pair.dx.tolist(), pair.dy.tolist()
-        # circle_r's logical case: (x1, y1, radius_sum, x2, y2)
-        return lambda i: (ORIGIN + ca.cx, ORIGIN + ca.cy, ca.r + cb.r, ORIGIN + dxs[i] + cb.cx, ORIGIN + dys[i] + cb.cy)
+        return lambda i: dict(x1=ORIGIN + ca.cx, y1=ORIGIN + ca.cy, radius_sum=ca.r + cb.r,  # asm/circle_r.toml
+                              x2=ORIGIN + dxs[i] + cb.cx, y2=ORIGIN + dys[i] + cb.cy)
 
 
 CIRCLE = CircleMethod(

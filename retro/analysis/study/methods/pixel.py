@@ -56,8 +56,8 @@ class PixelMethod(Method):
     def case_maker(self, pair: Pair):
         masks = opacity_bytes(pair.a), opacity_bytes(pair.b)
         dxs, dys = pair.dx.tolist(), pair.dy.tolist()
-        # pixel's logical case: the offset as two's-complement bytes, and the two opacity masks
-        return lambda i: (dxs[i] & 0xFF, dys[i] & 0xFF, *masks)
+        # asm/pixel.toml: the offset as two's-complement bytes, and the two opacity masks
+        return lambda i: dict(dx=dxs[i] & 0xFF, dy=dys[i] & 0xFF, mask_a=masks[0], mask_b=masks[1])
 
     def host_calls(self, pair: Pair, indices: list[int]):
         from retro.geometry.masks import mask_overlap

@@ -24,10 +24,10 @@ class SpriteEdgesMethod(BoxMethod):
 
         def case(i: int) -> tuple:
             b_left, b_right = SPRITE_X + dxs[i] + bx0, SPRITE_X + dxs[i] + bx1
-            # sprite_edges' logical case: (a_left, a_top, a_bottom1, a_left_hi, a_right, a_right_hi,
-            # b_left, b_left_hi, b_right, b_right_hi, b_top, b_bottom)
-            return (a_left & 0xFF, ORIGIN + ay0, ORIGIN + ay1 - 1, a_left >> 8, a_right & 0xFF, a_right >> 8,
-                    b_left & 0xFF, b_left >> 8, b_right & 0xFF, b_right >> 8, ORIGIN + dys[i] + by0, ORIGIN + dys[i] + by1)
+            return dict(a_left=a_left & 0xFF, a_left_hi=a_left >> 8, a_right=a_right & 0xFF,  # asm/sprite_edges.toml
+                        a_right_hi=a_right >> 8, a_top=ORIGIN + ay0, a_bottom1=ORIGIN + ay1 - 1,
+                        b_left=b_left & 0xFF, b_left_hi=b_left >> 8, b_right=b_right & 0xFF,
+                        b_right_hi=b_right >> 8, b_top=ORIGIN + dys[i] + by0, b_bottom=ORIGIN + dys[i] + by1)
         return case
 
 

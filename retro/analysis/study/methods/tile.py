@@ -72,7 +72,8 @@ class TileSession(Session):
             memory[address] = self.MARK
         x = s.SPRITE_X_AT_COLUMN_0 + ox + dx + bx0
         y = s.SPRITE_Y_AT_ROW_0 + oy + dy + by0
-        (answer,), cycles = self.runner.run((x & 0xFF, x >> 8, y, bx1 - bx0, by1 - by0))
+        case = dict(x=x & 0xFF, xh=x >> 8, y=y, w=bx1 - bx0, h=by1 - by0)  # asm/tile_box.toml
+        (answer,), cycles = self.runner.run(tuple(case[name] for name in self.runner.routine.input_names))
         return answer != 0, cycles
 
     def expected(self, index: int) -> bool:

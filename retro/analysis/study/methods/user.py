@@ -180,7 +180,7 @@ class UserMethod(Method):
                 if not condition.test(*case_values):
                     raise RunError(f"{self.path}: inputs: on {pair.name} at offset ({dx}, {dy}) the case is outside "
                                    f"the routine's domain ({condition.text})")
-            return case_values
+            return dict(zip((name for name, _, _ in self.inputs), case_values))
         return case
 
     def unmeasurable(self, pair: Pair) -> str:
