@@ -24,7 +24,8 @@ import os
 import signal
 import time
 from collections.abc import Callable, Iterator
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from collections import deque
+from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
 from itertools import islice
 
@@ -568,18 +569,16 @@ def _run_work(work: Iterator[tuple], jobs: int, report: Callable[[ChunkResult], 
                 return
         return
     pool = ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_interrupt)
-    pending: set[Future] = set()
+    pending: deque[Future] = deque()
     try:
         for function, arguments in work:
-            pending.add(pool.submit(function, *arguments))
+            pending.append(pool.submit(function, *arguments))
             if len(pending) >= 2 * jobs:  # bounded: cases are made as workers take them
-                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                for future in finished:
-                    report(future.result())
+                report(pending.popleft().result())  # in order: ties (first fastest case) do not depend on timing
             if stop():
                 break
-        for future in pending:
-            report(future.result())
+        while pending:
+            report(pending.popleft().result())
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
 
@@ -762,6 +761,7 @@ def check_record(check: RoutineCheck) -> dict:
               "domain": [{"condition": c.text, "cases": t.constraint_cases.get(c.text, 0),
                           "wrong": t.constraint_wrong.get(c.text, 0)} for c in check.routine.domain],
               **cycle_figures(check), "worst_reached": check.worst_reached, "coverage": coverage(check),
+              "input_space": check.routine.input_space(), "coverage_argument": check.routine.coverage or None,
               "examples": t.examples, "outside_examples": t.outside_examples, "engine": check.engine,
               "engine_agreement": None if check.agreement is None else {
                   "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
@@ -811,7 +811,9 @@ def format_check(check: RoutineCheck) -> list[str]:
                    f"{a.cases - a.cycle_mismatches - a.run_errors}")
     lines = [f"{routine.name}: {t.cases} cases, {verdict}; {cost}, {static}; {checked}"]
     if check.parts:
-        lines.append(f"  cases: {format_coverage(check)}")
+        lines.append(f"  cases: {format_coverage(check)}; input space {check.routine.input_space():,}")
+    if routine.coverage:
+        lines.append(f"  coverage: {routine.coverage}")
     if t.cycles_count:
         lines.append(f"  fastest: {describe_case(routine, t.min_case)}")
         lines.append(f"  slowest: {describe_case(routine, t.max_case)}")

@@ -1,18 +1,19 @@
 """Case generators of the seven built-in routines (asm/*.toml name them as `boundary`, `sweep` and
 `random_generator`), and the adapters their specs need.
 
-Cases are tuples in each spec's input order (the reference's argument order):
+Cases are tuples in each spec's input order (the reference's argument order), or column blocks (dicts
+of numpy arrays by input name) where there are many:
 - boundary: touching, one apart, overlapping by one, 0, 255/256, maximum sizes, screen edges;
 - sweep (with --exhaustive): mul8 every product; tile every 9-bit X by every Y; pixel every (dx, dy)
-  for three mask pairs; circle every pair of 8-bit deltas at the two radius sums that bracket their
-  distance; exhaustive slices across each domain boundary for the others;
+  for three mask pairs; circle and circle_r every (dx, dy) of both signs at every radius sum;
+  exhaustive slices across each domain boundary for the others;
 - random: distributions that put half the cases near the answer's edge.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from functools import lru_cache
 from itertools import product
 
@@ -76,16 +77,25 @@ def aabb8_random(rng: np.random.Generator, n: int) -> list[tuple]:
     return [tuple(int(v) for v in row) for row in cases]
 
 
-def aabb8_sweep() -> Iterable[tuple]:
+def _grid(*sizes: int) -> list[np.ndarray]:
+    """Every combination of 0..size-1 per axis (the last varies fastest), one column per axis."""
+    return [axis.ravel() for axis in np.meshgrid(*(np.arange(size) for size in sizes), indexing="ij")]
+
+
+def _block(names: str, **columns) -> dict[str, np.ndarray]:
+    """A column block: every named input, constants broadcast to the block's length."""
+    n = max(len(v) for v in columns.values() if isinstance(v, np.ndarray))
+    return {name: np.broadcast_to(np.asarray(columns[name], dtype=np.int64), (n,)).copy() for name in names.split()}
+
+
+def aabb8_sweep() -> Iterator[dict]:
     """Every (ax, aw) against boxes placed across the 255/256 end, and every (ay, ah) likewise."""
+    first, size = _grid(BYTE, BYTE)
+    names = "ax ay aw ah bx by bw bh"
     for bx, bw in ((0, 1), (120, 16), (250, 6)):
-        for ax in range(BYTE):
-            for aw in range(BYTE):
-                yield (ax, 10, aw, 5, bx, 8, bw, 5)
+        yield _block(names, ax=first, ay=10, aw=size, ah=5, bx=bx, by=8, bw=bw, bh=5)
     for by, bh in ((0, 1), (250, 6)):
-        for ay in range(BYTE):
-            for ah in range(BYTE):
-                yield (10, ay, 5, ah, 8, by, 5, bh)
+        yield _block(names, ax=10, ay=first, aw=5, ah=size, bx=8, by=by, bw=5, bh=bh)
 
 
 # ---- aabb_sprite -------------------------------------------------------------------------------
@@ -126,11 +136,11 @@ def aabb_sprite_random(rng: np.random.Generator, n: int) -> list[tuple]:
     return out
 
 
-def aabb_sprite_sweep() -> Iterable[tuple]:
+def aabb_sprite_sweep() -> Iterator[dict]:
     """Every pair of 9-bit X positions with two fixed hitboxes (the 255/256 boundary included)."""
-    for x1 in range(512):
-        for x2 in range(512):
-            yield _sprite_case(x1, 100, (4, 3, 16, 15), x2, 104, (0, 0, 24, 21))
+    x1, x2 = _grid(512, 512)
+    yield _block("x1 x1h y1 ox1 oy1 w1 h1 x2 x2h y2 ox2 oy2 w2 h2", x1=x1 & 0xFF, x1h=x1 >> 8, y1=100, ox1=4, oy1=3,
+                 w1=16, h1=15, x2=x2 & 0xFF, x2h=x2 >> 8, y2=104, ox2=0, oy2=0, w2=24, h2=21)
 
 
 # ---- circle ------------------------------------------------------------------------------------
@@ -165,20 +175,25 @@ def circle_random(rng: np.random.Generator, n: int) -> list[tuple]:
     return [tuple(int(v) for v in row) for row in cases]
 
 
-def circle_sweep() -> Iterable[tuple]:
-    """Every pair of 8-bit deltas (both signs) at the radius sums just below and at its distance,
-    where reachable (<= 255); then every radius pair at a few deltas (the radius domain)."""
-    for dx in range(-255, 256):
-        for dy in range(-255, 256):
-            distance_ceiling = math.isqrt(dx * dx + dy * dy - 1) + 1 if dx or dy else 0
-            for radius_sum in (distance_ceiling, distance_ceiling + 1):
-                if radius_sum <= 255:
-                    yield _circle_case(dx, dy, radius_sum)
-    for dx, dy in ((0, 0), (200, 100), (-255, -255)):
-        for r1 in range(BYTE):
-            for r2 in range(0, BYTE, 3):
-                case = _circle_case(dx, dy, 0)
-                yield (case[0], case[1], r1, case[3], case[4], r2)
+def _apart(delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two bytes whose difference (first - second) is delta (-255..255): one of them 0."""
+    return np.maximum(delta, 0), np.maximum(-delta, 0)
+
+
+def circle_sweep() -> Iterator[dict]:
+    """Every (dx, dy) of both signs (-255..255 each) at every radius sum 0..255, split r1 = sum // 2;
+    then every (r1, r2) pair (each 0..255) at a few deltas (the radius domain and its edge)."""
+    names = "x1 y1 r1 x2 y2 r2"
+    dy, radius_sum = _grid(2 * BYTE - 1, BYTE)
+    dy = dy - (BYTE - 1)
+    y1, y2 = _apart(dy)
+    for dx in range(-(BYTE - 1), BYTE):
+        x1, x2 = _apart(np.full(len(dy), dx))
+        yield _block(names, x1=x1, y1=y1, r1=radius_sum // 2, x2=x2, y2=y2, r2=radius_sum - radius_sum // 2)
+    r1, r2 = _grid(BYTE, BYTE)
+    for dx, dy_ in ((0, 0), (200, 100), (-255, -255), (3, 4)):
+        (x1, x2), (y1, y2) = _apart(np.array(dx)), _apart(np.array(dy_))
+        yield _block(names, x1=x1, y1=y1, r1=r1, x2=x2, y2=y2, r2=r2)
 
 
 # ---- mul8 ----------------------------------------------------------------------------------------
@@ -192,8 +207,9 @@ def mul8_random(rng: np.random.Generator, n: int) -> list[tuple]:
     return [tuple(int(v) for v in row) for row in _bytes(rng, n, 2)]
 
 
-def mul8_sweep() -> Iterable[tuple]:
-    return product(range(BYTE), repeat=2)
+def mul8_sweep() -> Iterator[dict]:
+    a, b = _grid(BYTE, BYTE)
+    yield {"a": a, "b": b}
 
 
 # ---- tile and tile_box ---------------------------------------------------------------------------
@@ -211,8 +227,10 @@ def tile_random(rng: np.random.Generator, n: int) -> list[tuple]:
     return [(int(a) & 0xFF, int(a) >> 8, int(b)) for a, b in zip(x, y)]
 
 
-def tile_sweep() -> Iterable[tuple]:
-    return ((x & 0xFF, x >> 8, y) for x in range(512) for y in range(BYTE))
+def tile_sweep() -> Iterator[dict]:
+    """Every 9-bit X by every Y."""
+    x, y = _grid(512, BYTE)
+    yield {"x": x & 0xFF, "xh": x >> 8, "y": y}
 
 
 def tile_box_boundary() -> list[tuple]:
@@ -233,15 +251,15 @@ def tile_box_random(rng: np.random.Generator, n: int) -> list[tuple]:
     return [(int(a) & 0xFF, int(a) >> 8, int(b), int(c), int(d)) for a, b, c, d in zip(x, y, w, h)]
 
 
-def tile_box_sweep() -> Iterable[tuple]:
+def tile_box_sweep() -> Iterator[dict]:
     """Every 9-bit X and every Y for a sprite-sized box; every width at a few heights and back."""
-    for x in range(512):
-        for y in range(0, BYTE):
-            yield (x & 0xFF, x >> 8, y, 24, 21)
-    for size in range(BYTE):
-        for other in (0, 1, 8, 21, 255):
-            yield (20, 0, 45, size, other)
-            yield (20, 0, 45, other, size)
+    names = "x xh y w h"
+    x, y = _grid(512, BYTE)
+    yield _block(names, x=x & 0xFF, xh=x >> 8, y=y, w=24, h=21)
+    size = np.arange(BYTE)
+    for other in (0, 1, 8, 21, 255):
+        yield _block(names, x=20, xh=0, y=45, w=size, h=other)
+        yield _block(names, x=20, xh=0, y=45, w=other, h=size)
 
 
 # ---- pixel ---------------------------------------------------------------------------------------
@@ -311,17 +329,13 @@ def pixel_sweep(seed: int = 0) -> Iterable[tuple]:
 
 # ---- circle_r ------------------------------------------------------------------------------------
 
-def circle_r_sweep() -> Iterable[tuple]:
-    """Every pair of 8-bit deltas (both signs) at the radius sums just below and at their distance
-    (where those are 1..255): the only places the answer can flip."""
-    for dx in range(-255, 256):
-        for dy in range(-255, 256):
-            distance_ceiling = math.isqrt(dx * dx + dy * dy - 1) + 1 if dx or dy else 0
-            x1, x2 = (dx, 0) if dx >= 0 else (0, -dx)
-            y1, y2 = (dy, 0) if dy >= 0 else (0, -dy)
-            for radius in (distance_ceiling, distance_ceiling + 1):
-                if 1 <= radius <= 255:
-                    yield (x1, y1, radius, x2, y2)
+def circle_r_sweep() -> Iterator[dict]:
+    """Every (dx, dy) of both signs (-255..255 each) at every radius sum 0..255."""
+    dy, radius = _grid(2 * BYTE - 1, BYTE)
+    y1, y2 = _apart(dy - (BYTE - 1))
+    for dx in range(-(BYTE - 1), BYTE):
+        x1, x2 = _apart(np.full(len(radius), dx))
+        yield _block("x1 y1 radius_sum x2 y2", x1=x1, y1=y1, radius_sum=radius, x2=x2, y2=y2)
 
 
 def circle_r_boundary() -> list[tuple]:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
-from itertools import islice
+from itertools import chain, islice
 
 import numpy as np
 
@@ -74,9 +74,10 @@ def plan(routine: Routine, *, exhaustive: bool, seed: int | None = None, random:
     seed = routine.seed if seed is None else seed
     parts = []
     if routine.boundary is not None:
-        made = list(_checked(routine, "cases.boundary",
-                             call_with(routine.boundary, {"seed": seed, "rng": np.random.default_rng(seed)})))
-        parts.append(Part("boundary", len(made), len(made), lambda: _blocks_of(routine, made)))
+        made = list(_function_blocks(routine, "cases.boundary",
+                                     call_with(routine.boundary, {"seed": seed, "rng": np.random.default_rng(seed)})))
+        count = sum(len(block[0]) for block in made)
+        parts.append(Part("boundary", count, count, lambda: iter(made)))
     if routine.exhaustive:
         total = routine.exhaustive_count()
         if exhaustive or total <= bounded_product:
@@ -85,7 +86,7 @@ def plan(routine: Routine, *, exhaustive: bool, seed: int | None = None, random:
             sample = min(BOUNDED_SAMPLE, bounded_product)
             parts.append(Part("exhaustive", sample, total, lambda: _product(routine, seed, sample)))
     if exhaustive and routine.sweep is not None:
-        parts.append(Part("sweep", None, 0, lambda: _blocks_of(routine, _lazy_sweep(routine, seed))))
+        parts.append(Part("sweep", None, 0, lambda: _lazy_sweep(routine, seed)))
     count = random_count(routine, exhaustive, random)
     if count:
         parts.append(Part("random", count, count, lambda: _random(routine, seed, count)))
@@ -117,11 +118,6 @@ def batches(parts: list[Part], size: int) -> Iterator[Columns]:
                 held = [rest] if count else []
     if count:
         yield [np.concatenate(column) for column in zip(*held)]
-
-
-def _blocks_of(routine: Routine, cases: Iterable[tuple]) -> Iterator[Columns]:
-    for chunk in chunks(cases):
-        yield cases_to_columns(routine, chunk)
 
 
 # ---- exhaustive product ----------------------------------------------------------------------------
@@ -185,7 +181,7 @@ def _random(routine: Routine, seed: int, count: int) -> Iterator[Columns]:
         n = min(RANDOM_BLOCK, count - done)
         if routine.random_generator is not None:
             made = call_with(routine.random_generator, {"rng": rng, "count": n, "n": n, "seed": seed})
-            yield from _blocks_of(routine, _checked(routine, "cases.random_generator", made, expected=n))
+            yield from _function_blocks(routine, "cases.random_generator", made, expected=n)
         else:
             for start in range(0, n, CHUNK):
                 m = min(CHUNK, n - start)
@@ -193,12 +189,78 @@ def _random(routine: Routine, seed: int, count: int) -> Iterator[Columns]:
         done += n
 
 
-def _lazy_sweep(routine: Routine, seed: int) -> Iterator[tuple]:
-    yield from _checked(routine, "cases.sweep", call_with(routine.sweep, {"seed": seed,
-                                                                       "rng": np.random.default_rng(seed)}))
+def _lazy_sweep(routine: Routine, seed: int) -> Iterator[Columns]:
+    yield from _function_blocks(routine, "cases.sweep", call_with(routine.sweep, {"seed": seed,
+                                                                               "rng": np.random.default_rng(seed)}))
 
 
 # ---- cases from users' functions ----------------------------------------------------------------------
+
+def _function_blocks(routine: Routine, key: str, made, expected: int | None = None) -> Iterator[Columns]:
+    """Cases from a spec's function as column blocks. The function returns (or yields) cases one by
+    one (tuples in input order, or dicts by name), or column blocks: dicts of numpy arrays by input
+    name, one element per case (a table input: one row of bytes per case) - the fast form."""
+    where = f"{routine.spec_path}: {key}"
+    if isinstance(made, dict):
+        made = [made]
+    try:
+        iterator = iter(made)
+    except TypeError:
+        raise InputError(f"{where}: the function must return a list or iterable of cases or of column "
+                         f"blocks, got {type(made).__name__}") from None
+    first = next(iterator, None)
+    if first is None:
+        produced = 0
+    elif isinstance(first, dict) and any(isinstance(v, np.ndarray) for v in first.values()):
+        produced = 0
+        for block in chain([first], iterator):
+            columns = _block_columns(routine, block, where)
+            produced += len(columns[0])
+            if len(columns[0]):
+                yield columns
+    else:
+        produced = 0
+        for chunk in chunks(_checked(routine, key, chain([first], iterator))):
+            produced += len(chunk)
+            yield cases_to_columns(routine, chunk)
+    if expected is not None and produced != expected:
+        raise InputError(f"{where}: asked for {expected} cases, the function returned {produced}")
+
+
+def _block_columns(routine: Routine, block, where: str) -> Columns:
+    """One column block (a dict of arrays by input name), checked: every input, one length, widths."""
+    if not isinstance(block, dict):
+        raise InputError(f"{where}: after a column block (a dict of arrays) every item must be one, got "
+                         f"{type(block).__name__}")
+    names = routine.input_names
+    missing = [n for n in names if n not in block]
+    extra = [k for k in block if k not in names]
+    if missing or extra:
+        raise InputError(f"{where}: a column block " + (f"lacks {missing[0]!r}" if missing else f"has unknown input {extra[0]!r}"))
+    columns = []
+    length = None
+    for port in routine.inputs:
+        try:
+            column = np.asarray(block[port.name])
+        except (TypeError, ValueError):
+            column = np.asarray([])
+        if column.dtype == bool or not np.issubdtype(column.dtype, np.integer):
+            raise InputError(f"{where}: column {port.name} must hold whole numbers, got {column.dtype}")
+        shape_ok = column.ndim == 2 and column.shape[1] == len(port.places) if port.table else column.ndim == 1
+        if not shape_ok:
+            raise InputError(f"{where}: column {port.name} must be " + (
+                f"n rows of {len(port.places)} bytes" if port.table else "one value per case (1-D)"))
+        length = len(column) if length is None else length
+        if len(column) != length:
+            raise InputError(f"{where}: column {port.name} has {len(column)} cases, {routine.inputs[0].name} {length}")
+        limit = 1 << (8 if port.table else port.bits)
+        if column.size and (column.min() < 0 or column.max() >= limit):
+            bad = column.min() if column.min() < 0 else column.max()
+            raise InputError(f"{where}: column {port.name} holds {int(bad)}, which does not fit in {port.describe()} "
+                             f"(0..{limit - 1})")
+        columns.append(column.astype(np.int64))
+    return columns
+
 
 def _checked(routine: Routine, key: str, made, expected: int | None = None) -> Iterator[tuple]:
     """Cases from a spec's function, normalised to tuples and checked against the inputs' widths."""

@@ -82,19 +82,33 @@ def tile(x, xh, y, screen, props):
     return _result(np.where(on, props[screen[index]], 0))
 
 
-def tile_box(x, xh, y, w, h, screen, props) -> int:
-    """OR of the property bytes of every on-screen cell that shares a pixel with the box."""
-    left = x + HIGH_BIT_WEIGHT * xh
+def _cell_span(start, size, origin: int, cells: int):
+    """First and last cell (inclusive, clipped to 0..cells-1) that the pixels start..start+size-1 touch,
+    and whether there is any."""
+    start = np.asarray(start, dtype=np.int64)
+    size = np.asarray(size, dtype=np.int64)
+    first = (start - origin) // CELL_PIXELS
+    last = (start + size - 1 - origin) // CELL_PIXELS
+    any_cell = (size >= 1) & (last >= 0) & (first < cells)
+    return np.clip(first, 0, cells - 1), np.clip(last, 0, cells - 1), any_cell
+
+
+def tile_box(x, xh, y, w, h, screen, props):
+    """OR of the property bytes of every on-screen cell that shares a pixel with the box.
+
+    Over arrays: per property bit, a table of running counts over the screen's cells tells whether
+    any cell of the box's rectangle of cells has that bit."""
+    left = np.asarray(x, dtype=np.int64) + HIGH_BIT_WEIGHT * np.asarray(xh, dtype=np.int64)
     grid = np.asarray(props, dtype=np.int64)[np.asarray(screen, dtype=np.int64)].reshape(ROWS, COLUMNS)
-    result = 0
-    for row in range(ROWS):
-        top = SPRITE_Y_AT_ROW_0 + row * CELL_PIXELS
-        if not _intervals_share_a_pixel(top, CELL_PIXELS, y, h):
-            continue
-        for column in range(COLUMNS):
-            if _intervals_share_a_pixel(SPRITE_X_AT_COLUMN_0 + column * CELL_PIXELS, CELL_PIXELS, left, w):
-                result |= int(grid[row, column])
-    return result
+    c0, c1, any_column = _cell_span(left, w, SPRITE_X_AT_COLUMN_0, COLUMNS)
+    r0, r1, any_row = _cell_span(y, h, SPRITE_Y_AT_ROW_0, ROWS)
+    result = np.zeros(np.broadcast(left, c0, r0).shape, dtype=np.int64)
+    for bit in range(8):
+        counts = np.zeros((ROWS + 1, COLUMNS + 1), dtype=np.int64)
+        counts[1:, 1:] = ((grid >> bit) & 1).cumsum(axis=0).cumsum(axis=1)
+        inside = counts[r1 + 1, c1 + 1] - counts[r0, c1 + 1] - counts[r1 + 1, c0] + counts[r0, c0]
+        result |= (inside > 0).astype(np.int64) << bit
+    return _result(np.where(any_column & any_row, result, 0))
 
 
 def mask_bits(rows: bytes | list[int]) -> np.ndarray:

@@ -52,7 +52,7 @@ PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "init", "load"}
 PORT_KEYS = {"at", "size", "values", "table"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays"}
-CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator"}
+CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage"}
 CYCLES_KEYS = {"max", "loops", "limit", "static"}
 
 _LABEL = re.compile(r"^(?P<name>[A-Za-z_@.][\w.:@]*)\s*(?:(?P<sign>[+-])\s*(?P<offset>\S+))?$")
@@ -166,6 +166,7 @@ class Routine:
     limit: int | None = None  # cycles one call may take before it is stopped as a runaway
     static: bool = True
     summary: str = ""
+    coverage: str = ""  # why the cases cover the input space (an argument the report quotes)
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -177,6 +178,13 @@ class Routine:
 
     def in_domain(self, case: tuple) -> bool:
         return all(condition.test(*case) for condition in self.domain)
+
+    def input_space(self) -> int:
+        """Distinct inputs: the product of every input's count of values."""
+        count = 1
+        for port in self.inputs:
+            count *= port.count
+        return count
 
     def exhaustive_count(self) -> int:
         count = 1
@@ -331,6 +339,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     random_count = r.number(cases_doc.get("random", DEFAULT_RANDOM), "cases.random", 0, MAX_RANDOM)
     seed = r.number(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1)
     where = cases_doc.get("where")
+    coverage = r.string(cases_doc, "coverage", "cases.coverage") or ""
     tables = frozenset(p.name for p in inputs if p.table)
     domain = parse_where(where, names, f"{r.source}: cases.where", tables) if where is not None else ()
     generators = {key: load_function(r.string(cases_doc, key, f"cases.{key}"), base, r, f"cases.{key}")
@@ -360,7 +369,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
         reference_name=reference_name, reference_memory=reference_memory, reference_arrays=reference_arrays, exhaustive=tuple(exhaustive),
         random=random_count, seed=seed, domain=domain, boundary=generators.get("boundary"),
         sweep=generators.get("sweep"), random_generator=generators.get("random_generator"), budget=budget,
-        loop_bounds=loop_bounds, limit=limit, static=static, summary=summary)
+        loop_bounds=loop_bounds, limit=limit, static=static, summary=summary, coverage=coverage)
     if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep):
         raise r.fail("cases", "no cases: give random = N, exhaustive = [...], boundary or sweep")
     if routine.exhaustive_count() > MAX_EXHAUSTIVE:
