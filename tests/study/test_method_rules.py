@@ -146,3 +146,31 @@ def test_shapes_for_the_hand_cases_are_what_they_say(hand_shapes):
     assert ind.bounds(block.mask) == (5, 6, 9, 10)
     assert len(ind.pixels(diagonal.mask)) == 10
     assert isinstance(block, Shape)
+
+
+def test_fitted_circles_of_every_corpus_shape():
+    """The fit itself (centre window, tie order, radius), shape by shape, both edge conventions; a
+    lopsided shape whose far pixel sets the radius from the middle column."""
+    from retro.analysis.study.corpus import DEFAULT_SHAPES, load_shapes
+    from retro.analysis.study.fits import fitted_circle
+
+    lopsided = np.zeros((21, 24), dtype=bool)
+    lopsided[10, [2, 3, 4, 5, 20]] = True  # tight box 2-20, middle 11: r = 10 from x = 11, 11 from x = 12
+    shapes = load_shapes(DEFAULT_SHAPES) + [Shape(name="lopsided", mask=lopsided)]
+    for shape in shapes:
+        for touching in (False, True):
+            c = fitted_circle(shape.mask, touching)
+            assert (c.cx, c.cy, c.r) == ind.smallest_circle(shape.mask, touching), (shape.name, touching)
+    assert ind.smallest_circle(lopsided) == (11, 9, 10)
+
+
+def test_user_box_inset_keeps_the_left_middle_pixel(tmp_path):
+    """A 2-px-wide shape with 1 px off each side: nothing would be left; the box keeps the left one of
+    the two middle columns (rounded down)."""
+    from retro.analysis.study.methods.user import load_method_file
+
+    path = tmp_path / "m.toml"
+    path.write_text('[hitbox]\nshape = "box"\ninset = 1\n')
+    mask = np.zeros((21, 24), dtype=bool)
+    mask[5:15, 10:12] = True
+    assert load_method_file(str(path)).box(Shape(name="two", mask=mask)) == (10, 6, 11, 14)
