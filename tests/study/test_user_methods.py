@@ -224,3 +224,21 @@ def test_advise_rejects_a_bad_method_file(tmp_path, capsys):
     path = write(tmp_path, '[hitbox]\nshape = "oval"\n')
     assert main(["advise", "examples/vic_two_balls.toml", "--method", path]) == 2
     assert "hitbox.shape" in capsys.readouterr().err
+
+
+def test_a_user_method_in_the_stability_study():
+    """The shrunk box (1 px in) sees the 4x4 bullet as 2x2: 1 + 2 - 1 positions against a 1 px wall
+    shrunk to its middle column, so it misses above 2 px/frame; on two full sprites it says no where
+    they share one column (its boxes are 1 px in on each side)."""
+    from retro.analysis.study.methods import BUILTIN
+    from retro.analysis.study.stability import edges, tunnelling
+
+    shrunk = load_method_file(str(EXAMPLES / "shrunk_box.toml"))
+    methods = BUILTIN + (shrunk,)
+    bullet = load_shapes(["bullet"])[0]
+    rows = tunnelling.tunnelling_table(bullet, speeds=tuple(range(1, 6)), thicknesses=(1,), methods=methods)
+    assert tunnelling.safe_speed(rows, "shrunk", 1) == 2
+    table = {(r.case, r.test): r.hit for r in edges.edge_table(methods)}
+    cases = list(edges.BOX_CASES)
+    assert [table[(c, "rule: tight box, 1 px in")] for c in cases] == [0.0, 0.0, 0.0]
+    assert [table[(c, "6502 aabb8 (shrunk)")] for c in cases] == [0.0, 0.0, 0.0]
