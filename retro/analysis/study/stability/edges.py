@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from retro.analysis.study.corpus import Pair, Shape, pair_at
+from retro.analysis.study.corpus import Shape, pair_at
 from retro.analysis.study.fits import fitted_circle
 from retro.analysis.study.methods import METHODS, Method
 
