@@ -456,7 +456,8 @@ def check_batch(spec: str, seed: int, columns: list) -> ChunkResult:
     n = len(columns[0]) if not len(stopped) else int(stopped[0])
     full = columns
     columns = [c[:n] for c in columns]
-    cases = case_sets.columns_to_cases(columns) if not routine.reference_arrays or routine.domain else None
+    case_by_case = not routine.reference_arrays or any(c.test_columns is None for c in routine.domain)
+    cases = case_sets.columns_to_cases(columns) if case_by_case else None
     inside = np.ones(n, dtype=bool)
     broken_by: list[np.ndarray] = []
     for condition in routine.domain:

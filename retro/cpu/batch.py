@@ -58,6 +58,12 @@ STACK_PAGE = 0x100
 BYTE = 0xFF
 WORD = 0xFFFF
 MAX_PRIVATE_BYTES = 512 << 20  # per-lane bytes a batch may hold before it must be split
+# A lane whose cycles reach the budget stops there on Machine. Here the budget is looked at when the
+# lowest waiting address is below the last one run (some lanes jumped back: every loop does), every
+# BUDGET_CHECK_EVERY group runs, and when a lane returns (then cycles > budget is the same verdict): a
+# lane past its budget may run a few more instructions, but it is reported as over the budget unless
+# it stops first for another reason (BRK, JAM), which is a run error all the same.
+BUDGET_CHECK_EVERY = 64
 DENSE_AFTER = 24  # a page with more per-lane bytes than this is held as one block
 NZ = FLAG_N | FLAG_Z
 NVZC = FLAG_N | FLAG_V | FLAG_Z | FLAG_C
@@ -136,7 +142,9 @@ class LaneMemory:
         array or slice(None) for every lane)."""
         if isinstance(address, (int, np.integer)):
             row = self.rows.get(int(address))
-            return int(self.shared[address]) if row is None else row[idx]
+            if row is None:
+                return int(self.shared[address])
+            return row.copy() if isinstance(idx, slice) else row[idx]  # never a view: the row may change
         values = self.shared[address].astype(np.int32)
         if self.rows:
             pages = address >> 8
@@ -199,7 +207,64 @@ def _uniform(values):
 
 
 def _nz(p, value):
-    return (p & ~NZ) | (value & FLAG_N) | ((value == 0) * FLAG_Z)
+    return (p & ~NZ) | NZ_TABLE[value]
+
+
+class Lanes:
+    """A group of lanes that stand at one address: their registers as contiguous arrays (no gather or
+    scatter per instruction) and their lane numbers (`ids`, slice(None) for every lane in order),
+    which index the per-lane memory rows."""
+
+    __slots__ = ("cpu", "ids", "a", "x", "y", "p", "sp", "cycles")
+
+    def __init__(self, cpu: "BatchCpu", ids, a, x, y, p, sp, cycles) -> None:
+        self.cpu, self.ids = cpu, ids
+        self.a, self.x, self.y, self.p, self.sp, self.cycles = a, x, y, p, sp, cycles
+
+    def __len__(self) -> int:
+        return len(self.a)
+
+    def take(self, index: np.ndarray) -> "Lanes":
+        """The lanes at these positions of the group, as a group of their own."""
+        ids = index if isinstance(self.ids, slice) else self.ids[index]
+        return Lanes(self.cpu, ids, self.a[index], self.x[index], self.y[index], self.p[index], self.sp[index],
+                     self.cycles[index])
+
+    @staticmethod
+    def join(groups: list["Lanes"]) -> "Lanes":
+        if len(groups) == 1:
+            return groups[0]
+        cpu = groups[0].cpu
+        ids = np.concatenate([cpu.memory.lanes_of(g.ids) for g in groups])
+        return Lanes(cpu, ids, *(np.concatenate([getattr(g, name) for g in groups])
+                                 for name in ("a", "x", "y", "p", "sp", "cycles")))
+
+    def store(self) -> None:
+        """Write the group's registers back to the machine's per-lane arrays."""
+        cpu, ids = self.cpu, self.ids
+        cpu.a[ids], cpu.x[ids], cpu.y[ids], cpu.p[ids], cpu.sp[ids], cpu.cycles[ids] = (
+            self.a, self.x, self.y, self.p, self.sp, self.cycles)
+
+    def stop(self, pc, kind: "LaneError") -> None:
+        self.store()
+        self.cpu.error[self.ids] = kind
+        self.cpu.error_pc[self.ids] = pc
+
+    # memory, for these lanes
+    def read(self, address):
+        return self.cpu.memory.read(self.ids, address)
+
+    def write(self, address, value) -> None:
+        self.cpu.memory.write(self.ids, address, value)
+
+    def push(self, value) -> None:
+        sp = self.sp
+        self.write(STACK_PAGE | _uniform(sp), value)
+        self.sp = (sp - 1) & BYTE
+
+    def pull(self):
+        self.sp = (self.sp + 1) & BYTE
+        return self.read(STACK_PAGE | _uniform(self.sp))
 
 
 class BatchCpu:
@@ -224,126 +289,119 @@ class BatchCpu:
         self.error_pc = zeros.copy()
         self.instructions = 0  # group executions (one instruction run by a group of lanes)
 
+    def _everyone(self) -> Lanes:
+        return Lanes(self, slice(None), self.a.copy(), self.x.copy(), self.y.copy(), self.p.copy(), self.sp.copy(),
+                     self.cycles.copy())
+
     # ---- running -------------------------------------------------------------------------------
 
     def call(self, entry: int, budget: int, return_pc: int, return_sp: int) -> None:
         """Run every lane from entry until it stands at return_pc with S = return_sp (the caller has
         pushed the return address and set S), or stops with an error. Cycles count from entry."""
-        every = slice(None)
-        pending: dict[int, list] = {entry: [every]}
-        lanes_of = self.memory.lanes_of
+        pending: dict[int, list[Lanes]] = {entry: [self._everyone()]}
+        runs = 0
+        last_pc = -1
         while pending:
             pc = min(pending)
-            parts = pending.pop(pc)
-            idx = parts[0] if len(parts) == 1 else np.concatenate([lanes_of(part) for part in parts])
-            if not isinstance(idx, slice) and len(idx) == self.lanes:
-                idx = every  # every lane: slices index without copying
+            group = Lanes.join(pending.pop(pc))
             if pc == return_pc:
-                home = self.sp[idx] == return_sp
+                home = group.sp == return_sp
                 if home.any():
-                    lanes = lanes_of(idx)
-                    done = lanes[home]
-                    self.pc[done] = pc
-                    self._stop(done[self.cycles[done] > budget], pc, LaneError.BUDGET)
-                    idx = lanes[~home]
-                    if not len(idx):
+                    done = group.take(np.flatnonzero(home))
+                    done.store()
+                    self.pc[done.ids] = pc
+                    late = np.flatnonzero(done.cycles > budget)
+                    if len(late):
+                        done.take(late).stop(pc, LaneError.BUDGET)
+                    if home.all():
                         continue
-            spent = self.cycles[idx] >= budget
-            if spent.any():
-                lanes = lanes_of(idx)
-                self._stop(lanes[spent], pc, LaneError.BUDGET)
-                idx = lanes[~spent]
-                if not len(idx):
-                    continue
-            for target, lanes in self._run_at(idx, pc):
-                if isinstance(target, int):
-                    pending.setdefault(target, []).append(lanes)
-                else:
-                    lanes = lanes_of(lanes)
-                    order = np.argsort(target, kind="stable")
-                    ordered = target[order]
-                    starts = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]])
-                    for start, end in zip(starts, np.r_[starts[1:], len(ordered)]):
-                        pending.setdefault(int(ordered[start]), []).append(lanes[order[start:end]])
+                    group = group.take(np.flatnonzero(~home))
+            runs += 1
+            backward, last_pc = pc < last_pc, pc
+            if backward or runs % BUDGET_CHECK_EVERY == 0:  # a loop jumps back: runaways are caught here
+                spent = group.cycles >= budget
+                if spent.any():
+                    group.take(np.flatnonzero(spent)).stop(pc, LaneError.BUDGET)
+                    if spent.all():
+                        continue
+                    group = group.take(np.flatnonzero(~spent))
+            for target, lanes in self._run_at(group, pc):
+                for where, part in _by_address(target, lanes):
+                    pending.setdefault(where, []).append(part)
 
     def step(self) -> None:
         """Run one instruction on every lane from its own PC (for single-step test vectors)."""
-        pc = _uniform(self.pc)
-        for target, lanes in self._run_at(slice(None), pc):
-            self.pc[lanes] = target
+        for target, lanes in self._run_at(self._everyone(), _uniform(self.pc)):
+            lanes.store()
+            self.pc[lanes.ids] = target
 
-    def _stop(self, idx, pc, kind: LaneError) -> None:
-        if isinstance(idx, slice) or len(idx):
-            self.error[idx] = kind
-            self.error_pc[idx] = pc
-
-    def _run_at(self, idx: np.ndarray, pc):
-        """Run the instruction at pc (an int, or per-lane) for the lanes idx; yield (next pc, lanes)."""
+    def _run_at(self, group: Lanes, pc):
+        """Run the instruction at pc (an int, or per-lane) for a group; yield (next pc, lanes)."""
         memory = self.memory
         if isinstance(pc, int) and not memory.is_private[pc >> 8] and not memory.is_private[((pc + 2) & WORD) >> 8]:
             shared = memory.shared
-            yield from self._dispatch(int(shared[pc]), idx, pc, int(shared[(pc + 1) & WORD]),
+            yield from self._dispatch(int(shared[pc]), group, pc, int(shared[(pc + 1) & WORD]),
                                       int(shared[(pc + 2) & WORD]))
             return
-        opcodes = _uniform(memory.read(idx, pc))
-        lo = _uniform(memory.read(idx, (pc + 1) & WORD))
-        hi = _uniform(memory.read(idx, (pc + 2) & WORD))
+        opcodes = _uniform(group.read(pc))
+        lo = _uniform(group.read((pc + 1) & WORD))
+        hi = _uniform(group.read((pc + 2) & WORD))
         if isinstance(opcodes, int):
-            yield from self._dispatch(opcodes, idx, pc, lo, hi)
+            yield from self._dispatch(opcodes, group, pc, lo, hi)
             return
-        lanes = memory.lanes_of(idx)
         for opcode in np.unique(opcodes).tolist():
-            hit = opcodes == opcode
-            yield from self._dispatch(opcode, lanes[hit], _uniform(pc if isinstance(pc, int) else pc[hit]),
+            hit = np.flatnonzero(opcodes == opcode)
+            yield from self._dispatch(opcode, group.take(hit), _uniform(pc if isinstance(pc, int) else pc[hit]),
                                       _uniform(lo if isinstance(lo, int) else lo[hit]),
                                       _uniform(hi if isinstance(hi, int) else hi[hit]))
 
-    def _dispatch(self, opcode: int, idx: np.ndarray, pc, lo, hi):
+    def _dispatch(self, opcode: int, group: Lanes, pc, lo, hi):
         self.instructions += 1
         handler = HANDLERS.get(opcode)
         if handler is None:
-            self._stop(idx, pc, LaneError.JAM if opcode in JAM_OPCODES else LaneError.UNSTABLE)
+            group.stop(pc, LaneError.JAM if opcode in JAM_OPCODES else LaneError.UNSTABLE)
             return
-        result = handler(self, idx, pc, lo, hi)
+        result = handler(group, pc, lo, hi)
         if isinstance(result, list):
             yield from result
         else:
-            yield result, idx
-
-    # ---- lane state helpers --------------------------------------------------------------------
+            yield result, group
 
     def read(self, address: int) -> np.ndarray:
         """Every lane's byte at address."""
         value = self.memory.read(slice(None), address)
         return np.full(self.lanes, value, dtype=np.int32) if isinstance(value, int) else value.copy()
 
-    def push(self, idx, value) -> None:
-        sp = self.sp[idx]
-        self.memory.write(idx, STACK_PAGE | _uniform(sp), value)
-        self.sp[idx] = (sp - 1) & BYTE
 
-    def pull(self, idx):
-        sp = (self.sp[idx] + 1) & BYTE
-        self.sp[idx] = sp
-        return self.memory.read(idx, STACK_PAGE | _uniform(sp))
+def _by_address(target, lanes: Lanes):
+    """(address, lanes) for one next address, or per distinct address of a per-lane array."""
+    if isinstance(target, int):
+        yield target, lanes
+        return
+    order = np.argsort(target, kind="stable")
+    ordered = target[order]
+    starts = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]])
+    for start, end in zip(starts.tolist(), np.r_[starts[1:], len(ordered)].tolist()):
+        yield int(ordered[start]), lanes.take(order[start:end])
 
 
 # ---- operand addresses ---------------------------------------------------------------------------------
-# Each returns (address, crossed): crossed is whether indexing moved the address into another page.
+# Each returns (address, crossed) for a group: crossed is whether indexing moved the address into
+# another page (an int or per-lane array address; a bool or per-lane bools).
 
-def _zpg(cpu, idx, lo, hi):
+def _zpg(g, lo, hi):
     return lo, False
 
 
-def _zpx(cpu, idx, lo, hi):
-    return (lo + cpu.x[idx]) & BYTE, False
+def _zpx(g, lo, hi):
+    return (lo + g.x) & BYTE, False
 
 
-def _zpy(cpu, idx, lo, hi):
-    return (lo + cpu.y[idx]) & BYTE, False
+def _zpy(g, lo, hi):
+    return (lo + g.y) & BYTE, False
 
 
-def _abs(cpu, idx, lo, hi):
+def _abs(g, lo, hi):
     return lo | hi << 8, False
 
 
@@ -352,24 +410,22 @@ def _indexed(base, index):
     return address, (base & PAGE_MASK) != (address & PAGE_MASK)
 
 
-def _abx(cpu, idx, lo, hi):
-    return _indexed(lo | hi << 8, cpu.x[idx])
+def _abx(g, lo, hi):
+    return _indexed(lo | hi << 8, g.x)
 
 
-def _aby(cpu, idx, lo, hi):
-    return _indexed(lo | hi << 8, cpu.y[idx])
+def _aby(g, lo, hi):
+    return _indexed(lo | hi << 8, g.y)
 
 
-def _inx(cpu, idx, lo, hi):
-    pointer = _uniform((lo + cpu.x[idx]) & BYTE)
-    read = cpu.memory.read
-    return _uniform(read(idx, pointer) | read(idx, (pointer + 1) & BYTE) << 8), False
+def _inx(g, lo, hi):
+    pointer = _uniform((lo + g.x) & BYTE)
+    return _uniform(g.read(pointer) | g.read((pointer + 1) & BYTE) << 8), False
 
 
-def _iny(cpu, idx, lo, hi):
-    read = cpu.memory.read
-    base = _uniform(read(idx, lo) | read(idx, (lo + 1) & BYTE) << 8)
-    return _indexed(base, cpu.y[idx])
+def _iny(g, lo, hi):
+    base = _uniform(g.read(lo) | g.read((lo + 1) & BYTE) << 8)
+    return _indexed(base, g.y)
 
 
 ADDRESSING = {"zpg": _zpg, "zpx": _zpx, "zpy": _zpy, "abs": _abs, "abx": _abx, "aby": _aby,
@@ -378,20 +434,39 @@ ADDRESSING = {"zpg": _zpg, "zpx": _zpx, "zpy": _zpy, "abs": _abs, "abx": _abx, "
 
 # ---- arithmetic ------------------------------------------------------------------------------------------
 
-def _binary_adc(a, value, p):
-    total = a + value + (p & FLAG_C)
+def _adc_table() -> np.ndarray:
+    """Binary ADC of every (A, operand, carry): result | (N V Z C) << 8, indexed A << 9 | operand << 1 | C."""
+    a, value, carry = (axis.ravel() for axis in np.meshgrid(np.arange(256), np.arange(256), np.arange(2), indexing="ij"))
+    total = a + value + carry
     result = total & BYTE
     overflow = (~(a ^ value) & (a ^ result) & 0x80) != 0
-    return result, ((p & ~NVZC) | (result & FLAG_N) | (overflow * FLAG_V) | ((result == 0) * FLAG_Z)
-                    | (total > BYTE) * FLAG_C)
+    flags = (result & FLAG_N) | overflow * FLAG_V | (result == 0) * FLAG_Z | (total > BYTE) * FLAG_C
+    return (result | flags << 8).astype(np.int32)
 
 
-def _adc(cpu, idx, a, value, p):
+def _compare_table() -> np.ndarray:
+    """N Z C of CMP for every (register, operand), indexed register << 8 | operand."""
+    register, value = (axis.ravel() for axis in np.meshgrid(np.arange(256), np.arange(256), indexing="ij"))
+    difference = (register - value) & BYTE
+    return ((difference & FLAG_N) | (difference == 0) * FLAG_Z | (register >= value) * FLAG_C).astype(np.int32)
+
+
+ADC_TABLE = _adc_table()
+COMPARE_TABLE = _compare_table()
+NZ_TABLE = np.array([(v & FLAG_N) | (v == 0) * FLAG_Z for v in range(256)], dtype=np.int32)
+
+
+def _binary_adc(a, value, p):
+    packed = ADC_TABLE[(a << 9) | (value << 1) | (p & FLAG_C)]
+    return packed & BYTE, (p & ~NVZC) | (packed >> 8)
+
+
+def _adc(g, a, value, p):
     """(A, P) after ADC: binary, or NMOS decimal for lanes with D set on a CPU that has it."""
     carry = p & FLAG_C
     total = a + value + carry
     result, flags = _binary_adc(a, value, p)
-    if not cpu.decimal:
+    if not g.cpu.decimal:
         return result, flags
     decimal = (p & FLAG_D) != 0
     if not np.any(decimal):
@@ -409,10 +484,10 @@ def _adc(cpu, idx, a, value, p):
     return np.where(decimal, dec_result, result), np.where(decimal, dec_flags, flags)
 
 
-def _sbc(cpu, idx, a, value, p):
+def _sbc(g, a, value, p):
     """(A, P) after SBC: flags from the binary difference in both modes (NMOS); A decimal-adjusted."""
     result, flags = _binary_adc(a, value ^ BYTE, p)
-    if not cpu.decimal:
+    if not g.cpu.decimal:
         return result, flags
     decimal = (p & FLAG_D) != 0
     if not np.any(decimal):
@@ -426,8 +501,7 @@ def _sbc(cpu, idx, a, value, p):
 
 
 def _compare(register, value, p):
-    difference = register - value
-    return (_nz(p, difference & BYTE) & ~FLAG_C) | (difference >= 0) * FLAG_C
+    return (p & ~(NZ | FLAG_C)) | COMPARE_TABLE[(register << 8) | value]
 
 
 def _asl(value, p):
@@ -464,8 +538,9 @@ SHIFTS = {"ASL": _asl, "LSR": _lsr, "ROL": _rol, "ROR": _ror, "INC": _inc, "DEC"
 
 
 # ---- handlers -------------------------------------------------------------------------------------------
-# A handler runs one opcode for the lanes idx (pc, lo, hi: ints or per-lane arrays), adds its cycles and
-# returns the next PC (an int or per-lane array) or a list of (next pc, lanes).
+# A handler runs one opcode for a group of lanes (pc, lo, hi: ints or per-lane arrays), adds its cycles
+# and returns the next PC (an int or per-lane array) or a list of (next pc, lanes). Registers are
+# rebound, never changed in place (two registers may share one array after a transfer).
 
 Handler = Callable[..., object]
 
@@ -474,85 +549,111 @@ def _next(pc, length: int):
     return (pc + length) & WORD
 
 
-def _add_cycles(cpu, idx, base: int, crossed, penalised: bool) -> None:
-    if penalised and not (crossed is False):
-        cpu.cycles[idx] += base + np.asarray(crossed, dtype=np.int64) * PAGE_CROSS_CYCLES
+def _full(g, value) -> np.ndarray:
+    """A per-lane register value (a constant becomes one per lane)."""
+    if isinstance(value, (int, np.integer)):
+        return np.full(len(g), value, dtype=np.int32)
+    return value
+
+
+def _add_cycles(g, base: int, crossed, penalised: bool) -> None:
+    if penalised and crossed is not False:
+        g.cycles += base + np.asarray(crossed, dtype=np.int64) * PAGE_CROSS_CYCLES
     else:
-        cpu.cycles[idx] += base
+        g.cycles += base
+
+
+def _operation(mnemonic: str):
+    """What a reading instruction does with its operand value, as fn(group, value)."""
+    if mnemonic in ("LDA", "LDX", "LDY", "LAX"):
+        def load(g, value):
+            value = _full(g, value)
+            if mnemonic in ("LDA", "LAX"):
+                g.a = value
+            if mnemonic in ("LDX", "LAX"):
+                g.x = value
+            if mnemonic == "LDY":
+                g.y = value
+            g.p = _nz(g.p, value)
+        return load
+    if mnemonic in ("ORA", "AND", "EOR"):
+        combine = {"ORA": np.bitwise_or, "AND": np.bitwise_and, "EOR": np.bitwise_xor}[mnemonic]
+
+        def logic(g, value):
+            g.a = combine(g.a, value)
+            g.p = _nz(g.p, g.a)
+        return logic
+    if mnemonic == "ADC":
+        def add(g, value):
+            g.a, g.p = _adc(g, g.a, value, g.p)
+        return add
+    if mnemonic in ("SBC", "USBC"):
+        def subtract(g, value):
+            g.a, g.p = _sbc(g, g.a, value, g.p)
+        return subtract
+    if mnemonic in ("CMP", "CPX", "CPY"):
+        register = {"CMP": "a", "CPX": "x", "CPY": "y"}[mnemonic]
+
+        def compare(g, value):
+            g.p = _compare(getattr(g, register), value, g.p)
+        return compare
+    if mnemonic == "BIT":
+        def bit(g, value):
+            g.p = ((g.p & ~(FLAG_N | FLAG_V | FLAG_Z)) | (value & (FLAG_N | FLAG_V)) | (((g.a & value) == 0) * FLAG_Z))
+        return bit
+    if mnemonic == "ANC":
+        def anc(g, value):
+            g.a = g.a & value
+            g.p = (_nz(g.p, g.a) & ~FLAG_C) | (g.a >> 7)
+        return anc
+    if mnemonic == "ALR":
+        def alr(g, value):
+            g.a, g.p = _lsr(g.a & value, g.p)
+        return alr
+    if mnemonic == "ARR":
+        def arr(g, value):
+            g.a, g.p = _arr(g, g.a & value, g.p)
+        return arr
+    if mnemonic == "SBX":
+        def sbx(g, value):
+            both = g.a & g.x
+            g.x = (both - value) & BYTE
+            g.p = _compare(both, value, g.p)
+        return sbx
+    if mnemonic == "NOP":
+        return lambda g, value: None
+    raise AssertionError(mnemonic)  # pragma: no cover - READS lists only the mnemonics handled here
 
 
 def _make_read(opcode: int, mnemonic: str, mode: str, cycles: int, penalised: bool, length: int) -> Handler:
     """Instructions that read an operand (immediate or memory) and change registers and flags."""
     address_of = ADDRESSING.get(mode)
-
-    def operate(cpu, idx, value):
-        a = cpu.a
-        p = cpu.p[idx]
-        if mnemonic in ("LDA", "LDX", "LDY", "LAX"):
-            if mnemonic in ("LDA", "LAX"):
-                a[idx] = value
-            if mnemonic in ("LDX", "LAX"):
-                cpu.x[idx] = value
-            if mnemonic == "LDY":
-                cpu.y[idx] = value
-            cpu.p[idx] = _nz(p, value)
-        elif mnemonic in ("ORA", "AND", "EOR"):
-            result = {"ORA": a[idx] | value, "AND": a[idx] & value, "EOR": a[idx] ^ value}[mnemonic]
-            a[idx] = result
-            cpu.p[idx] = _nz(p, result)
-        elif mnemonic == "ADC":
-            a[idx], cpu.p[idx] = _adc(cpu, idx, a[idx], value, p)
-        elif mnemonic in ("SBC", "USBC"):
-            a[idx], cpu.p[idx] = _sbc(cpu, idx, a[idx], value, p)
-        elif mnemonic in ("CMP", "CPX", "CPY"):
-            register = {"CMP": a, "CPX": cpu.x, "CPY": cpu.y}[mnemonic][idx]
-            cpu.p[idx] = _compare(register, value, p)
-        elif mnemonic == "BIT":
-            cpu.p[idx] = ((p & ~(FLAG_N | FLAG_V | FLAG_Z)) | (value & (FLAG_N | FLAG_V))
-                          | (((a[idx] & value) == 0) * FLAG_Z))
-        elif mnemonic == "ANC":
-            result = a[idx] & value
-            a[idx] = result
-            cpu.p[idx] = (_nz(p, result) & ~FLAG_C) | (result >> 7)
-        elif mnemonic == "ALR":
-            a[idx], cpu.p[idx] = _lsr(a[idx] & value, p)
-        elif mnemonic == "ARR":
-            a[idx], cpu.p[idx] = _arr(cpu, a[idx] & value, p)
-        elif mnemonic == "SBX":
-            both = a[idx] & cpu.x[idx]
-            cpu.x[idx] = (both - value) & BYTE
-            cpu.p[idx] = _compare(both, value, p)
-        elif mnemonic == "NOP":
-            pass
-        else:  # pragma: no cover - the table below lists only the mnemonics handled here
-            raise AssertionError(mnemonic)
-
+    operate = _operation(mnemonic)
     if mode == "imm":
-        def handler(cpu, idx, pc, lo, hi):
-            operate(cpu, idx, lo)
-            cpu.cycles[idx] += cycles
+        def handler(g, pc, lo, hi):
+            operate(g, lo)
+            g.cycles += cycles
             return _next(pc, length)
     elif mode == "imp":  # the undocumented one-byte NOPs
-        def handler(cpu, idx, pc, lo, hi):
-            cpu.cycles[idx] += cycles
+        def handler(g, pc, lo, hi):
+            g.cycles += cycles
             return _next(pc, length)
     else:
-        def handler(cpu, idx, pc, lo, hi):
-            address, crossed = address_of(cpu, idx, lo, hi)
-            address = _uniform(address)
-            operate(cpu, idx, cpu.memory.read(idx, address))
-            _add_cycles(cpu, idx, cycles, crossed, penalised)
+        def handler(g, pc, lo, hi):
+            address, crossed = address_of(g, lo, hi)
+            operate(g, g.read(_uniform(address)))
+            _add_cycles(g, cycles, crossed, penalised)
             return _next(pc, length)
     return handler
 
 
-def _arr(cpu, value, p):
+def _arr(g, value, p):
     """ARR: AND then ROR A with its own flags (No More Secrets, "ARR"; decimal mode as 64doc)."""
     carry = p & FLAG_C
     result = (value >> 1) | (carry << 7)
     flags = ((p & ~NVZC) | (result & FLAG_N) | ((result == 0) * FLAG_Z) | ((result >> 6) & 1) * FLAG_C
              | (((result >> 6) ^ (result >> 5)) & 1) * FLAG_V)
-    if not cpu.decimal:
+    if not g.cpu.decimal:
         return result, flags
     decimal = (p & FLAG_D) != 0
     if not np.any(decimal):
@@ -569,19 +670,12 @@ def _arr(cpu, value, p):
 
 def _make_store(mnemonic: str, mode: str, cycles: int, length: int) -> Handler:
     address_of = ADDRESSING[mode]
+    source = {"STA": lambda g: g.a, "STX": lambda g: g.x, "STY": lambda g: g.y, "SAX": lambda g: g.a & g.x}[mnemonic]
 
-    def handler(cpu, idx, pc, lo, hi):
-        address, _ = address_of(cpu, idx, lo, hi)
-        if mnemonic == "STA":
-            value = cpu.a[idx]
-        elif mnemonic == "STX":
-            value = cpu.x[idx]
-        elif mnemonic == "STY":
-            value = cpu.y[idx]
-        else:  # SAX
-            value = cpu.a[idx] & cpu.x[idx]
-        cpu.memory.write(idx, _uniform(address), value)
-        cpu.cycles[idx] += cycles
+    def handler(g, pc, lo, hi):
+        address, _ = address_of(g, lo, hi)
+        g.write(_uniform(address), source(g))
+        g.cycles += cycles
         return _next(pc, length)
     return handler
 
@@ -594,42 +688,23 @@ COMBINED = {"SLO": ("ASL", "ORA"), "RLA": ("ROL", "AND"), "SRE": ("LSR", "EOR"),
 def _make_rmw(mnemonic: str, mode: str, cycles: int, length: int) -> Handler:
     shift, then = COMBINED.get(mnemonic, (mnemonic, None))
     change = SHIFTS[shift]
+    operate = _operation(then) if then is not None else None
     if mode == "acc":
-        def handler(cpu, idx, pc, lo, hi):
-            cpu.a[idx], cpu.p[idx] = change(cpu.a[idx], cpu.p[idx])
-            cpu.cycles[idx] += cycles
+        def handler(g, pc, lo, hi):
+            g.a, g.p = change(g.a, g.p)
+            g.cycles += cycles
             return _next(pc, length)
         return handler
     address_of = ADDRESSING[mode]
 
-    def handler(cpu, idx, pc, lo, hi):
-        address, _ = address_of(cpu, idx, lo, hi)
+    def handler(g, pc, lo, hi):
+        address, _ = address_of(g, lo, hi)
         address = _uniform(address)
-        memory = cpu.memory
-        value = memory.read(idx, address)
-        p = cpu.p[idx]
-        result, p = change(value, p)
-        memory.write(idx, address, result)
-        if then is not None:
-            a = cpu.a[idx]
-            if then == "ORA":
-                a = a | result
-                p = _nz(p, a)
-            elif then == "AND":
-                a = a & result
-                p = _nz(p, a)
-            elif then == "EOR":
-                a = a ^ result
-                p = _nz(p, a)
-            elif then == "ADC":
-                a, p = _adc(cpu, idx, a, result, p)
-            elif then == "SBC":
-                a, p = _sbc(cpu, idx, a, result, p)
-            else:  # CMP
-                p = _compare(a, result, p)
-            cpu.a[idx] = a
-        cpu.p[idx] = p
-        cpu.cycles[idx] += cycles
+        result, g.p = change(g.read(address), g.p)
+        g.write(address, result)
+        if operate is not None:
+            operate(g, result)
+        g.cycles += cycles
         return _next(pc, length)
     return handler
 
@@ -638,103 +713,122 @@ def _make_branch(opcode: int, cycles: int) -> Handler:
     flag, wanted = BRANCH_CONDITIONS[opcode]
     extra_taken = BRANCH_TAKEN_CYCLES
 
-    def handler(cpu, idx, pc, lo, hi):
-        taken = ((cpu.p[idx] & flag) != 0) == bool(wanted)
+    def handler(g, pc, lo, hi):
+        flags = g.p & flag
+        taken = flags.astype(bool) if wanted else flags == 0
         following = (pc + 2) & WORD
         target = (following + _signed(lo)) & WORD
         crossed = (following & PAGE_MASK) != (target & PAGE_MASK)
-        cpu.cycles[idx] += cycles + taken * (extra_taken + crossed * BRANCH_PAGE_CYCLES)
+        g.cycles += cycles
         if isinstance(target, int) and isinstance(following, int):
-            if taken.all():
+            jump = np.flatnonzero(taken)
+            extra = extra_taken + crossed * BRANCH_PAGE_CYCLES
+            if len(jump) == len(taken):
+                g.cycles += extra
                 return target
-            if not taken.any():
+            if not len(jump):
                 return following
-            lanes = cpu.memory.lanes_of(idx)
-            return [(target, lanes[taken]), (following, lanes[~taken])]
+            stay = np.ones(len(taken), dtype=bool)
+            stay[jump] = False
+            jumped = g.take(jump)
+            jumped.cycles += extra
+            return [(target, jumped), (following, g.take(np.flatnonzero(stay)))]
+        g.cycles += taken * (extra_taken + crossed * BRANCH_PAGE_CYCLES)
         return np.where(taken, target, following)
     return handler
 
 
+FLAG_BITS = {"C": FLAG_C, "I": FLAG_I, "V": FLAG_V, "D": FLAG_D}
+
+
 def _implied(mnemonic: str, cycles: int) -> Handler:
-    def handler(cpu, idx, pc, lo, hi):
-        p = cpu.p
-        if mnemonic in ("CLC", "SEC", "CLI", "SEI", "CLV", "CLD", "SED"):
-            bit = {"C": FLAG_C, "I": FLAG_I, "V": FLAG_V, "D": FLAG_D}[mnemonic[2]]
-            p[idx] = (p[idx] | bit) if mnemonic[0] == "S" else (p[idx] & ~bit)
-        elif mnemonic in ("TAX", "TAY", "TXA", "TYA", "TSX"):
-            source = {"A": cpu.a, "X": cpu.x, "Y": cpu.y, "S": cpu.sp}[mnemonic[1]][idx]
-            target = {"A": cpu.a, "X": cpu.x, "Y": cpu.y}[mnemonic[2]]
-            target[idx] = source
-            p[idx] = _nz(p[idx], source)
-        elif mnemonic == "TXS":
-            cpu.sp[idx] = cpu.x[idx]
-        elif mnemonic in ("INX", "INY", "DEX", "DEY"):
-            register = cpu.x if mnemonic[2] == "X" else cpu.y
-            value = (register[idx] + (1 if mnemonic[0] == "I" else -1)) & BYTE
-            register[idx] = value
-            p[idx] = _nz(p[idx], value)
-        cpu.cycles[idx] += cycles
+    if mnemonic in ("CLC", "SEC", "CLI", "SEI", "CLV", "CLD", "SED"):
+        bit = FLAG_BITS[mnemonic[2]]
+        setting = mnemonic[0] == "S"
+
+        def operate(g):
+            g.p = (g.p | bit) if setting else (g.p & ~bit)
+    elif mnemonic in ("TAX", "TAY", "TXA", "TYA", "TSX"):
+        source = {"A": "a", "X": "x", "Y": "y", "S": "sp"}[mnemonic[1]]
+        target = {"A": "a", "X": "x", "Y": "y"}[mnemonic[2]]
+
+        def operate(g):
+            value = getattr(g, source)
+            setattr(g, target, value)
+            g.p = _nz(g.p, value)
+    elif mnemonic == "TXS":
+        def operate(g):
+            g.sp = g.x
+    else:  # INX INY DEX DEY
+        register = "x" if mnemonic[2] == "X" else "y"
+        step = 1 if mnemonic[0] == "I" else -1
+
+        def operate(g):
+            value = (getattr(g, register) + step) & BYTE
+            setattr(g, register, value)
+            g.p = _nz(g.p, value)
+
+    def handler(g, pc, lo, hi):
+        operate(g)
+        g.cycles += cycles
         return _next(pc, 1)
     return handler
 
 
 def _stack(mnemonic: str, cycles: int) -> Handler:
-    def handler(cpu, idx, pc, lo, hi):
+    def handler(g, pc, lo, hi):
         if mnemonic == "PHA":
-            cpu.push(idx, cpu.a[idx])
+            g.push(g.a)
         elif mnemonic == "PHP":
-            cpu.push(idx, cpu.p[idx] | FLAG_B | FLAG_U)
+            g.push(g.p | FLAG_B | FLAG_U)
         elif mnemonic == "PLA":
-            value = cpu.pull(idx)
-            cpu.a[idx] = value
-            cpu.p[idx] = _nz(cpu.p[idx], value)
+            g.a = _full(g, g.pull())
+            g.p = _nz(g.p, g.a)
         else:  # PLP: B and bit 5 exist only in pushed copies
-            cpu.p[idx] = (cpu.pull(idx) | FLAG_U) & ~FLAG_B
-        cpu.cycles[idx] += cycles
+            g.p = _full(g, (g.pull() | FLAG_U) & ~FLAG_B)
+        g.cycles += cycles
         return _next(pc, 1)
     return handler
 
 
 def _jump(mnemonic: str, mode: str, cycles: int) -> Handler:
-    def handler(cpu, idx, pc, lo, hi):
-        cpu.cycles[idx] += cycles
+    def handler(g, pc, lo, hi):
+        g.cycles += cycles
         if mnemonic == "JMP":
             pointer = lo | hi << 8
             if mode == "abs":
                 return pointer
             # NMOS: the high byte comes from the start of the pointer's page when the pointer ends one
             high_address = (pointer & PAGE_MASK) | ((pointer + 1) & BYTE)
-            read = cpu.memory.read
-            return _uniform(read(idx, pointer) | read(idx, _uniform(high_address)) << 8)
+            return _uniform(g.read(pointer) | g.read(_uniform(high_address)) << 8)
         if mnemonic == "JSR":
             back = (pc + 2) & WORD
-            cpu.push(idx, back >> 8)
-            cpu.push(idx, back & BYTE)
+            g.push(back >> 8)
+            g.push(back & BYTE)
             return lo | hi << 8
         if mnemonic == "RTS":
-            low = cpu.pull(idx)
-            return _uniform(((cpu.pull(idx) << 8 | low) + 1) & WORD)
+            low = g.pull()
+            return _uniform(((g.pull() << 8 | low) + 1) & WORD)
         if mnemonic == "RTI":
-            cpu.p[idx] = (cpu.pull(idx) | FLAG_U) & ~FLAG_B
-            low = cpu.pull(idx)
-            return _uniform(cpu.pull(idx) << 8 | low)
+            g.p = _full(g, (g.pull() | FLAG_U) & ~FLAG_B)
+            low = g.pull()
+            return _uniform(g.pull() << 8 | low)
         raise AssertionError(mnemonic)  # pragma: no cover
     return handler
 
 
 def _brk(cycles: int) -> Handler:
-    def handler(cpu, idx, pc, lo, hi):
-        if cpu.stop_on_brk:
-            cpu._stop(idx, pc, LaneError.BRK)
+    def handler(g, pc, lo, hi):
+        if g.cpu.stop_on_brk:
+            g.stop(pc, LaneError.BRK)
             return []
         back = (pc + 2) & WORD
-        cpu.push(idx, back >> 8)
-        cpu.push(idx, back & BYTE)
-        cpu.push(idx, cpu.p[idx] | FLAG_B | FLAG_U)
-        cpu.p[idx] = cpu.p[idx] | FLAG_I
-        cpu.cycles[idx] += cycles
-        read = cpu.memory.read
-        return _uniform(read(idx, IRQ_VECTOR) | read(idx, IRQ_VECTOR + 1) << 8)
+        g.push(back >> 8)
+        g.push(back & BYTE)
+        g.push(g.p | FLAG_B | FLAG_U)
+        g.p = g.p | FLAG_I
+        g.cycles += cycles
+        return _uniform(g.read(IRQ_VECTOR) | g.read(IRQ_VECTOR + 1) << 8)
     return handler
 
 
