@@ -119,7 +119,7 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
     md.append("\n![wrap](wrap.png)\n\n")
     pal9 = next(r for r in wrap_rows if r.video == "pal" and r.test.startswith("9-bit"))
     summary.append(f"wrap: on PAL a 9-bit box test disagrees with the chip in {pal9.software_only + pal9.hardware_only} "
-                   "of 262,144 X pairs (X $1F8-$1FF and the wrap to 0)")
+                   "of 262,144 X pairs (see wrap.png)")
 
     # Arithmetic range
     progress("stability: arithmetic range")
