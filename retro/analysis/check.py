@@ -287,6 +287,7 @@ def check_chunk(spec: str, seed: int, chunk: list[tuple], start: SceneStart | No
     name = routine.name
     read = runner.machine.memory.__getitem__
     out = ChunkResult()
+    answers = None
     for i, case in enumerate(chunk):
         steps: list = []
         try:
@@ -303,7 +304,18 @@ def check_chunk(spec: str, seed: int, chunk: list[tuple], start: SceneStart | No
             _compare_engines(out, routine, case, against, i, answer, cycles)
         broken = [c.text for c in routine.domain if not c.test(*case)]
         try:
-            expected = expected_outputs(routine, case, runner.memory_values)
+            if routine.reference_arrays:  # the whole chunk in one call, as the batched core asks it
+                if answers is None:
+                    columns = case_sets.cases_to_columns(routine, chunk)
+                    inside = np.ones(len(chunk), dtype=bool)
+                    for condition in routine.domain:
+                        inside &= condition.over(columns, chunk)
+                    answers, answered = expected_columns(routine, columns, chunk, runner.memory_values, inside)
+                if not answered[i]:
+                    raise InputError("outside the domain, the reference gave no answer")
+                expected = tuple(tuple(a[i].tolist()) if a.ndim == 2 else int(a[i]) for a in answers)
+            else:
+                expected = expected_outputs(routine, case, runner.memory_values)
         except InputError:
             if not broken:
                 raise
@@ -380,9 +392,14 @@ def agreement_chunk(spec: str, seed: int, chunk: list[tuple]) -> ChunkResult:
     return check_chunk(spec, seed, chunk, None, outcome)
 
 
-def expected_columns(routine: Routine, columns: list, cases: list[tuple] | None, memory: dict) -> list[np.ndarray]:
-    """The reference's answers for a block of cases, one array per output (a table: (n, bytes))."""
+def expected_columns(routine: Routine, columns: list, cases: list[tuple] | None, memory: dict,
+                     inside: np.ndarray | None = None) -> tuple[list[np.ndarray], np.ndarray]:
+    """The reference's answers for a block of cases, one array per output (a table: (n, bytes)), and
+    which cases it answered: outside the domain (`inside` False) it may refuse a case or answer out of
+    range; inside, that is a one-line error."""
     n = len(columns[0])
+    inside = np.ones(n, dtype=bool) if inside is None else inside
+    answerable = np.ones(n, dtype=bool)
     if routine.reference_arrays:
         arguments = dict(zip(routine.input_names, columns))
         arguments.update({name: memory[name] for name in routine.reference_memory})
@@ -415,34 +432,32 @@ def expected_columns(routine: Routine, columns: list, cases: list[tuple] | None,
                 raise InputError(f"{where} returned {array.dtype} of shape {array.shape} for {port.name}: expected "
                                  f"whole numbers of shape {shape}")
             limit = 1 << port.bits
-            if array.size and (array.min() < 0 or array.max() >= limit):
-                raise InputError(f"{where} returned a value outside 0..{limit - 1} for {port.name}")
+            fits = (array >= 0) & (array < limit)
+            if port.table:
+                fits = fits.all(axis=1)
+            answerable &= fits
             out.append(array.astype(np.int64))
-        return out
+        bad = np.flatnonzero(~answerable & inside)
+        if len(bad):
+            case = case_sets.columns_to_cases([c[int(bad[0]):int(bad[0]) + 1] for c in columns])[0]
+            port = next(p for p, a in zip(routine.outputs, out) if not (((a[bad[0]] >= 0) & (a[bad[0]] < (1 << p.bits)))
+                                                                         .all()))
+            raise InputError(f"{where} returned {out[routine.outputs.index(port)][bad[0]].tolist()} for {port.name}: "
+                             f"outside 0..{(1 << port.bits) - 1} (inputs {describe_case(routine, case)})")
+        return out, answerable
     cases = cases if cases is not None else case_sets.columns_to_cases(columns)
-    answers = [expected_outputs(routine, case, memory) for case in cases]
-    return [np.asarray([a[k] for a in answers], dtype=np.int64).reshape((n, len(port.places)) if port.table else (n,))
-            for k, port in enumerate(routine.outputs)]
-
-
-def _expected_inside(routine: Routine, columns: list, inside: np.ndarray, memory: dict):
-    """Expected outputs case by case where the reference answers (it must, inside the domain);
-    -> (arrays, answerable)."""
-    n = len(columns[0])
-    cases = case_sets.columns_to_cases(columns)
-    answers, answerable = [], np.zeros(n, dtype=bool)
-    blank = tuple(tuple(0 for _ in p.places) if p.table else 0 for p in routine.outputs)
+    answers = []
+    blank = tuple(tuple(-1 for _ in p.places) if p.table else -1 for p in routine.outputs)
     for i, case in enumerate(cases):
         try:
             answers.append(expected_outputs(routine, case, memory))
-            answerable[i] = True
         except InputError:
             if inside[i]:
                 raise
-            answers.append(blank)
-    arrays = [np.asarray([a[k] for a in answers], dtype=np.int64).reshape((n, len(p.places)) if p.table else (n,))
-              for k, p in enumerate(routine.outputs)]
-    return arrays, answerable
+            answers.append(blank)  # a reference may refuse inputs outside the domain: nothing to compare
+            answerable[i] = False
+    return [np.asarray([a[k] for a in answers], dtype=np.int64).reshape((n, len(port.places)) if port.table else (n,))
+            for k, port in enumerate(routine.outputs)], answerable
 
 
 def check_batch(spec: str, seed: int, columns: list) -> ChunkResult:
@@ -466,14 +481,7 @@ def check_batch(spec: str, seed: int, columns: list) -> ChunkResult:
         inside &= ~broken
         out.constraint_cases[condition.text] = int(broken.sum())
     if n:
-        try:
-            expected = expected_columns(routine, columns, cases, runner.memory_values)
-            answerable = np.ones(n, dtype=bool)
-        except InputError:
-            if inside.all():
-                raise
-            # a reference may refuse inputs outside the domain: ask it case by case for those inside
-            expected, answerable = _expected_inside(routine, columns, inside, runner.memory_values)
+        expected, answerable = expected_columns(routine, columns, cases, runner.memory_values, inside)
         got = [o[:n] for o in outcome.outputs]
         equal = np.ones(n, dtype=bool)
         for g, e in zip(got, expected):
