@@ -43,6 +43,7 @@ from retro.routines.spec import Routine, load_spec
 
 EXAMPLES_KEPT = 5
 ENGINES = ("auto", "scalar", "batch")
+DEFAULT_ENGINE = "auto"  # what engine=None means; the study commands' --engine sets it
 BATCH_LANES = 65_536  # cases the batched core runs at once (memory stays bounded: see LaneMemory)
 AUTO_BATCH_CASES = 20_000  # planned cases from which engine="auto" takes the batched core
 AGREEMENT_PER_PART = 2_000  # cases of each part also run on Machine when the batched core runs the check
@@ -600,10 +601,11 @@ def _chunks(parts: list[case_sets.Part]) -> Iterator[list[tuple]]:
 def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | None = None,
                   random_count: int | None = None, jobs: int = 1, progress: Callable[[str], None] | None = None,
                   start: SceneStart | None = None, bounded_product: int = case_sets.BOUNDED_PRODUCT,
-                  engine: str = "auto") -> RoutineCheck:
+                  engine: str | None = None) -> RoutineCheck:
     """Check one routine: a spec path, or a Routine built in Python (then in this process only).
     `engine`: "scalar" (Machine), "batch" (the batched core, checked against Machine on the first
     AGREEMENT_PER_PART cases of each part) or "auto" (batch from AUTO_BATCH_CASES planned cases)."""
+    engine = DEFAULT_ENGINE if engine is None else engine
     if engine not in ENGINES:
         raise InputError(f"--engine: {engine!r} is not one of {', '.join(ENGINES)}")
     if isinstance(spec, Routine):
@@ -701,7 +703,7 @@ def default_jobs() -> int:
 def run_checks(names: list[str] | None, *, exhaustive: bool = False, seed: int | None = None,
                random_count: int | None = None, jobs: int | None = None,
                progress: Callable[[str], None] | None = None, start: SceneStart | None = None,
-               bounded_product: int = case_sets.BOUNDED_PRODUCT, engine: str = "auto") -> list[RoutineCheck]:
+               bounded_product: int = case_sets.BOUNDED_PRODUCT, engine: str | None = None) -> list[RoutineCheck]:
     """Check the named routines (built-in names or spec paths; all built-ins when none are named);
     every name is loaded and validated before any work starts."""
     specs = select(names)

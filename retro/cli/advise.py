@@ -7,7 +7,7 @@ import argparse
 from retro.analysis.study.advisor import advice_lines, advise
 from retro.analysis.study.evaluate import quiet, stderr_progress
 from retro.analysis.study.methods import with_user_methods
-from retro.cli.chart import add_method_option
+from retro.cli.chart import add_engine_option, add_method_option, apply_engine
 from retro.errors import InputError
 from retro.numbers import parse_int
 
@@ -31,12 +31,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--accuracy", default=str(DEFAULT_ACCURACY), metavar="A",
                    help=f"required share of cases decided correctly, 0-1 or a percentage (default: {DEFAULT_ACCURACY})")
     add_method_option(p)
+    add_engine_option(p)
     p.add_argument("--jobs", default="2", metavar="N", help="worker processes (default: 2)")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     p.set_defaults(func=cmd_advise)
 
 
 def cmd_advise(args: argparse.Namespace) -> int:
+    apply_engine(args)
     target = _accuracy(args.accuracy)
     workers = parse_int(args.jobs, field="--jobs", lo=1, hi=64)
     advice = advise(args.scene, target, workers=workers, progress=quiet if args.quiet else stderr_progress,

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from retro.analysis.check import ENGINES
 from retro.analysis.study.chart_run import AUTO, REDUCED_COST_SAMPLES, run_chart, summary_lines
 from retro.analysis.study.evaluate import quiet, stderr_progress
 from retro.analysis.study.methods import with_user_methods
@@ -18,6 +19,20 @@ MAX_SAMPLES = 1_000_000
 def add_method_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("--method", action="append", default=[], metavar="FILE.toml",
                    help="a method of your own: a routine spec plus a hitbox rule (docs/methods.md); repeatable")
+
+
+def add_engine_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--engine", choices=ENGINES, default="auto",
+                   help="which engine runs the 6502 calls: scalar (Machine), batch (the numpy batched core) or auto "
+                        "(batch for many calls; default)")
+
+
+def apply_engine(args: argparse.Namespace) -> None:
+    """Make --engine the default of every routine run of this command (workers inherit it)."""
+    from retro.analysis import check
+    from retro.analysis.study.methods import base
+
+    base.ENGINE = check.DEFAULT_ENGINE = args.engine
 
 
 def samples_option(text: str) -> int | None | str:
@@ -33,6 +48,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR", help=f"output folder (default: {DEFAULT_OUT})")
     p.add_argument("--reduced", action="store_true", help="a small corpus (3 shapes) and fewer cycle samples: seconds")
     add_method_option(p)
+    add_engine_option(p)
     p.add_argument("--sprites", action="append", default=[], metavar="FILE",
                    help="add a file's sprites to the corpus (.spr/raw frames, SpritePad .spd, a 24x21 PNG, or a "
                         "VIC-II scene's enabled sprites); repeatable")
@@ -45,6 +61,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def cmd_chart(args: argparse.Namespace) -> int:
+    apply_engine(args)
     workers = parse_int(args.jobs, field="--jobs", lo=1, hi=64)
     samples = samples_option(args.samples)
     methods = with_user_methods(args.method)

@@ -46,8 +46,8 @@ def _measure_pair(method: Method, a: Shape, b: Shape, samples: int | None) -> tu
     session = method.session(pair)
     verdict = None if method.averaged else method.verdict(sub_pair(pair, indices)) > 0
     cycles = []
-    for k, index in enumerate(indices):
-        answer, spent = session.run(index)
+    answers, spent_cycles = session.run_many(indices)
+    for k, (index, answer, spent) in enumerate(zip(indices, answers, spent_cycles)):
         expected = session.expected(index) if verdict is None else bool(verdict[k])
         if answer != expected:
             raise RunError(f"{method.routine}: on {pair.name} at offset ({int(pair.dx[index])}, {int(pair.dy[index])}) "

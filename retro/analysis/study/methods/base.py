@@ -58,12 +58,24 @@ def routine_runner(name_or_path: str):
     return RoutineRunner(routine_spec(name_or_path))
 
 
+# Which engine runs a pair's calls: "auto" takes the batched core (retro.cpu.batch) from BATCH_FROM
+# calls on, "scalar" is Machine only, "batch" the batched core whatever the count. Set by the CLI's
+# --engine before any worker starts (workers inherit it).
+ENGINE = "auto"
+BATCH_FROM = 256
+
+
 class Session:
     """A method's 6502 routine loaded and ready for the cases of one pair."""
 
     def run(self, index: int) -> tuple[bool, int]:
         """(the routine's answer: hit or not, cycles of the call) on case `index` of the pair."""
         raise NotImplementedError
+
+    def run_many(self, indices: list[int]) -> tuple[list[bool], list[int]]:
+        """`run` on many cases: (answers, cycles) in the order given."""
+        results = [self.run(index) for index in indices]
+        return [r[0] for r in results], [r[1] for r in results]
 
     def expected(self, index: int) -> bool:
         """The answer the routine must give on this case, when it is not the method's verdict (a
@@ -91,6 +103,21 @@ class RoutineSession(Session):
         case = self.case(index)
         outputs, cycles = self.runner.run(tuple(case[name] for name in self.names))
         return bool(outputs[self.hit]), cycles
+
+    def run_many(self, indices: list[int]) -> tuple[list[bool], list[int]]:
+        """On the batched core when there are enough calls (ENGINE); a call that does not return is run
+        again on Machine, whose error names it."""
+        batched = self.runner.batchable and (ENGINE == "batch" or (ENGINE == "auto" and len(indices) >= BATCH_FROM))
+        if not batched or not indices:
+            return super().run_many(indices)
+        cases = [self.case(index) for index in indices]
+        columns = [np.asarray([case[name] for case in cases], dtype=np.int64) for name in self.names]
+        outcome = self.runner.run_batch(columns)
+        if outcome.error.any():
+            return super().run_many(indices)
+        hit = outcome.outputs[self.hit]
+        answers = hit.any(axis=1) if hit.ndim == 2 else hit != 0
+        return answers.tolist(), outcome.cycles.tolist()
 
 
 @dataclass(frozen=True, kw_only=True)
