@@ -20,6 +20,7 @@ part also run on `Machine` with the timing model, and the two engines must agree
 
 from __future__ import annotations
 
+import math
 import os
 import signal
 import time
@@ -42,6 +43,7 @@ from retro.routines.runner import BatchOutcome, RasterStart, RoutineRunner, Size
 from retro.routines.spec import Routine, load_spec
 
 EXAMPLES_KEPT = 5
+JSON_EXACT = 1 << 53  # larger whole numbers lose digits in JSON readers that use doubles
 ENGINES = ("auto", "scalar", "batch")
 DEFAULT_ENGINE = "auto"  # what engine=None means; the study commands' --engine sets it
 BATCH_LANES = 65_536  # cases the batched core runs at once (memory stays bounded: see LaneMemory)
@@ -772,7 +774,8 @@ def check_record(check: RoutineCheck) -> dict:
               "domain": [{"condition": c.text, "cases": t.constraint_cases.get(c.text, 0),
                           "wrong": t.constraint_wrong.get(c.text, 0)} for c in check.routine.domain],
               **cycle_figures(check), "worst_reached": check.worst_reached, "coverage": coverage(check),
-              "input_space": check.routine.input_space(), "coverage_argument": check.routine.coverage or None,
+              "input_space": space if (space := check.routine.input_space()) < JSON_EXACT else None,
+              "input_space_log2": round(math.log2(space), 3), "coverage_argument": check.routine.coverage or None,
               "examples": t.examples, "outside_examples": t.outside_examples, "engine": check.engine,
               "engine_agreement": None if check.agreement is None else {
                   "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
@@ -791,6 +794,10 @@ def check_record(check: RoutineCheck) -> dict:
 
 def _plain(values: tuple) -> list:
     return [list(v) if isinstance(v, tuple) else v for v in values]
+
+
+def format_space(space: int) -> str:
+    return f"{space:,}" if space < JSON_EXACT else f"2^{math.log2(space):.1f}"
 
 
 def format_coverage(check: RoutineCheck) -> str:
@@ -822,7 +829,7 @@ def format_check(check: RoutineCheck) -> list[str]:
                    f"{a.cases - a.cycle_mismatches - a.run_errors}")
     lines = [f"{routine.name}: {t.cases} cases, {verdict}; {cost}, {static}; {checked}"]
     if check.parts:
-        lines.append(f"  cases: {format_coverage(check)}; input space {check.routine.input_space():,}")
+        lines.append(f"  cases: {format_coverage(check)}; input space {format_space(check.routine.input_space())}")
     if routine.coverage:
         lines.append(f"  coverage: {routine.coverage}")
     if t.cycles_count:

@@ -441,14 +441,14 @@ def _adc_table() -> np.ndarray:
     result = total & BYTE
     overflow = (~(a ^ value) & (a ^ result) & 0x80) != 0
     flags = (result & FLAG_N) | overflow * FLAG_V | (result == 0) * FLAG_Z | (total > BYTE) * FLAG_C
-    return (result | flags << 8).astype(np.int32)
+    return (result | flags << 8).astype(np.uint16)  # 256 KiB: stays in cache
 
 
 def _compare_table() -> np.ndarray:
     """N Z C of CMP for every (register, operand), indexed register << 8 | operand."""
     register, value = (axis.ravel() for axis in np.meshgrid(np.arange(256), np.arange(256), indexing="ij"))
     difference = (register - value) & BYTE
-    return ((difference & FLAG_N) | (difference == 0) * FLAG_Z | (register >= value) * FLAG_C).astype(np.int32)
+    return ((difference & FLAG_N) | (difference == 0) * FLAG_Z | (register >= value) * FLAG_C).astype(np.uint8)
 
 
 ADC_TABLE = _adc_table()
@@ -457,7 +457,7 @@ NZ_TABLE = np.array([(v & FLAG_N) | (v == 0) * FLAG_Z for v in range(256)], dtyp
 
 
 def _binary_adc(a, value, p):
-    packed = ADC_TABLE[(a << 9) | (value << 1) | (p & FLAG_C)]
+    packed = ADC_TABLE[(a << 9) | (value << 1) | (p & FLAG_C)].astype(np.int32)
     return packed & BYTE, (p & ~NVZC) | (packed >> 8)
 
 

@@ -297,10 +297,37 @@ def _signed(value: int) -> int:
     return value - BYTE if value & 0x80 else value
 
 
-def pixel_reference(dx: int, dy: int, mask_a, mask_b) -> bool:
-    """reference.pixel on the routine's inputs: offsets as two's-complement bytes, masks as 63 bytes."""
-    return reference.pixel(_signed(dx), _signed(dy), reference.mask_bits(bytes(mask_a)),
-                           reference.mask_bits(bytes(mask_b)))
+OFFSET_SPAN = 24  # |dx| and |dy| below this can overlap two 24 x 21 masks; beyond, no pixel is shared
+
+
+@lru_cache(maxsize=64)
+def _overlap_table(mask_a: bytes, mask_b: bytes) -> np.ndarray:
+    """reference.pixel at every offset where masks can meet, indexed [dy + SPAN, dx + SPAN]."""
+    a, b = reference.mask_bits(mask_a), reference.mask_bits(mask_b)
+    span = range(-OFFSET_SPAN, OFFSET_SPAN + 1)
+    return np.array([[reference.pixel(dx, dy, a, b) for dx in span] for dy in span], dtype=bool)
+
+
+def pixel_reference(dx, dy, mask_a, mask_b):
+    """reference.pixel on the routine's inputs: offsets as two's-complement bytes, masks as 63 bytes.
+
+    Over arrays (one case per element, masks as rows of 63 bytes): each distinct mask pair's answers at
+    every offset come from reference.pixel once, then every case is a lookup."""
+    scalar = np.ndim(dx) == 0
+    dx, dy = np.atleast_1d(dx).astype(np.int64), np.atleast_1d(dy).astype(np.int64)
+    masks = np.concatenate([np.atleast_2d(mask_a), np.atleast_2d(mask_b)], axis=1).astype(np.uint8)
+    if (masks == masks[0]).all():  # a sweep's block: one mask pair
+        pairs, which = masks[:1], np.zeros(len(masks), dtype=np.int64)
+    else:
+        pairs, which = np.unique(masks, axis=0, return_inverse=True)
+    signed_dx, signed_dy = dx - ((dx & 0x80) << 1), dy - ((dy & 0x80) << 1)
+    near = (np.abs(signed_dx) <= OFFSET_SPAN) & (np.abs(signed_dy) <= OFFSET_SPAN)
+    hit = np.zeros(len(dx), dtype=bool)
+    for k, pair in enumerate(pairs):
+        cases = np.flatnonzero((which.ravel() == k) & near)
+        table = _overlap_table(pair[:MASK_BYTES].tobytes(), pair[MASK_BYTES:].tobytes())
+        hit[cases] = table[signed_dy[cases] + OFFSET_SPAN, signed_dx[cases] + OFFSET_SPAN]
+    return bool(hit[0]) if scalar else hit
 
 
 def pixel_boundary(seed: int = 0) -> list[tuple]:
@@ -310,21 +337,27 @@ def pixel_boundary(seed: int = 0) -> list[tuple]:
             for dy in offsets if abs(dy) <= 25 or dx == 0]
 
 
-def pixel_random(rng: np.random.Generator, n: int, seed: int = 0) -> list[tuple]:
+def _mask_columns(masks, pair: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    table = np.asarray(masks, dtype=np.int64)  # (pairs, 2, 63)
+    return table[pair, 0], table[pair, 1]
+
+
+def pixel_random(rng: np.random.Generator, n: int, seed: int = 0) -> dict:
     masks = pixel_masks(seed)
     dx = rng.integers(-26, 27, size=n)
     dy = rng.integers(-23, 24, size=n)
     pair = rng.integers(0, len(masks), size=n)
-    return [(int(a) & 0xFF, int(b) & 0xFF, *masks[int(c)]) for a, b, c in zip(dx, dy, pair)]
+    mask_a, mask_b = _mask_columns(masks, pair)
+    return {"dx": dx & 0xFF, "dy": dy & 0xFF, "mask_a": mask_a, "mask_b": mask_b}
 
 
-def pixel_sweep(seed: int = 0) -> Iterable[tuple]:
-    """Every pair of offset bytes for the full pair, the ring/dot pair and one random pair."""
+def pixel_sweep(seed: int = 0) -> Iterator[dict]:
+    """Every pair of offset bytes for every mask pair of the corpus."""
     masks = pixel_masks(seed)
-    for pair in (0, 3, 8):
-        for dx in range(BYTE):
-            for dy in range(BYTE):
-                yield (dx, dy, *masks[pair])
+    dx, dy = _grid(BYTE, BYTE)
+    for pair in range(len(masks)):
+        mask_a, mask_b = _mask_columns(masks, np.full(len(dx), pair))
+        yield {"dx": dx, "dy": dy, "mask_a": mask_a, "mask_b": mask_b}
 
 
 # ---- circle_r ------------------------------------------------------------------------------------

@@ -173,3 +173,13 @@ def test_auto_takes_the_batched_core_for_large_case_sets(capsys):
     assert (small["engine"], large["engine"]) == ("scalar", "batch")
     with pytest.raises(InputError):
         check_module.check_routine("mul8", engine="gpu")
+
+
+@pytest.mark.exhaustive
+@pytest.mark.parametrize("name, sweep", [("mul8", 256 * 256), ("tile", 512 * 256)])
+def test_every_input_of_mul8_and_tile_on_the_batched_core(name, sweep, capsys):
+    """Truly exhaustive in CI: mul8 every (a, b), tile every 9-bit X by every Y, against the reference."""
+    code, (record,) = check_json(capsys, name, "--exhaustive", "--engine", "batch", "--random", "1000")
+    assert code == 0 and record["mismatches"] == 0
+    assert next(p for p in record["coverage"] if p["part"] == "sweep")["cases"] == sweep
+    assert record["engine_agreement"]["cases"] >= 2_000 and record["engine_agreement"]["mismatches"] == 0
