@@ -308,6 +308,21 @@ def _overlap_table(mask_a: bytes, mask_b: bytes) -> np.ndarray:
     return np.array([[reference.pixel(dx, dy, a, b) for dx in span] for dy in span], dtype=bool)
 
 
+ROW_HASH = np.random.default_rng(0x6502).integers(1, 2 ** 63, size=2 * MASK_BYTES, dtype=np.uint64) | np.uint64(1)
+
+
+def _distinct_rows(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(distinct rows, each row's index among them): by a 64-bit hash of each row, checked row by row
+    (a collision falls back to sorting the rows themselves)."""
+    keys = rows.astype(np.uint64) @ ROW_HASH  # wraps modulo 2^64
+    _, first, which = np.unique(keys, return_index=True, return_inverse=True)
+    distinct = rows[first]
+    if (distinct[which.ravel()] == rows).all():
+        return distinct, which.ravel()
+    distinct, which = np.unique(rows, axis=0, return_inverse=True)
+    return distinct, which.ravel()
+
+
 def pixel_reference(dx, dy, mask_a, mask_b):
     """reference.pixel on the routine's inputs: offsets as two's-complement bytes, masks as 63 bytes.
 
@@ -316,10 +331,7 @@ def pixel_reference(dx, dy, mask_a, mask_b):
     scalar = np.ndim(dx) == 0
     dx, dy = np.atleast_1d(dx).astype(np.int64), np.atleast_1d(dy).astype(np.int64)
     masks = np.concatenate([np.atleast_2d(mask_a), np.atleast_2d(mask_b)], axis=1).astype(np.uint8)
-    if (masks == masks[0]).all():  # a sweep's block: one mask pair
-        pairs, which = masks[:1], np.zeros(len(masks), dtype=np.int64)
-    else:
-        pairs, which = np.unique(masks, axis=0, return_inverse=True)
+    pairs, which = _distinct_rows(masks)
     signed_dx, signed_dy = dx - ((dx & 0x80) << 1), dy - ((dy & 0x80) << 1)
     near = (np.abs(signed_dx) <= OFFSET_SPAN) & (np.abs(signed_dy) <= OFFSET_SPAN)
     hit = np.zeros(len(dx), dtype=bool)
