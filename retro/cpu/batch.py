@@ -12,7 +12,7 @@ and operands are fetched from the private copy when their page has one, so code 
 itself runs per lane.
 
 Semantics and cycle counts are those of `retro.cpu.mpu` (the scalar core, the reference): base
-cycles and page-crossing penalties from `retro.cpu.timing.OPCODES`, branch penalties, NMOS decimal
+cycles and page-crossing penalties from the opcode table (`retro.cpu.opcodes`), branch penalties, NMOS decimal
 mode on the 6510 (Bruce Clark, "Decimal Mode" tutorial, appendix A: the 6502's A, C, N, V and Z in
 decimal mode), binary-only ADC/SBC on the 2A03, and the stable undocumented opcodes ("NMOS 6510
 Unintended Opcodes - No More Secrets", groepaz, 2024). A lane stops with an error code (`LaneError`)
@@ -38,14 +38,13 @@ from retro.cpu.mpu import (
     FLAG_Z,
     IRQ_VECTOR,
     JAM_OPCODES,
-    UNSTABLE_OPCODES,
     VARIANTS,
 )
+from retro.cpu.opcodes import DOCUMENTED, MODE_LENGTH, OPCODE_TABLE, STABLE
 from retro.cpu.timing import (
     BRANCH_CONDITIONS,
     BRANCH_PAGE_CYCLES,
     BRANCH_TAKEN_CYCLES,
-    OPCODES,
     PAGE_CROSS_CYCLES,
     PAGE_MASK,
 )
@@ -844,14 +843,16 @@ JUMPS = {"JMP", "JSR", "RTS", "RTI"}
 
 def _build() -> dict[int, Handler]:
     handlers: dict[int, Handler] = {}
-    for opcode, op in OPCODES.items():
-        name, mode = op.mnemonic, op.mode
+    for opcode, op in OPCODE_TABLE.items():
+        if op.kind not in (DOCUMENTED, STABLE):
+            continue  # JAM and unstable opcodes stop their lanes (no handler)
+        name, mode, length = op.mnemonic, op.mode, MODE_LENGTH[op.mode]
         if name in READS:
-            handlers[opcode] = _make_read(opcode, name, mode, op.cycles, op.page_penalty, op.length)
+            handlers[opcode] = _make_read(opcode, name, mode, op.cycles, op.page_penalty, length)
         elif name in STORES:
-            handlers[opcode] = _make_store(name, mode, op.cycles, op.length)
+            handlers[opcode] = _make_store(name, mode, op.cycles, length)
         elif name in RMW:
-            handlers[opcode] = _make_rmw(name, mode, op.cycles, op.length)
+            handlers[opcode] = _make_rmw(name, mode, op.cycles, length)
         elif mode == "rel":
             handlers[opcode] = _make_branch(opcode, op.cycles)
         elif name in IMPLIED:
@@ -864,8 +865,6 @@ def _build() -> dict[int, Handler]:
             handlers[opcode] = _brk(op.cycles)
         else:  # pragma: no cover - a new table row needs its operation here
             raise AssertionError(f"no batch operation for {name} (${opcode:02X})")
-    for opcode in JAM_OPCODES | set(UNSTABLE_OPCODES):
-        handlers.pop(opcode, None)
     return handlers
 
 

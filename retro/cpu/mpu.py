@@ -43,6 +43,8 @@ from __future__ import annotations
 from py65.devices.mpu6502 import MPU as _Py65MPU
 from py65.utils.devices import make_instruction_decorator
 
+from retro.cpu.opcodes import JAM, MODE_LENGTH, OPCODE_TABLE, STABLE, UNSTABLE, opcodes_of
+
 ADDRESS_MASK = 0xFFFF
 PAGE_SHIFT = 8
 
@@ -73,13 +75,12 @@ INTERRUPT_WRITES = (3, 4, 5)  # the interrupt sequence pushes PCH, PCL, P like B
 RECENT_SIZE = 16  # a power of two: run_until keeps the addresses of this many recent instructions
 RECENT_MASK = RECENT_SIZE - 1
 _KEEP_ALL_BUT_NVZC = 0xFF & ~(FLAG_N | FLAG_V | FLAG_Z | FLAG_C)
-# 64doc / No More Secrets: these lock the NMOS CPU until reset.
-JAM_OPCODES = frozenset({0x02, 0x12, 0x22, 0x32, 0x42, 0x52, 0x62, 0x72, 0x92, 0xB2, 0xD2, 0xF2})
-# Results depend on the chip revision, temperature or bus state ("unstable" in No More Secrets).
-UNSTABLE_OPCODES = {
-    0x93: "SHA", 0x9F: "SHA", 0x9E: "SHX", 0x9C: "SHY", 0x9B: "TAS",
-    0xBB: "LAS", 0x8B: "ANE", 0xAB: "LXA",
-}
+# From the opcode table (retro.cpu.opcodes): JAM locks the NMOS CPU until reset; the unstable opcodes'
+# results depend on the chip revision, temperature or bus state ("unstable" in No More Secrets).
+JAM_OPCODES = frozenset(opcodes_of(JAM))
+UNSTABLE_OPCODES = {opcode: row.mnemonic for opcode, row in opcodes_of(UNSTABLE).items()}
+UNDOCUMENTED_RMW = ("SLO", "RLA", "SRE", "RRA", "DCP", "ISC")
+RMW_MNEMONICS = frozenset({"ASL", "LSR", "ROL", "ROR", "INC", "DEC", *UNDOCUMENTED_RMW})
 
 
 class CpuHalt(Exception):
@@ -566,62 +567,31 @@ class MPU6510(_Py65MPU):
 
 
 def _register_undocumented(cls) -> None:
-    """Fill the undocumented opcodes into cls's tables (cycle counts from 64doc)."""
+    """Fill the undocumented opcodes into cls's tables from their rows in retro.cpu.opcodes."""
     ins = cls.instruction
 
-    def op(opcode, name, mode, cycles, extra, body, length):
+    def op(opcode, row, body, length):
         def handler(self):
             body(self)
             self.pc += length - 1
         handler.__name__ = f"inst_0x{opcode:02x}"
-        ins(name=name, mode=mode, cycles=cycles, extracycles=extra)(handler)
+        ins(name=row.mnemonic, mode=row.mode, cycles=row.cycles, extracycles=int(row.page_penalty))(handler)
 
     modes = {
-        "zpg": (lambda s: s.ZeroPageAddr, 2),
-        "zpx": (lambda s: s.ZeroPageXAddr, 2),
-        "zpy": (lambda s: s.ZeroPageYAddr, 2),
-        "abs": (lambda s: s.AbsoluteAddr, 3),
-        "abx": (lambda s: s.AbsoluteXAddr, 3),
-        "aby": (lambda s: s.AbsoluteYAddr, 3),
-        "inx": (lambda s: s.IndirectXAddr, 2),
-        "iny": (lambda s: s.IndirectYAddr, 2),
-        "imm": (lambda s: s.ProgramCounter, 2),
+        "zpg": lambda s: s.ZeroPageAddr,
+        "zpx": lambda s: s.ZeroPageXAddr,
+        "zpy": lambda s: s.ZeroPageYAddr,
+        "abs": lambda s: s.AbsoluteAddr,
+        "abx": lambda s: s.AbsoluteXAddr,
+        "aby": lambda s: s.AbsoluteYAddr,
+        "inx": lambda s: s.IndirectXAddr,
+        "iny": lambda s: s.IndirectYAddr,
+        "imm": lambda s: s.ProgramCounter,
     }
 
-    def with_mode(opcode, name, mode, cycles, extra, method):
-        address_of, length = modes[mode]
-        op(opcode, name, mode, cycles, extra, lambda s: getattr(s, method)(address_of(s)), length)
-
-    # Read-modify-write families: same opcode layout and cycle counts for all six.
-    rmw_layout = [("zpg", 0x07, 5), ("zpx", 0x17, 6), ("inx", 0x03, 8), ("iny", 0x13, 8),
-                  ("abs", 0x0F, 6), ("abx", 0x1F, 7), ("aby", 0x1B, 7)]
-    rmw = set()
-    for base, name in [(0x00, "SLO"), (0x20, "RLA"), (0x40, "SRE"), (0x60, "RRA"), (0xC0, "DCP"), (0xE0, "ISC")]:
-        for mode, low, cycles in rmw_layout:
-            with_mode(base + low, name, mode, cycles, 0, f"op{name}")
-            rmw.add(base + low)
-
-    for opcode, mode, cycles, extra in [(0xA7, "zpg", 3, 0), (0xB7, "zpy", 4, 0), (0xA3, "inx", 6, 0),
-                                        (0xB3, "iny", 5, 1), (0xAF, "abs", 4, 0), (0xBF, "aby", 4, 1)]:
-        with_mode(opcode, "LAX", mode, cycles, extra, "opLAX")
-    for opcode, mode, cycles in [(0x87, "zpg", 3), (0x97, "zpy", 4), (0x83, "inx", 6), (0x8F, "abs", 4)]:
-        with_mode(opcode, "SAX", mode, cycles, 0, "opSAX")
-
-    # Undocumented NOPs: implied, immediate, and ones that really read memory.
-    for opcode in (0x1A, 0x3A, 0x5A, 0x7A, 0xDA, 0xFA):
-        op(opcode, "NOP", "imp", 2, 0, lambda s: None, 1)
-    for opcode in (0x80, 0x82, 0x89, 0xC2, 0xE2):
-        op(opcode, "NOP", "imm", 2, 0, lambda s: None, 2)
-    for opcode in (0x04, 0x44, 0x64):
-        with_mode(opcode, "NOP", "zpg", 3, 0, "opNOPRead")
-    for opcode in (0x14, 0x34, 0x54, 0x74, 0xD4, 0xF4):
-        with_mode(opcode, "NOP", "zpx", 4, 0, "opNOPRead")
-    with_mode(0x0C, "NOP", "abs", 4, 0, "opNOPRead")
-    for opcode in (0x1C, 0x3C, 0x5C, 0x7C, 0xDC, 0xFC):
-        with_mode(opcode, "NOP", "abx", 4, 1, "opNOPRead")
-
-    def immediate(opcode, name, body):
-        op(opcode, name, "imm", 2, 0, lambda s: body(s, s.ByteAt(s.pc)), 2)
+    def with_mode(opcode, row, method):
+        address_of = modes[row.mode]
+        op(opcode, row, lambda s: getattr(s, method)(address_of(s)), MODE_LENGTH[row.mode])
 
     def anc(s, v):
         s.a = s._nz(s.a & v)
@@ -632,21 +602,25 @@ def _register_undocumented(cls) -> None:
         s.p = (s.p & ~FLAG_C) | (FLAG_C if diff >= 0 else 0)
         s.x = s._nz(diff & 0xFF)
 
-    immediate(0x0B, "ANC", anc)
-    immediate(0x2B, "ANC", anc)
-    immediate(0x4B, "ALR", lambda s, v: setattr(s, "a", s._lsr(s.a & v)))
-    immediate(0x6B, "ARR", lambda s, v: s._arr(v))
-    immediate(0xCB, "SBX", sbx)
-    immediate(0xEB, "SBC", lambda s, v: s._sbc(v))
-
-    for opcode in JAM_OPCODES:
-        op(opcode, "JAM", "imp", 2, 0, lambda s: s.halt_on("JAM"), 1)
-    for opcode, name in UNSTABLE_OPCODES.items():
-        op(opcode, name, "imp", 2, 0, lambda s, n=name: s.halt_on(f"unstable opcode {n}"), 1)
-
-    documented_rmw = {0x06, 0x16, 0x0E, 0x1E, 0x26, 0x36, 0x2E, 0x3E, 0x46, 0x56, 0x4E, 0x5E,
-                      0x66, 0x76, 0x6E, 0x7E, 0xC6, 0xD6, 0xCE, 0xDE, 0xE6, 0xF6, 0xEE, 0xFE}
-    cls.RMW_OPCODES = frozenset(rmw | documented_rmw)
+    immediates = {"ANC": anc, "ALR": lambda s, v: setattr(s, "a", s._lsr(s.a & v)), "ARR": lambda s, v: s._arr(v),
+                  "SBX": sbx, "SBC": lambda s, v: s._sbc(v)}
+    for opcode, row in opcodes_of(STABLE).items():
+        name = row.mnemonic
+        if name in UNDOCUMENTED_RMW or name in ("LAX", "SAX"):
+            with_mode(opcode, row, f"op{name}")
+        elif name == "NOP" and row.mode in ("imp", "imm"):
+            op(opcode, row, lambda s: None, MODE_LENGTH[row.mode])
+        elif name == "NOP":
+            with_mode(opcode, row, "opNOPRead")  # these really read memory
+        else:
+            body = immediates[name]
+            op(opcode, row, lambda s, body=body: body(s, s.ByteAt(s.pc)), MODE_LENGTH[row.mode])
+    for opcode, row in opcodes_of(JAM).items():
+        op(opcode, row, lambda s: s.halt_on("JAM"), 1)
+    for opcode, row in opcodes_of(UNSTABLE).items():
+        op(opcode, row, lambda s, n=row.mnemonic: s.halt_on(f"unstable opcode {n}"), 1)
+    cls.RMW_OPCODES = frozenset(opcode for opcode, row in OPCODE_TABLE.items()
+                                if row.mode != "acc" and row.mnemonic in RMW_MNEMONICS)
 
 
 _register_undocumented(MPU6510)
