@@ -35,6 +35,7 @@ class Mutant:
 
 VIC_TESTS = ("tests/vic",)
 CPU_TESTS = ("tests/cpu",)
+BATCH_TESTS = ("tests/cpu/test_batch_vectors.py", "tests/routines/test_batch_check.py")
 CHECK_TESTS = ("tests/routines/test_user_specs.py", "tests/routines/test_routines_cli.py",
                "tests/routines/test_routines_exhaustive.py")
 
@@ -100,6 +101,27 @@ MUTANTS = [
            ("tests/routines",)),
     Mutant("high-byte-of-output-dropped", "retro/routines/runner.py",
            "value |= byte << (8 * shift)", "value |= byte if shift == 0 else 0", ("tests/routines",)),
+    # ---- the batched core and its checks --------------------------------------------------------
+    Mutant("batch-branch-page-costs-nothing", "retro/cpu/batch.py",
+           "extra = extra_taken + crossed * BRANCH_PAGE_CYCLES", "extra = extra_taken", BATCH_TESTS),
+    Mutant("batch-page-cross-costs-nothing", "retro/cpu/batch.py",
+           "if penalised and crossed is not False:", "if False:", BATCH_TESTS),
+    Mutant("batch-decimal-high-adjust-off-by-one", "retro/cpu/batch.py",
+           "high = np.where(high >= 0xA0, high + 0x60, high)", "high = np.where(high >= 0xA1, high + 0x60, high)",
+           BATCH_TESTS),
+    Mutant("batch-rts-without-plus-one", "retro/cpu/batch.py",
+           "return _uniform(((g.pull() << 8 | low) + 1) & WORD)", "return _uniform((g.pull() << 8 | low) & WORD)",
+           BATCH_TESTS),
+    Mutant("batch-lane-rows-ignored-on-read", "retro/cpu/batch.py",
+           "            row = self.rows.get(int(address))\n            if row is None:",
+           "            row = None\n            if row is None:", BATCH_TESTS),
+    Mutant("batch-result-mismatches-not-counted", "retro/analysis/check.py",
+           "out.result_mismatches = len(wrong_inside)", "out.result_mismatches = 0", BATCH_TESTS),
+    Mutant("engine-disagreement-not-counted", "retro/analysis/check.py",
+           "found += self.agreement.engine_mismatches + self.agreement.cycle_mismatches", "found += 0",
+           BATCH_TESTS),
+    Mutant("agreement-run-skipped", "retro/analysis/check.py",
+           "agreement.merge(agreement_chunk(spec, seed, chunk))", "pass", BATCH_TESTS),
 ]
 
 

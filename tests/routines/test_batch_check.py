@@ -62,6 +62,10 @@ def test_an_engine_disagreement_is_a_mismatch(monkeypatch, capsys):
     code, (record,) = check_json(capsys, "aabb8", "--engine", "batch", "--random", "300")
     assert code == 1
     assert record["engine_agreement"]["mismatches"] > 0
+    # the disagreements are mismatches in their own right (the extra cycle also breaks the static bound)
+    assert record["mismatches"] == (record["result_mismatches"] + record["cycle_mismatches"] + record["run_errors"]
+                                    + len(record["bounds_violations"]) + len(record["budget_violations"])
+                                    + record["engine_agreement"]["mismatches"])
     assert record["first_failure"]["kind"] == "engine"
     assert "engines disagree" in record["first_failure"]["message"]
 
