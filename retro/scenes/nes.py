@@ -19,11 +19,12 @@ Format (see docs/nes.md):
     tiles = { "0:3" = ["33333333", ...] }   # "table:index": 8 rows of 8 values 0-3 ('.' = 0), or 16 bytes
     [[nametable]]                      # 32x30 tiles; index 0-3; anything not given is tile 0
     index = 0
-    fill = 0
+    fill = 0                           # or file = "title.nam" (1024 bytes: 960 tiles + 64 attribute bytes)
     cells = [{ col = 16, row = 15, tile = 3 }]
 
 OAM entries not given are $FF (off screen); nametable cells not given are 0, and so are the
-attribute bytes. Numbers may be TOML integers or strings in any notation `parse_int` accepts.
+attribute bytes unless a `.nam` file gives them. Numbers may be TOML integers or strings in any
+notation `parse_int` accepts.
 """
 
 from __future__ import annotations
@@ -54,6 +55,7 @@ from retro.chips.ppu.state import PpuState
 from retro.errors import InputError
 from retro.fileio import read_bytes
 from retro.loaders.gfx_chr import chr_from_bytes
+from retro.loaders.gfx_nametable import ATTRIBUTE_BYTES, NAMETABLE_TILES, nametable_from_bytes
 from retro.numbers import parse_int
 from retro.scenes import earlier_spelling
 
@@ -64,7 +66,7 @@ TOP_KEYS = {"chip", "video", "ppu", "oam", "chr", "nametable"}
 PPU_KEYS = {"ctrl", "mask", "scroll_x", "scroll_y", "mirroring"}
 OAM_KEYS = {"y", "tile", "attr", "x"}
 CHR_KEYS = {"file", "table", "tiles"}
-NAMETABLE_KEYS = {"index", "fill", "cells"}
+NAMETABLE_KEYS = {"index", "fill", "file", "cells"}
 CELL_KEYS = {"col", "row", "tile"}
 
 
@@ -88,6 +90,8 @@ class Nametable:
     index: int
     fill: int
     cells: tuple[NametableCell, ...]
+    tiles: bytes | None = None             # 960 tile numbers from a .nam file (then `fill` is unused)
+    attributes: bytes = bytes(ATTRIBUTE_BYTES)  # the attribute table (from a .nam file; else 0)
 
 
 @dataclass(frozen=True)
@@ -115,7 +119,9 @@ class NesScene:
         ciram = bytearray(CIRAM_SIZE)
         for table in self.nametables:
             base = MIRRORING[self.mirroring][table.index] * NAMETABLE_SIZE
-            ciram[base: base + NAMETABLE_ROWS * NAMETABLE_COLUMNS] = bytes([table.fill]) * (NAMETABLE_ROWS * NAMETABLE_COLUMNS)
+            tiles = table.tiles if table.tiles is not None else bytes([table.fill]) * NAMETABLE_TILES
+            ciram[base: base + NAMETABLE_TILES] = tiles
+            ciram[base + NAMETABLE_TILES: base + NAMETABLE_SIZE] = table.attributes
             for cell in table.cells:
                 ciram[base + cell.row * NAMETABLE_COLUMNS + cell.col] = cell.tile
         return bytes(ciram)
@@ -299,6 +305,26 @@ def _parse_nametables(value, source: str, mirroring: str) -> tuple[Nametable, ..
                 col=_int(_required(cell, "col", source, cell_field), source, f"{cell_field}.col", 0, NAMETABLE_COLUMNS - 1),
                 row=_int(_required(cell, "row", source, cell_field), source, f"{cell_field}.row", 0, NAMETABLE_ROWS - 1),
                 tile=_byte(_required(cell, "tile", source, cell_field), source, f"{cell_field}.tile")))
+        tiles, attributes = None, bytes(ATTRIBUTE_BYTES)
+        if "file" in table:
+            if "fill" in table:
+                raise _fail(source, f"{field}.fill", "give fill or file, not both (the file gives every tile)")
+            content = _read_file(table["file"], source, f"{field}.file", "nametable file")
+            try:
+                loaded = nametable_from_bytes(content, repr(table["file"]))
+            except InputError as exc:
+                raise _fail(source, f"{field}.file", str(exc)) from None
+            tiles, attributes = loaded.tiles, loaded.attributes
         result.append(Nametable(index=index, fill=_byte(table.get("fill", 0), source, f"{field}.fill"),
-                                cells=tuple(cells)))
+                                cells=tuple(cells), tiles=tiles, attributes=attributes))
     return tuple(result)
+
+
+def _read_file(name, source: str, field: str, what: str) -> bytes:
+    """A file named relative to the scene file; any failure is one line naming the field."""
+    if not isinstance(name, str) or not name:
+        raise _fail(source, field, f"expected a file name, got {name!r}")
+    try:
+        return read_bytes(Path(source).parent / name, what)
+    except InputError as exc:
+        raise _fail(source, field, str(exc)) from None

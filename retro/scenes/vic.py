@@ -1,7 +1,8 @@
 """VIC-II scene files: the TOML format of docs/vic.md -> VicScene (validated dataclasses).
 
 Every error is one line naming the file and the field: `FILE: sprite[2].x: ...`. Sprite `file`
-paths, and charset/bitmap files, resolve relative to the scene file.
+paths, and the files `[memory]` reads (charset, bitmap, screen and colour RAM, CharPad projects,
+Koala pictures: retro/loaders/gfx_screen.py), resolve relative to the scene file.
 """
 
 from __future__ import annotations
@@ -12,7 +13,6 @@ from pathlib import Path
 import numpy as np
 
 from retro.chips.vic.constants import (
-    BITMAP_BYTES,
     CHAR_HEIGHT,
     COLOR_MASK,
     READ_ONLY_LATCHES,
@@ -43,7 +43,9 @@ from retro.errors import InputError
 from retro.fileio import read_bytes
 from retro.numbers import parse_int
 from retro.scenes import earlier_spelling
-from retro.loaders.gfx_charset import charset_from_bytes
+from retro.loaders.gfx_charpad import read_ctm
+from retro.loaders.gfx_koala import koala_from_bytes
+from retro.loaders.gfx_screen import vic_part, vic_parts
 from retro.sprites import parse_hex, parse_rows, read_png, read_spr
 
 TOP_KEYS = {"chip", "video", "registers", "sprite", "memory", "cpu"}
@@ -51,8 +53,12 @@ CPU_KEYS = {"start_line", "start_cycle", "irq_vector"}  # where the beam is when
 SPRITE_KEYS = {"index", "x", "y", "enabled", "multicolor", "expand_x", "expand_y", "behind", "color", "data",
                "rows", "file", "frame", "velocity"}
 MAX_SPEED = 255  # pixels a frame, either axis: faster than anything on screen
-MEMORY_KEYS = {"screen", "color", "charset", "bitmap", "idle"}
-FILL_KEYS = {"fill", "cells"}
+MEMORY_KEYS = {"screen", "color", "charset", "bitmap", "idle", "charpad", "koala"}
+FILL_KEYS = {"fill", "cells", "file"}
+# keys that read one file into several parts of memory (retro/loaders/gfx_screen.py)
+WHOLE_FILE_PARTS = {"charpad": ("charset", "screen", "color"), "koala": ("bitmap", "screen", "color")}
+WHOLE_FILE_KEYS = {"charpad": {"file", "col", "row"}, "koala": {"file"}}
+MAX_MAP_CELL = 0xFFFF * 8  # a CharPad map is at most 65535 entries of tiles up to 8 cells wide
 SCREEN_CELL_KEYS = {"col", "row", "value"}
 BITMAP_KEYS = {"cells", "file"}
 BITMAP_CELL_KEYS = {"col", "row", "bytes"}
@@ -219,9 +225,14 @@ def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: _Where) 
     return SpriteSpec(n, data[:SPRITE_BYTES], source, velocity)
 
 
-def _fill_cells(spec, name: str, where: _Where, hi: int) -> np.ndarray:
-    spec = where.table(spec, f"memory.{name}", FILL_KEYS)
+def _fill_cells(spec, name: str, where: _Where, hi: int, given: tuple | None) -> np.ndarray:
+    """memory.screen / memory.color: `fill`, then a `file` (or the part a whole-file key gave), then `cells`."""
+    spec = where.table(spec if spec is not None else {}, f"memory.{name}", FILL_KEYS)
     values = np.full(SCREEN_CELLS, where.number(spec.get("fill", 0), f"memory.{name}.fill", 0, hi), np.uint8)
+    part = _part_file(spec, name, where, given)
+    if part is not None:
+        covered = part.covered if part.covered is not None else slice(None)
+        values[covered] = part.values[covered]
     cells = spec.get("cells", [])
     if not isinstance(cells, list):
         raise where.error(f"memory.{name}.cells", "expected a list of {col, row, value} tables")
@@ -230,6 +241,58 @@ def _fill_cells(spec, name: str, where: _Where, hi: int) -> np.ndarray:
         cell, index = _cell(cell, field_name, SCREEN_CELL_KEYS, where)
         values[index] = where.number(cell["value"], f"{field_name}.value", 0, hi)
     return values
+
+
+def _part_file(table: dict, part: str, where: _Where, given: tuple | None):
+    """The part (gfx_screen.Part) a `file` key in memory.PART gives, or the one a whole-file key
+    (memory.charpad, memory.koala) gave; both is an error."""
+    if "file" not in table:
+        return given[0] if given else None
+    if given:
+        raise where.error(f"memory.{part}.file", f"memory.{given[1]} gives the {part} already; give one of them")
+    field_name = f"memory.{part}.file"
+    path = where.file(table["file"], field_name, "file")
+    try:
+        return vic_part(read_bytes(path), repr(table["file"]), part)
+    except InputError as exc:
+        raise where.error(field_name, str(exc)) from None
+
+
+def _whole_files(spec: dict, where: _Where) -> dict[str, tuple]:
+    """memory.charpad and memory.koala: {part: (gfx_screen.Part, key)} for every part they give."""
+    given: dict[str, tuple] = {}
+    for key, parts in WHOLE_FILE_PARTS.items():
+        if key not in spec:
+            continue
+        value = spec[key]
+        table = {"file": value} if isinstance(value, str) else where.table(value, f"memory.{key}", WHOLE_FILE_KEYS[key])
+        field_name = f"memory.{key}" if isinstance(value, str) else f"memory.{key}.file"
+        if "file" not in table:
+            raise where.error(field_name, "missing: the file to read")
+        col = where.number(table.get("col", 0), f"memory.{key}.col", 0, MAX_MAP_CELL)
+        row = where.number(table.get("row", 0), f"memory.{key}.row", 0, MAX_MAP_CELL)
+        for part in parts:
+            if part in given:
+                raise where.error(f"memory.{key}", f"memory.{given[part][1]} gives the {part} already; give one of them")
+        path = where.file(table["file"], field_name, "file")
+        raw = read_bytes(path)
+        name = repr(table["file"])
+        try:
+            if key == "charpad":
+                rows, cols = read_ctm(raw, name).size
+                for axis, value, size in (("col", col, cols), ("row", row, rows)):
+                    if value >= size:
+                        raise where.error(f"memory.charpad.{axis}", f"{name}: the map is {cols} x {rows} screen cells: "
+                                                                    f"{axis} {value} is past its edge")
+            else:
+                koala_from_bytes(raw, name)  # refuses what is not a Koala picture
+            for part, values in vic_parts(raw, name, parts, col, row).items():
+                given[part] = (values, key)
+        except InputError as exc:
+            if str(exc).startswith(f"{where.source}: "):
+                raise
+            raise where.error(field_name, str(exc)) from None
+    return given
 
 
 def _cell(cell, field_name: str, keys, where: _Where) -> tuple[dict, int]:
@@ -243,31 +306,24 @@ def _cell(cell, field_name: str, keys, where: _Where) -> tuple[dict, int]:
     return cell, row * TEXT_COLUMNS + col
 
 
-def _file_bytes(value, field_name: str, size: int, where: _Where) -> np.ndarray:
-    path = where.file(value, field_name, "file")
-    raw = read_bytes(path)
-    if len(raw) != size:
-        raise where.error(field_name, f"{value!r} must hold {size} bytes, got {len(raw)}")
-    return np.frombuffer(raw, dtype=np.uint8).copy()
-
-
 def _memory(doc, where: _Where) -> VicMemory:
     spec = where.table(doc, "memory", MEMORY_KEYS)
     memory = VicMemory.blank()
-    screen = _fill_cells(spec["screen"], "screen", where, 0xFF) if "screen" in spec else memory.screen
-    color = _fill_cells(spec["color"], "color", where, COLOR_MASK) if "color" in spec else memory.color
+    given = _whole_files(spec, where)
+    screen = memory.screen
+    if "screen" in spec or "screen" in given:
+        screen = _fill_cells(spec.get("screen"), "screen", where, 0xFF, given.get("screen"))
+    color = memory.color
+    if "color" in spec or "color" in given:
+        color = _fill_cells(spec.get("color"), "color", where, COLOR_MASK, given.get("color"))
     charset = memory.charset
-    if "charset" in spec:
-        table = spec["charset"]
+    if "charset" in spec or "charset" in given:
+        table = spec.get("charset", {})
         if not isinstance(table, dict):
             raise where.error("memory.charset", "expected a table of glyphs by code (\"1\" = [8 bytes]) or file =")
-        if "file" in table:
-            path = where.file(table["file"], "memory.charset.file", "file")
-            try:
-                glyphs = charset_from_bytes(read_bytes(path), repr(table["file"]))
-            except InputError as exc:
-                raise where.error("memory.charset.file", str(exc)) from None
-            charset = np.frombuffer(glyphs, dtype=np.uint8).copy()
+        part = _part_file(table, "charset", where, given.get("charset"))
+        if part is not None:
+            charset = part.values
         spelled: dict[int, str] = {}
         for key, glyph in table.items():
             if key == "file":
@@ -278,10 +334,11 @@ def _memory(doc, where: _Where) -> VicMemory:
             charset[code * CHAR_HEIGHT:(code + 1) * CHAR_HEIGHT] = where.byte_list(glyph, f"memory.charset.{key}",
                                                                                    CHAR_HEIGHT)
     bitmap = memory.bitmap
-    if "bitmap" in spec:
-        table = where.table(spec["bitmap"], "memory.bitmap", BITMAP_KEYS)
-        if "file" in table:
-            bitmap = _file_bytes(table["file"], "memory.bitmap.file", BITMAP_BYTES, where)
+    if "bitmap" in spec or "bitmap" in given:
+        table = where.table(spec.get("bitmap", {}), "memory.bitmap", BITMAP_KEYS)
+        part = _part_file(table, "bitmap", where, given.get("bitmap"))
+        if part is not None:
+            bitmap = part.values
         cells = table.get("cells", [])
         if not isinstance(cells, list):
             raise where.error("memory.bitmap.cells", "expected a list of {col, row, bytes} tables")
