@@ -5,14 +5,16 @@ in raw .spr files each sprite takes a 64-byte block (the last byte unused); a fi
 blocks (animation frames). Hires: one bit per pixel, 1 opaque. Multicolor: two bits per double-wide
 pixel; 01, 10 and 11 are opaque, 00 transparent [Bauer 3.8.1, 3.8.2].
 
-PNG: 24x21 pixels. Transparent (alpha 0) or black pixels are 0. Hires: any other colour is 1.
-Multicolor: each pair of pixels holds one value; the left pixel's colour must be one of
-MULTICOLOR_PREVIEW (the colours `write_png` uses), so files written here read back exactly.
+Sprite files are read by content, whatever their name (`read_sprite_frames`, `read_sprite`):
+PNG (signature, or a .png name): a sprite or a sheet of them, colours through a C64 palette
+(retro/loaders/gfx_png_sprites.py; `write_png`'s preview colours read back exactly); Spritemate
+JSON (retro/loaders/gfx_spritemate.py); SpritePad (retro/loaders/gfx_spritepad.py); otherwise raw
+64-byte blocks (or one 63-byte sprite).
 """
 
 from __future__ import annotations
 
-import io
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -28,13 +30,16 @@ from retro.chips.vic.constants import (
 )
 from retro.errors import InputError
 from retro.fileio import read_bytes, write_atomic
+from retro.loaders.gfx_png_sprites import PNG_MAGIC, SpriteColours, read_png_sheet
+from retro.loaders.gfx_spritemate import looks_like_spm, parse_spm
 from retro.loaders.gfx_spritepad import looks_like_spd, parse_spd
 
 HIRES_ROW_CHARS = {".": 0, "#": 1}
 MULTICOLOR_ROW_CHARS = {".": 0, "1": 1, "2": 2, "3": 3}
 TRANSPARENT_PREVIEW = (0, 0, 0)
 HIRES_PREVIEW = (255, 255, 255)
-# Preview colours for the multicolor values 1, 2, 3 (light blue, white, yellow: C64-like, distinct)
+# Preview colours for the multicolor values 1, 2, 3: light blue, white, yellow, exactly Colodore's C64 colours
+# 14, 1 and 7 (retro/render/palette.py), so a PNG written here reads back as C64 colours too
 MULTICOLOR_PREVIEW = {1: (112, 109, 235), 2: (255, 255, 255), 3: (237, 241, 113)}
 
 
@@ -114,62 +119,112 @@ def format_rows(data: bytes, multicolor: bool = False) -> list[str]:
     return ["".join(chars[v] for v in row) for row in decode(data, multicolor)]
 
 
-def read_spr(path: str | Path, frame: int = 0, field: str = "file") -> bytes:
-    """Frame N of a raw .spr file (64-byte blocks; a lone 63-byte sprite is accepted) or of a
-    SpritePad .spd file (detected by content) -> 63 bytes."""
-    raw = read_bytes(path, "sprite file")
+@dataclass(frozen=True)
+class SpriteFrame:
+    """One sprite of a file: the 63 bytes scenes use, and what the format says about it."""
+
+    data: bytes
+    multicolor: bool | None  # None: the format does not record the mode (raw, PNG)
+    colour: int | None = None  # the sprite's own colour ($D027+n), where the format records it
+    overlay: bool = False  # SpritePad / Spritemate: the next sprite is drawn over this one
+    name: str = ""
+
+
+def sprite_format(raw: bytes, path: str | Path) -> str:
+    """"png", "spm", "spd" or "raw", from the content (the name only breaks ties, see below).
+
+    A PNG starts with its 8-byte signature (a file named .png is read as one whatever it holds, so a
+    broken one says so). A Spritemate file is a JSON object: one named .spm, or one that is not a
+    raw sprite length, is read as Spritemate; a raw-length file starting with "{" is tried as
+    Spritemate first and read raw if it is not JSON. SpritePad: see gfx_spritepad.looks_like_spd."""
+    suffix = Path(path).suffix.lower()
+    if raw.startswith(PNG_MAGIC) or suffix == ".png":
+        return "png"
+    if suffix == ".spm" or (looks_like_spm(raw) and not _raw_length(raw)):
+        return "spm"
+    if looks_like_spm(raw):
+        try:
+            parse_spm(raw, str(path))
+            return "spm"
+        except InputError:
+            pass
     if looks_like_spd(raw):
-        sprites = parse_spd(raw, str(path)).sprites
-        if not 0 <= frame < len(sprites):
-            raise InputError(f"{path}: frame: {frame} is outside 0..{len(sprites) - 1} "
-                             f"({len(sprites)} sprites in the SpritePad file)")
-        return sprites[frame].data
-    if len(raw) == SPRITE_BYTES:
-        frames = 1
-    elif raw and len(raw) % SPRITE_BLOCK == 0:
-        frames = len(raw) // SPRITE_BLOCK
-    else:
+        return "spd"
+    return "raw"
+
+
+def _raw_length(raw: bytes) -> bool:
+    return len(raw) == SPRITE_BYTES or (bool(raw) and len(raw) % SPRITE_BLOCK == 0)
+
+
+def scene_colours(registers, index: int) -> SpriteColours:
+    """The colours sprite `index` shows in, from a VIC-II register image ($D000 at 0)."""
+    from retro.chips.vic.constants import COLOR_MASK, REG_BACKGROUND0, REG_SPRITE_COLOR0, REG_SPRITE_MC0, REG_SPRITE_MC1
+
+    return SpriteColours(registers[REG_BACKGROUND0] & COLOR_MASK, registers[REG_SPRITE_MC0] & COLOR_MASK,
+                         registers[REG_SPRITE_COLOR0 + index] & COLOR_MASK, registers[REG_SPRITE_MC1] & COLOR_MASK)
+
+
+def read_sprite_frames(path: str | Path, multicolor: bool = False, colours: SpriteColours | None = None,
+                       palette: str | None = None, field: str = "file") -> list[SpriteFrame]:
+    """Every sprite of a sprite file, whatever its format (see `sprite_format`).
+
+    `multicolor`, `colours` and `palette` matter for PNG only (its pixels do not say the mode; see
+    gfx_png_sprites for the colours); giving a palette for another format is an error."""
+    return _read_frames(path, multicolor, colours, palette, field)[0]
+
+
+def _read_frames(path: str | Path, multicolor: bool, colours: SpriteColours | None, palette: str | None,
+                 field: str) -> tuple[list[SpriteFrame], str]:
+    raw = read_bytes(path, "sprite file")  # read once: a FIFO works
+    kind = sprite_format(raw, path)
+    if palette is not None and kind != "png":
+        raise InputError(f"{path}: palette: only a PNG's colours go through a palette (this is a "
+                         f"{KIND_NAMES[kind]})")
+    if kind == "png":
+        sheet = read_png_sheet(raw, str(path), multicolor, colours, palette)
+        return [SpriteFrame(data, None) for data in sheet.frames], kind
+    if kind == "spm":
+        spm = parse_spm(raw, str(path))
+        return [SpriteFrame(s.data, s.multicolor, s.colour, s.overlay, s.name) for s in spm.sprites], kind
+    if kind == "spd":
+        spd = parse_spd(raw, str(path))
+        return [SpriteFrame(s.data, s.multicolor, s.colour, s.overlay) for s in spd.sprites], kind
+    if not _raw_length(raw):
         raise InputError(f"{path}: {field}: a raw sprite file holds 64-byte blocks (or one 63-byte sprite), "
                          f"got {len(raw)} bytes")
-    if not 0 <= frame < frames:
-        raise InputError(f"{path}: frame: {frame} is outside 0..{frames - 1} ({frames} frames in the file)")
-    return raw[frame * SPRITE_BLOCK: frame * SPRITE_BLOCK + SPRITE_BYTES]
+    return [SpriteFrame(raw[i:i + SPRITE_BYTES], None) for i in range(0, len(raw), SPRITE_BLOCK)], kind
+
+
+KIND_NAMES = {"png": "PNG", "spm": "Spritemate file", "spd": "SpritePad file", "raw": "raw sprite file"}
+
+
+def read_sprite(path: str | Path, frame: int = 0, multicolor: bool = False, colours: SpriteColours | None = None,
+                palette: str | None = None, field: str = "file") -> bytes:
+    """Frame N of any sprite file -> 63 bytes."""
+    frames, kind = _read_frames(path, multicolor, colours, palette, field)
+    if not 0 <= frame < len(frames):
+        raise InputError(f"{path}: frame: {frame} is outside 0..{len(frames) - 1} "
+                         f"({len(frames)} sprite{'s' if len(frames) != 1 else ''} in the {KIND_NAMES[kind]})")
+    return frames[frame].data
+
+
+def read_spr(path: str | Path, frame: int = 0, field: str = "file") -> bytes:
+    """Frame N of a sprite file (raw .spr blocks, SpritePad, Spritemate, or a hires PNG) -> 63 bytes."""
+    return read_sprite(path, frame, field=field)
 
 
 def write_spr(path: str | Path, frames: list[bytes]) -> Path:
     return write_atomic(path, b"".join(block(f) for f in frames))
 
 
-def read_png(path: str | Path, multicolor: bool = False) -> bytes:
-    """A 24x21 PNG -> 63 bytes (see the module docstring for the colour rules)."""
-    raw = read_bytes(path, "sprite PNG")
-    try:
-        image = Image.open(io.BytesIO(raw))  # reads the header only: the size is known before decoding
-    except Exception:  # Pillow raises several types for bad files
-        raise InputError(f"{path}: not a readable PNG image") from None
-    if image.size != (SPRITE_WIDTH, SPRITE_HEIGHT):
-        raise InputError(f"{path}: a sprite PNG must be {SPRITE_WIDTH}x{SPRITE_HEIGHT} pixels, "
-                         f"got {image.width}x{image.height}")
-    try:
-        image = image.convert("RGBA")
-    except Exception:  # a valid header over damaged pixel data
-        raise InputError(f"{path}: not a readable PNG image") from None
-    rgba = np.asarray(image)
-    empty = (rgba[..., 3] == 0) | np.all(rgba[..., :3] == TRANSPARENT_PREVIEW, axis=-1)
-    if not multicolor:
-        return encode(~empty)
-    pixels = np.zeros((SPRITE_HEIGHT, SPRITE_MC_WIDTH), dtype=np.uint8)
-    for r in range(SPRITE_HEIGHT):
-        for c in range(SPRITE_MC_WIDTH):
-            if empty[r, 2 * c]:
-                continue
-            colour = tuple(int(v) for v in rgba[r, 2 * c, :3])
-            value = next((v for v, rgb in MULTICOLOR_PREVIEW.items() if rgb == colour), None)
-            if value is None:
-                raise InputError(f"{path}: pixel ({2 * c}, {r}) has colour {colour}, which is none of the "
-                                 f"multicolor preview colours {MULTICOLOR_PREVIEW}")
-            pixels[r, c] = value
-    return encode(pixels, True)
+def read_png(path: str | Path, multicolor: bool = False, frame: int = 0, colours: SpriteColours | None = None,
+             palette: str | None = None) -> bytes:
+    """Frame N of a PNG sprite or sheet -> 63 bytes (rules: retro/loaders/gfx_png_sprites.py)."""
+    frames = read_png_sheet(read_bytes(path, "sprite PNG"), str(path), multicolor, colours, palette).frames
+    if not 0 <= frame < len(frames):
+        raise InputError(f"{path}: frame: {frame} is outside 0..{len(frames) - 1} ({len(frames)} sprites in the PNG)")
+    return frames[frame]
 
 
 def to_image(data: bytes, multicolor: bool = False) -> Image.Image:

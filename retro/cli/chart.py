@@ -50,8 +50,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_method_option(p)
     add_engine_option(p)
     p.add_argument("--sprites", action="append", default=[], metavar="FILE",
-                   help="add a file's sprites to the corpus (.spr/raw frames, SpritePad .spd, a 24x21 PNG, or a "
-                        "VIC-II scene's enabled sprites); repeatable")
+                   help="add a file's sprites to the corpus (raw .spr frames, SpritePad .spd, Spritemate .spm, a PNG "
+                        "sprite or sheet, or a VIC-II scene's enabled sprites); repeatable")
     p.add_argument("--samples", default="auto", metavar="N",
                    help=f"cases per pair whose cycles are measured: a number, or `all` (default: all; "
                         f"{REDUCED_COST_SAMPLES} with --reduced)")

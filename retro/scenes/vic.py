@@ -46,12 +46,12 @@ from retro.scenes import earlier_spelling
 from retro.loaders.gfx_charpad import read_ctm
 from retro.loaders.gfx_koala import koala_from_bytes
 from retro.loaders.gfx_screen import vic_part, vic_parts
-from retro.sprites import parse_hex, parse_rows, read_png, read_spr
+from retro.sprites import parse_hex, parse_rows, read_sprite, scene_colours
 
 TOP_KEYS = {"chip", "video", "registers", "sprite", "memory", "cpu"}
 CPU_KEYS = {"start_line", "start_cycle", "irq_vector"}  # where the beam is when the routine starts
 SPRITE_KEYS = {"index", "x", "y", "enabled", "multicolor", "expand_x", "expand_y", "behind", "color", "data",
-               "rows", "file", "frame", "velocity"}
+               "rows", "file", "frame", "palette", "velocity"}
 MAX_SPEED = 255  # pixels a frame, either axis: faster than anything on screen
 MEMORY_KEYS = {"screen", "color", "charset", "bitmap", "idle", "charpad", "koala"}
 FILL_KEYS = {"fill", "cells", "file"}
@@ -195,8 +195,9 @@ def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: _Where) 
     given = [k for k in ("data", "rows", "file") if k in entry]
     if len(given) != 1:
         raise where.error(name, f"give exactly one of data, rows, file (got {', '.join(given) or 'none'})")
-    if "frame" in entry and given[0] != "file":
-        raise where.error(f"{name}.frame", "goes with file")
+    for key in ("frame", "palette"):
+        if key in entry and given[0] != "file":
+            raise where.error(f"{name}.{key}", "goes with file")
     kind = given[0]
     try:
         if kind == "data":
@@ -207,13 +208,9 @@ def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: _Where) 
             source = "rows"
         else:
             path = where.file(entry["file"], f"{name}.file", "sprite file")
-            if path.suffix.lower() == ".png":
-                if "frame" in entry:
-                    raise where.error(f"{name}.frame", "a PNG holds one sprite")
-                data = read_png(path, multicolor)
-            else:
-                frame = where.number(entry.get("frame", 0), f"{name}.frame", 0, 1 << 16)
-                data = read_spr(path, frame)
+            frame = where.number(entry.get("frame", 0), f"{name}.frame", 0, 1 << 16)
+            # any sprite file, by content (retro/sprites.py); a PNG is read in this sprite's colours
+            data = read_sprite(path, frame, multicolor, scene_colours(registers, n), entry.get("palette"))
             source = f"file {entry['file']}"
     except InputError as exc:
         message = str(exc)

@@ -1,5 +1,6 @@
-"""SpritePad .spd readers: samples built byte by byte from the documented layouts (see
-retro/loaders/gfx_spritepad.py), expected pixels and attributes worked by hand."""
+"""SpritePad .spd readers (1.x, 2.0 beta): samples built byte by byte from the documented layouts
+(see retro/loaders/gfx_spritepad.py), expected pixels and attributes worked by hand. SpritePad Pro,
+Spritemate and PNG sheets: test_sprite_editor_files.py."""
 
 from __future__ import annotations
 
@@ -70,8 +71,8 @@ def test_raw_spr_still_raw(tmp_path):
 
 
 @pytest.mark.parametrize("raw, message", [
-    (b"SPD" + bytes([4]) + bytes(100), "format version 4 is not supported"),
-    (b"SPD" + bytes([5]) + bytes(100), "format version 5 is not supported"),
+    (b"SPD" + bytes([2]) + bytes(100), "format version 2 is not supported"),
+    (b"SPD" + bytes([3]) + bytes(100), "format version 3 is not supported"),
     (b"SPD" + bytes([1, 3, 0, 0, 0, 0]) + bytes(64), "says 4 sprites"),
     (b"SPD\x01", "header is 4 bytes"),
     (bytes(70), "3 \\+ 64n bytes"),
@@ -83,7 +84,7 @@ def test_bad_spritepad_files_one_line(raw, message):
 
 def test_scene_uses_spritepad_file_and_cli_errors_cleanly(tmp_path):
     (tmp_path / "s.spd").write_bytes(beta_file())
-    (tmp_path / "bad.spd").write_bytes(b"SPD" + bytes([5]) + bytes(80))
+    (tmp_path / "bad.spd").write_bytes(b"SPD" + bytes([3]) + bytes(80))
     scene = """chip = "vic-ii"
 
 [[sprite]]
@@ -112,7 +113,7 @@ frame = 1
     bad = subprocess.run([sys.executable, "-m", "retro", "vic", str(tmp_path / "bad.toml")],
                          capture_output=True, text=True)
     assert bad.returncode == 2
-    assert len(bad.stderr.strip().splitlines()) == 1 and "version 5" in bad.stderr
+    assert len(bad.stderr.strip().splitlines()) == 1 and "version 3" in bad.stderr
 
 
 def test_huge_png_refused_from_its_header(tmp_path):
@@ -128,5 +129,5 @@ def test_huge_png_refused_from_its_header(tmp_path):
     path = tmp_path / "huge.png"
     path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IEND", b""))
     from retro.sprites import read_png
-    with pytest.raises(InputError, match="must be 24x21 pixels, got 9000x9000"):
+    with pytest.raises(InputError, match="is 24x21 pixels or a sheet of them .*got 9000x9000"):
         read_png(path)

@@ -1,13 +1,13 @@
 """Sprite files -> shapes for the study, through retro.sprites (the one sprite decoder).
 
 `load_sprite_files` reads a user's sprites into the corpus (`retro chart --sprites FILE`), by content
-and suffix, every format `retro` reads sprites from:
-- a SpritePad file (.spd, 1.x or 2.0 beta; detected by content): every sprite, multicolor as its
-  attribute byte says;
+(retro.sprites.read_sprite_frames), every format `retro` reads sprites from:
+- a SpritePad file (.spd: 1.x, 2.0 beta, Pro 4 and 5) or a Spritemate file (.spm): every sprite,
+  multicolor as the file says;
 - a raw sprite file (64-byte blocks, or one 63-byte sprite; .spr, .bin, .raw, ...): every frame,
   multicolor when the name starts with `mc_` (raw files do not record the mode);
-- a 24x21 PNG: one sprite, multicolor when the name starts with `mc_` (preview colours, see
-  retro.sprites);
+- a PNG sprite or sheet: every sprite, multicolor when the name starts with `mc_` (no scene gives
+  colours here, so multicolour pixels are read in the preview colours, see gfx_png_sprites);
 - a VIC-II scene (.toml): its enabled sprites with their multicolor and expansion flags.
 Fully transparent sprites are left out (they never collide); a file with none left is an error.
 """
@@ -75,22 +75,12 @@ def scene_shapes(path: str, minimum: int = 0) -> list[tuple[int, object]]:
     return shapes
 
 
-def _raw_frames(path: Path) -> list[tuple[str, bytes, bool]]:
-    from retro.chips.vic.constants import SPRITE_BLOCK, SPRITE_BYTES
-    from retro.fileio import read_bytes
-    from retro.loaders.gfx_spritepad import looks_like_spd, parse_spd
-
-    raw = read_bytes(path, "sprite file")
-    if looks_like_spd(raw):
-        found = parse_spd(raw, str(path)).sprites
-        return [(f"{path.stem}.{i}" if len(found) > 1 else path.stem, s.data, s.multicolor)
-                for i, s in enumerate(found)]
-    count = 1 if len(raw) == SPRITE_BYTES else len(raw) // SPRITE_BLOCK if raw and len(raw) % SPRITE_BLOCK == 0 else 0
-    if not count:
-        sprites.read_spr(path)  # raises the one-line error naming the size
-    multicolor = is_multicolor(path)
-    return [(f"{path.stem}.{i}" if count > 1 else path.stem, sprites.read_spr(path, i), multicolor)
-            for i in range(count)]
+def _file_frames(path: Path) -> list[tuple[str, bytes, bool]]:
+    """(name, 63 bytes, multicolor) for every sprite of a sprite file."""
+    found = sprites.read_sprite_frames(path, multicolor=is_multicolor(path))
+    return [(f"{path.stem}.{i}" if len(found) > 1 else path.stem, frame.data,
+             is_multicolor(path) if frame.multicolor is None else frame.multicolor)
+            for i, frame in enumerate(found)]
 
 
 def load_sprite_file(path_text: str) -> list:
@@ -98,16 +88,10 @@ def load_sprite_file(path_text: str) -> list:
     from retro.analysis.study.corpus import Shape
 
     path = Path(path_text)
-    suffix = path.suffix.lower()
-    if suffix == ".toml":
+    if path.suffix.lower() == ".toml":
         return [shape for _, shape in scene_shapes(path_text)]
-    if suffix == ".png":
-        multicolor = is_multicolor(path)
-        entries = [(path.stem, sprites.read_png(path, multicolor), multicolor)]
-    else:
-        entries = _raw_frames(path)
     shapes = []
-    for name, data, multicolor in entries:
+    for name, data, multicolor in _file_frames(path):
         mask = sprites.opaque_mask(data, multicolor)
         if mask.any():
             shapes.append(Shape(name=name, mask=mask, multicolor=multicolor, source=str(path), data=bytes(data)))
