@@ -20,7 +20,6 @@ from retro.cpu.mpu import (
     FLAG_U,
     FLAG_V,
     FLAG_Z,
-    RECENT_MASK,
     VARIANTS,
     CpuHalt,
 )
@@ -170,7 +169,8 @@ class Machine:
         entries: list[TraceEntry] | None = [] if trace else None
         start = self._enter(address, a, x, y, p)
         stolen_before = self.mpu.stolen
-        count = self._execute(RETURN_TRAP, CALL_STACK_TOP, start + budget, entries)
+        count = self._execute(RETURN_TRAP, CALL_STACK_TOP, start + budget,
+                              None if entries is None else _Tracer(self, entries))
         cycles = self._returned(start, budget, count)
         mpu = self.mpu
         status = _status(mpu.p)
@@ -213,38 +213,11 @@ class Machine:
         for target, value in writes:
             memory[target] = value
         start = self._enter(address, a, x, y, p)
-        if record is None:
-            count = self._execute(RETURN_TRAP, CALL_STACK_TOP, start + budget, None)
-        else:
-            count = self._execute_recorded(start + budget, record, pointer_pcs)
+        observer = None if record is None else _Recorder(record, pointer_pcs)
+        count = self._execute(RETURN_TRAP, CALL_STACK_TOP, start + budget, observer)
         cycles = self._returned(start, budget, count)
         mpu = self.mpu
         return cycles, mpu.a, mpu.x, mpu.y, _status(mpu.p)
-
-    def _execute_recorded(self, limit: int, record: list, pointer_pcs: frozenset[int]) -> int:
-        mpu = self.mpu
-        memory = self.bus.memory
-        append = record.append
-        step = mpu.step if mpu.lines is None else mpu.step_timed
-        count = 0
-        try:
-            while not (mpu.pc == RETURN_TRAP and mpu.sp == CALL_STACK_TOP) and mpu.processorCycles < limit:
-                if mpu.pending_interrupt is not None:
-                    step()  # the interrupt sequence: not an instruction, not recorded
-                    continue
-                pc = mpu.pc
-                mpu.recent[count & RECENT_MASK] = pc
-                count += 1
-                mpu.executed = count
-                if pc in pointer_pcs:
-                    zp = memory[(pc + 1) & 0xFFFF]
-                    append((pc, mpu.x, mpu.y, _status(mpu.p), memory[zp] | memory[(zp + 1) & 0xFF] << 8))
-                else:
-                    append((pc, mpu.x, mpu.y, _status(mpu.p), 0))
-                step()
-            return count
-        except CpuHalt as halt:
-            raise RunError(f"{halt}; last instructions: {self._describe_recent(mpu.executed)}") from None
 
     def run(self, entry: str | int, *, until: str | int | None = None, cycles: int = DEFAULT_BUDGET) -> int:
         """Run from entry for a number of cycles, or until the PC reaches `until` (error if it never does).
@@ -259,25 +232,12 @@ class Machine:
             self._over_budget(cycles, count)
         return count
 
-    def _execute(self, stop_pc: int, stop_sp: int, limit: int, entries: list[TraceEntry] | None) -> int:
-        """Run to stop_pc (and stop_sp) or the limit; a CpuHalt becomes a RunError saying where."""
+    def _execute(self, stop_pc: int, stop_sp: int, limit: int, observer=None) -> int:
+        """Run to stop_pc (and stop_sp) or the limit (the MPU's one run loop); a CpuHalt becomes a
+        RunError saying where."""
         mpu = self.mpu
         try:
-            if entries is None:
-                if mpu.lines is not None:
-                    return mpu.run_timed(stop_pc, stop_sp, limit)
-                return mpu.run_until(stop_pc, stop_sp, limit)
-            count = 0
-            while not (mpu.pc == stop_pc and (stop_sp < 0 or mpu.sp == stop_sp)) and mpu.processorCycles < limit:
-                if len(entries) >= MAX_TRACE:
-                    raise RunError(f"the trace is longer than {MAX_TRACE:,} instructions (at PC ${mpu.pc:04X}): "
-                                   "give a smaller budget, or run without the trace")
-                if mpu.pending_interrupt is None:
-                    mpu.recent[count & RECENT_MASK] = mpu.pc
-                    count += 1
-                    mpu.executed = count
-                entries.append(self._traced_step())
-            return count
+            return mpu.run(stop_pc, stop_sp, limit, observer)
         except CpuHalt as halt:
             raise RunError(f"{halt}; last instructions: {self._describe_recent(mpu.executed)}") from None
 
@@ -302,36 +262,6 @@ class Machine:
             return ((memory[lo] | memory[(lo + 1) & 0xFF] << 8) + mpu.y) & 0xFFFF
         return None
 
-    def _traced_step(self) -> TraceEntry:
-        mpu = self.mpu
-        address = mpu.pc
-        opcode = mpu.memory[address]
-        mnemonic, mode = mpu.disassemble[opcode]
-        operand = self._operand_address(address, mode) if mnemonic not in ("JMP", "JSR") else None
-        reads = operand is not None and mnemonic not in STORES
-        before_value = self.bus.peek(operand) if reads and mnemonic not in LOADS else None
-        before = mpu.processorCycles
-        if mpu.lines is None:
-            mpu.step()
-            stolen = 0
-        else:
-            interrupt = mpu.pending_interrupt
-            instruction = mpu.step_timed()
-            stolen = mpu.last_stolen
-            if not instruction:  # the interrupt sequence: its own trace line, at the address it interrupts
-                return TraceEntry(address=address, opcode=-1, mnemonic=interrupt, mode="int",
-                                  cycles=mpu.processorCycles - before, page_crossed=False, branch_taken=False,
-                                  stolen=stolen)
-        cycles = mpu.processorCycles - before
-        extra = cycles - stolen - mpu.cycletime[opcode]
-        is_branch = mode == "rel"
-        value = before_value
-        if reads and mnemonic in LOADS:  # what the load put in its register is what it read
-            value = {"LDA": mpu.a, "LDX": mpu.x, "LDY": mpu.y, "LAX": mpu.a}[mnemonic]
-        return TraceEntry(address=address, opcode=opcode, mnemonic=mnemonic, mode=mode, cycles=cycles,
-                          page_crossed=(extra == 2) if is_branch else extra == 1,
-                          branch_taken=is_branch and extra >= 1, stolen=stolen, operand=operand, read=value)
-
     def _over_budget(self, budget: int, count: int) -> None:
         raise RunError(f"cycle budget of {budget} cycles used up at PC ${self.mpu.pc:04X} after {count} "
                        f"instructions; last instructions: {self._describe_recent(count)}")
@@ -355,3 +285,69 @@ class Machine:
             "rel": f"${(address + 2 + (lo - 256 if lo & 0x80 else lo)) & 0xFFFF:04X}",
         }.get(mode, "")
         return f"{mnemonic} {operand}".strip()
+
+
+class _Recorder:
+    """Observer of the run loop: each instruction's (pc, x, y, p, pointer) before it runs, for the
+    timing model (pointer: the zero-page word of an (indirect),Y instruction in `pointer_pcs`, else 0)."""
+
+    def __init__(self, record: list, pointer_pcs: frozenset[int]) -> None:
+        self.append = record.append
+        self.pointer_pcs = pointer_pcs
+
+    def before(self, mpu) -> None:
+        if mpu.pending_interrupt is not None:
+            return  # the interrupt sequence is not an instruction
+        pc = mpu.pc
+        if pc in self.pointer_pcs:
+            memory = mpu.memory
+            zp = memory[(pc + 1) & 0xFFFF]
+            self.append((pc, mpu.x, mpu.y, _status(mpu.p), memory[zp] | memory[(zp + 1) & 0xFF] << 8))
+        else:
+            self.append((pc, mpu.x, mpu.y, _status(mpu.p), 0))
+
+    def after(self, mpu) -> None:
+        pass
+
+
+class _Tracer:
+    """Observer of the run loop: a TraceEntry per step (an instruction, or an interrupt sequence at
+    the address it interrupts), at most MAX_TRACE of them."""
+
+    def __init__(self, machine: Machine, entries: list[TraceEntry]) -> None:
+        self.machine = machine
+        self.entries = entries
+
+    def before(self, mpu) -> None:
+        if len(self.entries) >= MAX_TRACE:
+            raise RunError(f"the trace is longer than {MAX_TRACE:,} instructions (at PC ${mpu.pc:04X}): "
+                           "give a smaller budget, or run without the trace")
+        self.address = address = mpu.pc
+        self.interrupt = mpu.pending_interrupt if mpu.lines is not None else None
+        self.cycles_before = mpu.processorCycles
+        if self.interrupt is not None:
+            return
+        self.opcode = opcode = mpu.memory[address]
+        self.mnemonic, self.mode = mnemonic, mode = mpu.disassemble[opcode]
+        operand = self.machine._operand_address(address, mode) if mnemonic not in ("JMP", "JSR") else None
+        self.operand = operand
+        self.reads = reads = operand is not None and mnemonic not in STORES
+        self.before_value = self.machine.bus.peek(operand) if reads and mnemonic not in LOADS else None
+
+    def after(self, mpu) -> None:
+        stolen = 0 if mpu.lines is None else mpu.last_stolen
+        cycles = mpu.processorCycles - self.cycles_before
+        if self.interrupt is not None:  # the interrupt sequence: its own line, at the address it interrupts
+            self.entries.append(TraceEntry(address=self.address, opcode=-1, mnemonic=self.interrupt, mode="int",
+                                           cycles=cycles, page_crossed=False, branch_taken=False, stolen=stolen))
+            return
+        mnemonic, mode = self.mnemonic, self.mode
+        extra = cycles - stolen - mpu.cycletime[self.opcode]
+        is_branch = mode == "rel"
+        value = self.before_value
+        if self.reads and mnemonic in LOADS:  # what the load put in its register is what it read
+            value = {"LDA": mpu.a, "LDX": mpu.x, "LDY": mpu.y, "LAX": mpu.a}[mnemonic]
+        self.entries.append(TraceEntry(address=self.address, opcode=self.opcode, mnemonic=mnemonic, mode=mode,
+                                       cycles=cycles, page_crossed=(extra == 2) if is_branch else extra == 1,
+                                       branch_taken=is_branch and extra >= 1, stolen=stolen, operand=self.operand,
+                                       read=value))

@@ -19,9 +19,12 @@ What this adds to py65 1.2.0:
   list; opcodes and operands are always fetched from it. Dummy reads are not put on the bus.
   docs/cpu.md has the model and what it leaves out.
 - BRK optionally stops the run (`stop_on_brk`), which `Machine.call` uses.
-- `run_until`, the loop `Machine` runs: `step` inlined, with a ring of recent instruction addresses
-  for error messages. It and the cheaper operand fetches make it faster than bare py65.
-- `run_timed` / `step_timed`, used instead when a chip drives the CPU's control lines (`lines`, a
+- `run`, the one run loop `Machine` uses: stop address and stack, cycle limit, a ring of recent
+  instruction addresses for error messages, and an optional observer told before and after each
+  step (the trace and the timing model's record of the path). `run_until` is the same loop with
+  `step` inlined, taken when nothing observes and no chip drives the control lines; it and the
+  cheaper operand fetches make it faster than bare py65.
+- `step_timed`, the step `run` takes when a chip drives the CPU's control lines (`lines`, a
   `retro.cpu.bus.CpuLines`; the VIC-II on a C64): RDY/BA stalls and IRQ/NMI. Without such a chip
   none of this code runs, so plain RAM and passive devices cost nothing extra.
   * Stalls [Bauer 3.6.3]: while BA is low the CPU stops at its first read cycle and goes on when BA
@@ -119,7 +122,7 @@ class MPU6510(_Py65MPU):
         # Addresses of the last RECENT_SIZE instructions started by run_until (a ring, indexed by count).
         self.recent = [0] * RECENT_SIZE
         self.executed = 0  # instructions started by the last run_until, including one that halted
-        self.lines = None  # a CpuLines when a chip drives RDY/IRQ/NMI (run_timed)
+        self.lines = None  # a CpuLines when a chip drives RDY/IRQ/NMI (then run steps with step_timed)
         self.pending_interrupt = None  # "IRQ" or "NMI", decided by the poll of the last instruction
         self.stolen = 0  # cycles lost to stalls since power-on (part of processorCycles)
         self.last_stolen = 0  # of the last step_timed
@@ -254,10 +257,20 @@ class MPU6510(_Py65MPU):
         self.stolen += delay
         self.last_stolen = delay
 
-    def run_timed(self, stop_pc: int, stop_sp: int, limit: int) -> int:
-        """run_until with stalls and interrupts; returns the instructions executed (not interrupt entries)."""
+    def run(self, stop_pc: int, stop_sp: int, limit: int, observer=None) -> int:
+        """The run loop: execute until PC == stop_pc (and SP == stop_sp, unless stop_sp < 0) or the clock
+        reaches limit; return the instructions executed (interrupt sequences are not instructions).
+
+        Each step is an instruction, or the interrupt sequence when one is pending (with a chip on
+        the control lines, `step_timed`). An observer (a trace, a record of the path) is told before
+        and after every step: `observer.before(mpu)` and `observer.after(mpu)`. Without an observer
+        or control lines the loop is `run_until`, the same loop with `step` inlined for speed.
+        CpuHalt propagates with `executed` counting the halting instruction.
+        """
+        if observer is None and self.lines is None:
+            return self.run_until(stop_pc, stop_sp, limit)
         recent = self.recent
-        step = self.step_timed
+        step = self.step if self.lines is None else self.step_timed
         count = 0
         try:
             while True:
@@ -269,7 +282,13 @@ class MPU6510(_Py65MPU):
                 if self.pending_interrupt is None:
                     recent[count & RECENT_MASK] = pc
                     count += 1
-                step()
+                    self.executed = count
+                if observer is None:
+                    step()
+                else:
+                    observer.before(self)
+                    step()
+                    observer.after(self)
         finally:
             self.executed = count
 
