@@ -32,7 +32,7 @@ from retro.fileio import read_bytes
 LEGACY_PENS = {"t": 0, "i": 1, "m1": 2, "m2": 3}  # before 2018-05-26
 LEGACY_COLOUR_KEYS = {"t": "0", "m1": "2", "m2": "3"}
 PEN_PAIR = (0b00, 0b10, 0b01, 0b11)  # pen -> multicolour bit pair
-MAX_SPRITES = 1 << 16
+MAX_SPRITES = 4096  # Spritemate files hold a few hundred at most; this bounds the work on a hostile file
 
 
 @dataclass(frozen=True)

@@ -204,6 +204,7 @@ def test_spritemate_read_by_content_whatever_the_name(tmp_path):
      "colors.2: 16 is not a C64 colour"),
     (json.dumps({"colors": {"0": 0, "2": 1, "3": 2}, "sprites": [{"pixels": grid()}]}), "sprites[0].color: missing"),
     (json.dumps({"colors": {"0": 0, "2": 1, "3": 2}, "sprites": []}), "sprites: expected a list of at least one"),
+    (json.dumps({"colors": {"0": 0, "2": 1, "3": 2}, "sprites": [{}] * 4097}), "4097 sprites, at most 4096"),
 ])
 def test_bad_spritemate_files_one_line(tmp_path, text, message):
     path = tmp_path / "bad.spm"
