@@ -8,7 +8,6 @@ plain dataclasses. Every scene object has `cpu_variant` ("6510" or "2a03") and
 
 from __future__ import annotations
 
-import importlib
 import sys
 from pathlib import Path
 
@@ -20,7 +19,7 @@ else:  # pragma: no cover
 from retro.errors import InputError
 from retro.fileio import read_text
 
-CHIP_MODULES = {"vic-ii": "retro.scenes.vic", "nes": "retro.scenes.nes"}
+CHIPS = ("vic-ii", "nes")  # the `chip` key of a scene file
 
 
 def read_toml(path: str | Path) -> dict:
@@ -36,10 +35,12 @@ def read_toml(path: str | Path) -> dict:
 def load_scene(path: str | Path):
     doc = read_toml(path)
     chip = doc.get("chip")
-    if not isinstance(chip, str) or chip not in CHIP_MODULES:
-        raise InputError(f"{path}: chip: expected one of {', '.join(repr(c) for c in CHIP_MODULES)}, got {chip!r}")
-    module = importlib.import_module(CHIP_MODULES[chip])
-    return module.parse(doc, source=str(path))
+    if not isinstance(chip, str) or chip not in CHIPS:
+        raise InputError(f"{path}: chip: expected one of {', '.join(repr(c) for c in CHIPS)}, got {chip!r}")
+    from retro.scenes import nes, vic  # here, not at the top: both use this package's helpers
+
+    parse = {"vic-ii": vic.parse, "nes": nes.parse}[chip]
+    return parse(doc, source=str(path))
 
 
 def earlier_spelling(seen: dict, canonical, spelling: str) -> str | None:
