@@ -620,7 +620,9 @@ def load_function(text: str | None, base: Path, r: _Reader, key: str) -> Callabl
 
 
 @lru_cache(maxsize=64)
-def _module_cached(path: str, mtime: float):
+def import_user_module(path: str, mtime: float):
+    """A user's Python file as a module, imported once per (path, modification time); its folder is
+    put on sys.path so that it may import its neighbours. Routine specs and method files use it."""
     name = f"retro_user_{abs(hash(path)):x}"
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
@@ -634,7 +636,7 @@ def _module_cached(path: str, mtime: float):
 
 def _module_from_file(path: Path, r: _Reader, key: str):
     try:
-        return _module_cached(str(path), path.stat().st_mtime)
+        return import_user_module(str(path), path.stat().st_mtime)
     except Exception as exc:  # the user's module failed to import: one line, whatever it raised
         line = ""
         tb = exc.__traceback__

@@ -25,11 +25,9 @@ accuracy counts and the routine is what its cycles count.
 
 from __future__ import annotations
 
-import importlib.util
 import re
 import sys
 from dataclasses import dataclass, field
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +37,7 @@ from retro.analysis.study.fits import Box, Circle, fitted_circle, full_box, tigh
 from retro.analysis.study.methods.base import ORIGIN, Method
 from retro.errors import InputError, RunError
 from retro.fileio import read_bytes
+from retro.routines.spec import import_user_module
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -219,25 +218,13 @@ def _load_function(path: Path, shown: str, text) -> object:
     if not file.is_file():
         raise _fail(shown, key, f"{file_text}: file not found")
     try:
-        module = _module(str(file), file.stat().st_mtime)
+        module = import_user_module(str(file), file.stat().st_mtime)
     except Exception as exc:  # the user's module failed to import: one line, whatever it raised
         raise _fail(shown, key, f"{file.name} failed to import: {type(exc).__name__}: {exc}") from None
     function = getattr(module, name, None)
     if not callable(function):
         raise _fail(shown, key, f"{file_text} has no function {name!r}")
     return function
-
-
-@lru_cache(maxsize=32)
-def _module(path: str, mtime: float):
-    name = f"retro_method_{abs(hash((path, mtime))):x}"
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    folder = str(Path(path).parent)
-    if folder not in sys.path:  # the user's module may import its neighbours, as a script would
-        sys.path.append(folder)
-    spec.loader.exec_module(module)
-    return module
 
 
 def _int_list(shown: str, key: str, value, count: int, lo: int, hi: int) -> tuple[int, ...]:
