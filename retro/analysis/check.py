@@ -22,11 +22,10 @@ from __future__ import annotations
 
 import math
 import os
-import signal
 import time
 from collections.abc import Callable, Iterator
 from collections import deque
-from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import Future
 from dataclasses import dataclass, field
 from itertools import islice
 
@@ -41,6 +40,7 @@ from retro.routines.registry import select
 from retro.cpu.batch import LaneError
 from retro.routines.runner import BatchOutcome, RasterStart, RoutineRunner, Size, describe_value
 from retro.routines.spec import Routine, load_spec
+from retro.workers import worker_pool
 
 EXAMPLES_KEPT = 5
 JSON_EXACT = 1 << 53  # larger whole numbers lose digits in JSON readers that use doubles
@@ -566,10 +566,6 @@ def static_bounds(routine: Routine, runner: RoutineRunner | None = None) -> Boun
 
 # ---- a whole check -----------------------------------------------------------------------------------
 
-def _ignore_interrupt() -> None:
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C goes to the parent, which stops the pool
-
-
 def _run_work(work: Iterator[tuple], jobs: int, report: Callable[[ChunkResult], None],
               stop: Callable[[], int]) -> None:
     """Run (function, arguments) items in order, over `jobs` worker processes when more than one,
@@ -580,7 +576,7 @@ def _run_work(work: Iterator[tuple], jobs: int, report: Callable[[ChunkResult], 
             if stop():
                 return
         return
-    pool = ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_interrupt)
+    pool = worker_pool(jobs)
     pending: deque[Future] = deque()
     try:
         for function, arguments in work:

@@ -10,7 +10,6 @@ statistic. The verdict is computed on the measured cases only.
 
 from __future__ import annotations
 
-from concurrent.futures import ProcessPoolExecutor
 from itertools import combinations_with_replacement
 
 from retro.analysis.study.corpus import Pair, Shape, make_pair
@@ -19,6 +18,7 @@ from retro.analysis.study.evaluate import Progress, default_workers, quiet
 from retro.analysis.study.host_timing import host_microseconds
 from retro.analysis.study.methods import METHODS, Method, sub_pair
 from retro.errors import RunError
+from retro.workers import worker_pool
 
 HOST_SAMPLES = 48  # cases per pair timed on the host (a secondary figure)
 
@@ -67,7 +67,7 @@ def measure_costs(shapes: list[Shape], samples: int | None, workers: int | None 
     measured = [m for m in methods if not m.host_only]
     tasks = [(m, a, b) for m in measured for a, b in jobs]
     if workers > 1 and len(tasks) > 1:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
+        with worker_pool(workers) as pool:
             futures = [pool.submit(_measure_pair, m, a, b, samples) for m, a, b in tasks]
             results = []
             for (m, _, _), future in zip(tasks, futures):

@@ -5,12 +5,12 @@ from __future__ import annotations
 import os
 import sys
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 from retro.analysis.study.accuracy import Confusion, confusion, pooled
 from retro.analysis.study.corpus import Shape, make_pair
 from retro.analysis.study.methods import METHODS, Method
+from retro.workers import worker_pool
 
 Progress = Callable[[str], None]
 
@@ -68,7 +68,7 @@ def evaluate(shapes: list[Shape], methods: tuple[Method, ...] = METHODS, workers
             results.append(_evaluate_pair(a, b, methods))
             progress(f"accuracy: pair {i}/{len(jobs)} {a.name}+{b.name}")
     else:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
+        with worker_pool(workers) as pool:
             futures = [pool.submit(_evaluate_pair, a, b, methods) for a, b in jobs]
             for i, future in enumerate(futures, 1):
                 results.append(future.result())
