@@ -3,11 +3,17 @@
 from __future__ import annotations
 
 import os
+import sys
 import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 
 from retro.errors import InputError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
 
 MAX_INPUT_BYTES = 64 << 20  # no file a user gives retro (program, symbols, sprites, scenes) is near this
 
@@ -73,7 +79,11 @@ def _resolved(path: Path) -> Path:
 
 def _checked_target(path: Path) -> Path:
     target = _resolved(path)
-    if target.exists() and not target.is_file():
+    try:
+        exists = target.exists()
+    except OSError as exc:  # a name too long, a component that is not a folder, ...
+        raise InputError(f"{str(path)[:80]}: cannot write there: {exc.strerror}") from None
+    if exists and not target.is_file():
         kind = "a folder" if target.is_dir() else "not a regular file"
         raise InputError(f"{path}: is {kind}: give a file name to write")
     return target
@@ -111,6 +121,21 @@ def read_text(path: str | os.PathLike, what: str = "file") -> str:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise InputError(f"{path}: {what} is not UTF-8 text (byte {exc.start})") from None
+
+
+def parse_toml(data: bytes, shown: str) -> dict:
+    """A TOML document, or one line naming the file: not UTF-8, not TOML, nested too deeply (the
+    reader recurses per level), or a number longer than Python converts (4,300 digits)."""
+    try:
+        return tomllib.loads(data.decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{shown}: not UTF-8 text (byte {exc.start})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{shown}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise InputError(f"{shown}: not valid TOML: nested too deeply") from None
+    except ValueError as exc:  # int() of a huge literal inside the reader
+        raise InputError(f"{shown}: not valid TOML: {str(exc).split(':')[0]}") from None
 
 
 def output_folder(path: str | os.PathLike) -> Path:

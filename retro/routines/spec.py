@@ -23,14 +23,10 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
 
 from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z, VARIANTS
 from retro.errors import InputError
-from retro.fileio import read_bytes
+from retro.fileio import parse_toml, read_bytes
 from retro.loaders import load_program
 from retro.numbers import parse_int
 from retro.program import Program
@@ -258,14 +254,7 @@ def read_spec_document(path: str | Path) -> dict:
     data = read_bytes(path, "routine spec")
     if len(data) > MAX_SPEC_BYTES:
         raise InputError(f"{shown}: a routine spec of {len(data)} bytes is too large (at most {MAX_SPEC_BYTES})")
-    try:
-        return tomllib.loads(data.decode("utf-8"))
-    except UnicodeDecodeError as exc:
-        raise InputError(f"{shown}: not UTF-8 text (byte {exc.start})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{shown}: not valid TOML: {exc}") from None
-    except RecursionError:
-        raise InputError(f"{shown}: not valid TOML: nested too deeply") from None
+    return parse_toml(data, shown)
 
 
 @lru_cache(maxsize=64)

@@ -8,28 +8,16 @@ plain dataclasses. Every scene object has `cpu_variant` ("6510" or "2a03") and
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
-
 from retro.errors import InputError
-from retro.fileio import read_text
+from retro.fileio import parse_toml, read_bytes
 
 CHIPS = ("vic-ii", "nes")  # the `chip` key of a scene file
 
 
 def read_toml(path: str | Path) -> dict:
-    text = read_text(path, "scene file")
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: not valid TOML: {exc}") from None
-    except RecursionError:  # tomllib recurses per nesting level
-        raise InputError(f"{path}: not valid TOML: nested too deeply") from None
+    return parse_toml(read_bytes(path, "scene file"), str(path))
 
 
 def load_scene(path: str | Path):

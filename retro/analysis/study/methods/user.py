@@ -26,7 +26,6 @@ accuracy counts and the routine is what its cycles count.
 from __future__ import annotations
 
 import re
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -36,13 +35,9 @@ from retro.analysis.study.corpus import Pair, Shape
 from retro.analysis.study.fits import Box, Circle, fitted_circle, full_box, tight_box
 from retro.analysis.study.methods.base import ORIGIN, Method
 from retro.errors import InputError, RunError
-from retro.fileio import read_bytes
+from retro.fileio import parse_toml, read_bytes
 from retro.routines.spec import import_user_module
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
 
 MAX_METHOD_BYTES = 1 << 16
 TOP_KEYS = {"name", "label", "routine", "prepare", "hit", "colour", "marker", "hitbox", "inputs"}
@@ -326,14 +321,7 @@ def load_method_file(path_text: str, index: int = 0) -> UserMethod:
     path = Path(path_text)
     shown = str(path_text)
     raw = read_bytes(path, "method file", limit=MAX_METHOD_BYTES)
-    try:
-        doc = tomllib.loads(raw.decode("utf-8"))
-    except UnicodeDecodeError as exc:
-        raise InputError(f"{shown}: not UTF-8 text (byte {exc.start})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{shown}: not valid TOML: {exc}") from None
-    except RecursionError:
-        raise InputError(f"{shown}: not valid TOML: nested too deeply") from None
+    doc = parse_toml(raw, shown)
     for key in doc:
         if key not in TOP_KEYS:
             raise _fail(shown, key, f"unknown key (known: {', '.join(sorted(TOP_KEYS))})")
