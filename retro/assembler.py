@@ -23,7 +23,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from retro.errors import InputError
-from retro.fileio import read_text
+from retro.fileio import exists, is_dir, is_file, read_text
 from retro.program import ADDRESS_LIMIT, Program
 
 _OPHIS_DRIVER = "import sys; from Ophis.Main import run_ophis; sys.exit(run_ophis(sys.argv[1:]))"
@@ -66,7 +66,7 @@ def assemble_file(path: str | Path, data: bytes | None = None) -> Program:
     FIFO, a device) is read once (or its bytes are given as `data`, already read) and handed to
     Ophis as text, its includes relative to its folder."""
     source_path = Path(path)
-    if source_path.exists() and not source_path.is_file() and not source_path.is_dir():
+    if exists(source_path) and not is_file(source_path) and not is_dir(source_path):
         text = _decode(source_path, data) if data is not None else _read_once(source_path)
         return _assemble(_STDIN, str(source_path), text, cwd=source_path.parent)
     text = read_text(source_path, "source file")
@@ -104,7 +104,7 @@ def _fingerprint(path: Path, text: str) -> str:
     digest = hashlib.sha256(text.encode())
     for included in sorted(re.findall(r'\.(?:include|incbin|require)\s+"([^"]+)"', text)):
         candidate = path.parent / included
-        if candidate.is_file():
+        if is_file(candidate):
             digest.update(candidate.read_bytes())
     return digest.hexdigest()
 

@@ -99,9 +99,29 @@ def _mode_for(target: Path) -> int:
         return 0o666 & ~umask
 
 
+def _asks(test, path) -> bool:
+    try:
+        return test(Path(path))
+    except (OSError, ValueError):  # a name too long, a NUL byte in it, ...: there is no such file
+        return False
+
+
+def is_file(path: str | os.PathLike) -> bool:
+    """Path.is_file for names users give: False, not an exception, for names no file can have."""
+    return _asks(Path.is_file, path)
+
+
+def is_dir(path: str | os.PathLike) -> bool:
+    return _asks(Path.is_dir, path)
+
+
+def exists(path: str | os.PathLike) -> bool:
+    return _asks(Path.exists, path)
+
+
 def read_bytes(path: str | os.PathLike, what: str = "file", limit: int = MAX_INPUT_BYTES) -> bytes:
     """The file's bytes, read once (a FIFO works); more than `limit` bytes is an error, not a hang."""
-    if Path(path).is_dir():
+    if is_dir(path):
         raise InputError(f"{path}: {what} is a folder, not a file")
     try:
         with open(path, "rb") as stream:
@@ -111,8 +131,8 @@ def read_bytes(path: str | os.PathLike, what: str = "file", limit: int = MAX_INP
         return data
     except FileNotFoundError:
         raise InputError(f"{path}: {what} not found") from None
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read {what}: {exc.strerror or exc}") from None
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{str(path)[:200]}: cannot read {what}: {getattr(exc, 'strerror', None) or exc}") from None
 
 
 def read_text(path: str | os.PathLike, what: str = "file") -> str:

@@ -9,6 +9,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from retro.errors import InputError
+from retro.fileio import is_file
 from retro.paths import ASM_DIR
 from retro.routines.spec import Routine, load_spec
 
@@ -29,7 +30,7 @@ def spec_path(name_or_path: str) -> Path:
     if is_spec_path(name_or_path):
         return Path(name_or_path)
     path = ASM_DIR / f"{name_or_path}{SPEC_SUFFIX}"
-    if not path.is_file():
+    if not is_file(path):
         known = ", ".join(builtin_names())
         raise InputError(f"unknown routine {name_or_path!r} (built-in: {known}; or give a spec file NAME.toml)")
     return path

@@ -26,7 +26,7 @@ from pathlib import Path
 
 from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z, VARIANTS
 from retro.errors import InputError
-from retro.fileio import parse_toml, read_bytes
+from retro.fileio import exists, is_dir, is_file, parse_toml, read_bytes
 from retro.loaders import load_program
 from retro.numbers import parse_int
 from retro.program import Program
@@ -244,8 +244,8 @@ class _Reader:
 
     def path(self, base: Path, value: str, field_name: str) -> Path:
         path = (base / value).resolve() if not Path(value).is_absolute() else Path(value)
-        if not path.is_file():
-            raise self.fail(field_name, f"{value}: file not found" if not path.exists() else f"{value}: not a file")
+        if not is_file(path):
+            raise self.fail(field_name, f"{value}: file not found" if not exists(path) else f"{value}: not a file")
         return path
 
 
@@ -270,7 +270,7 @@ def load_spec(path: str | Path) -> Routine:
     except OSError:
         read_bytes(spec_path, "routine spec")  # raises the one-line error
         raise
-    if spec_path.is_dir():
+    if is_dir(spec_path):
         raise InputError(f"{path}: is a folder, not a routine spec")
     return _load_cached(str(spec_path.resolve()), str(path), mtime)
 

@@ -35,7 +35,7 @@ from retro.analysis.study.corpus import Pair, Shape
 from retro.analysis.study.fits import Box, Circle, fitted_circle, full_box, tight_box
 from retro.analysis.study.methods.base import ORIGIN, Method
 from retro.errors import InputError, RunError
-from retro.fileio import parse_toml, read_bytes
+from retro.fileio import is_file, parse_toml, read_bytes
 from retro.routines.spec import import_user_module
 
 
@@ -210,7 +210,7 @@ def _load_function(path: Path, shown: str, text) -> object:
     if not file_text.endswith(".py") or not name.isidentifier():
         raise _fail(shown, key, f"{text!r}: expected FILE.py:NAME (relative to the method file)")
     file = (path.parent / file_text).resolve()
-    if not file.is_file():
+    if not is_file(file):
         raise _fail(shown, key, f"{file_text}: file not found")
     try:
         module = import_user_module(str(file), file.stat().st_mtime)
