@@ -243,6 +243,8 @@ class _Reader:
             raise self.fail(field_name, f"expected a number in {lo}..{hi}, got {value!r}") from None
 
     def path(self, base: Path, value: str, field_name: str) -> Path:
+        if "\0" in value:
+            raise self.fail(field_name, "a file name cannot hold a NUL character")
         path = (base / value).resolve() if not Path(value).is_absolute() else Path(value)
         if not is_file(path):
             raise self.fail(field_name, f"{value}: file not found" if not exists(path) else f"{value}: not a file")
