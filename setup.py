@@ -6,7 +6,8 @@ and retro/_data/sprites (side by side, as the examples refer to ../sprites), so 
 from setuptools import find_packages, setup
 
 DATA_DIRS = {"retro._data.asm": "asm", "retro._data.examples": "examples", "retro._data.sprites": "sprites"}
-DATA_FILES = {"retro._data.asm": ["*.s", "*.toml"], "retro._data.examples": ["*.toml", "*.s"],
+DATA_FILES = {"retro._data.asm": ["*.s", "*.toml", "broad/*.s", "broad/*.toml"],
+              "retro._data.examples": ["*.toml", "*.s"],
               "retro._data.sprites": ["*.spr", "*.png", "*.md"]}
 
 setup(packages=find_packages(include=["retro", "retro.*"]) + list(DATA_DIRS), package_dir=DATA_DIRS,

@@ -1,5 +1,5 @@
-"""`retro chart [--out DIR] [--reduced] [--method FILE.toml ...] [--sprites FILE ...] [--samples N]`:
-speed against accuracy of every collision method."""
+"""`retro chart [--out DIR] [--reduced] [--method FILE.toml ...] [--sprites FILE ...] [--samples N] [--per-frame]`:
+speed against accuracy of every collision method, and with --per-frame its cost per frame."""
 
 from __future__ import annotations
 
@@ -55,6 +55,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--samples", default="auto", metavar="N",
                    help=f"cases per pair whose cycles are measured: a number, or `all` (default: all; "
                         f"{REDUCED_COST_SAMPLES} with --reduced)")
+    p.add_argument("--per-frame", action="store_true",
+                   help="also chart 6502 cycles per frame against the number of objects (1-64) for each method, "
+                        "with its preparation and a broad phase (every pair, sort along X): per_frame.png/.csv/.md")
     p.add_argument("--jobs", default="2", metavar="N", help="worker processes (default: 2)")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     p.set_defaults(func=cmd_chart)
@@ -67,7 +70,7 @@ def cmd_chart(args: argparse.Namespace) -> int:
     methods = with_user_methods(args.method)
     output = run_chart(Path(args.out), reduced=args.reduced, workers=workers,
                        progress=quiet if args.quiet else stderr_progress, cost_samples=samples, methods=methods,
-                       sprite_files=tuple(args.sprites))
+                       sprite_files=tuple(args.sprites), per_frame=args.per_frame)
     for line in summary_lines(output):
         print(line)
     return 0

@@ -18,7 +18,10 @@ def run_cli(*args: str) -> subprocess.CompletedProcess:
     (["advise", "no-such-scene.toml"], "no-such-scene.toml"),
     (["advise", "examples/vic_two_balls.toml", "--accuracy", "1.5"], "--accuracy"),
     (["advise", "examples/vic_two_balls.toml", "--accuracy", "most"], "--accuracy"),
-    (["advise", "examples/nes_sprite0.toml"], "chip"),
+    (["advise", "examples/nes_8x16_left_clip.toml"], "oam"),  # one sprite on screen: no pair
+    (["advise", "examples/vic_two_balls.toml", "--objects", "65"], "--objects"),
+    (["advise", "examples/vic_two_balls.toml", "--objects", "0"], "--objects"),
+    (["advise", "sprites/ball.spr"], "sprites/ball.spr"),
     (["chart", "--jobs", "0"], "--jobs"),
 ])
 def test_bad_input_is_one_line_and_exit_2(args, field, capsys):

@@ -16,6 +16,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 
+from retro.analysis.study.layout import finish, fit_text, legend_below, place_label, renderer_of  # noqa: E402
 from retro.analysis.study.report import ALL, FigureRow  # noqa: E402
 
 GREY = "#b0b0b0"
@@ -50,10 +51,10 @@ def _x_limits(rows: list[FigureRow]) -> tuple[float, float]:
 
 
 def _draw_panel(ax, rows: list[FigureRow], styles: Styles, xlim: tuple[float, float], labels: bool,
-                title: str) -> None:
+                title: str, ylim: tuple[float, float] | None = None) -> None:
+    """Points, bars, the software front and the host-only lines; the point labels come after the layout
+    (`_place_labels`), when the axes' size is final."""
     measured = [r for r in rows if not math.isnan(r.cycles_mean)]
-    accuracies = [r.accuracy for r in rows if not math.isnan(r.accuracy)]
-    y_low = max(0.0, min(accuracies) - 0.06) if accuracies else 0.0
     for r in measured:
         hardware = r.hardware
         lit = r.pareto_software or hardware
@@ -72,12 +73,9 @@ def _draw_panel(ax, rows: list[FigureRow], styles: Styles, xlim: tuple[float, fl
     for r in rows:
         if math.isnan(r.cycles_mean) and not math.isnan(r.accuracy):
             ax.axhline(r.accuracy, color=_colour(styles, r.method), linestyle="--", linewidth=1.2)
-            text = f"{r.label}: {100 * r.accuracy:.1f}% (host only, no 6502 routine)" if labels else f"{r.method} (host)"
-            ax.text(xlim[1] / 1.08, r.accuracy, text, fontsize=8.5 if labels else 6.5,
-                    color=_colour(styles, r.method), va="top", ha="right")
     ax.set_xscale("log")
     ax.set_xlim(*xlim)
-    ax.set_ylim(y_low, 1.0 + (1.0 - y_low) * 0.06)
+    ax.set_ylim(*(ylim or y_limits(rows)))
     ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0) if labels else (1.0,)))
     ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     ax.xaxis.set_minor_formatter(NullFormatter())
@@ -85,8 +83,33 @@ def _draw_panel(ax, rows: list[FigureRow], styles: Styles, xlim: tuple[float, fl
     ax.grid(True, which="major", alpha=0.3)
     ax.set_title(title, fontsize=11 if labels else 8.5)
     ax.tick_params(labelsize=9 if labels else 7)
-    if labels:
-        _place_labels(ax, measured)
+
+
+def y_limits(rows: list[FigureRow]) -> tuple[float, float]:
+    """Accuracy from just under the lowest figure to just over 100%."""
+    accuracies = [r.accuracy for r in rows if not math.isnan(r.accuracy)]
+    y_low = max(0.0, min(accuracies) - 0.06) if accuracies else 0.0
+    return y_low, 1.0 + (1.0 - y_low) * 0.06
+
+
+def _host_line_labels(ax, rows: list[FigureRow], styles: Styles, labels: bool, renderer) -> None:
+    """Each host-only method's name on its line, at the right; shortened, then smaller, to stay inside
+    the axes."""
+    area = ax.get_window_extent(renderer)
+    xlim = ax.get_xlim()
+    for r in rows:
+        if not (math.isnan(r.cycles_mean) and not math.isnan(r.accuracy)):
+            continue
+        texts = ([f"{r.label}: {100 * r.accuracy:.1f}% (host only, no 6502 routine)", f"{r.label} (host only)"]
+                 if labels else [f"{r.method} (host)"])
+        for i, text in enumerate(texts):
+            t = ax.text(xlim[1] / 1.08, r.accuracy, text, fontsize=8.5 if labels else 6.5,
+                        color=_colour(styles, r.method), va="top", ha="right")
+            if i == len(texts) - 1:
+                fit_text(t, area.width * 0.9, renderer)
+            if t.get_window_extent(renderer).x0 >= area.x0 or i == len(texts) - 1:
+                break
+            t.remove()
 
 
 # Label positions tried in turn (offset in points, horizontal alignment) until one overlaps nothing.
@@ -95,14 +118,12 @@ _LABEL_SLOTS = ((9, -16, "left"), (9, 5, "left"), (-9, 5, "right"), (-9, -16, "r
                 (-9, -44, "right"), (-9, 32, "right"), (9, -58, "left"), (-9, -58, "right"))
 
 
-def _place_labels(ax, rows: list[FigureRow]) -> None:
-    """Label each point with its name and figures, avoiding the labels already placed."""
-    fig = ax.figure
-    fig.canvas.draw()
-    renderer = fig.canvas.get_renderer()
+def _place_labels(ax, rows: list[FigureRow], renderer) -> None:
+    """Label each point with its name and figures where the label overlaps no other label, marker or
+    line label and stays inside the axes; a point with no such place keeps only its marker (the
+    legend names it)."""
     from matplotlib.transforms import Bbox
 
-    area = ax.get_window_extent(renderer)
     taken = [t.get_window_extent(renderer) for t in ax.texts]  # the host-only methods' line labels
     for r in rows:  # keep labels off every marker
         px, py = ax.transData.transform((r.cycles_mean, r.accuracy))
@@ -112,84 +133,82 @@ def _place_labels(ax, rows: list[FigureRow]) -> None:
         if r.hardware:
             text += "\n(hardware: not which pair, not when)"
         lit = r.pareto_software or r.hardware
-        for dx, dy, align in _LABEL_SLOTS:
-            note = ax.annotate(text, (r.cycles_mean, r.accuracy), textcoords="offset points", xytext=(dx, dy),
-                               ha=align, fontsize=8.5, color="black" if lit else "#707070",
-                               bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8), zorder=4)
-            box = note.get_window_extent(renderer)
-            inside = area.x0 <= box.x0 and box.x1 <= area.x1 and area.y0 <= box.y0 and box.y1 <= area.y1
-            if inside and not any(box.overlaps(other) for other in taken):
-                break
-            note.remove()
-        else:
-            note = ax.annotate(text, (r.cycles_mean, r.accuracy), textcoords="offset points", xytext=_LABEL_SLOTS[0][:2],
-                               fontsize=8.5, color="black" if lit else "#707070", zorder=4)
-            box = note.get_window_extent(renderer)
-        taken.append(box)
+        place_label(ax, text, (r.cycles_mean, r.accuracy), _LABEL_SLOTS, taken, renderer, fontsize=8.5,
+                    color="black" if lit else "#707070",
+                    bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8), zorder=4)
 
 
 def overall_chart(rows: list[FigureRow], styles: Styles, note: str = "") -> bytes:
     return _png(overall_figure(rows, styles, note))
 
 
-def overall_figure(rows: list[FigureRow], styles: Styles, note: str = ""):
-    """One large panel for the pooled corpus, every point labelled. The front is that of the software
-    methods; the hardware latch (hollow marker) is drawn in colour beside it for reference."""
+OVERALL_SIZE = (10, 6.5)
+
+
+def overall_figure(rows: list[FigureRow], styles: Styles, note: str = "", size: tuple[float, float] = OVERALL_SIZE):
+    """One large panel for the pooled corpus, every point labelled where a label fits. The front is
+    that of the software methods; the hardware latch (hollow marker) is drawn in colour beside it for
+    reference. The legend and the note sit below the panel, as wide as the figure allows."""
     chosen = [r for r in rows if r.scope == ALL]
-    fig, ax = plt.subplots(figsize=(10, 6.5))
-    fig.subplots_adjust(left=0.08, right=0.80, bottom=0.12, top=0.94)  # fixed before labels are placed
+    fig, ax = plt.subplots(figsize=size)
     _draw_panel(ax, chosen, styles, _x_limits(chosen), labels=True,
                 title=f"Speed against accuracy, all pairs pooled ({chosen[0].cases if chosen else 0} cases)")
     ax.set_xlabel("6502 cycles per test (mean; bar = min to max over the corpus inputs), log scale")
     ax.set_ylabel("accuracy (share of cases decided correctly)")
-    _legend(fig, styles, list(dict.fromkeys(r.method for r in chosen)))
-    if note:
-        fig.text(0.01, 0.01, note, fontsize=8, color="#555555", wrap=True)
+    bottom = legend_below(fig, _legend_handles(styles, list(dict.fromkeys(r.method for r in chosen))), 8.5, note=note)
+    finish(fig, [ax], bottom)
+    renderer = renderer_of(fig)
+    _host_line_labels(ax, chosen, styles, True, renderer)
+    _place_labels(ax, [r for r in chosen if not math.isnan(r.cycles_mean)], renderer)
     return fig
 
 
-LEGEND_COLUMNS = 6  # below a grid: rows of at most this many entries, so none is cut off
+LEGEND_COLUMNS = 6  # at most this many entries in a row below a grid
 
 
-def _legend(fig, styles: Styles, keys: list[str], below: bool = False) -> int:
-    """The legend; returns its number of rows (below a grid)."""
+def _legend_handles(styles: Styles, keys: list[str]) -> list:
     from matplotlib.lines import Line2D
 
     handles = [Line2D([], [], marker=_marker(styles, k), color=_colour(styles, k), linestyle="", markersize=8,
                       markeredgecolor="black", label=k) for k in keys]
     handles.append(Line2D([], [], marker="o", color=GREY, linestyle="", markersize=8, label="dominated (grey)"))
-    handles.append(Line2D([], [], color="black", alpha=0.5, label="Pareto front\n(software methods)"))
-    if below:
-        columns = min(len(handles), LEGEND_COLUMNS)
-        fig.legend(handles=handles, loc="lower center", ncol=columns, fontsize=9, frameon=False)
-        return math.ceil(len(handles) / columns)
-    fig.legend(handles=handles, loc="upper right", fontsize=8.5, frameon=True, title="method", title_fontsize=9)
-    return 1
+    handles.append(Line2D([], [], color="black", alpha=0.5, label="Pareto front (software methods)"))
+    return handles
 
 
 def pairs_chart(rows: list[FigureRow], styles: Styles, columns: int = 6) -> bytes:
     return _png(pairs_figure(rows, styles, columns))
 
 
-def pairs_figure(rows: list[FigureRow], styles: Styles, columns: int = 6):
-    """A faceted grid, one small panel per shape pair, sharing the x range."""
+def pairs_figure(rows: list[FigureRow], styles: Styles, columns: int = 6, size: tuple[float, float] | None = None):
+    """A faceted grid, one small panel per shape pair, sharing the x range and the y range."""
     scopes = [s for s in dict.fromkeys(r.scope for r in rows) if s != ALL]
     count = max(1, len(scopes))
     columns = min(columns, count)
     lines = math.ceil(count / columns)
     keys = list(dict.fromkeys(r.method for r in rows))
     legend_rows = math.ceil((len(keys) + 2) / LEGEND_COLUMNS)
-    fig, axes = plt.subplots(lines, columns, figsize=(max(2.5 * columns + 0.6, 11), 2.2 * lines + 1.0 + 0.3 * legend_rows),
-                             squeeze=False)
-    xlim = _x_limits([r for r in rows if r.scope != ALL])
+    figsize = size or (max(2.5 * columns + 0.6, 11), 2.2 * lines + 1.0 + 0.3 * legend_rows)
+    fig, axes = plt.subplots(lines, columns, figsize=figsize, squeeze=False)
+    pair_rows = [r for r in rows if r.scope != ALL]
+    xlim, ylim = _x_limits(pair_rows), y_limits(pair_rows)
+    panels = []
     for i, scope in enumerate(scopes):
         ax = axes[i // columns][i % columns]
-        _draw_panel(ax, [r for r in rows if r.scope == scope], styles, xlim, labels=False, title=scope)
+        _draw_panel(ax, [r for r in rows if r.scope == scope], styles, xlim, labels=False, title=scope, ylim=ylim)
+        panels.append(ax)
     for j in range(len(scopes), lines * columns):
         axes[j // columns][j % columns].axis("off")
-    _legend(fig, styles, keys, below=True)
-    bottom = (0.35 + 0.3 * legend_rows) / fig.get_figheight()  # inches of legend, as a share of the figure
-    fig.supxlabel("6502 cycles per test (mean, bar = min-max; log scale)", fontsize=10, y=bottom)
-    fig.supylabel("accuracy", fontsize=10)
-    fig.tight_layout(rect=(0, bottom + 0.02, 1, 1))
+    bottom = legend_below(fig, _legend_handles(styles, keys), 9, max_columns=LEGEND_COLUMNS)
+    renderer = renderer_of(fig)
+    xlabel = fig.text(0.5, bottom, "6502 cycles per test (mean, bar = min-max; log scale)", fontsize=10,
+                      ha="center", va="bottom")
+    fit_text(xlabel, fig.bbox.width - 12, renderer)
+    ylabel = fig.text(0.005, 0.5 + bottom / 2, "accuracy", fontsize=10, rotation=90, ha="left", va="center")
+    above = (xlabel.get_window_extent(renderer).y1 + 4) / fig.bbox.height
+    beside = (ylabel.get_window_extent(renderer).x1 + 4) / fig.bbox.width
+    finish(fig, panels, above, left=beside)
+    renderer = renderer_of(fig)
+    for scope, ax in zip(scopes, panels):
+        _host_line_labels(ax, [r for r in rows if r.scope == scope], styles, False, renderer)
     return fig

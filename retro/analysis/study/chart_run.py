@@ -26,6 +26,9 @@ CSV_NAME = "study.csv"
 MARKDOWN_NAME = "study.md"
 OVERALL_PNG = "study_overall.png"
 PAIRS_PNG = "study_pairs.png"
+PER_FRAME_CSV = "per_frame.csv"
+PER_FRAME_MARKDOWN = "per_frame.md"
+PER_FRAME_PNG = "per_frame.png"
 
 
 @dataclass(frozen=True)
@@ -33,14 +36,17 @@ class ChartOutput:
     rows: list[report.FigureRow]
     files: list[Path]
     seconds: float
+    per_frame: object = None  # per_frame.PerFrame with --per-frame
 
 
 def run_chart(out_dir: Path, reduced: bool = False, workers: int | None = None, progress: Progress = quiet,
               shape_names: tuple[str, ...] | None = None, cost_samples: int | None | str = AUTO,
-              methods: tuple[Method, ...] = METHODS, sprite_files: tuple[str, ...] = ()) -> ChartOutput:
+              methods: tuple[Method, ...] = METHODS, sprite_files: tuple[str, ...] = (),
+              per_frame: bool = False) -> ChartOutput:
     """The study on the corpus (the named shapes from sprites/, then every sprite of `sprite_files`)
     for the given methods. `cost_samples`: cases per pair whose cycles are measured (None: every
-    case; AUTO: every case, or REDUCED_COST_SAMPLES with `reduced`)."""
+    case; AUTO: every case, or REDUCED_COST_SAMPLES with `reduced`). `per_frame`: the cost per frame
+    too, from the same run's cycles per test (per_frame.py)."""
     from retro.analysis.study.cost_runs import measure_costs
     from retro.analysis.study.sprites_io import load_sprite_files
 
@@ -68,7 +74,27 @@ def run_chart(out_dir: Path, reduced: bool = False, workers: int | None = None, 
     styles = styles_of(methods)
     files.append(write_atomic(out_dir / OVERALL_PNG, overall_chart(rows, styles, note)))
     files.append(write_atomic(out_dir / PAIRS_PNG, pairs_chart(rows, styles)))
-    return ChartOutput(rows=rows, files=files, seconds=time.perf_counter() - start)
+    frames = None
+    if per_frame:
+        frames = _per_frame(out_dir, shapes, methods, costs, rows, reduced, workers, progress, files, shown)
+    return ChartOutput(rows=rows, files=files, seconds=time.perf_counter() - start, per_frame=frames)
+
+
+def _per_frame(out_dir: Path, shapes, methods, costs, rows, reduced, workers, progress, files, shown: str):
+    from retro.analysis.study import per_frame_report
+    from retro.analysis.study.per_frame import PAL_BUDGET, per_frame
+    from retro.analysis.study.per_frame_chart import per_frame_chart
+
+    result = per_frame(methods, {k: c.overall for k, c in costs.items()}, shapes, reduced=reduced, workers=workers,
+                       progress=progress)
+    accuracy = {r.method: r.accuracy for r in rows if r.scope == report.ALL}
+    note = (f"objects: the shapes {shown} in turn, on a field one byte wide; cycles per test from this run's "
+            f"corpus, preparation from `retro check`, broad phases measured on {result.broad.layouts} layouts x "
+            f"{result.broad.frames} frames per object count; budget: {PAL_BUDGET.label}")
+    files.append(write_atomic(out_dir / PER_FRAME_CSV, per_frame_report.rows_to_csv(result.rows)))
+    files.append(write_atomic(out_dir / PER_FRAME_MARKDOWN, per_frame_report.markdown(result, note, accuracy)))
+    files.append(write_atomic(out_dir / PER_FRAME_PNG, per_frame_chart(result, note)))
+    return result
 
 
 def markdown_report(rows: list[report.FigureRow], note: str, costs: dict, methods: tuple[Method, ...] = METHODS) -> str:
@@ -92,5 +118,24 @@ def summary_lines(output: ChartOutput) -> list[str]:
         lines.append(f"{r.label:<34} {cycles:>14}  accuracy {100 * r.accuracy:6.2f}%  "
                      f"FP {100 * r.fp_rate:5.1f}%  FN {100 * r.fn_rate:4.1f}%"
                      + ("  software Pareto front" if r.pareto_software else ""))
+    if output.per_frame is not None:
+        lines += per_frame_lines(output.per_frame)
     lines.append(f"wrote {', '.join(p.name for p in output.files)} in {output.seconds:.1f} s")
+    return lines
+
+
+def per_frame_lines(result) -> list[str]:
+    """Where each method leaves the PAL frame and the line budget (typical frames), cheapest phase."""
+    from retro.analysis.study.per_frame import PHASE_LABELS
+
+    b = result.budget
+    lines = [f"cost per frame ({b.label}: frame {float(b.frame_cycles):,.0f} cycles, {b.lines} lines "
+             f"{float(b.lines_cycles):,.0f}): first object count over each budget, typical frame"]
+    labels = {m.key: m.label for m in result.methods}
+    for e in result.exits:
+        frame = f"over {e.served}" if e.frame_typical is None else str(e.frame_typical)
+        line = f"over {e.served}" if e.lines_typical is None else str(e.lines_typical)
+        lines.append(f"  {labels.get(e.method, e.method):<34} {PHASE_LABELS[e.phase]:<27} frame at {frame:>7}, "
+                     f"{b.lines} lines at {line:>7}" + ("" if e.served == max(x.served for x in result.exits)
+                                                         else f" (serves at most {e.served} objects)"))
     return lines

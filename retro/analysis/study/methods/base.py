@@ -15,8 +15,12 @@ A `Method` holds
   method's Python reference;
 - its **label**, the sentence that states its rule, its chart colour and marker, and what its cycle
   figure counts (`counted`);
-- its limits: `hardware` (it needs the VIC-II's collision latch), `advice_note(sprites)` (why it
-  cannot serve a scene).
+- its limits: `hardware` (it needs the VIC-II's collision latch), `machines` (where it exists: the
+  C64, the NES), `advice_note(sprites)` (why it cannot serve a scene);
+- what it costs per frame (per_frame.py): `prepare_per` (its preparation runs once per object, or
+  once per pair of object kinds), `once_per_frame` (one call a frame for all objects, as the latch
+  read; then at most `max_objects`), and `x_extent(shape)`, the X interval outside which it never
+  reports a hit (a broad phase along X must hand on every pair whose intervals meet).
 
 The chart, the stability study, the advisor, the report and the cost runs iterate over method
 objects; none of them looks at a method's key to decide what to do.
@@ -31,6 +35,10 @@ from functools import lru_cache
 import numpy as np
 
 from retro.analysis.study.corpus import Pair
+
+OBJECT = "object"  # Method.prepare_per: the preparation runs once per object and frame
+KIND_PAIR = "kind_pair"  # ... or once per pair of object kinds (a radius sum); charged every frame here
+PREPARE_SCOPES = (OBJECT, KIND_PAIR)
 
 ORIGIN = 64  # shape a's sprite box sits at (64, 64): every coordinate of the corpus stays in 0..255
 
@@ -135,6 +143,10 @@ class Method:
     averaged: bool = False  # the verdict is a share of grid alignments, not a 0/1 answer
     max_cost_samples: int | None = None  # a cap on measured calls per pair when a call is costly to set up
     origin: str = ""  # where the method is defined (a module, or the user's TOML file)
+    machines: tuple[str, ...] = ("c64", "nes")  # where the method exists (the latch: the C64's VIC-II only)
+    prepare_per: str = OBJECT  # the `prepare` routine runs once per object and frame, or per KIND_PAIR
+    once_per_frame: bool = False  # one call a frame answers for every object (the latch read), not one per pair
+    max_objects: int | None = None  # the most objects it can serve (hardware sprites)
 
     @property
     def host_only(self) -> bool:
@@ -174,3 +186,9 @@ class Method:
     def advice_note(self, sprites: int) -> str:
         """Why the method cannot serve a scene with this many sprites ("" when it can)."""
         return ""
+
+    def x_extent(self, shape) -> tuple[int, int]:
+        """(lo, hi): the half-open X interval, in the sprite's pixels (0 = its left column), outside
+        which the method never reports a hit: two objects whose intervals do not meet never collide
+        under its rule. By default the sprite box (the corpus has no case with the boxes apart)."""
+        return 0, shape.width

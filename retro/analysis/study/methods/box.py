@@ -38,6 +38,10 @@ class BoxMethod(Method):
         a, b = self.boxes(pair)
         return box_overlap(a, b, pair.dx, pair.dy).astype(float)
 
+    def x_extent(self, shape) -> tuple[int, int]:
+        x0, _, x1, _ = self.fit(shape.mask)
+        return x0, x1
+
     def case_maker(self, pair: Pair):
         (ax0, ay0, ax1, ay1), (bx0, by0, bx1, by1) = self.boxes(pair)
         dxs, dys = pair.dx.tolist(), pair.dy.tolist()

@@ -17,7 +17,7 @@ import numpy as np
 
 from retro.analysis.study.corpus import Pair
 from retro.analysis.study.fits import Circle, fitted_circle
-from retro.analysis.study.methods.base import ORIGIN, Method
+from retro.analysis.study.methods.base import KIND_PAIR, ORIGIN, Method
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -34,6 +34,12 @@ class CircleMethod(Method):
         d2 = ddx * ddx + ddy * ddy
         reach = (ca.r + cb.r) ** 2
         return (d2 <= reach if self.touching else d2 < reach).astype(float)
+
+    def x_extent(self, shape) -> tuple[int, int]:
+        """|dx| < r1 + r2 is needed for a hit (|dx| <= r1 + r2 when touching), and [cx - r, cx + r)
+        intervals meet exactly when |dx| < r1 + r2."""
+        c = fitted_circle(shape.mask, self.touching)
+        return c.cx - c.r, c.cx + c.r + (1 if self.touching else 0)
 
     def case_maker(self, pair: Pair):
         ca, cb = self.circles(pair)
@@ -66,7 +72,7 @@ CIRCLE = CircleMethod(
 
 CIRCLE_R = RadiusSumCircleMethod(
     key="circle_r", label="fitted circle, radius sum prepared", colour="#ffbb78", marker="h", routine="circle_r",
-    prepare="circle_r_prepare",
+    prepare="circle_r_prepare", prepare_per=KIND_PAIR,
     rule="the fitted circles' rule, tested with r1 + r2 prepared once per pair of object kinds",
     counted="asm/circle_r.s per pair, R = r1 + r2 made beforehand by circle_r_prepare (not counted here); "
             "its tables counted", origin=__name__)

@@ -12,6 +12,7 @@ import numpy as np
 
 from retro.analysis.study.corpus import Pair
 from retro.analysis.study.methods.base import Method, Session
+from retro.chips.vic.constants import SPRITE_COUNT
 from retro.paths import ASM_DIR
 
 SOURCE = "latch_test.s"
@@ -58,7 +59,15 @@ class LatchMethod(Method):
 
         return [lambda dx=int(pair.dx[i]), dy=int(pair.dy[i]): frame_latch(pair, dx, dy) for i in indices]
 
+    def x_extent(self, shape) -> tuple[int, int]:
+        from retro.analysis.study.fits import tight_box
+
+        x0, _, x1, _ = tight_box(shape.mask)
+        return x0, x1
+
     def advice_note(self, sprites: int) -> str:
+        if sprites > SPRITE_COUNT:
+            return f"{sprites} objects: more than the VIC-II's {SPRITE_COUNT} sprites (without a multiplexer)"
         if sprites != 2:
             return f"{sprites} sprites: $D01E's bits cannot say which pair collided"
         return ""
@@ -66,6 +75,7 @@ class LatchMethod(Method):
 
 LATCH = LatchMethod(
     key="latch", label="VIC-II latch $D01E", colour="#17becf", marker="^", routine=ENTRY, hardware=True,
+    machines=("c64",), once_per_frame=True, max_objects=SPRITE_COUNT,
     # each measured call needs the case's whole frame drawn by the VIC-II model, and the routine is
     # straight-line code (19 cycles whatever the latch holds): a sample per pair is enough
     max_cost_samples=192,

@@ -14,10 +14,15 @@ from retro.analysis.study.methods.base import Method
 
 def opacity_bytes(shape: Shape) -> tuple[int, ...]:
     """The sprite's opacity as hires rows (what a software pixel test ANDs: for a multicolor sprite,
-    a pair 01/10/11 becomes 11, so the 01 rim counts, as on the VIC-II)."""
+    a pair 01/10/11 becomes 11, so the 01 rim counts, as on the VIC-II). A smaller shape (an NES
+    sprite, 8x8 or 8x16) sits in the top-left corner of the 24x21 rows, the rest transparent: the
+    same pixels meet at every offset."""
+    from retro.chips.vic.constants import SPRITE_HEIGHT, SPRITE_WIDTH
     from retro.sprites import encode
 
-    return tuple(encode(shape.mask.astype("uint8")))
+    rows = np.zeros((SPRITE_HEIGHT, SPRITE_WIDTH), dtype="uint8")
+    rows[:shape.height, :shape.width] = shape.mask
+    return tuple(encode(rows))
 
 
 def pixel_grid(pair: Pair) -> np.ndarray:
@@ -39,6 +44,13 @@ def pixel_grid(pair: Pair) -> np.ndarray:
 
 @dataclass(frozen=True, kw_only=True)
 class PixelMethod(Method):
+    def x_extent(self, shape) -> tuple[int, int]:
+        """Hits only where opaque pixels meet: the tight box's columns."""
+        from retro.analysis.study.fits import tight_box
+
+        x0, _, x1, _ = tight_box(shape.mask)
+        return x0, x1
+
     def verdict(self, pair: Pair) -> np.ndarray:
         grid = pixel_grid(pair)
         row, col = pair.dy + pair.b.height - 1, pair.dx + pair.b.width - 1
@@ -48,9 +60,10 @@ class PixelMethod(Method):
         return out
 
     def unmeasurable(self, pair: Pair) -> str:
-        sizes = {pair.a.mask.shape, pair.b.mask.shape}
-        if sizes != {(21, 24)}:
-            return "asm/pixel.s takes unexpanded 24x21 sprites"
+        from retro.chips.vic.constants import SPRITE_HEIGHT, SPRITE_WIDTH
+
+        if any(s.height > SPRITE_HEIGHT or s.width > SPRITE_WIDTH for s in (pair.a, pair.b)):
+            return "asm/pixel.s takes sprites of at most 24x21 pixels (not expanded ones)"
         return ""
 
     def case_maker(self, pair: Pair):

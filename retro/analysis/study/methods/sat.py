@@ -41,6 +41,13 @@ def hulls_overlap(hull_a, hull_b, dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True, kw_only=True)
 class SatMethod(Method):
+    def x_extent(self, shape) -> tuple[int, int]:
+        """Hits only where opaque pixels meet: the tight box's columns."""
+        from retro.analysis.study.fits import tight_box
+
+        x0, _, x1, _ = tight_box(shape.mask)
+        return x0, x1
+
     def verdict(self, pair: Pair) -> np.ndarray:
         return hulls_overlap(pixel_hull(pair.a.mask), pixel_hull(pair.b.mask), pair.dx, pair.dy).astype(float)
 

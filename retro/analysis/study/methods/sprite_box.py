@@ -33,7 +33,7 @@ class SpriteEdgesMethod(BoxMethod):
 
 SPRITE_EDGES = SpriteEdgesMethod(
     key="sprite_edges", label="tight hitbox, 9-bit sprite edges", fit=tight_box, colour="#006400", marker="8",
-    routine="sprite_edges", prepare="sprite_edges_prepare",
+    routine="sprite_edges", prepare="sprite_edges_prepare", machines=("c64",),
     rule="the bounding boxes of the opaque pixels overlap (half-open), in 9-bit sprite X across 255/256, from "
          "edges prepared once per sprite",
     counted="asm/sprite_edges.s per pair, on edges made once per sprite and frame by sprite_edges_prepare "

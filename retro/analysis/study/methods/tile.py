@@ -18,6 +18,7 @@ from retro.analysis.study.methods.base import ORIGIN, Method, Session, routine_r
 
 CELL = 8  # a C64 text cell / NES tile is 8x8 pixels
 ALIGNMENTS = CELL * CELL
+PAD_LEFT, PAD_RIGHT = CELL // 2 - 1, CELL // 2  # x_extent: CELL - 1 pixels in all
 
 
 def cell_overlap_fraction(a0: int, a1: int, b0: int, b1: int, d: np.ndarray) -> np.ndarray:
@@ -94,6 +95,12 @@ class TileMethod(Method):
 
     def session(self, pair: Pair) -> Session:
         return TileSession(self, pair)
+
+    def x_extent(self, shape) -> tuple[int, int]:
+        """The tight box grown by PAD_LEFT + PAD_RIGHT = CELL - 1 pixels: boxes whose columns are
+        CELL apart (b's left at least a's last column + CELL) never share a cell, at any alignment."""
+        x0, _, x1, _ = tight_box(shape.mask)
+        return x0 - PAD_LEFT, x1 + PAD_RIGHT
 
     def host_calls(self, pair: Pair, indices: list[int]):
         ax0, ay0, ax1, ay1 = tight_box(pair.a.mask)

@@ -4,6 +4,7 @@
     label = "tight box, 1 px in"    # the chart's label (default: the name)
     routine = "aabb8"               # a built-in routine or a spec file (relative to this file); none: host only
     prepare = "aabb_edges_prepare"  # optional: the once-per-object preparation routine
+    prepare_per = "object"          # optional: "object" (default) or "kind_pair" (once per pair of kinds)
     hit = "hit"                     # optional: the routine's output that answers (default: its first)
 
     [hitbox]
@@ -40,7 +41,7 @@ from retro.routines.spec import import_user_module
 
 
 MAX_METHOD_BYTES = 1 << 16
-TOP_KEYS = {"name", "label", "routine", "prepare", "hit", "colour", "marker", "hitbox", "inputs"}
+TOP_KEYS = {"name", "label", "routine", "prepare", "prepare_per", "hit", "colour", "marker", "hitbox", "inputs"}
 SHAPE_KEYS = {"box": {"shape", "fit", "inset", "touching"}, "circle": {"shape", "inset", "touching"},
               "mask": {"shape"}, "function": {"shape", "function"}}
 FITS = {"tight": tight_box, "full": full_box}
@@ -106,6 +107,21 @@ class UserMethod(Method):
             raise InputError(f"{self.path}: hitbox.inset: {self.hitbox.inset[0]} is more than the radius {c.r} "
                              f"of sprite {shape.name}")
         return Circle(c.cx, c.cy, r)
+
+    def x_extent(self, shape: Shape) -> tuple[int, int]:
+        """The X columns of the hitbox (one more on the right when touching counts), the tight box
+        for a mask, the sprite box for a function (the corpus decides nothing outside it)."""
+        grow = 1 if self.hitbox.touching else 0
+        if self.hitbox.shape == "box":
+            x0, _, x1, _ = self.box(shape)
+            return x0, x1 + grow
+        if self.hitbox.shape == "circle":
+            c = self.circle(shape)
+            return c.cx - c.r, c.cx + c.r + grow
+        if self.hitbox.shape == "mask":
+            x0, _, x1, _ = tight_box(shape.mask)
+            return x0, x1
+        return super().x_extent(shape)
 
     def verdict(self, pair: Pair) -> np.ndarray:
         shape, touching = self.hitbox.shape, self.hitbox.touching
@@ -334,6 +350,13 @@ def load_method_file(path_text: str, index: int = 0) -> UserMethod:
     hitbox = _hitbox(path, shown, doc["hitbox"])
     routine_name = _spec_name(path, shown, "routine", _string(shown, doc, "routine"))
     prepare = _spec_name(path, shown, "prepare", _string(shown, doc, "prepare"))
+    from retro.analysis.study.methods.base import OBJECT, PREPARE_SCOPES
+
+    prepare_per = _string(shown, doc, "prepare_per", OBJECT)
+    if prepare_per not in PREPARE_SCOPES:
+        raise _fail(shown, "prepare_per", f"expected one of {', '.join(PREPARE_SCOPES)}, got {prepare_per!r}")
+    if "prepare_per" in doc and prepare is None:
+        raise _fail(shown, "prepare_per", "needs a prepare routine (prepare = \"aabb_edges_prepare\" or a spec file)")
     inputs, bits, domain, hit = (), (), (), 0
     if routine_name is None:
         for key in ("inputs", "hit", "prepare"):
@@ -366,8 +389,8 @@ def load_method_file(path_text: str, index: int = 0) -> UserMethod:
     counted = (f"{Path(routine_name).name if routine_name else ''} called through its spec with the inputs of "
                f"{path.name}" if routine_name else "host only: no routine given")
     return UserMethod(key=name, label=label, rule=rule, colour=colour, marker=marker, routine=routine_name,
-                      prepare=prepare, hit_output=hit, counted=counted, origin=shown, path=shown, hitbox=hitbox,
-                      inputs=inputs, input_bits=bits, domain=domain)
+                      prepare=prepare, prepare_per=prepare_per, hit_output=hit, counted=counted, origin=shown,
+                      path=shown, hitbox=hitbox, inputs=inputs, input_bits=bits, domain=domain)
 
 
 def _describe(h: Hitbox) -> str:

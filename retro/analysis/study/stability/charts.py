@@ -10,6 +10,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import math  # noqa: E402
 
 from retro.analysis.study.chart import _png  # noqa: E402
+from retro.analysis.study.layout import finish, legend_below, title_above  # noqa: E402
 from retro.analysis.study.stability.tunnelling import GROUP, SWEPT, TunnelRow  # noqa: E402
 
 SWEPT_LABEL = "swept tight box (retro.geometry)"
@@ -29,14 +30,14 @@ def tunnelling_chart(rows: list[TunnelRow], mover: str, methods) -> bytes:
     return _png(tunnelling_figure(rows, mover, methods))
 
 
-def tunnelling_figure(rows: list[TunnelRow], mover: str, methods):
+def tunnelling_figure(rows: list[TunnelRow], mover: str, methods, size: tuple[float, float] | None = None):
     """One panel per wall thickness: miss rate against speed, one line per method group."""
     by_key = {m.key: m for m in methods}
     thicknesses = sorted({r.thickness for r in rows})
     groups = list(dict.fromkeys(r.method for r in rows))
     legend_rows = math.ceil(len(groups) / LEGEND_COLUMNS)
     height = 3.6 + 0.25 * legend_rows
-    fig, axes = plt.subplots(1, len(thicknesses), figsize=(3.6 * len(thicknesses) + 1.5, height), sharey=True,
+    fig, axes = plt.subplots(1, len(thicknesses), figsize=size or (3.6 * len(thicknesses) + 1.5, height), sharey=True,
                              squeeze=False)
     for ax, t in zip(axes[0], thicknesses):
         for key in groups:
@@ -51,10 +52,10 @@ def tunnelling_figure(rows: list[TunnelRow], mover: str, methods):
         ax.grid(True, alpha=0.3)
         ax.set_ylim(-3, 100)
     axes[0][0].set_ylabel("crossings missed (% of start phases)")
-    handles, labels = axes[0][0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=min(len(groups), LEGEND_COLUMNS), fontsize=8.5, frameon=False)
-    fig.suptitle(f"Tunnelling: a {mover} crossing a wall at v px/frame, tested once per frame", fontsize=11)
-    fig.tight_layout(rect=(0, (0.3 * legend_rows + 0.2) / height, 1, 1))
+    handles, _ = axes[0][0].get_legend_handles_labels()
+    bottom = legend_below(fig, handles, 8.5, max_columns=LEGEND_COLUMNS)
+    top = title_above(fig, f"Tunnelling: a {mover} crossing a wall at v px/frame, tested once per frame", 11)
+    finish(fig, list(axes[0]), bottom, top=top)
     return fig
 
 
@@ -62,7 +63,7 @@ def wrap_chart(maps: dict, rows: list) -> bytes:
     return _png(wrap_figure(maps, rows))
 
 
-def wrap_figure(maps: dict, rows: list):
+def wrap_figure(maps: dict, rows: list, size: tuple[float, float] | None = None):
     """One map per (video, software test): for every pair of X registers, whether the software box
     test and the VIC-II agree."""
     from matplotlib.colors import ListedColormap
@@ -74,7 +75,7 @@ def wrap_figure(maps: dict, rows: list):
     names = ["both: no collision", "both: collision", "software only (chip shows none)",
              "chip only (software misses)"]
     keys = list(maps)
-    fig, axes = plt.subplots(1, len(keys), figsize=(3.9 * len(keys), 4.9), squeeze=False)
+    fig, axes = plt.subplots(1, len(keys), figsize=size or (3.9 * len(keys), 4.9), squeeze=False)
     counts = {(r.video, r.test): r for r in rows}
     for ax, key in zip(axes[0], keys):
         ax.imshow(maps[key], cmap=ListedColormap(colours), vmin=0, vmax=3, origin="lower",
@@ -87,9 +88,8 @@ def wrap_figure(maps: dict, rows: list):
         ax.set_yticks([0, 128, 256, 384, 504])
         ax.tick_params(labelsize=7.5)
     axes[0][0].set_ylabel("X of sprite a", fontsize=8.5)
-    fig.legend(handles=[Patch(color=c, label=n, ec="black", lw=0.5) for c, n in zip(colours, names)],
-               loc="lower center", ncol=4, fontsize=8.5, frameon=False)
-    fig.suptitle("Coordinate wrap: box test on sprite X registers against the VIC-II (two full 24x21 sprites)",
-                 fontsize=10.5)
-    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    bottom = legend_below(fig, [Patch(color=c, label=n, ec="black", lw=0.5) for c, n in zip(colours, names)], 8.5)
+    top = title_above(fig, "Coordinate wrap: box test on sprite X registers against the VIC-II (two full 24x21 "
+                           "sprites)", 10.5)
+    finish(fig, list(axes[0]), bottom, top=top)
     return fig
