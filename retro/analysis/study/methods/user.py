@@ -253,7 +253,7 @@ def _hitbox(path: Path, shown: str, doc) -> Hitbox:
     if not isinstance(doc, dict):
         raise _fail(shown, "hitbox", "expected a table: [hitbox] shape = \"box\" (or circle, mask, function)")
     shape = doc.get("shape")
-    if shape not in SHAPE_KEYS:
+    if not isinstance(shape, str) or shape not in SHAPE_KEYS:
         raise _fail(shown, "hitbox.shape", f"expected one of box, circle, mask, function, got {shape!r}")
     for key in doc:
         if key not in SHAPE_KEYS[shape]:
