@@ -260,7 +260,7 @@ def _hitbox(path: Path, shown: str, doc) -> Hitbox:
             raise _fail(shown, f"hitbox.{key}", f"unknown for shape {shape!r} (known: "
                                                 f"{', '.join(sorted(SHAPE_KEYS[shape]))})")
     fit = doc.get("fit", "tight")
-    if fit not in FITS:
+    if not isinstance(fit, str) or fit not in FITS:
         raise _fail(shown, "hitbox.fit", f"expected \"tight\" or \"full\", got {fit!r}")
     touching = doc.get("touching", False)
     if not isinstance(touching, bool):
