@@ -21,8 +21,11 @@
 ;   Out: `order` sorted, `count`.
 ;   Domain: w >= 1 and x + w <= 255 for every object (the right edge fits a byte).
 ;
-; Cost with the bare RTS: pairs_all 15 + 26n + 28 per pair (n >= 1; 41 for n = 0); sweep_x depends
-; on the layout: measured per frame by retro chart --per-frame (docs/study.md, "Cost per frame").
+; Cost with the bare RTS: pairs_all 15 + 26n + 28 per pair (n >= 1; 41 for n = 0). sweep_x, objects
+; already in order with no pair: 65 + 100(n - 1) (n >= 1); + 44 per pair (13 less when the pair's
+; second object is the last one); + 19 per place an object moves in the sort. Measured on generated
+; layouts by retro chart --per-frame (docs/study.md, "Cost per frame"); tests/study/test_per_frame.py
+; derives these from the instructions.
         .org $c000
         .alias n      $02
         .alias pair_a $03

@@ -294,3 +294,25 @@ def test_per_frame_figure_draws_the_rows(measured):
         levels = sorted(line.get_ydata()[0] for line in ax.get_lines() if list(line.get_xdata()) == [0, 1])
         assert levels == [TWENTY_LINES, PAL_FRAME]
     assert not math.isnan(result.rows[0].frame_cycles)
+
+
+def test_chart_per_frame_writes_its_files(tmp_path, capsys):
+    """`retro chart --per-frame`: the three files beside the chart's, every method and phase for every
+    object count 1-64, and the summary names where each method leaves the PAL frame."""
+    from retro.analysis.study.per_frame_report import rows_from_csv
+    from retro.cli import main
+
+    out = tmp_path / "chart"
+    assert main(["chart", "--reduced", "--per-frame", "--samples", "8", "--jobs", "1", "--quiet",
+                 "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    for name in ("per_frame.csv", "per_frame.md", "per_frame.png", "study.csv"):
+        assert (out / name).stat().st_size > 0
+    rows = rows_from_csv((out / "per_frame.csv").read_text())
+    software = {m.key for m in BUILTIN if not m.host_only and not m.once_per_frame}
+    for key in software:
+        for phase in bp.PHASES:
+            assert sorted(r.objects for r in rows if r.method == key and r.phase == phase) == list(range(1, 65))
+    assert "cost per frame (C64 PAL (6569): frame 19,656 cycles, 20 lines 1,260)" in printed
+    text = (out / "per_frame.md").read_text()
+    assert "## Where the curves cross" in text and "## Where each method leaves the budget" in text
