@@ -18,16 +18,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from PIL import Image
 
 from retro.chips.vic.constants import (
     SPRITE_BLOCK,
     SPRITE_BYTES,
-    SPRITE_BYTES_PER_ROW,
     SPRITE_HEIGHT,
     SPRITE_MC_WIDTH,
     SPRITE_WIDTH,
 )
+from retro.chips.vic.sprite_bits import decode, opaque_mask  # noqa: F401 - part of this module's API
 from retro.errors import InputError
 from retro.fileio import read_bytes, write_atomic
 from retro.loaders.gfx_png_sprites import PNG_MAGIC, SpriteColours, read_png_sheet
@@ -39,19 +38,8 @@ MULTICOLOR_ROW_CHARS = {".": 0, "1": 1, "2": 2, "3": 3}
 TRANSPARENT_PREVIEW = (0, 0, 0)
 HIRES_PREVIEW = (255, 255, 255)
 # Preview colours for the multicolor values 1, 2, 3: light blue, white, yellow, exactly Colodore's C64 colours
-# 14, 1 and 7 (retro/render/palette.py), so a PNG written here reads back as C64 colours too
+# 14, 1 and 7 (retro/chips/palettes.py), so a PNG written here reads back as C64 colours too
 MULTICOLOR_PREVIEW = {1: (112, 109, 235), 2: (255, 255, 255), 3: (237, 241, 113)}
-
-
-def decode(data: bytes, multicolor: bool = False) -> np.ndarray:
-    """63 (or 64) bytes -> (21, 24) uint8 of 0/1 (hires) or (21, 12) uint8 of 0-3 (multicolor)."""
-    raw = np.frombuffer(bytes(data[:SPRITE_BYTES]), dtype=np.uint8)
-    if raw.size != SPRITE_BYTES:
-        raise InputError(f"sprite data: expected {SPRITE_BYTES} or {SPRITE_BLOCK} bytes, got {len(data)}")
-    bits = np.unpackbits(raw.reshape(SPRITE_HEIGHT, SPRITE_BYTES_PER_ROW), axis=1)
-    if not multicolor:
-        return bits
-    return bits[:, 0::2] * 2 + bits[:, 1::2]
 
 
 def encode(pixels: np.ndarray, multicolor: bool = False) -> bytes:
@@ -67,13 +55,6 @@ def encode(pixels: np.ndarray, multicolor: bool = False) -> bytes:
     else:
         bits = pixels & 1
     return np.packbits(bits, axis=1).tobytes()
-
-
-def opaque_mask(data: bytes, multicolor: bool = False) -> np.ndarray:
-    """(21, 24) bool: where the sprite outputs a non-transparent pixel (what collides)."""
-    if not multicolor:
-        return decode(data).astype(bool)
-    return np.repeat(decode(data, True) != 0, 2, axis=1)
 
 
 def block(data: bytes) -> bytes:
@@ -225,21 +206,3 @@ def read_png(path: str | Path, multicolor: bool = False, frame: int = 0, colours
     if not 0 <= frame < len(frames):
         raise InputError(f"{path}: frame: {frame} is outside 0..{len(frames) - 1} ({len(frames)} sprites in the PNG)")
     return frames[frame]
-
-
-def to_image(data: bytes, multicolor: bool = False) -> Image.Image:
-    """The sprite as a 24x21 RGB image in the preview colours (what read_png reads back)."""
-    rgb = np.zeros((SPRITE_HEIGHT, SPRITE_WIDTH, 3), dtype=np.uint8)
-    if multicolor:
-        values = np.repeat(decode(data, True), 2, axis=1)
-        for value, colour in MULTICOLOR_PREVIEW.items():
-            rgb[values == value] = colour
-    else:
-        rgb[decode(data).astype(bool)] = HIRES_PREVIEW
-    return Image.fromarray(rgb, "RGB")
-
-
-def write_png(path: str | Path, data: bytes, multicolor: bool = False, scale: int = 1) -> Path:
-    from retro.render.images import save_png, upscale
-
-    return save_png(upscale(to_image(data, multicolor), scale), path)

@@ -25,7 +25,8 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from retro.sprites import encode, write_png, write_spr  # noqa: E402
+from retro.render.sprite_png import write_png  # noqa: E402
+from retro.sprites import encode, write_spr  # noqa: E402
 
 WIDTH, HEIGHT, MC_WIDTH = 24, 21, 12
 CENTRE_X, CENTRE_Y = 11.5, 10.0  # pixel centres are at integer + 0.5 horizontally for a 24-wide grid

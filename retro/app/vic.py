@@ -24,7 +24,7 @@ from retro.chips.vic.constants import (
 )
 from retro.chips.vic.model import LatchReport, frame_collisions, run_frames
 from retro.errors import InputError
-from retro.render.palette import C64_DEFAULT_PALETTE
+from retro.chips.palettes import C64_DEFAULT_PALETTE
 from retro.scenes.vic import VicScene, load
 
 DEMO_SCENE = "vic_two_balls.toml"

@@ -7,7 +7,7 @@ import json
 
 from retro.app.vic import MAX_FRAMES, MAX_SCALE, report_json, report_lines, run_scene
 from retro.numbers import parse_int
-from retro.render.palette import C64_DEFAULT_PALETTE
+from retro.chips.palettes import C64_DEFAULT_PALETTE
 
 
 def register(sub: argparse._SubParsersAction) -> None:

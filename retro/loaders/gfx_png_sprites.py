@@ -20,7 +20,7 @@ Colours, pixel by pixel:
      colours: background -> 00, $D025 -> 01, sprite colour -> 10, $D026 -> 11 [Bauer 3.8.2]; black,
      when it is none of the sprite's colours, -> 00; any other colour is refused, naming the pixel;
    - multicolour otherwise (no colours given, or two of them alike, as in a scene that sets none):
-     the preview colours `retro.sprites.write_png` draws with, light blue -> 01, white -> 10,
+     the preview colours `retro.render.sprite_png.write_png` draws with, light blue -> 01, white -> 10,
      yellow -> 11; black, and the background colour when it is none of those three, -> 00; any
      other colour is refused, naming the pixel.
 4. Multicolour layout: an image whose width is a multiple of 24 and whose every horizontal pixel
@@ -40,7 +40,7 @@ from PIL import Image
 
 from retro.chips.vic.constants import SPRITE_HEIGHT, SPRITE_MC_WIDTH, SPRITE_WIDTH
 from retro.errors import InputError
-from retro.render.palette import C64_DEFAULT_PALETTE, PALETTES
+from retro.chips.palettes import C64_DEFAULT_PALETTE, PALETTES
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 MAX_SHEET_SPRITES = 1024  # a 32 x 32 sheet; 1024 x 24 x 21 pixels decode to about 2 MB of RGBA

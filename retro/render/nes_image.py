@@ -32,7 +32,7 @@ from retro.render.images import (
     upscale,
     zoom,
 )
-from retro.render.palette import palette
+from retro.chips.palettes import palette
 
 # 2C02 colour numbers used for the picture.
 BACKGROUND_COLOURS = (0x0F, 0x00, 0x10, 0x3D)   # pattern values 0-3: black to light grey

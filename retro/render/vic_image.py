@@ -36,7 +36,7 @@ from retro.render.images import (
     side_by_side,
     upscale,
 )
-from retro.render.palette import C64_DEFAULT_PALETTE, palette
+from retro.chips.palettes import C64_DEFAULT_PALETTE, palette
 from retro.sprites import decode
 
 SPRITE_SPRITE_HIGHLIGHT = (255, 0, 255)  # magenta: no C64 colour is this saturated

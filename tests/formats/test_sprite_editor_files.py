@@ -21,7 +21,7 @@ from retro.errors import InputError
 from retro.loaders.gfx_png_sprites import SpriteColours, read_png_sheet
 from retro.loaders.gfx_spritemate import parse_spm
 from retro.loaders.gfx_spritepad import parse_spd
-from retro.render.palette import PALETTES
+from retro.chips.palettes import PALETTES
 from retro.sprites import read_png, read_spr, read_sprite, read_sprite_frames
 
 PEPTO = PALETTES["c64-pepto"]

@@ -165,7 +165,8 @@ def test_an_input_that_does_not_fit_is_a_run_error(tmp_path, ball_bar):
 
 def test_sprites_from_every_format(tmp_path):
     from retro.analysis.study.sprites_io import load_sprite_files
-    from retro.sprites import read_spr, write_png
+    from retro.render.sprite_png import write_png
+    from retro.sprites import read_spr
 
     ball, ring = read_spr(SPRITES_DIR / "ball.spr"), read_spr(SPRITES_DIR / "ring.spr")
     blank = bytes(63)

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from retro.errors import InputError
+from retro.render.sprite_png import write_png
 from retro.sprites import (
     decode,
     encode,
@@ -16,7 +17,6 @@ from retro.sprites import (
     parse_rows,
     read_png,
     read_spr,
-    write_png,
     write_spr,
 )
 

@@ -68,7 +68,7 @@ from retro.chips.vic.constants import (
     Video,
 )
 from retro.chips.vic.graphics import VicMemory, foreground_points
-from retro.sprites import opaque_mask
+from retro.chips.vic.sprite_bits import opaque_mask
 
 # Registers whose value changes what collides (the device recomputes its schedule when they change)
 COLLISION_REGISTERS = (tuple(range(REG_SPRITE_X0, REG_SPRITE_X_MSB + 1))
