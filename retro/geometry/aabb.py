@@ -79,16 +79,6 @@ def aabb_mtv(a_min: PointLike, a_max: PointLike, b_min: PointLike, b_max: PointL
     return min(candidates, key=lambda c: c[1])
 
 
-def aabb_union(a_min: Point, a_max: Point, b_min: Point, b_max: Point) -> Box:
-    """Smallest box containing both boxes (inputs assumed checked)."""
-    return ((min(a_min[0], b_min[0]), min(a_min[1], b_min[1])), (max(a_max[0], b_max[0]), max(a_max[1], b_max[1])))
-
-
-def aabb_perimeter(box_min: Point, box_max: Point) -> Number:
-    """Perimeter, the insertion cost the dynamic AABB tree minimises (inputs assumed checked)."""
-    return 2 * ((box_max[0] - box_min[0]) + (box_max[1] - box_min[1]))
-
-
 def aabb_contains_box(outer_min: Point, outer_max: Point, inner_min: Point, inner_max: Point) -> bool:
     """True when the inner box lies inside the outer one, edges included (inputs assumed checked)."""
     return (outer_min[0] <= inner_min[0] and outer_min[1] <= inner_min[1]

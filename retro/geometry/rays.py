@@ -69,7 +69,16 @@ def ray_circle(origin: PointLike, direction: PointLike, center: PointLike, radiu
     dx, dy = as_nonzero_vector(direction, "direction")
     cx, cy = as_point(center, "center")
     r = as_positive(radius, "radius")
-    mx, my = ox - cx, oy - cy
+    roots = circle_roots(ox - cx, oy - cy, dx, dy, r)
+    if roots is None or roots[1] <= 0:
+        return None
+    return roots
+
+
+def circle_roots(mx: float, my: float, dx: float, dy: float, r: float) -> tuple[float, float] | None:
+    """The two t (ascending) at which a point at (mx, my) relative to a circle's centre, moving by
+    (dx, dy) per unit of t (not zero), is at distance r from it; None when it never is, or only
+    touches (a tangent). Shared by rays and swept circles."""
     a = dx * dx + dy * dy
     b = 2 * (dx * mx + dy * my)
     c = mx * mx + my * my - r * r
@@ -79,8 +88,6 @@ def ray_circle(origin: PointLike, direction: PointLike, center: PointLike, radiu
     # The numerically stable pair of roots (no cancellation between -b and sqrt(disc)).
     q = -(b + math.copysign(math.sqrt(disc), b)) / 2
     t1, t2 = sorted((q / a, c / q))
-    if t2 <= 0:
-        return None
     return float(t1), float(t2)
 
 

@@ -15,6 +15,7 @@ import math
 from dataclasses import dataclass
 
 from retro.geometry.aabb import as_box
+from retro.geometry.rays import circle_roots
 from retro.geometry.vectors import Number, PointLike, as_point, as_positive
 
 
@@ -89,13 +90,10 @@ def swept_circle(center: PointLike, radius: Number, velocity: PointLike,
     c = mx * mx + my * my - r * r
     if vx == 0 and vy == 0:
         return 0.0 if c < 0 else None
-    a = vx * vx + vy * vy
-    b = 2 * (vx * mx + vy * my)
-    disc = b * b - 4 * a * c
-    if disc <= 0:
+    roots = circle_roots(mx, my, vx, vy, r)
+    if roots is None:
         return None
-    q = -(b + math.copysign(math.sqrt(disc), b)) / 2
-    t1, t2 = sorted((q / a, c / q))
+    t1, t2 = roots
     if t1 >= 1 or t2 <= 0:
         return None
     return float(max(t1, 0.0))
