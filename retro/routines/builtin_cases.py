@@ -20,6 +20,7 @@ from itertools import product
 import numpy as np
 
 from retro.chips.vic.constants import SPRITE_HEIGHT, SPRITE_WIDTH
+from retro.chips.vic.constants import SPRITE_X_POSITIONS as X_POSITIONS  # 9-bit X
 from retro.routines import reference
 from retro.chips.vic.screen import SPRITE_ROW_BYTES
 
@@ -112,7 +113,7 @@ def aabb_sprite_boundary() -> list[tuple]:
             right1 = x1 + box1[0] + box1[2]
             for x2 in {right1 - box2[0] - 1, right1 - box2[0], right1 - box2[0] + 1,
                        x1 + box1[0] - box2[0] - box2[2], x1 + box1[0] - box2[0] - box2[2] + 1, x1}:
-                if 0 <= x2 < 512:
+                if 0 <= x2 < X_POSITIONS:
                     out.append(_sprite_case(x1, 100, box1, x2, 100, box2))
         for y1 in (0, 50, 200, 240, 255):
             bottom1 = y1 + box1[1] + box1[3]
@@ -123,8 +124,8 @@ def aabb_sprite_boundary() -> list[tuple]:
 
 
 def aabb_sprite_random(rng: np.random.Generator, n: int) -> list[tuple]:
-    x1 = rng.integers(0, 512, size=n)
-    x2 = np.where(rng.random(n) < 0.6, (x1 + rng.integers(-48, 48, size=n)) % 512, rng.integers(0, 512, size=n))
+    x1 = rng.integers(0, X_POSITIONS, size=n)
+    x2 = np.where(rng.random(n) < 0.6, (x1 + rng.integers(-48, 48, size=n)) % X_POSITIONS, rng.integers(0, X_POSITIONS, size=n))
     y1 = rng.integers(0, BYTE, size=n)
     y2 = np.where(rng.random(n) < 0.6, (y1 + rng.integers(-42, 42, size=n)) % BYTE, rng.integers(0, BYTE, size=n))
     small = rng.random(n) < 0.7
@@ -138,9 +139,9 @@ def aabb_sprite_random(rng: np.random.Generator, n: int) -> list[tuple]:
 
 def aabb_sprite_sweep() -> Iterator[dict]:
     """Every pair of 9-bit X positions with two fixed hitboxes (the 255/256 boundary included)."""
-    x1, x2 = _grid(512, 512)
+    x1, x2 = _grid(X_POSITIONS, X_POSITIONS)
     yield _block("x1 x1h y1 ox1 oy1 w1 h1 x2 x2h y2 ox2 oy2 w2 h2", x1=x1 & 0xFF, x1h=x1 >> 8, y1=100, ox1=4, oy1=3,
-                 w1=16, h1=15, x2=x2 & 0xFF, x2h=x2 >> 8, y2=104, ox2=0, oy2=0, w2=24, h2=21)
+                 w1=16, h1=15, x2=x2 & 0xFF, x2h=x2 >> 8, y2=104, ox2=0, oy2=0, w2=SPRITE_WIDTH, h2=SPRITE_HEIGHT)
 
 
 # ---- circle ------------------------------------------------------------------------------------
@@ -222,14 +223,14 @@ def tile_boundary() -> list[tuple]:
 
 
 def tile_random(rng: np.random.Generator, n: int) -> list[tuple]:
-    x = rng.integers(0, 512, size=n)
+    x = rng.integers(0, X_POSITIONS, size=n)
     y = rng.integers(0, BYTE, size=n)
     return [(int(a) & 0xFF, int(a) >> 8, int(b)) for a, b in zip(x, y)]
 
 
 def tile_sweep() -> Iterator[dict]:
     """Every 9-bit X by every Y."""
-    x, y = _grid(512, BYTE)
+    x, y = _grid(X_POSITIONS, BYTE)
     yield {"x": x & 0xFF, "xh": x >> 8, "y": y}
 
 
@@ -237,13 +238,13 @@ def tile_box_boundary() -> list[tuple]:
     out = []
     for x in _EDGE_X:
         for y in _EDGE_Y:
-            for w, h in ((0, 5), (5, 0), (1, 1), (8, 8), (9, 9), (24, 21), (255, 255)):
+            for w, h in ((0, 5), (5, 0), (1, 1), (8, 8), (9, 9), (SPRITE_WIDTH, SPRITE_HEIGHT), (255, 255)):
                 out.append((x & 0xFF, x >> 8, y, w, h))
     return out
 
 
 def tile_box_random(rng: np.random.Generator, n: int) -> list[tuple]:
-    x = rng.integers(0, 512, size=n)
+    x = rng.integers(0, X_POSITIONS, size=n)
     y = rng.integers(0, BYTE, size=n)
     small = rng.random(n) < 0.8
     w = np.where(small, rng.integers(0, 33, size=n), rng.integers(0, BYTE, size=n))
@@ -254,7 +255,7 @@ def tile_box_random(rng: np.random.Generator, n: int) -> list[tuple]:
 def tile_box_sweep() -> Iterator[dict]:
     """Every 9-bit X and every Y for a sprite-sized box; every width at a few heights and back."""
     names = "x xh y w h"
-    x, y = _grid(512, BYTE)
+    x, y = _grid(X_POSITIONS, BYTE)
     yield _block(names, x=x & 0xFF, xh=x >> 8, y=y, w=24, h=21)
     size = np.arange(BYTE)
     for other in (0, 1, 8, 21, 255):
@@ -423,8 +424,8 @@ def aabb_edges_random(rng: np.random.Generator, n: int) -> list[tuple]:
 
 
 def sprite_edges_random(rng: np.random.Generator, n: int) -> list[tuple]:
-    a_left, a_width = _boxes(rng, n, 512 + 48)
-    b_left = _near(rng, a_left, a_width, 512 + 48)
+    a_left, a_width = _boxes(rng, n, X_POSITIONS + 48)
+    b_left = _near(rng, a_left, a_width, X_POSITIONS + 48)
     b_width = np.where(rng.random(n) < 0.5, rng.integers(1, 48, size=n), rng.integers(1, 256, size=n))
     a_top, a_height = _boxes(rng, n, 256)
     b_height = np.where(rng.random(n) < 0.5, rng.integers(1, 48, size=n), rng.integers(1, 256, size=n))

@@ -80,6 +80,7 @@ SPRITE_BYTES_PER_ROW = 3
 SPRITE_MC_WIDTH = SPRITE_WIDTH // 2  # multicolor: 12 pairs of bits per row
 Y_COMPARE_MASK = 0xFF  # the sprite Y compare sees only the low 8 bits of the raster line
 X_BITS_MASK = 0x1FF
+SPRITE_X_POSITIONS = X_BITS_MASK + 1  # 9-bit X: 0..511 ($D010 holds bit 8)
 
 # ---- screen geometry [Bauer 3.4, 3.7] -------------------------------------------------------------
 TEXT_COLUMNS = 40
