@@ -126,3 +126,11 @@ def test_ctrl_c_in_a_check_exits_130_without_a_traceback(tmp_path):
     process.send_signal(signal.SIGINT)
     out, err = process.communicate(timeout=60)
     assert process.returncode == 130 and "Traceback" not in err and err.strip().endswith("interrupted"), err
+
+
+def test_a_folder_given_as_a_sprite_file_says_so(tmp_path, capsys):
+    (tmp_path / "ball.spr").mkdir()
+    (tmp_path / "scene.toml").write_text('chip = "vic-ii"\nvideo = "pal"\n[registers]\n"$d015" = 1\n'
+                                         '[[sprite]]\nindex = 0\nx = 100\ny = 100\nfile = "ball.spr"\n')
+    assert main(["vic", str(tmp_path / "scene.toml")]) == 2
+    assert "is a folder, not a file" in _one_line(capsys)

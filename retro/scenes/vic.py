@@ -40,7 +40,7 @@ from retro.chips.vic.constants import (
 from retro.chips.vic.graphics import VicMemory
 from retro.chips.vic.model import VicState
 from retro.errors import InputError
-from retro.fileio import is_file, read_bytes
+from retro.fileio import is_dir, is_file, read_bytes
 from retro.numbers import parse_int
 from retro.scenes import earlier_spelling
 from retro.loaders.gfx_charpad import read_ctm
@@ -142,6 +142,8 @@ class _Where:
         path = Path(value)
         if not path.is_absolute():
             path = Path(self.source).parent / path
+        if is_dir(path):
+            raise self.error(field_name, f"{what} {value!r} is a folder, not a file ({path})")
         if not is_file(path):
             raise self.error(field_name, f"{what} {value!r} not found (looked for {path})")
         return path
