@@ -631,7 +631,7 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         now = time.monotonic()
         if progress and now - shown[0] >= PROGRESS_SECONDS:
             shown[0] = now
-            progress(f"check {routine.name}: {done:,} cases of {known:,} and the sweep" if unknown else
+            progress(f"check {routine.name}: {done:,} cases ({known:,} planned, plus the sweep)" if unknown else
                      f"check {routine.name}: {done:,}/{known:,} cases")
 
     agreement = None
