@@ -38,7 +38,7 @@ from retro.errors import InputError, RunError
 from retro.routines import cases as case_sets
 from retro.routines.registry import select
 from retro.cpu.batch import LaneError
-from retro.routines.runner import BatchOutcome, RasterStart, RoutineRunner, Size, describe_value
+from retro.routines.runner import BatchOutcome, RasterStart, RoutineRunner, Size, describe_value, row_of
 from retro.routines.spec import Routine, load_spec
 from retro.workers import worker_pool
 
@@ -316,7 +316,7 @@ def check_chunk(spec: str, seed: int, chunk: list[tuple], start: SceneStart | No
                     answers, answered = expected_columns(routine, columns, chunk, runner.memory_values, inside)
                 if not answered[i]:
                     raise InputError("outside the domain, the reference gave no answer")
-                expected = tuple(tuple(a[i].tolist()) if a.ndim == 2 else int(a[i]) for a in answers)
+                expected = row_of(answers, i)
             else:
                 expected = expected_outputs(routine, case, runner.memory_values)
         except InputError:
@@ -423,7 +423,7 @@ def expected_columns(routine: Routine, columns: list, cases: list[tuple] | None,
             if len(values) != len(routine.outputs):
                 raise InputError(f"{where}: with {len(routine.outputs)} outputs it must return a dict or a tuple of "
                                  f"{len(routine.outputs)} arrays")
-        out = []
+        out, fitting = [], []
         for port, item in zip(routine.outputs, values):
             array = np.asarray(item)
             if array.dtype == bool:
@@ -439,14 +439,15 @@ def expected_columns(routine: Routine, columns: list, cases: list[tuple] | None,
             if port.table:
                 fits = fits.all(axis=1)
             answerable &= fits
+            fitting.append(fits)
             out.append(array.astype(np.int64))
         bad = np.flatnonzero(~answerable & inside)
         if len(bad):
-            case = case_sets.columns_to_cases([c[int(bad[0]):int(bad[0]) + 1] for c in columns])[0]
-            port = next(p for p, a in zip(routine.outputs, out) if not (((a[bad[0]] >= 0) & (a[bad[0]] < (1 << p.bits)))
-                                                                         .all()))
-            raise InputError(f"{where} returned {out[routine.outputs.index(port)][bad[0]].tolist()} for {port.name}: "
-                             f"outside 0..{(1 << port.bits) - 1} (inputs {describe_case(routine, case)})")
+            i = int(bad[0])
+            k = next(k for k, fits in enumerate(fitting) if not fits[i])
+            port = routine.outputs[k]
+            raise InputError(f"{where} returned {out[k][i].tolist()} for {port.name}: outside 0..{(1 << port.bits) - 1} "
+                             f"(inputs {describe_case(routine, case_sets.case_of(columns, i))})")
         return out, answerable
     cases = cases if cases is not None else case_sets.columns_to_cases(columns)
     answers = []
@@ -498,22 +499,20 @@ def check_batch(spec: str, seed: int, columns: list) -> ChunkResult:
         for condition, broken in zip(routine.domain, broken_by):
             out.constraint_wrong[condition.text] = int((broken & wrong_outside).sum())
         case_at = (lambda i: cases[i]) if cases is not None else (
-            lambda i: case_sets.columns_to_cases([c[i:i + 1] for c in columns])[0])
+            lambda i: case_sets.case_of(columns, i))
 
-        def outputs_at(arrays, i):
-            return tuple(tuple(a[i].tolist()) if a.ndim == 2 else int(a[i]) for a in arrays)
         for i in wrong_inside[:EXAMPLES_KEPT].tolist():
             out.examples.append(f"{name}({describe_case(routine, case_at(i))}): returned "
-                                f"{describe_outputs(routine, outputs_at(got, i))}, reference "
-                                f"{describe_outputs(routine, outputs_at(expected, i))}")
+                                f"{describe_outputs(routine, row_of(got, i))}, reference "
+                                f"{describe_outputs(routine, row_of(expected, i))}")
         if len(wrong_inside):
             first = int(wrong_inside[0])
-            out.failure = Failure(case_at(first), "result", outputs_at(got, first), outputs_at(expected, first))
+            out.failure = Failure(case_at(first), "result", row_of(got, first), row_of(expected, first))
         for i in np.flatnonzero(wrong_outside)[:EXAMPLES_KEPT].tolist():
             broken = [c.text for c, b in zip(routine.domain, broken_by) if b[i]]
             out.outside_examples.append(
-                f"{name}({describe_case(routine, case_at(i))}): returned {describe_outputs(routine, outputs_at(got, i))}, "
-                f"reference {describe_outputs(routine, outputs_at(expected, i))} (outside: {', '.join(broken)})")
+                f"{name}({describe_case(routine, case_at(i))}): returned {describe_outputs(routine, row_of(got, i))}, "
+                f"reference {describe_outputs(routine, row_of(expected, i))} (outside: {', '.join(broken)})")
         cycles = outcome.cycles[:n][inside]
         if len(cycles):
             positions = np.flatnonzero(inside)
@@ -524,7 +523,7 @@ def check_batch(spec: str, seed: int, columns: list) -> ChunkResult:
             out.cycles_count = len(cycles)
             out.cpu_min, out.cpu_max = out.cycles_min, out.cycles_max
     if len(stopped):  # the first call that did not return stops the check, as on Machine
-        case = case_sets.columns_to_cases([c[n:n + 1] for c in full])[0]
+        case = case_sets.case_of(full, n)
         out.cases += 1
         out.run_errors += 1
         try:

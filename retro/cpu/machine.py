@@ -32,6 +32,7 @@ MAX_BUDGET = 100_000_000  # cycles; about 100 s of C64 time, a minute or two on 
 MAX_TRACE = 200_000  # instructions a trace keeps (about 30 MB); a longer traced run is stopped
 RETURN_TRAP = 0x0000  # the routine "returns" here: RTS to $0000 with the stack back where it started
 CALL_STACK_TOP = 0xFF
+STACK_BASE = 0x100  # the 6502's stack is page 1
 DEFAULT_FLAGS = FLAG_U | FLAG_I
 RECENT_SHOWN = 8  # instructions listed in a failure message
 NO_ADDRESS = -1  # a stop address the PC never equals
@@ -67,6 +68,15 @@ class CallResult:
     trace: list[TraceEntry] | None = None
     flags: dict[str, bool] = field(default_factory=dict)
     stolen: int = 0  # of `cycles`, those the CPU stood still (only with a chip driving BA)
+
+
+def push_return_trap(memory) -> int:
+    """Put on an empty stack what a JSR from RETURN_TRAP pushes (its return address minus one, high
+    byte first) and return S after it: how every call is entered, on Machine and the batched core."""
+    back = (RETURN_TRAP - 1) & 0xFFFF
+    top = STACK_BASE | CALL_STACK_TOP
+    memory[top], memory[top - 1] = back >> 8, back & 0xFF
+    return CALL_STACK_TOP - 2
 
 
 def _status(p: int) -> int:
@@ -182,8 +192,7 @@ class Machine:
         """Set registers and the stack as a JSR from the return trap would; return the start cycle."""
         mpu = self.mpu
         mpu.a, mpu.x, mpu.y, mpu.p = a, x, y, _status(p)
-        mpu.sp = CALL_STACK_TOP
-        mpu.stPushWord((RETURN_TRAP - 1) & 0xFFFF)
+        mpu.sp = push_return_trap(mpu.memory)
         mpu.pc = address
         mpu.pending_interrupt = None  # a poll before the call does not carry into it
         return mpu.processorCycles

@@ -53,6 +53,11 @@ def columns_to_cases(block: Columns) -> list[tuple]:
     return list(zip(*(c.tolist() if c.ndim == 1 else [tuple(row) for row in c.tolist()] for c in block)))
 
 
+def case_of(block: Columns, i: int) -> tuple:
+    """Case i of a column block, as a tuple."""
+    return columns_to_cases([c[i:i + 1] for c in block])[0]
+
+
 def cases_to_columns(routine: Routine, cases: list[tuple]) -> Columns:
     columns = []
     for index, port in enumerate(routine.inputs):

@@ -23,7 +23,15 @@ import numpy as np
 
 from retro.assembler import requested_tables
 from retro.cpu.batch import BatchCpu, LaneMemoryFull
-from retro.cpu.machine import CALL_STACK_TOP, DEFAULT_BUDGET, DEFAULT_FLAGS, RETURN_TRAP, CallResult, Machine
+from retro.cpu.machine import (
+    CALL_STACK_TOP,
+    DEFAULT_BUDGET,
+    DEFAULT_FLAGS,
+    RETURN_TRAP,
+    CallResult,
+    Machine,
+    push_return_trap,
+)
 from retro.cpu.mpu import FLAG_B, FLAG_U
 from retro.cpu.timing import OPCODES
 from retro.errors import InputError
@@ -127,7 +135,12 @@ class BatchOutcome:
     error: np.ndarray
 
     def case_outputs(self, i: int) -> tuple:
-        return tuple(tuple(o[i].tolist()) if o.ndim == 2 else int(o[i]) for o in self.outputs)
+        return row_of(self.outputs, i)
+
+
+def row_of(arrays: list, i: int) -> tuple:
+    """Case i of per-output arrays ((n,) numbers or (n, bytes) tables) as the tuple a scalar run gives."""
+    return tuple(tuple(a[i].tolist()) if a.ndim == 2 else int(a[i]) for a in arrays)
 
 
 @dataclass(frozen=True)
@@ -271,9 +284,7 @@ class RoutineRunner:
 
     def _run_lanes(self, columns: list, n: int) -> "BatchOutcome":
         image = bytearray(self.call_image)
-        stack = 0x100 | CALL_STACK_TOP
-        back = (RETURN_TRAP - 1) & 0xFFFF  # the return address a JSR from the trap would push
-        image[stack], image[stack - 1] = back >> 8, back & 0xFF
+        stack_pointer = push_return_trap(image)
         cpu = BatchCpu(self.routine.cpu, image, n)
         registers = {"a": cpu.a, "x": cpu.x, "y": cpu.y}
         for index, register, shift in self.register_inputs:
@@ -286,7 +297,7 @@ class RoutineRunner:
         for index, addresses in self.table_inputs:
             for byte, address in enumerate(addresses):
                 cpu.memory.fill(address, columns[index][:, byte])
-        cpu.sp[:] = CALL_STACK_TOP - 2
+        cpu.sp[:] = stack_pointer
         cpu.call(self.entry, self.limit, RETURN_TRAP, CALL_STACK_TOP)
         lanes = {"a": cpu.a, "x": cpu.x, "y": cpu.y}
         outputs = []
