@@ -624,7 +624,7 @@ def _operation(mnemonic: str):
     raise AssertionError(mnemonic)  # pragma: no cover - READS lists only the mnemonics handled here
 
 
-def _make_read(opcode: int, mnemonic: str, mode: str, cycles: int, penalised: bool, length: int) -> Handler:
+def _make_read(mnemonic: str, mode: str, cycles: int, penalised: bool, length: int) -> Handler:
     """Instructions that read an operand (immediate or memory) and change registers and flags."""
     address_of = ADDRESSING.get(mode)
     operate = _operation(mnemonic)
@@ -848,7 +848,7 @@ def _build() -> dict[int, Handler]:
             continue  # JAM and unstable opcodes stop their lanes (no handler)
         name, mode, length = op.mnemonic, op.mode, MODE_LENGTH[op.mode]
         if name in READS:
-            handlers[opcode] = _make_read(opcode, name, mode, op.cycles, op.page_penalty, length)
+            handlers[opcode] = _make_read(name, mode, op.cycles, op.page_penalty, length)
         elif name in STORES:
             handlers[opcode] = _make_store(name, mode, op.cycles, length)
         elif name in RMW:

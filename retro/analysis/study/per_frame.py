@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from fractions import Fraction
 
@@ -49,6 +48,7 @@ from retro.analysis.study.evaluate import Progress, default_workers, quiet
 from retro.analysis.study.methods.base import KIND_PAIR, Method
 from retro.chips.vic import constants as vic
 from retro.errors import RunError
+from retro.workers import worker_pool
 
 BUDGET_LINES = 20  # "a typical budget of 20 raster lines"
 OBJECT_COUNTS = tuple(range(1, MAX_OBJECTS + 1))
@@ -139,7 +139,7 @@ def measure_broad(extent_sets: Sequence[Extents], counts: Sequence[int], layouts
     tasks = [(e, n) for e in dict.fromkeys(extent_sets) for n in counts]
     sweep: dict[tuple[Extents, int], list[BroadSample]] = {}
     if workers > 1 and len(tasks) > 1:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
+        with worker_pool(workers) as pool:
             futures = [pool.submit(_sweep_task, e, n, layouts, frames) for e, n in tasks]
             for i, future in enumerate(futures, 1):
                 e, n, samples = future.result()
