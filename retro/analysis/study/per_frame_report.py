@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-import csv
-import io
 from dataclasses import fields
 
 from retro.analysis.study.broad_phase import MAX_OBJECTS, PHASES, SORT_X
+from retro.analysis.study.csvdata import csv_records, csv_text
 from retro.analysis.study.per_frame import ONCE, PHASE_CROSSING, PHASE_LABELS, FrameRow, PerFrame, cheapest
 
 COLUMNS = [f.name for f in fields(FrameRow)]
@@ -20,21 +19,13 @@ def _cell(value) -> str:
 
 
 def rows_to_csv(rows: list[FrameRow]) -> str:
-    out = io.StringIO()
-    writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(COLUMNS)
-    for r in rows:
-        writer.writerow([_cell(getattr(r, c)) for c in COLUMNS])
-    return out.getvalue()
+    return csv_text(COLUMNS, ([_cell(getattr(r, c)) for c in COLUMNS] for r in rows))
 
 
 def rows_from_csv(text: str) -> list[FrameRow]:
     types = {f.name: f.type for f in fields(FrameRow)}
     parse = {"int": int, "float": float, "str": str}
-    reader = csv.DictReader(io.StringIO(text))
-    if reader.fieldnames != COLUMNS:
-        raise ValueError(f"CSV columns {reader.fieldnames} differ from {COLUMNS}")
-    return [FrameRow(**{c: parse[str(types[c])](row[c]) for c in COLUMNS}) for row in reader]
+    return [FrameRow(**{c: parse[str(types[c])](row[c]) for c in COLUMNS}) for row in csv_records(text, COLUMNS)]
 
 
 def _n(value: int | None, served: int = MAX_OBJECTS) -> str:

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from dataclasses import asdict, dataclass, fields
 
 from retro.analysis.study.accuracy import Confusion
 from retro.analysis.study.costs import MethodCost
+from retro.analysis.study.csvdata import csv_records, csv_text
 from retro.analysis.study.evaluate import AccuracyTable
 from retro.analysis.study.pareto import pareto_front
 
@@ -90,12 +89,7 @@ def _cell(value: object) -> str:
 
 
 def rows_to_csv(rows: list[FigureRow]) -> str:
-    out = io.StringIO()
-    writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(COLUMNS)
-    for r in rows:
-        writer.writerow([_cell(getattr(r, c)) for c in COLUMNS])
-    return out.getvalue()
+    return csv_text(COLUMNS, ([_cell(getattr(r, c)) for c in COLUMNS] for r in rows))
 
 
 _INT_OR_NONE = {"cycles_min", "cycles_max", "code_bytes", "table_bytes"}
@@ -117,10 +111,7 @@ def _parse(column: str, text: str) -> object:
 
 
 def rows_from_csv(text: str) -> list[FigureRow]:
-    reader = csv.DictReader(io.StringIO(text))
-    if reader.fieldnames != COLUMNS:
-        raise ValueError(f"CSV columns {reader.fieldnames} differ from {COLUMNS}")
-    return [FigureRow(**{c: _parse(c, row[c]) for c in COLUMNS}) for row in reader]
+    return [FigureRow(**{c: _parse(c, row[c]) for c in COLUMNS}) for row in csv_records(text, COLUMNS)]
 
 
 # ---- Markdown -------------------------------------------------------------------------------------

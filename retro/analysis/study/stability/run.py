@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import csv
-import io
 import time
 from dataclasses import astuple, dataclass, fields
 from pathlib import Path
 
 from retro.analysis.study.corpus import load_shapes
+from retro.analysis.study.csvdata import csv_text
 from retro.analysis.study.evaluate import Progress, quiet
 from retro.fileio import output_folder, write_atomic
 
@@ -24,13 +23,9 @@ class StabilityOutput:
 
 
 def _csv(rows: list) -> str:
-    out = io.StringIO()
-    writer = csv.writer(out, lineterminator="\n")
-    if rows:
-        writer.writerow([f.name for f in fields(rows[0])])
-        for r in rows:
-            writer.writerow(["" if v is None else v for v in astuple(r)])
-    return out.getvalue()
+    if not rows:
+        return ""
+    return csv_text([f.name for f in fields(rows[0])], (["" if v is None else v for v in astuple(r)] for r in rows))
 
 
 def _md_table(header: list[str], body: list[list[object]]) -> str:
@@ -146,11 +141,8 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
     found = latch_pitfalls.pitfalls(ship, ball)
     flat = [(p.scenario, p.kind, p.truth, "; ".join(f"frame {r.frame} line {r.line}: ${r.value:02X}" for r in p.reads),
              p.conclusion) for p in found]
-    out = io.StringIO()
-    writer = csv.writer(out, lineterminator="\n")
-    writer.writerow(["scenario", "kind", "truth", "reads", "conclusion"])
-    writer.writerows(flat)
-    files.append(write_atomic(out_dir / "latch_pitfalls.csv", out.getvalue()))
+    files.append(write_atomic(out_dir / "latch_pitfalls.csv",
+                              csv_text(["scenario", "kind", "truth", "reads", "conclusion"], flat)))
     md.append("## Latch pitfalls\n\nA ship (sprite 0) and balls, driven through the VIC-II device; reads of "
               "$D01E at the raster lines shown:\n\n")
     md.append(_md_table(["scenario", "what happened", "reads of $D01E", "what the program concludes", "error"],
