@@ -290,6 +290,8 @@ def check_chunk(spec: str, seed: int, chunk: list[tuple], start: SceneStart | No
     name = routine.name
     read = runner.machine.memory.__getitem__
     out = ChunkResult()
+    columns = case_sets.cases_to_columns(routine, chunk)
+    holds = [condition.over(columns, chunk) for condition in routine.domain]  # per condition, per case
     answers = None
     for i, case in enumerate(chunk):
         steps: list = []
@@ -305,14 +307,11 @@ def check_chunk(spec: str, seed: int, chunk: list[tuple], start: SceneStart | No
             break  # a broken routine stops the check: the next case could run away as well
         if against is not None:
             _compare_engines(out, routine, case, against, i, answer, cycles)
-        broken = [c.text for c in routine.domain if not c.test(*case)]
+        broken = [c.text for c, held in zip(routine.domain, holds) if not held[i]]
         try:
             if routine.reference_arrays:  # the whole chunk in one call, as the batched core asks it
                 if answers is None:
-                    columns = case_sets.cases_to_columns(routine, chunk)
-                    inside = np.ones(len(chunk), dtype=bool)
-                    for condition in routine.domain:
-                        inside &= condition.over(columns, chunk)
+                    inside = np.logical_and.reduce(holds) if holds else np.ones(len(chunk), dtype=bool)
                     answers, answered = expected_columns(routine, columns, chunk, runner.memory_values, inside)
                 if not answered[i]:
                     raise InputError("outside the domain, the reference gave no answer")
