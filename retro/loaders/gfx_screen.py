@@ -2,7 +2,9 @@
 
 `vic_part(raw, name, part)` gives one part ("screen", "color", "charset", "bitmap") of:
 - a CharPad project (starts with "CTM"; retro/loaders/gfx_charpad.py): charset, screen (the
-  40 x 25 window of its map at col, row) and colour RAM;
+  40 x 25 window of its map at col, row) and colour RAM; a project in a bitmap display mode
+  (CharPad 2.8 and later) gives the bitmap (each window cell's character), screen RAM (its
+  screen-matrix colours) and colour RAM, and no charset;
 - a Koala picture (10003 bytes, or 10001 without the load address; retro/loaders/gfx_koala.py):
   bitmap, screen and colour RAM;
 - a raw memory dump: screen or colour RAM as 1000 bytes (40 x 25) or 1024 (the whole 1 KiB, sprite
@@ -56,6 +58,15 @@ def vic_parts(raw: bytes, name: str, parts, col: int = 0, row: int = 0) -> dict[
         project = read_ctm(raw, name)
         what = f"CharPad version {project.version}"
         out = {}
+        if project.bitmap_mode:
+            if "charset" in parts:
+                raise InputError(f"{name}: a CharPad project in display mode {project.mode} has no charset: give it "
+                                 f"as bitmap, screen and color files (memory.bitmap.file, ...)")
+            bitmap, screen, colours, covered = project.bitmap_window(col, row, name)
+            covered = None if covered.all() else covered
+            out = {"bitmap": Part(bitmap, None, what), "screen": Part(screen, covered, what),
+                   "color": Part(colours, covered, what)}
+            return {part: out[part] for part in parts}
         if "bitmap" in parts:
             raise InputError(f"{name}: a CharPad project has no bitmap")
         if "charset" in parts:

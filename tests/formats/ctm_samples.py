@@ -1,8 +1,9 @@
 """CharPad .ctm sample files written field by field from the format tables in CharPad's manuals
-(CharPad 2.3 User Manual: versions 1, 2, 4, 5; CharPad 2.6 User Manual: version 6) and, for
-version 7's 12-byte header, c64lib's reader (see retro/loaders/gfx_charpad.py). Nothing here calls
-the reader: the expected screen, colours and materials are worked out by plain loops over the
-same level description.
+(CharPad 2.3 User Manual: versions 1-5; CharPad 2.6 User Manual: version 6) and, for version 7's
+12-byte header and versions 8, 82 and 9 (and the CharPad 2.8 preview layout of version 8), the
+readers named in retro/loaders/gfx_charpad.py (c64lib, Oscar64, C64Studio). Nothing here calls the
+reader: the expected screen, colours and materials are worked out by plain loops over the same
+level description.
 """
 
 from __future__ import annotations
@@ -140,6 +141,67 @@ def v4(level: Level, colouring: str, charex: int = 0) -> bytes:
     return header + data + bytes(_flat(level.map()))
 
 
+def v3(level: Level, colouring: str, charex: int = 0) -> bytes:
+    """CharPad 1.8 before Rev 3: 20-byte header; square tiles; tile-cell attributes MMMMCCCC (material
+    3 + tile number in every cell of a tile); no char attributes; an 8-bit map."""
+    assert level.tile_h == level.tile_w and level.tiles_on
+    header = (b"CTM" + bytes([3]) + _colours(level) + bytes([COLOURING[colouring], int(level.multicolor)])
+              + _u16(level.map_w, level.map_h, len(level.chars) - 1) + bytes([len(level.tiles()) - 1, level.tile_w])
+              + bytes([charex, 0]))
+    data = bytes(_flat(level.chars)) + _tile_bytes(level, 2)
+    data += bytes(((3 + t) << 4) | c for t, tile in enumerate(level.cell_colours()) for c in _flat(tile))
+    if colouring == "per-tile":
+        data += bytes(level.tile_colours)
+    return header + data + bytes(_flat(level.map()))
+
+
+# versions 8, 82, 9: display modes and what a colour entry holds
+MODE_BYTES = {"hires": 0, "multicolor": 1, "ecm": 2, "bitmap-hires": 3, "bitmap-multicolor": 4}
+BASE_SCREEN = (7, 8)  # the global screen-matrix low and high nybble in the samples
+
+
+def screen_lo_hi(kind: str, index: int) -> tuple[int, int]:
+    """The sample's screen-matrix colours (low, high nybble) of char or tile `index`."""
+    return ((index + 3) % 16, (index + 5) % 16) if kind == "char" else ((index + 11) % 16, (index + 2) % 16)
+
+
+def _entry(mode: str, colour: int, lo: int, hi: int, prototype: bool) -> bytes:
+    """One colour entry: text modes the colour matrix; bitmap hires screen low, high; bitmap
+    multicolour colour matrix, screen low, high; the preview layout 4 bytes, colour matrix last."""
+    if prototype:
+        return bytes([12, 13, 14, colour])
+    return {"bitmap-hires": bytes([lo, hi]), "bitmap-multicolor": bytes([colour, lo, hi])}.get(mode, bytes([colour]))
+
+
+def v8(level: Level, colouring: str, version: int = 8, mode: str | None = None, prototype: bool = False,
+       flexigrid: bytes = b"\x28\x00\x19\x00\x00") -> bytes:
+    """CharPad 2.8+ / Pro: display mode, colouring, flags (b0 TILESYS); version 9 the flexigrid
+    (width, height 16-bit, configuration); screen colour, multicolour 1, 2, background 4, base colours
+    (colour matrix, screen low, high; the preview layout a 4th, the colour matrix); then blocks: chars,
+    materials (a byte a char), [char colours], [tiles, [tile colours], tags, names], map."""
+    mode = mode or ("multicolor" if level.multicolor else "hires")
+    header = bytes([MODE_BYTES[mode], COLOURING[colouring], 1 if level.tiles_on else 0])
+    if version == 9:
+        header += flexigrid
+    header += bytes([level.background, level.mc1, level.mc2, 4])
+    header += bytes([9, 10, 11, level.char_colour]) if prototype else bytes([level.char_colour, *BASE_SCREEN])
+    blocks = [_u16(len(level.chars) - 1) + bytes(_flat(level.chars)), bytes(level.materials)]
+    if colouring == "per-char":
+        blocks.append(b"".join(_entry(mode, c, *screen_lo_hi("char", i), prototype)
+                               for i, c in enumerate(level.char_colours)))
+    if level.tiles_on:
+        tiles = level.tiles()
+        blocks.append(_u16(len(tiles) - 1) + bytes([level.tile_w, level.tile_h]) + _tile_bytes(level, 2))
+        if colouring == "per-tile":
+            blocks.append(b"".join(_entry(mode, c, *screen_lo_hi("tile", i), prototype)
+                                   for i, c in enumerate(level.tile_colours)))
+        blocks.append(bytes(range(len(tiles))))
+        blocks.append(b"".join(f"t{i}".encode() + b"\0" for i in range(len(tiles))))
+    blocks.append(_u16(level.map_w, level.map_h) + _u16(*_flat(level.map())))
+    body = b"".join(bytes([0xDA, 0xB0 + n]) + block for n, block in enumerate(blocks))
+    return b"CTM" + bytes([version]) + header + body
+
+
 def _attributes(level: Level, colouring: str) -> bytes:
     """MMMMCCCC per char; [CP26]: colours only stored with per-character colouring."""
     return bytes(m << 4 | (c if colouring == "per-char" else 0) for m, c in zip(level.materials, level.char_colours))
@@ -189,10 +251,10 @@ def v7(level: Level, colouring: str, mode: int | None = None) -> bytes:
     return b"CTM" + bytes([7]) + header + _blocks(level, colouring)
 
 
-WRITERS = {1: v1, 2: v2, 4: v4, 5: v5, 6: v6, 7: v7}
-COLOURINGS = {1: ("global", "per-tile", "per-tile-cell"), 2: ("global", "per-tile", "per-tile-cell"),
-              4: ("global", "per-tile", "per-tile-cell"), 5: ("global", "per-tile", "per-char"),
-              6: ("global", "per-tile", "per-char"), 7: ("global", "per-tile", "per-char")}
+WRITERS = {1: v1, 2: v2, 3: v3, 4: v4, 5: v5, 6: v6, 7: v7, 8: v8, 9: lambda level, c: v8(level, c, 9),
+           82: lambda level, c: v8(level, c, 82)}
+OLD, NEW = ("global", "per-tile", "per-tile-cell"), ("global", "per-tile", "per-char")
+COLOURINGS = {1: OLD, 2: OLD, 3: OLD, 4: OLD, 5: NEW, 6: NEW, 7: NEW, 8: NEW, 9: NEW, 82: NEW}
 
 
 def level_for(version: int, **kw) -> Level:

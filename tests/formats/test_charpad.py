@@ -15,7 +15,7 @@ from retro.chips.vic.model import frame_collisions
 from retro.errors import InputError
 from retro.loaders.gfx_charpad import material_table, read_ctm, screen_codes
 from retro.scenes import load_scene
-from ctm_samples import COLOURINGS, WRITERS, Level, level_for, v4, v5, v6, v7
+from ctm_samples import BASE_SCREEN, COLOURINGS, WRITERS, Level, level_for, screen_lo_hi, v3, v4, v5, v6, v7, v8
 
 CASES = [(version, colouring) for version, colourings in COLOURINGS.items() for colouring in colourings]
 
@@ -38,10 +38,16 @@ def test_every_version_and_colouring(version, colouring):
     assert (project.version, project.colouring, project.mode) == (version, colouring, "hires")
     assert project.charset()[:32] == bytes(sum(level.chars, []))
     assert project.charset()[32:] == bytes(2048 - 32)
-    # version 1 has no materials; the others give each char its material (v4: from the char attributes,
-    # not the cell attributes, which the sample sets to 3 everywhere)
-    materials = [0, 0, 0, 0] if version == 1 else level.materials
-    assert project.material_table() == bytes(materials) + bytes(252)
+    # version 1 has no materials; version 3 has them per tile cell only; the others give each char its
+    # material (v4: from the char attributes, not the cell attributes, which the sample sets to 3)
+    if version == 3:
+        with pytest.raises(InputError, match=r"^v3.ctm: CHAR_ATTRIBS: a version 3 project keeps its materials per "
+                                             r"tile cell"):
+            project.material_table("v3.ctm")
+        assert project.cell_materials[:, 0, 0].tolist() == [3, 4, 5]  # 3 + the tile number, every cell
+    else:
+        materials = [0, 0, 0, 0] if version == 1 else level.materials
+        assert project.material_table() == bytes(materials) + bytes(252)
     codes, colours, covered = project.window(0, 0)
     want_codes, want_colours, want_covered = expected_window(level, colouring)
     assert codes.tolist() == want_codes
@@ -49,7 +55,7 @@ def test_every_version_and_colouring(version, colouring):
     assert covered.tolist() == want_covered
 
 
-@pytest.mark.parametrize("version", [5, 6, 7])
+@pytest.mark.parametrize("version", [5, 6, 7, 8, 9, 82])
 def test_projects_without_a_tile_set_map_characters(version):
     level = Level(tiles_on=False, map_w=45, map_h=30)
     project = read_ctm(WRITERS[version](level, "per-char"), "chars.ctm")
@@ -59,7 +65,8 @@ def test_projects_without_a_tile_set_map_characters(version):
     assert codes.tolist() == want_codes and colours.tolist() == want_colours and covered.all()
 
 
-@pytest.mark.parametrize("writer, mode", [(v5, "multicolor"), (v6, "multicolor"), (v7, "multicolor")])
+@pytest.mark.parametrize("writer, mode", [(v3, "multicolor"), (v5, "multicolor"), (v6, "multicolor"),
+                                          (v7, "multicolor"), (v8, "multicolor")])
 def test_multicolour_flag(writer, mode):
     assert read_ctm(writer(Level(multicolor=True), "global"), "mc.ctm").mode == mode
 
@@ -88,10 +95,25 @@ def truncated(raw: bytes, cut: int) -> bytes:
 
 
 @pytest.mark.parametrize("raw, message", [
-    (b"CTM\x03" + bytes(40), "VERSION: CharPad format version 3 (CharPad 1.8 before Rev 3) is not read"),
-    (b"CTM\x08" + bytes(40), "VERSION: CharPad format version 8 is not read"),
-    (b"CTM\x09" + bytes(40), "VERSION: CharPad format version 9 is not read"),
-    (b"CTM\x52" + bytes(40), "VERSION: CharPad format version 82 is not read"),
+    (b"CTM\x0a" + bytes(40), "VERSION: CharPad format version 10 is not read"),
+    (b"CTM\x53" + bytes(40), "VERSION: CharPad format version 83 is not read"),
+    (b"CTM\x00", "VERSION: CharPad format version 0 is not read"),
+    (b"CTM\x08" + bytes(40), "CHARDAT block marker: expected $DA $B0 at byte 14, found $00 $00"),
+    (b"CTM\x09" + bytes(40), "CHARDAT block marker: expected $DA $B0 at byte 19, found $00 $00"),
+    (b"CTM\x52" + bytes(8), "BASE_COLOURS: needs 3 bytes from byte 11, the file ends at byte 12"),
+    (b"CTM\x09\x00\x00\x00\x01\x02", "FLEXIGRID: needs 5 bytes from byte 7, the file ends at byte 9"),
+    (b"CTM\x08\x05" + bytes(20), "DISP_MODE: display mode 5 is not one of 0 (hires), 1 (multicolor), 2 (ecm), "
+                                 "3 (bitmap-hires), 4 (bitmap-multicolor)"),
+    (v8(Level(), "global", mode="bitmap-multicolor", prototype=True),
+     "DISP_MODE: a bitmap-multicolor project in the CharPad 2.8 preview layout of version 8 is not read"),
+    (v8(Level(), "per-char", mode="bitmap-multicolor").split(b"t2\0")[0] + b"t2", "TILENAMES: a tile name from byte"),
+    # header 14, chars 2 + 2 + 32, materials 2 + 4, colours marker 2: 4 entries of 2 bytes from byte 58
+    (v8(Level(tiles_on=False), "per-char", mode="bitmap-hires")[:63],
+     "CHARCOLRS: needs 8 bytes from byte 58, the file ends at byte 63"),
+    (v8(Level(), "global") + b"\0", "file size: the data ends at byte"),
+    (v8(Level(tiles_on=False), "per-tile"), "COLR_METH: per-tile colouring in a project without a tile set"),
+    (v3(Level(), "global", charex=1), "CHAREX: the character set is saved expanded"),
+    (truncated(v3(Level(), "per-tile"), 21 * 13 + 1), "TILE_COLOURS: needs 3 bytes from byte"),
     (b"CTX\x05", "ID_STR: not a CharPad project"),
     (b"CTM", "VERSION: needs 1 bytes from byte 3, the file ends at byte 3"),
     (v4(Level(), "global", charex=1), "CHAREX: the character set is saved expanded"),
@@ -191,10 +213,10 @@ def test_cli_reads_the_project_and_refuses_a_bad_one_in_one_line(tmp_path):
     done = run_vic(tmp_path / "s.toml", "--json")
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout)["d01f"] == 1
-    (tmp_path / "level.ctm").write_bytes(b"CTM\x09" + bytes(30))
+    (tmp_path / "level.ctm").write_bytes(b"CTM\x0a" + bytes(30))
     done = run_vic(tmp_path / "s.toml")
     assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
-    assert "s.toml: memory.charpad: 'level.ctm': VERSION: CharPad format version 9 is not read" in done.stderr
+    assert "s.toml: memory.charpad: 'level.ctm': VERSION: CharPad format version 10 is not read" in done.stderr
 
 
 @pytest.mark.parametrize("memory, field, message", [
@@ -272,3 +294,121 @@ def test_materials_as_the_tile_routines_property_table(tmp_path):
     for col, row, material in [(6, 4, 1), (7, 4, 2), (6, 5, 15), (7, 5, 1), (21, 11, 2), (5, 4, 0)]:
         outputs, _ = runner.run((24 + 8 * col + 3, 0, 50 + 8 * row + 5))
         assert outputs == (material,), (col, row)
+
+
+# ---- versions 8, 82, 9: the preview layout, bitmap display modes, hostile bytes ----------------------
+
+@pytest.mark.parametrize("colouring", ["global", "per-tile", "per-char"])
+@pytest.mark.parametrize("multicolor", [False, True])
+def test_v8_preview_layout_is_told_by_its_first_block_marker(colouring, multicolor):
+    """The CharPad 2.8 preview layout: a 4th base colour (the char colour; the sample puts 9, 10, 11 in
+    the other three) and 4-byte colour entries, the colour-matrix byte last (the sample's first three
+    are 12, 13, 14)."""
+    level = Level(multicolor=multicolor)
+    project = read_ctm(v8(level, colouring, prototype=True), "p.ctm")
+    assert project.layout == "prototype" and project.char_colour == level.char_colour
+    codes, colours, covered = project.window(0, 0)
+    want_codes, want_colours, _ = expected_window(level, colouring)
+    assert codes.tolist() == want_codes and colours.tolist() == want_colours
+    assert project.material_table() == bytes(level.materials) + bytes(252)
+    assert read_ctm(v8(level, colouring), "r.ctm").layout == ""
+
+
+def test_v9_flexigrid_is_skipped_and_v82_reads_as_8():
+    level = Level()
+    for raw in (v8(level, "per-char", 9, flexigrid=b"\xff\xff\xff\xff\xda"), v8(level, "per-char", 82)):
+        project = read_ctm(raw, "x.ctm")
+        assert (project.background, project.multicolor1, project.multicolor2, project.char_colour) == (6, 11, 12, 14)
+        assert project.window(0, 0)[1].tolist() == expected_window(level, "per-char")[1]
+
+
+def expected_bitmap(level: Level, colouring: str, mode: str):
+    """(bitmap, screen bytes, colour nibbles) of the 40 x 25 window at (0, 0), by hand."""
+    bitmap, screen, colours = [], [], []
+    for r in range(25):
+        for c in range(40):
+            cell = level.screen_cell(c, r)
+            code, tile, _ = cell if cell else (0, None, None)
+            bitmap.append(level.chars[code] if cell else [0] * 8)
+            if colouring == "per-char":
+                lo, hi = screen_lo_hi("char", code)
+            elif colouring == "per-tile":
+                lo, hi = screen_lo_hi("tile", tile)
+            else:
+                lo, hi = BASE_SCREEN
+            colour = level.expected_colour(c, r, colouring) if mode == "bitmap-multicolor" or colouring == "global" else 0
+            screen.append(hi << 4 | lo if cell else 0)
+            colours.append(colour if cell else 0)
+    return [b for cell in bitmap for b in cell], screen, colours
+
+
+@pytest.mark.parametrize("colouring", ["global", "per-tile", "per-char"])
+@pytest.mark.parametrize("mode", ["bitmap-hires", "bitmap-multicolor"])
+def test_bitmap_display_modes_give_bitmap_screen_and_colour(mode, colouring):
+    from retro.loaders.gfx_screen import vic_parts
+
+    level = Level()  # 42 x 26 cells: the window at (0, 0) is covered
+    raw = v8(level, colouring, mode=mode)
+    project = read_ctm(raw, "bm.ctm")
+    assert project.mode == mode and project.bitmap_mode
+    bitmap, screen, colours, covered = project.bitmap_window(0, 0, "bm.ctm")
+    want_bitmap, want_screen, want_colours = expected_bitmap(level, colouring, mode)
+    assert bitmap.tolist() == want_bitmap
+    assert screen.tolist() == want_screen
+    assert colours.tolist() == want_colours and covered.all()
+    parts = vic_parts(raw, "bm.ctm", ("bitmap", "screen", "color"))
+    assert parts["bitmap"].values.tolist() == want_bitmap and parts["screen"].values.tolist() == want_screen
+    with pytest.raises(InputError, match=r"^bm.ctm: a CharPad project in display mode .* has no charset"):
+        vic_parts(raw, "bm.ctm", ("charset",))
+
+
+def test_bitmap_mode_takes_characters_past_255():
+    level = Level(tiles_on=False, map_w=40, map_h=25, chars=[[i % 256] * 8 for i in range(300)],
+                  materials=[0] * 300, char_colours=[1] * 300)
+    raw = bytearray(v8(level, "global", mode="bitmap-multicolor"))
+    raw[-2000:-1998] = (299).to_bytes(2, "little")  # map cell (0, 0): char 299
+    bitmap, *_ = read_ctm(bytes(raw), "b.ctm").bitmap_window()
+    assert bitmap[:8].tolist() == [299 % 256] * 8
+    raw[-2000:-1998] = (300).to_bytes(2, "little")
+    with pytest.raises(InputError, match=r"^b.ctm: screen cell \(column 0, row 0\) shows character 300, the project has 300$"):
+        read_ctm(bytes(raw), "b.ctm").bitmap_window(0, 0, "b.ctm")
+
+
+def test_bitmap_project_in_a_scene_through_the_part_files(tmp_path):
+    level = Level()
+    (tmp_path / "bm.ctm").write_bytes(v8(level, "per-char", mode="bitmap-multicolor"))
+    files = 'bitmap = { file = "bm.ctm" }\nscreen = { file = "bm.ctm" }\ncolor = { file = "bm.ctm" }\n'
+    (tmp_path / "s.toml").write_text(f'chip = "vic-ii"\n[memory]\n{files}')
+    memory = load_scene(tmp_path / "s.toml").state.memory
+    want_bitmap, want_screen, want_colours = expected_bitmap(level, "per-char", "bitmap-multicolor")
+    assert memory.screen.tolist() == want_screen and memory.color.tolist() == want_colours
+    (tmp_path / "s.toml").write_text('chip = "vic-ii"\n[memory]\ncharpad = "bm.ctm"\n')
+    with pytest.raises(InputError, match="has no charset"):
+        load_scene(tmp_path / "s.toml")
+
+
+SAMPLES = [v3(Level(), "per-tile"), v8(Level(), "per-char", mode="bitmap-multicolor"),
+           v8(Level(), "per-tile", 9), v8(Level(multicolor=True), "per-char", prototype=True)]
+
+
+@pytest.mark.parametrize("sample", range(len(SAMPLES)))
+def test_every_cut_and_many_flipped_bytes_are_one_line(sample):
+    import random
+
+    raw = SAMPLES[sample]
+    rng = random.Random(sample)
+    variants = [raw[:n] for n in range(len(raw))]
+    for _ in range(300):
+        bad = bytearray(raw)
+        for _ in range(rng.randint(1, 4)):
+            bad[rng.randrange(4, len(bad))] = rng.randrange(256)
+        variants.append(bytes(bad))
+    for bad in variants:
+        try:
+            project = read_ctm(bad, "f.ctm")
+            if project.bitmap_mode:
+                project.bitmap_window(0, 0, "f.ctm")
+            else:
+                project.window(0, 0, "f.ctm")
+        except InputError as exc:
+            assert str(exc).startswith("f.ctm: ") and "\n" not in str(exc)
