@@ -22,8 +22,18 @@ and c64lib's reading (both read 4 exactly as 5):
   Tiles (2 bytes a cell) and animation tables follow the blocks; they are not read.
   (VS64's resource compiler reads the two overlay distances before the colours; the four readers
   above and the real files put the colours first, as here.)
-Versions 2 and 3 (SpritePad 2.x previews between the beta and Pro) are refused with one line: they
-are not read here.
+SpritePad 2.x previews ("SPD" format versions 2 and 3): the Pro header without the two overlay
+distances, 16 bytes:
+  $00-$02 "SPD"; $03 version; $04 flags; $05-$06 sprite count (little-endian, not minus one);
+  $07-$08 tile count; $09-$0A animation counts; $0B-$0C tile width and height; $0D background,
+  $0E multicolour 1, $0F multicolour 2; $10 the first 64-byte block.
+  Version 2: GoDot's notes from Subchrist Software's mail in Esshahn/spritemate issue #150 (2019:
+  SpritePad 2.3.0 Preview writes format version 2; it reads $09-$0A as one 16-bit animation count).
+  Version 3: Oscar64 (Preprocessor.cpp, SPDHeader3) and C64Studio (SpritePadProject.cs, version 3);
+  both put the count at $05 and the colours at $0D-$0F, as GoDot's version 2. (C64Studio reads a
+  version 2 file as 2.0 beta; GoDot, who had the files, describes the 16-byte header.) No real file of
+  either version was at hand: the samples are built from this layout.
+Other versions are refused with one line naming the version.
 
 In every version the 64th byte of each block is the sprite's attribute: low nibble its colour
 ($D027+n), bit 4 overlay (the next sprite - or, in Pro files, the sprite `overlay distance` further
@@ -45,6 +55,8 @@ V1_HEADER = 3  # background, multicolour 1, multicolour 2
 BETA_VERSION = 1
 BETA_HEADER = 9  # magic, version, sprites - 1, animations - 1, three colours
 PRO_VERSIONS = (4, 5)
+PREVIEW_VERSIONS = (2, 3)
+PREVIEW_HEADER = 0x10
 PRO_HEADER = 0x14
 PRO_COUNT = 0x05  # 16-bit sprite count
 PRO_COLOURS = 0x0D  # background, multicolour 1, multicolour 2
@@ -66,7 +78,7 @@ class SpritePadSprite:
 
 @dataclass(frozen=True)
 class SpritePadFile:
-    version: str  # "1", "2.0 beta", "Pro 4" or "Pro 5"
+    version: str  # "1", "2.0 beta", "2.x preview 2", "2.x preview 3", "Pro 4" or "Pro 5"
     background: int
     multicolor1: int
     multicolor2: int
@@ -102,15 +114,19 @@ def _blocks(raw: bytes, start: int, count: int, name: str) -> bytes:
 
 
 def _pro(raw: bytes, version: int, name: str) -> SpritePadFile:
-    if len(raw) < PRO_HEADER:
-        raise InputError(f"{name}: SpritePad Pro header is {len(raw)} bytes, needs {PRO_HEADER}")
+    """Pro (4, 5) and the 2.x previews (2, 3): the same fields up to the colours; Pro adds the overlay
+    distances before the blocks."""
+    pro = version in PRO_VERSIONS
+    header, what = (PRO_HEADER, "Pro") if pro else (PREVIEW_HEADER, f"2.x preview version {version}")
+    if len(raw) < header:
+        raise InputError(f"{name}: SpritePad {what} header is {len(raw)} bytes, needs {header}")
     count = int.from_bytes(raw[PRO_COUNT:PRO_COUNT + 2], "little")
     if count == 0:
         raise InputError(f"{name}: SpritePad header says 0 sprites")
     background, mc1, mc2 = (b & 15 for b in raw[PRO_COLOURS:PRO_COLOURS + 3])
-    overlay = int.from_bytes(raw[PRO_OVERLAY:PRO_OVERLAY + 2], "little", signed=True)
-    return SpritePadFile(f"Pro {version}", background, mc1, mc2,
-                         _sprites(_blocks(raw, PRO_HEADER, count, name)), overlay)
+    overlay = int.from_bytes(raw[PRO_OVERLAY:PRO_OVERLAY + 2], "little", signed=True) if pro else 1
+    return SpritePadFile(f"Pro {version}" if pro else f"2.x preview {version}", background, mc1, mc2,
+                         _sprites(_blocks(raw, header, count, name)), overlay)
 
 
 def parse_spd(raw: bytes, name: str = "sprite file") -> SpritePadFile:
@@ -119,11 +135,12 @@ def parse_spd(raw: bytes, name: str = "sprite file") -> SpritePadFile:
         if len(raw) < 4:
             raise InputError(f"{name}: SpritePad header is {len(raw)} bytes, needs {BETA_HEADER}")
         version = raw[3]
-        if version in PRO_VERSIONS:
+        if version in PRO_VERSIONS + PREVIEW_VERSIONS:
             return _pro(raw, version, name)
         if version != BETA_VERSION:
             raise InputError(f"{name}: SpritePad format version {version} is not supported "
-                             f"(read: SpritePad 1.x, 2.0 beta version 1, Pro versions 4 and 5)")
+                             f"(read: SpritePad 1.x, 2.0 beta version 1, 2.x previews versions 2 and 3, "
+                             f"Pro versions 4 and 5)")
         if len(raw) < BETA_HEADER:
             raise InputError(f"{name}: SpritePad header is {len(raw)} bytes, needs {BETA_HEADER}")
         count = raw[4] + 1

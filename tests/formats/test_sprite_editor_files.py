@@ -79,6 +79,53 @@ def test_spritepad_pro_version_4_header_and_a_negative_overlay_distance():
     assert [(s.colour, s.multicolor) for s in spd.sprites] == [(0, True), (1, True), (2, True)]
 
 
+def preview_header(version: int, count: int, *, flags: int = 0, tiles: int = 0, anim_bytes: bytes = b"\0\0",
+                   tile_w: int = 0, tile_h: int = 0, colours=(6, 2, 7)) -> bytes:
+    """The 16-byte header of the SpritePad 2.x previews (GoDot's notes for version 2, Oscar64 and
+    C64Studio for version 3): "SPD", version, flags, sprite count (16-bit LE, not minus one), tile count,
+    2 bytes of animation counts, tile width and height, background, multicolour 1 and 2."""
+    header = (b"SPD" + bytes([version, flags]) + struct.pack("<HH", count, tiles) + anim_bytes
+              + bytes([tile_w, tile_h]) + bytes(colours))
+    assert len(header) == 0x10
+    return header
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_spritepad_preview_versions_2_and_3(tmp_path, version):
+    tiles = struct.pack("<HH", 1, 0)  # one tile of 2x1 sprites, after the blocks; not read
+    raw = (preview_header(version, 2, flags=0x01, tiles=1, tile_w=2, tile_h=1, colours=(0x1B, 0, 1))
+           + SPRITE_A + bytes([0x01]) + SPRITE_B + bytes([0x95]) + tiles)
+    spd = parse_spd(raw, "prev.spd")
+    assert spd.version == f"2.x preview {version}"
+    assert (spd.background, spd.multicolor1, spd.multicolor2, spd.overlay_distance) == (11, 0, 1, 1)
+    a, b = spd.sprites
+    assert (a.data, a.colour, a.multicolor, a.overlay) == (SPRITE_A, 1, False, False)
+    assert (b.data, b.colour, b.multicolor, b.overlay) == (SPRITE_B, 5, True, True)
+    # 300 sprites: the count is 16-bit; read by content whatever the name
+    path = tmp_path / "many.bin"
+    path.write_bytes(preview_header(version, 300) + b"".join(struct.pack("<H", i) + bytes(61) + b"\x81"
+                                                               for i in range(300)))
+    frames = read_sprite_frames(path)
+    assert len(frames) == 300 and frames[299].data[:2] == struct.pack("<H", 299) and frames[0].multicolor
+
+
+def test_spritepad_preview_in_a_scene(tmp_path):
+    (tmp_path / "p.spd").write_bytes(preview_header(3, 2) + SPRITE_A + b"\x01" + SPRITE_B + b"\x01")
+    (tmp_path / "s.toml").write_text('chip = "vic-ii"\n[[sprite]]\nindex = 0\nx = 100\ny = 100\nfile = "p.spd"\n'
+                                     'frame = 1\n')
+    from retro.scenes import load_scene
+    scene = load_scene(tmp_path / "s.toml")
+    assert bytes(scene.sprites[0].data) == SPRITE_B
+
+
+def test_spritepad_preview_cut_anywhere_is_one_line():
+    raw = preview_header(2, 2) + SPRITE_A + b"\x01" + SPRITE_B + b"\x01"
+    for n in range(4, len(raw)):
+        with pytest.raises(InputError) as exc:
+            parse_spd(raw[:n], "cut.spd")
+        one_line(exc, "cut.spd: ")
+
+
 def test_spritepad_pro_counts_past_255_sprites(tmp_path):
     count = 300
     blocks = b"".join(struct.pack("<H", i) + bytes(61) + bytes([0x01]) for i in range(count))

@@ -71,8 +71,10 @@ def test_raw_spr_still_raw(tmp_path):
 
 
 @pytest.mark.parametrize("raw, message", [
-    (b"SPD" + bytes([2]) + bytes(100), "format version 2 is not supported"),
-    (b"SPD" + bytes([3]) + bytes(100), "format version 3 is not supported"),
+    (b"SPD" + bytes([6]) + bytes(100), "format version 6 is not supported"),
+    (b"SPD" + bytes([3]) + bytes(100), "header says 0 sprites"),
+    (b"SPD" + bytes([2, 0, 2, 0]) + bytes(9) + bytes(64), "says 2 sprites \\(144 bytes\\), file has 80 bytes"),
+    (b"SPD" + bytes([2, 0, 1]) + bytes(5), "SpritePad 2.x preview version 2 header is 11 bytes, needs 16"),
     (b"SPD" + bytes([1, 3, 0, 0, 0, 0]) + bytes(64), "says 4 sprites"),
     (b"SPD\x01", "header is 4 bytes"),
     (bytes(70), "3 \\+ 64n bytes"),
@@ -84,7 +86,7 @@ def test_bad_spritepad_files_one_line(raw, message):
 
 def test_scene_uses_spritepad_file_and_cli_errors_cleanly(tmp_path):
     (tmp_path / "s.spd").write_bytes(beta_file())
-    (tmp_path / "bad.spd").write_bytes(b"SPD" + bytes([3]) + bytes(80))
+    (tmp_path / "bad.spd").write_bytes(b"SPD" + bytes([6]) + bytes(80))
     scene = """chip = "vic-ii"
 
 [[sprite]]
@@ -113,7 +115,7 @@ frame = 1
     bad = subprocess.run([sys.executable, "-m", "retro", "vic", str(tmp_path / "bad.toml")],
                          capture_output=True, text=True)
     assert bad.returncode == 2
-    assert len(bad.stderr.strip().splitlines()) == 1 and "version 3" in bad.stderr
+    assert len(bad.stderr.strip().splitlines()) == 1 and "version 6" in bad.stderr
 
 
 def test_huge_png_refused_from_its_header(tmp_path):
