@@ -46,11 +46,80 @@ def test_koala_parts(raw, load):
     assert picture.background == 0x0B
 
 
-@pytest.mark.parametrize("raw", [bytes(10002), bytes(9000), koala(b"\x00\x20", b"\0"), koala(b"\x00\x60", bytes(255))])
+@pytest.mark.parametrize("raw", [bytes(10002), koala(b"\x00\x20", b"\0"), koala(b"\x00\x60", bytes(255))])
 def test_not_a_koala_picture_is_one_line(raw):
     with pytest.raises(InputError) as info:
         koala_from_bytes(raw, "p.kla")
     assert str(info.value).startswith(f"p.kla: file size: {len(raw)} bytes: a Koala picture is 10003 bytes")
+    assert str(info.value).endswith("or a compressed (GG) picture of fewer than 10001 bytes")
+
+
+# ---- compressed (GG) pictures: $FE value count, anything else itself, to 10001 bytes ---------------------
+
+def gg(data: bytes, load: bytes = b"\x00\x60") -> bytes:
+    """Pack data the GG way, runs of 4 or more (and every $FE) as $FE value count."""
+    out, i = bytearray(load), 0
+    while i < len(data):
+        run = 1
+        while i + run < len(data) and data[i + run] == data[i] and run < 255:
+            run += 1
+        if run >= 4 or data[i] == 0xFE:
+            out += bytes([0xFE, data[i], run])
+        else:
+            out += data[i:i + run]
+        i += run
+    return bytes(out)
+
+
+def test_gg_picture_unpacks_to_the_koala_layout():
+    plain = koala(None)
+    packed = gg(plain)
+    assert len(packed) < 10001 and 0xFE in packed[2:]
+    picture = koala_from_bytes(packed, "p.gg")
+    reference = koala_from_bytes(plain, "p.kla")
+    assert picture.load_address == 0x6000
+    for part in ("bitmap", "screen", "colour"):
+        assert getattr(picture, part).tolist() == getattr(reference, part).tolist()
+    assert picture.background == 0x0B
+
+
+def test_gg_runs_by_hand():
+    # 7999 zeros as runs of 255 and one of 94, one $FE value kept by a run of 1, count 0 writing nothing,
+    # then screen 1000 x $12, colour 1000 x $F3, background 6; a run past the end is cut
+    runs = b"".join(b"\xfe\x00\xff" for _ in range(31)) + b"\xfe\x00\x5e" + b"\xfe\x77\x00" + b"\xfe\xfe\x01"
+    screen = b"".join(b"\xfe\x12\xfa" for _ in range(4)) + b"\xfe\x12\x00"  # 4 x 250
+    colour = b"\xfe\xf3\xff" * 3 + b"\xfe\xf3\xeb" + b"\xfe\x06\x09"  # 765 + 235, then 9 cut to 1
+    picture = koala_from_bytes(b"\x00\x60" + runs + screen + colour, "h.gg")
+    assert picture.bitmap[:7999].tolist() == [0] * 7999 and picture.bitmap[7999] == 0xFE
+    assert picture.screen.tolist() == [0x12] * 1000 and picture.colour.tolist() == [3] * 1000
+    assert picture.background == 6
+
+
+@pytest.mark.parametrize("raw, message", [
+    (bytes(9000), "file size: 9000 bytes: not a Koala picture (10003 bytes, or 10001 without the load address), "
+                  "and as a compressed (GG) picture it unpacks to 8998 of 10001 bytes"),
+    (b"\x00\x60\xfe\x00\xff\xfe\x00", "GG run at byte 5: needs 3 bytes ($FE, value, count), the file ends at byte 7"),
+    (b"\x00", "file size: 1 bytes: not a Koala picture"),
+    (gg(koala(None)) + bytes(255), "as a compressed (GG) picture it is whole at byte"),
+])
+def test_bad_gg_pictures_are_one_line(raw, message):
+    with pytest.raises(InputError) as info:
+        koala_from_bytes(raw, "p.gg")
+    assert str(info.value).startswith("p.gg: ") and message in str(info.value) and "\n" not in str(info.value)
+
+
+def test_gg_picture_by_content_and_in_a_scene(tmp_path):
+    from retro.loaders.gfx_koala import looks_like_koala
+
+    packed = gg(koala(None))
+    assert looks_like_koala(packed) and not looks_like_koala(gg(koala(None), b"\x00\x20"))
+    assert not looks_like_koala(packed[:-1]) and not looks_like_koala(packed + b"\0")
+    (tmp_path / "pic.gg").write_bytes(packed)
+    for memory in ('koala = "pic.gg"', 'bitmap = { file = "pic.gg" }'):
+        (tmp_path / "s.toml").write_text(BITMAP_SCENE.format(x=24 + 80, y=51 + 8 * 5 - 1, rows=json.dumps(TWO_PIXELS),
+                                                             memory=memory))
+        scene = load_scene(tmp_path / "s.toml")
+        assert set(frame_collisions(scene.state).sb_pixels[1].tolist()) == {104, 105}
 
 
 BITMAP_SCENE = """chip = "vic-ii"
