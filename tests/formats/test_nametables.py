@@ -7,6 +7,7 @@ attribute bytes, put there."""
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 
@@ -14,7 +15,7 @@ import pytest
 
 from retro.chips.ppu.hit import sprite_zero_hit
 from retro.errors import InputError
-from retro.loaders.gfx_nametable import nametable_from_bytes, palette_at
+from retro.loaders.gfx_nametable import nametable_from_bytes, nametables_from_bytes, palette_at
 from retro.scenes import load_scene
 
 SOLID = 3  # the scene's CHR tile 3 is solid
@@ -49,10 +50,35 @@ def test_palette_of_a_tile(col, row, palette):
     assert palette_at(bytes(attributes), col, row) == palette
 
 
-@pytest.mark.parametrize("size", [0, 960, 1023, 1025, 2048])
+@pytest.mark.parametrize("size", [0, 959, 961, 1023, 1025, 1984, 3072, 5120, 8192])
 def test_other_sizes_are_one_line(size):
-    with pytest.raises(InputError, match=rf"^t.nam: file size: {size} bytes: a nametable file is 1024 bytes"):
-        nametable_from_bytes(bytes(size), "t.nam")
+    for read in (nametable_from_bytes, nametables_from_bytes):
+        with pytest.raises(InputError, match=rf"^t.nam: file size: {size} bytes: a nametable file is 1024 bytes .*, "
+                                             r"960 \(tile numbers only\), or 2 or 4 nametables of 1024 bytes$"):
+            read(bytes(size), "t.nam")
+
+
+def test_960_bytes_are_the_tiles_without_attributes():
+    raw = nam({(16, 15): 7, (31, 29): 9}, {0: 0xE4})[:960]
+    loaded = nametable_from_bytes(raw, "t.nam")
+    assert loaded.tiles[15 * 32 + 16] == 7 and loaded.tiles[959] == 9 and len(loaded.tiles) == 960
+    assert loaded.attributes == bytes(64) and not loaded.has_attributes
+    assert nametable_from_bytes(nam(), "t.nam").has_attributes
+
+
+@pytest.mark.parametrize("count", [2, 4])
+def test_several_nametables_in_ppu_order(count):
+    # nametable n has tile n + 1 at (n, n) and attribute byte n = $10 + n
+    raw = b"".join(nam({(n, n): n + 1}, {n: 0x10 + n}) for n in range(count))
+    tables = nametables_from_bytes(raw, "t.nam")
+    assert len(tables) == count
+    for n, table in enumerate(tables):
+        assert table.tiles[n * 32 + n] == n + 1 and sum(1 for t in table.tiles if t) == 1
+        assert table.attributes[n] == 0x10 + n and sum(1 for a in table.attributes if a) == 1
+    addresses = ", ".join(f"${a:04X}" for a in (0x2000, 0x2400, 0x2800, 0x2C00)[:count])
+    with pytest.raises(InputError, match=rf"^t.nam: file size: {1024 * count} bytes hold {count} nametables "
+                                         rf"\({re.escape(addresses)}\): a \[\[nametable\]\] file is one nametable"):
+        nametable_from_bytes(raw, "t.nam")
 
 
 SCENE = """chip = "nes"
@@ -85,6 +111,13 @@ def test_tiles_from_the_file_decide_the_hit(tmp_path):
     assert not hit(tmp_path, nam({(17, 15): SOLID}), y=119).hit  # x 136-143: beside the sprite
 
 
+def test_a_960_byte_file_in_a_scene(tmp_path):
+    result = hit(tmp_path, nam({(16, 15): SOLID})[:960], y=119)
+    assert (result.hit, result.line, result.x) == (True, 120, 128)
+    # no attribute table: at Y scroll 240 the attribute row shows tile 0 (empty) under the sprite
+    assert not hit(tmp_path, nam({(16, 15): SOLID}, {16: SOLID})[:960], y=0, scroll_y=240).hit
+
+
 def test_cells_go_on_top_of_the_file(tmp_path):
     result = hit(tmp_path, nam(), y=119, table='file = "screen.nam"\ncells = [{ col = 16, row = 15, tile = 3 }]')
     assert (result.hit, result.line, result.x) == (True, 120, 128)
@@ -104,6 +137,7 @@ def test_attribute_bytes_from_the_file_show_at_y_scroll_240(tmp_path):
     (nam(), 'file = "screen.nam"\nfill = 3', "nametable[0].fill", "give fill or file, not both"),
     (nam(), 'file = "missing.nam"', "nametable[0].file", "nametable file not found"),
     (nam(), "file = 3", "nametable[0].file", "expected a file name, got 3"),
+    (nam() * 2, 'file = "screen.nam"', "nametable[0].file", "'screen.nam': file size: 2048 bytes hold 2 nametables"),
 ])
 def test_scene_errors_are_one_line(tmp_path, content, table, field, message):
     with pytest.raises(InputError) as info:
