@@ -26,6 +26,7 @@ import pytest
 
 from retro.chips.vic.constants import (
     NTSC,
+    NTSC_OLD,
     PAL,
     REG_CONTROL1,
     REG_SPRITE_ENABLE,
@@ -244,6 +245,21 @@ def test_a_sprite_whose_x_falls_in_its_own_halt_never_shows():
     assert placement(pair_state(PAL, 2, 0, 1, 0x17F), 1) is not None
     assert placement(pair_state(PAL, 2, 0, 1, 0x164), 0) is None  # sprite 0 at $163
     assert placement(pair_state(NTSC, 2, 0, 1, 0x16C), 0) is None  # sprite 0 at $16B
+
+
+def test_the_6567r56a_draws_each_x_once_so_a_halted_x_never_comes_back():
+    # No real-hardware dump of a 6567R56A: worked by hand from the rule above, with Bauer's 6567R56A
+    # diagram (64 cycles, 512 X coordinates, 8 a cycle from $19C in cycle 1; sprite 1's fetch in
+    # cycle 59 + 2 = 61). The sequencer runs 4 X behind: cycle c draws X $198 + 8(c - 1) (mod $200),
+    # cycle 61 X $178-$17F. Sprite 1 halts at its pixel 3, X $17B, and may start again from pixel 7
+    # of cycle 62, X $187: at X $17B-$186 it never shows. The 6567R8 draws $180-$187 a second time
+    # in cycle 63, after the halt, so there sprite 1 at $180-$186 does show (the spritegap dumps).
+    for x in (0x17B, 0x180, 0x186):
+        assert placement(pair_state(NTSC_OLD, 2, 0, 1, x), 1) is None, hex(x)
+    for x in (0x17A, 0x187):
+        assert placement(pair_state(NTSC_OLD, 2, 0, 1, x), 1) is not None, hex(x)
+    assert placement(pair_state(NTSC, 2, 0, 1, 0x17B), 1) is None
+    assert placement(pair_state(NTSC, 2, 0, 1, 0x180), 1) is not None
 
 
 def test_the_last_row_goes_when_x_comes_after_the_display_check():

@@ -1,9 +1,10 @@
 """The CPU's timeline on a C64: Bad Lines and sprite DMA stop it, the VIC-II's IRQ interrupts it.
 
 Every expected figure is worked out by hand from the rules in docs/vic.md ("CPU timeline"): Bauer's
-6569/6567R8 timing diagrams (Bad Line BA low in cycles 12-54, sprite n's s-accesses in cycles
-58+2n and 59+2n of the line before its row (60+2n on the 6567R8), BA low 3 cycles earlier, the CPU
-stopping at its first read cycle) and the 6502's interrupt polling (penultimate cycle; a taken
+6569/6567R56A/6567R8 timing diagrams (Bad Line BA low in cycles 12-54, sprite n's s-accesses in
+cycles 58+2n and 59+2n of the line before its row; 59+2n and 60+2n on the 6567R56A, and on the
+6567R8 as the real machines of VICE-testprogs VICII/spritesteal show), BA low 3 cycles earlier, the
+CPU stopping at its first read cycle) and the 6502's interrupt polling (penultimate cycle; a taken
 branch without page crossing polls a cycle earlier; CLI/SEI/PLP act after the poll). Offsets below
 count cycles from the routine's first cycle; "line L cycle c" is offset c - 1 when it starts there.
 """
@@ -78,8 +79,9 @@ def count_to_next_line(video, control1: int, line: int, sprites=()) -> tuple[int
     # BNE waits 19 cycles, iteration 5 reads at 81: X = 6, 81 + 11.
     (PAL, DEN_OFF, 100, range(8), (6, 92, 19)),
     # 6567R8 (65 cycles): no DMA: first read at offset >= 65 is 73 (X = 7). One sprite: s-accesses
-    # in cycles 60-61, BA low 57-61 (offsets 56-60): iteration 4's BNE (54-56) stops in its dummy
-    # read at 56 and waits 5; iteration 5 reads at 67 >= 65: X = 6.
+    # in cycles 59-60, BA low 56-60 (offsets 55-59): iteration 4's BNE (54-56) stops reading its
+    # operand at 55 and waits 5; iteration 5 reads at 67 >= 65: X = 6 (the 6567R56A and eight
+    # sprites: tests/vic/test_sprite_dma_timing.py).
     (NTSC, DEN_OFF, 100, (), (7, 84, 0)),
     (NTSC, DEN_OFF, 100, (0,), (6, 78, 5)),
 ])

@@ -5,10 +5,11 @@ Timing model (docs/vic.md):
   is frame-time t = m - m0; frame = t // (lines * cycles_per_line); line and cycle (1-based, as in
   Bauer's timing diagrams) follow from the remainder.
 - Cycle 1 of a line draws the X coordinates first_x .. first_x+7 ($194 on the 6569, $19C on the
-  6567R8, where the raster IRQ fires) [Bauer 3.4, 3.6.1]; each cycle draws the next 8 X coordinates,
-  which run up to $1F7 (6569) or $1FF (6567R8) and continue at 0. So pixel X of line L is drawn in
-  cycle 1 + ((X - first_x) mod x_positions) // 8 of line L. The 6567R8's 65th cycle has no X
-  coordinate of its own in this model.
+  6567R8 and 6567R56A, where the raster IRQ fires) [Bauer 3.4, 3.6.1]; each cycle draws the next 8
+  X coordinates, which run up to $1F7 (6569) or $1FF (6567R8, 6567R56A) and continue at 0. So
+  pixel X of line L is drawn in cycle 1 + ((X - first_x) mod x_positions) // 8 of line L. The
+  6567R8's 65th cycle has no X coordinate of its own in this model; the 6567R56A's 64 cycles draw
+  its 512 X exactly.
 - A collision at pixel X is latched COLLISION_LATCH_DELAY (4) X coordinates later than that, in
   cycle 1 + ((X + 4 - first_x) mod x_positions) // 8 (measured by the VICE test programs
   VICII/spritecollisions/*-collision-cycle; see constants.py). On the 6569 the last four X

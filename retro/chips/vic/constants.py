@@ -1,4 +1,4 @@
-"""VIC-II hardware numbers, each named once (6569 PAL and 6567R8 NTSC).
+"""VIC-II hardware numbers, each named once (6569 PAL, 6567R8 NTSC, 6567R56A old NTSC).
 
 Sources:
 - [Bauer] Christian Bauer, "The MOS 6567/6569 video controller (VIC-II) and its application in the
@@ -101,7 +101,7 @@ WINDOW_LINES = {1: (51, 250), 0: (55, 246)}
 WINDOW_X = {1: (24, 343), 0: (31, 334)}
 
 
-@dataclass(frozen=True, eq=False)  # two instances only: identity hashing keeps the caches cheap
+@dataclass(frozen=True, eq=False)  # three instances only: identity hashing keeps the caches cheap
 class Video:
     """One chip's raster: lines, cycles and the X coordinates that exist [Bauer 3.4, 3.6.1]."""
 
@@ -115,19 +115,22 @@ class Video:
     visible_lines: int
     first_visible_x: int
     visible_pixels: int  # per line, in drawing order from first_visible_x (through the X wrap)
-    # First cycle the VIC takes from the CPU for sprite 0's s-accesses, in the line before the one
-    # where the row is shown; sprite n takes this cycle + 2n and the next (numbers past the line's
-    # last cycle fall in the next line) [Bauer 3.6.3 timing diagrams; the 6567R8 has two idle
-    # cycles more before sprite 0's p-access than the 6569 (the "N" in his diagrams)].
-    sprite0_dma_cycle: int
-    # The sprite gap (see SPRITE_HALT_PIXEL below): the cycle of sprite 0's p-access as its pixel
-    # sequencer sees it (sprite n: + 2n; the next cycle holds its other s-accesses), the cycle whose
-    # pixel SPRITE_PENDING_PIXEL copies the display flags to the sequencer, and the cycle that draws
-    # the X coordinates of the cycle before it again (0: none). [VICE viciisc/vicii-chip-model.c
-    # cycle_tab_pal / cycle_tab_ntsc; checked against the real-hardware dumps of VICE-testprogs
-    # VICII/spritegap. On the 6567R8 those dumps put sprite 0's p-access in cycle 59, as VICE does,
-    # where sprite0_dma_cycle (read from Bauer's diagram, used for BA) says 60: docs/vic.md.]
-    sprite0_pointer_cycle: int
+    # Sprite 0's fetch cycle: its p-access (first phase) and its first s-access (second phase),
+    # so the first cycle the VIC takes from the CPU; the other two s-accesses take the next cycle.
+    # Sprite n fetches in this cycle + 2n (SPRITE_DMA_CYCLES per sprite) and the next, in the line
+    # before the one where the row is shown (numbers past the line's last cycle fall in the next
+    # line); BA goes low BA_LEAD cycles before. The same cycle places the sprite gap (see
+    # SPRITE_HALT_PIXEL below). Sources, docs/vic.md "Sprite DMA cycle": 6569 58 [Bauer 3.6.3; VICE
+    # cycle_tab_pal]; 6567R8 59 [VICE cycle_tab_ntsc; real 6567R8s: VICE-testprogs
+    # VICII/spritesteal (spritesteal_ntsc, BA low for sprite 0 in cycles 56-60) and the
+    # VICII/spritegap dumps (sprite 0 halts at X $16B, pixel 3 of cycle 59); Bauer's 6567R8
+    # diagram puts it one cycle later, in 60]; 6567R56A 59 [Bauer's 6567R56A diagram; VICE
+    # cycle_tab_ntsc_old; spritesteal_ntscold's table, no real-machine result recorded].
+    sprite0_fetch_cycle: int
+    # The cycle whose pixel SPRITE_PENDING_PIXEL copies the display flags to the sprite sequencer,
+    # and the cycle that draws the X coordinates of the cycle before it again (0: none). [VICE
+    # viciisc/vicii-chip-model.c cycle tables; checked against the real-hardware dumps of
+    # VICE-testprogs VICII/spritegap.]
     display_check_cycle: int
     repeated_x_cycle: int = 0
 
@@ -149,19 +152,29 @@ PIXELS_PER_CYCLE = 8
 # PAL cycle 25 of the line that shows a one-pixel overlap: X 86 and 87 are seen, X 88-92 are not.
 # Cycle 25 covers X 92-99 by Bauer's counter, so without a delay X 84-91 would all be seen; with
 # this delay a read in cycle c sees X up to 8(c-1) + first_x - 5, i.e. 87 (docs/vic.md, timing).
-# The NTSC versions of those programs are unverified; the same delay is assumed for the 6567R8.
+# The NTSC versions of those programs are unverified; the same delay is assumed for the 6567R8
+# and the 6567R56A.
 COLLISION_LATCH_DELAY = 4
 PAL = Video("pal", "6569", lines=312, cycles_per_line=63, x_positions=0x1F8, first_x=0x194,
             first_visible_line=16, visible_lines=284, first_visible_x=0x1E0, visible_pixels=403,
-            sprite0_dma_cycle=58, sprite0_pointer_cycle=58, display_check_cycle=58)
+            sprite0_fetch_cycle=58, display_check_cycle=58)
 # 65 cycles draw 520 pixels but only 512 X coordinates exist. For collision times the model gives
 # the 65th cycle no X coordinate (see docs/vic.md, timing model); the sprite sequencer draws X
 # $180-$187 twice, in cycles 62 and 63 (VICE cycle_tab_ntsc; the spritegap dumps of a 6567R8 show
 # sprite 0 at X $187 and sprite 1 at $188 not meeting).
 NTSC = Video("ntsc", "6567R8", lines=263, cycles_per_line=65, x_positions=0x200, first_x=0x19C,
              first_visible_line=41, visible_lines=235, first_visible_x=0x1E9, visible_pixels=418,
-             sprite0_dma_cycle=60, sprite0_pointer_cycle=59, display_check_cycle=59, repeated_x_cycle=63)
-VIDEOS = {"pal": PAL, "ntsc": NTSC}
+             sprite0_fetch_cycle=59, display_check_cycle=59, repeated_x_cycle=63)
+# The 6567R56A, the first NTSC chip [Bauer 3.4 tables, 3.6.3 6567R56A diagram]: 262 lines, 64
+# cycles a line, so its 512 X coordinates ($19C at cycle 1, 8 a cycle) fill the line exactly and no
+# X is drawn twice; vertical blank in lines 13-40 as on the 6567R8; sprites 3-7 fetch in cycles 1-10
+# as on the 6569. Its sequencer around the fetches (display check, gap) is taken to be the 6567R8's,
+# which is the same up to cycle 61 in Bauer's X row and in VICE's cycle_tab_ntsc_old: no
+# real-hardware dump of an R56A was found (docs/vic.md).
+NTSC_OLD = Video("ntsc-old", "6567R56A", lines=262, cycles_per_line=64, x_positions=0x200, first_x=0x19C,
+                 first_visible_line=41, visible_lines=234, first_visible_x=0x1E8, visible_pixels=411,
+                 sprite0_fetch_cycle=59, display_check_cycle=59)
+VIDEOS = {"pal": PAL, "ntsc": NTSC, "ntsc-old": NTSC_OLD}
 
 # ---- the sprite gap: each sprite's pixel sequencer around its own fetches -------------------------
 # [VICE viciisc/vicii-draw-cycle.c draw_sprites8, checked against the real-hardware results of the
@@ -170,7 +183,7 @@ VIDEOS = {"pal": PAL, "ntsc": NTSC}
 # The sequencer steps through 8 positions per cycle; cycle 1's first position draws X
 # first_x - COLLISION_LATCH_DELAY (the sprite X compare runs 4 X behind Bauer's counter: VICE draws
 # the X of each cycle's first phase rounded down to 8, the same 4 the collision latch measurements
-# give). Pixel SPRITE_HALT_PIXEL of the cycle of sprite n's p-access (sprite0_pointer_cycle + 2n,
+# give). Pixel SPRITE_HALT_PIXEL of the cycle of sprite n's p-access (sprite0_fetch_cycle + 2n,
 # counted on into the next line) halts that sprite's shift register: it repeats the pixel it showed
 # last; pixel SPRITE_DROP_PIXEL of the next cycle drops the rest of the row, pixel SPRITE_LOAD_PIXEL
 # loads the row just fetched (anywhere inside the halt gives the same pixels), and from pixel
@@ -189,10 +202,11 @@ SPRITE_PENDING_PIXEL = 4
 RASTER_IRQ_LINE0_DELAY = 1
 
 # ---- bus arbitration: BA and AEC [Bauer 3.5, 3.6.3, 3.8.1] --------------------------------------
-# BA goes low BA_LEAD cycles before the first cycle the VIC takes; the CPU goes on through write
-# cycles and stops at its first read cycle while BA is low, until BA is high again.
+# BA goes low BA_LEAD cycles before the first cycle the VIC takes (sprite n: BA low from cycle
+# sprite0_fetch_cycle + 2n - BA_LEAD through sprite0_fetch_cycle + 2n + 1); the CPU goes on through
+# write cycles and stops at its first read cycle while BA is low, until BA is high again.
 BA_LEAD = 3
-# A Bad Line's c-accesses take cycles 15-54 (both chips), so BA is low from cycle 12 to 54.
+# A Bad Line's c-accesses take cycles 15-54 (all three chips), so BA is low from cycle 12 to 54.
 BAD_LINE_FIRST_STOLEN = 15
 BAD_LINE_LAST_STOLEN = 54
 SPRITE_DMA_CYCLES = 2  # two s-accesses fall in the CPU's half of the cycles taken per sprite and line

@@ -2,12 +2,15 @@
 
 Rules [Bauer 3.5, 3.6.3, 3.8.1; the timing diagrams of 3.6.3]:
 - A Bad Line is a line in $30-$F7 whose low three bits equal YSCROLL ($D011 bits 0-2) while DEN
-  ($D011 bit 4) is set. Its c-accesses take cycles 15-54; BA is low from cycle 12 (BA_LEAD earlier).
+  ($D011 bit 4) is set. Its c-accesses take cycles 15-54 on all three chips; BA is low from cycle 12
+  (BA_LEAD earlier).
 - Sprite n whose row is shown on line D fetches it in the line before: its two s-accesses take
-  cycles sprite0_dma_cycle + 2n and the next one, counted from line D-1 (6569: 58-59 for sprite 0,
-  60-61 sprite 1, 62-63 sprite 2, then cycles 1-10 of line D for sprites 3-7; the 6567R8 has the
-  first three two cycles later). BA is low from BA_LEAD cycles before. An expanded sprite fetches
-  on all 42 lines.
+  cycles sprite0_fetch_cycle + 2n and the next one, counted from line D-1 (6569: 58-59 for sprite 0,
+  60-61 sprite 1, 62-63 sprite 2, then cycles 1-10 of line D for sprites 3-7; 6567R56A: 59-60 for
+  sprite 0, 61-62, 63-64, then cycles 1-10 for sprites 3-7; 6567R8: 59-60 for sprite 0, 61-62,
+  63-64, 65 and 1 of line D for sprite 3, then cycles 2-9 for sprites 4-7). BA is low from BA_LEAD cycles
+  before. An expanded sprite fetches on all 42 lines. (The 6567R8's cycle: VICE-testprogs
+  VICII/spritesteal on real 6567R8s, docs/vic.md "Sprite DMA cycle".)
 - The CPU stops at its first read cycle while BA is low and goes on when BA is high again; it never
   stops in a write cycle (the machine applies this: retro.cpu.mpu).
 Between two sprites' DMA BA stays low when their BA windows touch (sprites 0 and 2 without 1 cost
@@ -92,7 +95,7 @@ def ba_low(video: Video, registers: bytes) -> np.ndarray:
         if not enabled >> n & 1:
             continue
         lines = np.flatnonzero(sprite_fetch_lines(video, registers[REG_SPRITE_Y0 + 2 * n], bool(expanded >> n & 1)))
-        first_stolen = lines * cpl + video.sprite0_dma_cycle + 2 * n - 1
+        first_stolen = lines * cpl + video.sprite0_fetch_cycle + SPRITE_DMA_CYCLES * n - 1
         for offset in range(-BA_LEAD, SPRITE_DMA_CYCLES):
             low[(first_stolen + offset) % video.frame_cycles] = True
     return low

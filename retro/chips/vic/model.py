@@ -13,8 +13,8 @@ Rules [Bauer 3.8.1-3.8.2, PRG p.145]:
   then drops the rest of the row; a sprite whose X falls there never shows; the last row of a
   sprite whose X comes after the display check (X $164 on the 6569) is never shown. X is 9 bits;
   X coordinates wrap after the last one that exists ($1F7 on the 6569, so a sprite at $1F8-$1FF
-  never shows; $1FF on the 6567R8, whose sequencer draws X $180-$187 twice). Hires `1` and
-  multicolor `01`, `10`, `11` are opaque.
+  never shows; $1FF on the 6567R8, whose sequencer draws X $180-$187 twice, and on the 6567R56A,
+  whose 64 cycles draw each X once). Hires `1` and multicolor `01`, `10`, `11` are opaque.
 - $D01E: every sprite with an opaque pixel where another enabled sprite has one, anywhere in the
   frame (border and off-screen included). Disabled sprites never collide; priority does not matter.
 - $D01F: a sprite's opaque pixel over a foreground pixel (graphics.foreground), nowhere in the
@@ -221,7 +221,7 @@ class SpriteGap:
 
 @lru_cache(maxsize=None)
 def sprite_gap(video: Video, n: int) -> SpriteGap:
-    pointer = (video.sprite0_pointer_cycle - 1 + SPRITE_DMA_CYCLES * n) * PIXELS_PER_CYCLE
+    pointer = (video.sprite0_fetch_cycle - 1 + SPRITE_DMA_CYCLES * n) * PIXELS_PER_CYCLE
     after = pointer + PIXELS_PER_CYCLE  # the cycle of its other s-accesses
     return SpriteGap(halt=pointer + SPRITE_HALT_PIXEL, drop=after + SPRITE_DROP_PIXEL, load=after + SPRITE_LOAD_PIXEL,
                      resume=after + SPRITE_RESUME_PIXEL,
