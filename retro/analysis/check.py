@@ -38,7 +38,15 @@ from retro.errors import InputError, RunError
 from retro.routines import cases as case_sets
 from retro.routines.registry import select
 from retro.cpu.batch import LaneError
-from retro.routines.runner import BatchOutcome, RasterStart, RoutineRunner, Size, describe_value, row_of
+from retro.routines.runner import (
+    NEEDS_A_VIC_SCENE,
+    BatchOutcome,
+    RasterStart,
+    RoutineRunner,
+    Size,
+    describe_value,
+    row_of,
+)
 from retro.routines.spec import Routine, load_spec
 from retro.workers import worker_pool
 
@@ -263,8 +271,11 @@ class SceneStart:
 
     def raster_start(self) -> RasterStart:
         from retro.scenes import load_scene
+        from retro.scenes.vic import VicScene
 
         scene = load_scene(self.scene)
+        if not isinstance(scene, VicScene):
+            raise InputError(f"--scene {self.scene}: {NEEDS_A_VIC_SCENE}")
         line = scene.start_line if self.line is None else self.line
         cycle = scene.start_cycle if self.cycle is None else self.cycle
         video = scene.state.video

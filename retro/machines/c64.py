@@ -1,5 +1,8 @@
 """A C64 as far as timing needs one: the 6510, the VIC-II driving BA and IRQ, and the raster budget.
 
+`build_c64` is the one place a C64 is put together; a VIC-II scene only says what to put in it
+(`retro.machines.build_machine` reads it).
+
 No CIA, SID, KERNAL or disk. A scene may ask for the KERNAL's IRQ entry so that a program can hook
 the `$0314` vector as it would on a real C64: then the ROM's entry and exit code (a fact of the
 machine: `$FF48`-`$FF5A` and `$EA81`-`$EA86` of the KERNAL, as listed in S. Leemon, *Mapping the
@@ -9,15 +12,17 @@ handler is reached 29 cycles after the interrupt sequence, as on the real machin
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 
 from retro.chips.vic.beam import position
+from retro.chips.vic.constants import VIC_BASE, VIC_LAST
 from retro.chips.vic.device import VicDevice
+from retro.chips.vic.model import VicState
+from retro.cpu.machine import Machine
 from retro.errors import InputError
+from retro.scenes.vic import IRQ_VECTOR_HARDWARE, IRQ_VECTOR_KERNAL, VicScene
 
-IRQ_VECTOR_HARDWARE = "$fffe"  # the program puts its handler's address at $FFFE/$FFFF in RAM
-IRQ_VECTOR_KERNAL = "$0314"  # the program puts it at $0314/$0315; the KERNAL entry saves A, X, Y first
-IRQ_VECTOR_MODES = (IRQ_VECTOR_HARDWARE, IRQ_VECTOR_KERNAL)
+CPU = "6510"
 CPU_IRQ_VECTOR = 0xFFFE
 KERNAL_IRQ_ENTRY = 0xFF48
 # PHA / TXA / PHA / TYA / PHA / TSX / LDA $0104,X / AND #$10 / BEQ +3 / JMP ($0316) / JMP ($0314)
@@ -27,7 +32,25 @@ KERNAL_IRQ_EXIT = 0xEA81
 KERNAL_IRQ_EXIT_CODE = bytes([0x68, 0xA8, 0x68, 0xAA, 0x68, 0x40])  # PLA / TAY / PLA / TAX / PLA / RTI
 
 
-def install_kernal_irq_entry(machine) -> None:
+def build_c64(state: VicState, *, start_line: int = 0, start_cycle: int = 1,
+              irq_vector: str = IRQ_VECTOR_HARDWARE) -> Machine:
+    """A fresh C64: a 6510 with a VIC-II holding `state` at $D000-$D3FF, driving the CPU's BA and IRQ
+    lines, its beam at line `start_line`, cycle `start_cycle` now; with `irq_vector` "$0314" the
+    KERNAL's IRQ entry is in RAM."""
+    machine = Machine(CPU)
+    machine.attach(VicDevice.at_beam(state, machine.cycle, start_line, start_cycle), VIC_BASE, VIC_LAST)
+    if irq_vector == IRQ_VECTOR_KERNAL:
+        install_kernal_irq_entry(machine)
+    return machine
+
+
+def vic_of(machine: Machine) -> VicDevice | None:
+    """The machine's VIC-II, or None on a machine without one."""
+    device = machine.mpu.lines
+    return device if isinstance(device, VicDevice) else None
+
+
+def install_kernal_irq_entry(machine: Machine) -> None:
     """Put the KERNAL's IRQ entry and exit in RAM and point the CPU's IRQ vector at the entry."""
     machine.bus.load(KERNAL_IRQ_ENTRY, KERNAL_IRQ_ENTRY_CODE)
     machine.bus.load(KERNAL_IRQ_EXIT, KERNAL_IRQ_EXIT_CODE)
@@ -78,8 +101,8 @@ def call_budget(machine, result) -> RasterBudget | None:
 
     The call ended at the machine's clock now, so it began `result.cycles` earlier.
     """
-    device = machine.mpu.lines
-    if not isinstance(device, VicDevice):
+    device = vic_of(machine)
+    if device is None:
         return None
     return raster_budget(device, machine.cycle - result.cycles, result.cycles, result.stolen)
 
@@ -93,8 +116,8 @@ def interrupt_budgets(machine, result) -> list[RasterBudget]:
     Each runs from the first cycle of its 7-cycle interrupt sequence through the RTI that returns
     from it (nested interrupts counted inside the outer one). Empty without a VIC-II or a trace.
     """
-    device = machine.mpu.lines
-    if not isinstance(device, VicDevice) or not result.trace:
+    device = vic_of(machine)
+    if device is None or not result.trace:
         return []
     budgets = []
     at = machine.cycle - result.cycles
@@ -112,20 +135,17 @@ def interrupt_budgets(machine, result) -> list[RasterBudget]:
     return budgets
 
 
-def call_at_line(scene, program, entry, line: int, cycle: int = 1, **call_args):
+def call_at_line(scene: VicScene, program, entry, line: int, cycle: int = 1, **call_args):
     """Call `entry` of `program` on a fresh C64 with `scene`'s VIC-II, the beam at (line, cycle).
 
     Returns (CallResult, RasterBudget): what `retro cycles SPEC --scene S --at-line L` needs per call
     (`call_args` go to Machine.call: a=, x=, y=, p=, memory=, budget=, trace=).
     """
-    from retro.cpu.machine import Machine
-
     video = scene.state.video
     if not 0 <= line < video.lines or not 1 <= cycle <= video.cycles_per_line:
         raise InputError(f"--at-line: the {video.chip} has lines 0-{video.lines - 1} and cycles "
                          f"1-{video.cycles_per_line}, got line {line} cycle {cycle}")
-    machine = Machine(scene.cpu_variant)
-    replace(scene, start_line=line, start_cycle=cycle).attach(machine)
+    machine = build_c64(scene.state, start_line=line, start_cycle=cycle, irq_vector=scene.irq_vector)
     machine.load(program)
     result = machine.call(entry, **call_args)
     return result, call_budget(machine, result)

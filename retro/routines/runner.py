@@ -29,17 +29,20 @@ from retro.cpu.machine import (
     DEFAULT_FLAGS,
     RETURN_TRAP,
     CallResult,
-    Machine,
     push_return_trap,
 )
 from retro.cpu.mpu import FLAG_B, FLAG_U
 from retro.cpu.timing import OPCODES
 from retro.errors import InputError
 from retro.fileio import read_text
+from retro.machines import build_machine
+from retro.machines.c64 import vic_of
 from retro.program import Program
 from retro.routines.spec import Port, Routine, call_with
+from retro.scenes.vic import VicScene
 from retro.tables import GENERATORS, STORAGE_TABLES
 
+NEEDS_A_VIC_SCENE = "--at-line needs a VIC-II scene (chip = \"vic-ii\")"
 MEMORY_RNG_OFFSET = 1  # memory blocks draw from seed + 1, cases from seed: changing one never moves the other
 
 
@@ -148,7 +151,7 @@ class RasterStart:
     """Run every call with a VIC-II scene on the bus and the beam at this line and cycle (the CPU
     then stalls on Bad Lines and sprite DMA as on a real C64)."""
 
-    scene: object  # a VicScene (retro.scenes.vic)
+    scene: VicScene
     line: int
     cycle: int = 1
 
@@ -161,15 +164,17 @@ class RoutineRunner:
         self.seed = seed
         self.start = start
         self.program = load_program(routine.program_file, symbols=routine.symbols_file, load=routine.load)
-        self.machine = Machine(routine.cpu)
         self.vic = None
-        if start is not None:
-            if getattr(start.scene, "cpu_variant", None) != routine.cpu:
+        if start is None:
+            self.machine = build_machine(cpu=routine.cpu)
+        else:
+            if start.scene.cpu_variant != routine.cpu:
                 raise InputError(f"--scene: a {start.scene.cpu_variant} scene cannot run the {routine.cpu} routine "
                                  f"{routine.name}")
-            if not hasattr(start.scene.state, "video") or not hasattr(start.scene, "start_line"):
-                raise InputError("--at-line needs a VIC-II scene (chip = \"vic-ii\")")
-            self.vic = start.scene.attach(self.machine)
+            if not isinstance(start.scene, VicScene):
+                raise InputError(NEEDS_A_VIC_SCENE)
+            self.machine = build_machine(start.scene)
+            self.vic = vic_of(self.machine)
         self.machine.load(self.program)
         self.last_stolen = 0  # cycles of the last call in which the VIC-II held the CPU
         self.entry = self.machine.resolve(routine.entry, "program.entry")

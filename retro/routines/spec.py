@@ -26,9 +26,9 @@ from pathlib import Path
 
 from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z, VARIANTS
 from retro.errors import InputError
-from retro.fileio import exists, is_dir, is_file, parse_toml, read_bytes
+from retro.fields import Fields, describe
+from retro.fileio import is_dir, parse_toml, read_bytes
 from retro.loaders import load_program
-from retro.numbers import parse_int
 from retro.program import Program
 from retro.routines.where import Condition, parse_where
 
@@ -39,6 +39,7 @@ DEFAULT_RANDOM = 10_000  # random cases when a spec does not say (2,000 of them 
 MAX_TABLE = 0x10000
 MAX_SPEC_BYTES = 1 << 20  # a spec file is a page of TOML, never megabytes
 MAX_LOOP_BOUND = 1 << 20
+NUMBER_CHARACTERS = 40  # the longest number a spec may write as text
 REGISTERS = ("A", "X", "Y")
 FLAGS = {"C": FLAG_C, "Z": FLAG_Z, "I": FLAG_I, "D": FLAG_D, "V": FLAG_V, "N": FLAG_N}
 CPUS = tuple(VARIANTS)
@@ -192,65 +193,6 @@ class Routine:
 
 # ---- reading a spec --------------------------------------------------------------------------------
 
-class _Reader:
-    """Validation helpers that name the spec file and the key in every error."""
-
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, key: str, message: str) -> InputError:
-        return InputError(f"{self.source}: {key}: {message}")
-
-    def table(self, doc: dict, key: str, allowed: set[str], required: bool = False) -> dict:
-        value = doc.get(key.rsplit(".", 1)[-1])
-        if value is None:
-            if required:
-                raise InputError(f"{self.source}: [{key}] is missing")
-            return {}
-        if not isinstance(value, dict):
-            raise self.fail(key, f"expected a table, got {type(value).__name__}")
-        self.known(value, key, allowed)
-        return value
-
-    def known(self, doc: dict, key: str, allowed: set[str] | None) -> None:
-        if allowed is None:
-            return
-        unknown = sorted(set(doc) - allowed)
-        if unknown:
-            raise self.fail(f"{key}.{unknown[0]}" if key else unknown[0],
-                            f"unknown key (known: {', '.join(sorted(allowed))})")
-
-    def string(self, doc: dict, key: str, field_name: str, required: bool = False) -> str | None:
-        value = doc.get(key)
-        if value is None:
-            if required:
-                raise self.fail(field_name, "missing")
-            return None
-        if not isinstance(value, str) or not value.strip():
-            raise self.fail(field_name, f"expected a non-empty string, got {value!r:.60}")
-        return value.strip()
-
-    def number(self, value, field_name: str, lo: int, hi: int) -> int:
-        if isinstance(value, float):
-            raise self.fail(field_name, f"expected a whole number, got {value}")
-        if not isinstance(value, (int, str)) or isinstance(value, bool):
-            raise self.fail(field_name, f"expected a number, got {type(value).__name__}")
-        if isinstance(value, str) and len(value) > 40:
-            raise self.fail(field_name, f"not a number: {value[:40]!r}...")
-        try:
-            return parse_int(value, field=f"{self.source}: {field_name}", lo=lo, hi=hi)
-        except InputError:
-            raise self.fail(field_name, f"expected a number in {lo}..{hi}, got {value!r}") from None
-
-    def path(self, base: Path, value: str, field_name: str) -> Path:
-        if "\0" in value:
-            raise self.fail(field_name, "a file name cannot hold a NUL character")
-        path = (base / value).resolve() if not Path(value).is_absolute() else Path(value)
-        if not is_file(path):
-            raise self.fail(field_name, f"{value}: file not found" if not exists(path) else f"{value}: not a file")
-        return path
-
-
 def read_spec_document(path: str | Path) -> dict:
     shown = str(path)
     data = read_bytes(path, "routine spec")
@@ -278,19 +220,18 @@ def load_spec(path: str | Path) -> Routine:
 
 
 def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
-    r = _Reader(shown or str(path))
-    r.known(doc, "", TOP_KEYS)
-    base = path.parent
-    program_doc = r.table(doc, "program", PROGRAM_KEYS, required=True)
-    program_file = r.path(base, r.string(program_doc, "file", "program.file", required=True), "program.file")
-    symbols_name = r.string(program_doc, "symbols", "program.symbols")
-    symbols_file = r.path(base, symbols_name, "program.symbols") if symbols_name else None
-    load = r.number(program_doc["load"], "program.load", 0, 0xFFFF) if "load" in program_doc else None
-    cpu = r.string(program_doc, "cpu", "program.cpu") or None
-    if cpu is not None and cpu.lower() not in CPUS:
-        raise r.fail("program.cpu", f"expected one of {', '.join(repr(c) for c in CPUS)}, got {cpu!r}")
+    r = Fields(shown or str(path), folder=path.parent, number_characters=NUMBER_CHARACTERS)
+    r.table(doc, "", TOP_KEYS)
+    program_doc = r.table(r.required(doc, "program", hint="the [program] table"), "program", PROGRAM_KEYS)
+    program_file = r.file(_text(r, program_doc, "file", "program.file", required=True), "program.file", resolve=True)
+    symbols_name = _text(r, program_doc, "symbols", "program.symbols")
+    symbols_file = r.file(symbols_name, "program.symbols", resolve=True) if symbols_name else None
+    load = r.integer(program_doc["load"], "program.load", 0, 0xFFFF) if "load" in program_doc else None
+    cpu = _text(r, program_doc, "cpu", "program.cpu")
+    if cpu is not None:
+        cpu = r.choice(cpu, "program.cpu", CPUS, fold_case=True)
     program = load_program(program_file, symbols=symbols_file, load=load)
-    cpu = cpu.lower() if cpu else (program.cpu or "6510")
+    cpu = cpu or program.cpu or "6510"
     entry = _entry_text(r, program_doc, "entry", required=True)
     _resolve(r, program, entry, "program.entry")
     init = _entry_text(r, program_doc, "init")
@@ -298,62 +239,57 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
         _resolve(r, program, init, "program.init")
 
     inputs = tuple(_port(r, program, name, value, "inputs", is_input=True)
-                   for name, value in r.table(doc, "inputs", None, required=True).items())
+                   for name, value in r.table(r.required(doc, "inputs", hint="the [inputs] table"), "inputs").items())
     outputs = tuple(_port(r, program, name, value, "outputs", is_input=False)
-                    for name, value in r.table(doc, "outputs", None, required=True).items())
+                    for name, value in r.table(r.required(doc, "outputs", hint="the [outputs] table"),
+                                               "outputs").items())
     if not outputs:
-        raise InputError(f"{r.source}: [outputs] names no output")
+        raise r.error("outputs", "names no output")
     _no_overlap(r, inputs, "inputs")
-    memory = tuple(_memory_block(r, program, base, name, value)
-                   for name, value in r.table(doc, "memory", None).items())
+    memory = tuple(_memory_block(r, program, name, value)
+                   for name, value in r.table(doc.get("memory", {}), "memory").items())
     _no_overlap_memory(r, memory, inputs)
 
-    reference_doc = r.table(doc, "reference", REFERENCE_KEYS, required=True)
-    reference_name = r.string(reference_doc, "function", "reference.function", required=True)
-    reference = load_function(reference_name, base, r, "reference.function")
+    reference_doc = r.table(r.required(doc, "reference", hint="the [reference] table"), "reference", REFERENCE_KEYS)
+    reference_name = _text(r, reference_doc, "function", "reference.function", required=True)
+    reference = load_function(reference_name, r, "reference.function")
     reference_memory = _reference_signature(r, reference, reference_name, inputs, memory)
-    reference_arrays = reference_doc.get("arrays", False)
-    if not isinstance(reference_arrays, bool):
-        raise r.fail("reference.arrays", "expected true (the function takes numpy arrays, one element per case) "
-                     "or false")
+    # true: the function takes numpy arrays, one element per case
+    reference_arrays = r.flag(reference_doc.get("arrays", False), "reference.arrays")
 
-    cases_doc = r.table(doc, "cases", CASES_KEYS)
+    cases_doc = r.table(doc.get("cases", {}), "cases", CASES_KEYS)
     names = tuple(p.name for p in inputs)
     exhaustive = cases_doc.get("exhaustive", [])
     if not isinstance(exhaustive, list) or not all(isinstance(n, str) for n in exhaustive):
-        raise r.fail("cases.exhaustive", "expected a list of input names")
+        raise r.error("cases.exhaustive", "expected a list of input names")
     for n in exhaustive:
         if n not in names:
-            raise r.fail("cases.exhaustive", f"unknown input {n!r} (inputs: {', '.join(names)})")
+            raise r.error("cases.exhaustive", f"unknown input {n!r} (inputs: {', '.join(names)})")
     if len(set(exhaustive)) != len(exhaustive):
-        raise r.fail("cases.exhaustive", "an input is named twice")
-    random_count = r.number(cases_doc.get("random", DEFAULT_RANDOM), "cases.random", 0, MAX_RANDOM)
-    seed = r.number(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1)
+        raise r.error("cases.exhaustive", "an input is named twice")
+    random_count = r.integer(cases_doc.get("random", DEFAULT_RANDOM), "cases.random", 0, MAX_RANDOM)
+    seed = r.integer(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1)
     where = cases_doc.get("where")
-    coverage = r.string(cases_doc, "coverage", "cases.coverage") or ""
+    coverage = _text(r, cases_doc, "coverage", "cases.coverage") or ""
     tables = frozenset(p.name for p in inputs if p.table)
     domain = parse_where(where, names, f"{r.source}: cases.where", tables) if where is not None else ()
-    generators = {key: load_function(r.string(cases_doc, key, f"cases.{key}"), base, r, f"cases.{key}")
+    generators = {key: load_function(_text(r, cases_doc, key, f"cases.{key}"), r, f"cases.{key}")
                   for key in ("boundary", "sweep", "random_generator") if key in cases_doc}
 
-    cycles_doc = r.table(doc, "cycles", CYCLES_KEYS)
-    budget = r.number(cycles_doc["max"], "cycles.max", 1, 1 << 40) if "max" in cycles_doc else None
-    limit = r.number(cycles_doc["limit"], "cycles.limit", 1, 1 << 40) if "limit" in cycles_doc else None
-    loops_doc = cycles_doc.get("loops", {})
-    if not isinstance(loops_doc, dict):
-        raise r.fail("cycles.loops", "expected a table of label = bound, e.g. { loop = 8 }")
+    cycles_doc = r.table(doc.get("cycles", {}), "cycles", CYCLES_KEYS)
+    budget = r.integer(cycles_doc["max"], "cycles.max", 1, 1 << 40) if "max" in cycles_doc else None
+    limit = r.integer(cycles_doc["limit"], "cycles.limit", 1, 1 << 40) if "limit" in cycles_doc else None
+    loops_doc = r.table(cycles_doc.get("loops", {}), "cycles.loops")  # label = bound, e.g. { loop = 8 }
     loop_bounds = {}
     for label, bound in loops_doc.items():
         _resolve(r, program, label, f"cycles.loops.{label}")
-        loop_bounds[label] = r.number(bound, f"cycles.loops.{label}", 1, MAX_LOOP_BOUND)
-    static = cycles_doc.get("static", True)
-    if not isinstance(static, bool):
-        raise r.fail("cycles.static", "expected true or false")
+        loop_bounds[label] = r.integer(bound, f"cycles.loops.{label}", 1, MAX_LOOP_BOUND)
+    static = r.flag(cycles_doc.get("static", True), "cycles.static")
 
-    name = r.string(doc, "name", "name") or path.stem
+    name = _text(r, doc, "name", "name") or path.stem
     summary = doc.get("summary", "")
     if not isinstance(summary, str):
-        raise r.fail("summary", "expected a string")
+        raise r.error("summary", f"expected a string, got {describe(summary)}")
     routine = Routine(
         name=name, spec_path=path, program_file=program_file, symbols_file=symbols_file, load=load, entry=entry,
         cpu=cpu, init=init, inputs=inputs, outputs=outputs, memory=memory, reference=reference,
@@ -362,25 +298,32 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
         sweep=generators.get("sweep"), random_generator=generators.get("random_generator"), budget=budget,
         loop_bounds=loop_bounds, limit=limit, static=static, summary=summary, coverage=coverage)
     if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep):
-        raise r.fail("cases", "no cases: give random = N, exhaustive = [...], boundary or sweep")
+        raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary or sweep")
     if routine.exhaustive_count() > MAX_EXHAUSTIVE:
-        raise r.fail("cases.exhaustive", f"{routine.exhaustive_count():,} cases is more than 2^32: "
+        raise r.error("cases.exhaustive", f"{routine.exhaustive_count():,} cases is more than 2^32: "
                                          "narrow the inputs' values or sweep fewer inputs")
     return routine
 
 
-def _entry_text(r: _Reader, doc: dict, key: str, required: bool = False) -> str | None:
-    value = doc.get(key)
-    if value is None:
-        if required:
-            raise r.fail(f"program.{key}", "missing (a label or an address)")
+def _text(r: Fields, doc: dict, key: str, field: str, required: bool = False) -> str | None:
+    """doc[key] as a string without its surrounding spaces; None when it is absent and not required."""
+    if key not in doc and not required:
         return None
+    return r.string(r.required(doc, key, field.rpartition(".")[0]), field).strip()
+
+
+def _entry_text(r: Fields, doc: dict, key: str, required: bool = False) -> str | None:
+    if key not in doc:
+        if required:
+            r.required(doc, key, "program", "a label or an address")
+        return None
+    value = doc[key]
     if isinstance(value, int) and not isinstance(value, bool):
-        return str(r.number(value, f"program.{key}", 0, 0xFFFF))
-    return r.string(doc, key, f"program.{key}")
+        return str(r.integer(value, f"program.{key}", 0, 0xFFFF))
+    return _text(r, doc, key, f"program.{key}")
 
 
-def _resolve(r: _Reader, program: Program, text: str, field_name: str) -> int:
+def _resolve(r: Fields, program: Program, text: str, field_name: str) -> int:
     """A label (optionally `label+N`) of the program, or an address."""
     text = str(text).strip()
     if text in program.symbols:
@@ -388,33 +331,33 @@ def _resolve(r: _Reader, program: Program, text: str, field_name: str) -> int:
     if text in program.ambiguous:
         from retro.program import ambiguity_message
 
-        raise r.fail(field_name, ambiguity_message(text, program.ambiguous[text]))
+        raise r.error(field_name, ambiguity_message(text, program.ambiguous[text]))
     if text[:1] in "$%" or text[:1].isdigit():
-        return r.number(text, field_name, 0, 0xFFFF)
+        return r.integer(text, field_name, 0, 0xFFFF)
     match = _LABEL.match(text)
     if match and match.group("sign"):
         base = _resolve(r, program, match.group("name"), field_name)
-        offset = r.number(match.group("offset"), field_name, 0, 0xFFFF)
+        offset = r.integer(match.group("offset"), field_name, 0, 0xFFFF)
         address = base + offset if match.group("sign") == "+" else base - offset
         if not 0 <= address <= 0xFFFF:
-            raise r.fail(field_name, f"{text} is outside $0000-$FFFF")
+            raise r.error(field_name, f"{text} is outside $0000-$FFFF")
         return address
     hint = " (registers are written A, X, Y and flags C, Z, I, D, V, N)" if text.upper() in (*REGISTERS, *FLAGS) else ""
     if not program.symbols:
         hint = f" ({program.source or 'the program'} has no symbols: give [program] symbols, or an address)"
-    raise r.fail(field_name, f"unknown label {text!r}{hint}")
+    raise r.error(field_name, f"unknown label {text!r}{hint}")
 
 
-def _places(r: _Reader, program: Program, at, size: int | None, key: str) -> tuple[Place, ...]:
+def _places(r: Fields, program: Program, at, size: int | None, key: str) -> tuple[Place, ...]:
     items = at if isinstance(at, list) else [at]
     if not items:
-        raise r.fail(key, "expected a register, flag, label or address")
+        raise r.error(key, "expected a register, flag, label or address")
     places: list[Place] = []
     for item in items:
         if isinstance(item, int) and not isinstance(item, bool):
             item = str(item)
         if not isinstance(item, str) or not item.strip():
-            raise r.fail(key, f"expected a register, flag, label or address, got {item!r:.40}")
+            raise r.error(key, f"expected a register, flag, label or address, got {item!r:.40}")
         text = item.strip()
         if text in REGISTERS:
             places.append(Place("register", register=text.lower()))
@@ -424,57 +367,54 @@ def _places(r: _Reader, program: Program, at, size: int | None, key: str) -> tup
             places.append(Place("memory", address=_resolve(r, program, text, key)))
     if size is not None:
         if len(places) != 1 or places[0].kind != "memory":
-            raise r.fail(key, "size goes with one memory location (a label or an address)")
+            raise r.error(key, "size goes with one memory location (a label or an address)")
         start = places[0].address
         if start + size > 0x10000:
-            raise r.fail(key, f"{size} bytes from ${start:04X} run past $FFFF")
+            raise r.error(key, f"{size} bytes from ${start:04X} run past $FFFF")
         places = [Place("memory", address=start + i) for i in range(size)]
     if any(p.kind == "flag" for p in places) and len(places) > 1:
-        raise r.fail(key, "a flag is one bit: it cannot be combined with other places")
+        raise r.error(key, "a flag is one bit: it cannot be combined with other places")
     return tuple(places)
 
 
-def parse_values(r: _Reader, value, key: str) -> Values:
+def parse_values(r: Fields, value, key: str) -> Values:
     if isinstance(value, str):
         lo_text, sep, hi_text = value.partition("..")
         if not sep:
-            raise r.fail(key, f"expected a range LO..HI or a list, got {value!r:.40}")
-        lo = r.number(lo_text.strip(), key, 0, (1 << 32) - 1)
-        hi = r.number(hi_text.strip(), key, 0, (1 << 32) - 1)
+            raise r.error(key, f"expected a range LO..HI or a list, got {value!r:.40}")
+        lo = r.integer(lo_text.strip(), key, 0, (1 << 32) - 1)
+        hi = r.integer(hi_text.strip(), key, 0, (1 << 32) - 1)
         if hi < lo:
-            raise r.fail(key, f"empty range {value!r}")
+            raise r.error(key, f"empty range {value!r}")
         return Values(lo, hi)
     if isinstance(value, list):
         if not value:
-            raise r.fail(key, "the list of values is empty")
+            raise r.error(key, "the list of values is empty")
         if len(value) > MAX_TABLE:
-            raise r.fail(key, f"more than {MAX_TABLE} listed values")
-        listed = tuple(dict.fromkeys(r.number(v, key, 0, (1 << 32) - 1) for v in value))
+            raise r.error(key, f"more than {MAX_TABLE} listed values")
+        listed = tuple(dict.fromkeys(r.integer(v, key, 0, (1 << 32) - 1) for v in value))
         return Values(min(listed), max(listed), listed)
-    raise r.fail(key, f"expected a range \"LO..HI\" or a list of numbers, got {type(value).__name__}")
+    raise r.error(key, f"expected a range \"LO..HI\" or a list of numbers, got {describe(value)}")
 
 
-def _port(r: _Reader, program: Program, name: str, value, section: str, is_input: bool) -> Port:
+def _port(r: Fields, program: Program, name: str, value, section: str, is_input: bool) -> Port:
     key = f"{section}.{name}"
     if not name.isidentifier() or name.startswith("__"):
-        raise r.fail(key, "a name must be a Python identifier (it names the reference's argument)")
+        raise r.error(key, "a name must be a Python identifier (it names the reference's argument)")
     doc = {"at": value} if isinstance(value, (str, list)) else value
     if not isinstance(doc, dict):
-        raise r.fail(key, "expected a location (\"A\", \"C\", \"label\", \"$fb\") or a table { at = ... }")
+        raise r.error(key, "expected a location (\"A\", \"C\", \"label\", \"$fb\") or a table { at = ... }")
     r.known(doc, key, PORT_KEYS if is_input else PORT_KEYS - {"values"})
-    if "at" not in doc:
-        raise r.fail(f"{key}.at", "missing")
-    size = r.number(doc["size"], f"{key}.size", 1, MAX_TABLE) if "size" in doc else None
+    r.required(doc, "at", key)
+    size = r.integer(doc["size"], f"{key}.size", 1, MAX_TABLE) if "size" in doc else None
     places = _places(r, program, doc["at"], size, f"{key}.at")
     values = parse_values(r, doc["values"], f"{key}.values") if "values" in doc else None
-    table_flag = doc.get("table")
-    if table_flag is not None and not isinstance(table_flag, bool):
-        raise r.fail(f"{key}.table", "expected true or false")
+    table_flag = r.flag(doc["table"], f"{key}.table") if "table" in doc else None
     # `size` N with byte values is a table of N bytes; otherwise an N-byte little-endian number
     table = table_flag if table_flag is not None else (
         size is not None and size > 1 and values is not None and values.hi < BYTE_VALUES)
     if table and (size is None or places[0].kind != "memory"):
-        raise r.fail(f"{key}.table", "a table needs a memory location and a size")
+        raise r.error(f"{key}.table", "a table needs a memory location and a size")
     port = Port(name, places, table, None)
     width = 1 << port.bits
     if values is None and is_input:
@@ -482,62 +422,55 @@ def _port(r: _Reader, program: Program, name: str, value, section: str, is_input
     if values is not None:
         limit = BYTE_VALUES if table else width
         if values.hi >= limit:
-            raise r.fail(f"{key}.values", f"{values.describe()} does not fit in {port.describe()} "
+            raise r.error(f"{key}.values", f"{values.describe()} does not fit in {port.describe()} "
                                           f"({'each byte ' if table else ''}0..{limit - 1})")
     return Port(name, places, table, values)
 
 
-def _no_overlap(r: _Reader, ports: tuple[Port, ...], section: str) -> None:
+def _no_overlap(r: Fields, ports: tuple[Port, ...], section: str) -> None:
     owner: dict[Place, str] = {}
     for port in ports:
         for place in port.places:
             if place in owner:
-                raise r.fail(f"{section}.{port.name}.at",
-                             f"{place.describe()} is also where {section}.{owner[place]} goes")
+                raise r.error(f"{section}.{port.name}.at",
+                              f"{place.describe()} is also where {section}.{owner[place]} goes")
             owner[place] = port.name
 
 
-def _memory_block(r: _Reader, program: Program, base: Path, name: str, doc) -> MemoryBlock:
+def _memory_block(r: Fields, program: Program, name: str, doc) -> MemoryBlock:
     key = f"memory.{name}"
     if not name.isidentifier():
-        raise r.fail(key, "a name must be a Python identifier (the reference may take it by name)")
+        raise r.error(key, "a name must be a Python identifier (the reference may take it by name)")
     if not isinstance(doc, dict):
-        raise r.fail(key, "expected a table { at = ..., bytes = [...] | file = ... | generator = ... | values + size }")
+        raise r.error(key, "expected a table { at = ..., bytes = [...] | file = ... | generator = ... | values + size }")
     r.known(doc, key, MEMORY_KEYS)
-    if "at" not in doc:
-        raise r.fail(f"{key}.at", "missing")
+    r.required(doc, "at", key)
     (place,) = _places(r, program, doc["at"], None, f"{key}.at")[:1] or (None,)
     if place is None or place.kind != "memory" or isinstance(doc["at"], list):
-        raise r.fail(f"{key}.at", "expected one label or address")
-    sources = [k for k in ("bytes", "file", "generator", "values", "fill") if k in doc]
-    if len(sources) != 1:
-        raise r.fail(key, "give exactly one of bytes, file, generator, values (random, with size) or fill (with size)")
-    source = sources[0]
+        raise r.error(f"{key}.at", "expected one label or address")
+    source = r.exactly_one(doc, ("bytes", "file", "generator", "values", "fill"), key)
     address = place.address
     if source == "bytes":
         data = _byte_list(r, doc["bytes"], f"{key}.bytes")
     elif source == "file":
-        file_name = doc["file"]
-        if not isinstance(file_name, str):
-            raise r.fail(f"{key}.file", "expected a path")
-        raw = read_bytes(r.path(base, file_name, f"{key}.file"), f"{key}.file")
-        skip = r.number(doc.get("skip", 0), f"{key}.skip", 0, len(raw))
+        raw = read_bytes(r.file(doc["file"], f"{key}.file", resolve=True), f"{key}.file")
+        skip = r.integer(doc.get("skip", 0), f"{key}.skip", 0, len(raw))
         data = tuple(raw[skip:])
         if "size" in doc:
-            data = data[:r.number(doc["size"], f"{key}.size", 0, MAX_TABLE)]
+            data = data[:r.integer(doc["size"], f"{key}.size", 0, MAX_TABLE)]
     elif source == "fill":
-        size = r.number(doc.get("size", None) if "size" in doc else _missing(r, f"{key}.size"), f"{key}.size", 1, MAX_TABLE)
-        data = (r.number(doc["fill"], f"{key}.fill", 0, 0xFF),) * size
+        size = r.integer(r.required(doc, "size", key), f"{key}.size", 1, MAX_TABLE)
+        data = (r.integer(doc["fill"], f"{key}.fill", 0, 0xFF),) * size
     else:
         data = None
     if data is not None:
         _fits(r, key, address, len(data))
         return MemoryBlock(name, address, data, None, len(data))
     if source == "values":
-        size = r.number(doc["size"] if "size" in doc else _missing(r, f"{key}.size"), f"{key}.size", 1, MAX_TABLE)
+        size = r.integer(r.required(doc, "size", key), f"{key}.size", 1, MAX_TABLE)
         values = parse_values(r, doc["values"], f"{key}.values")
         if values.hi >= BYTE_VALUES:
-            raise r.fail(f"{key}.values", "memory bytes are 0..255")
+            raise r.error(f"{key}.values", "memory bytes are 0..255")
         _fits(r, key, address, size)
 
         def make(rng, _values=values, _size=size):
@@ -545,68 +478,60 @@ def _memory_block(r: _Reader, program: Program, base: Path, name: str, doc) -> M
                 return rng.choice(list(_values.listed), size=_size)
             return rng.integers(_values.lo, _values.hi + 1, size=_size)
         return MemoryBlock(name, address, None, make, size)
-    function = load_function(doc["generator"] if isinstance(doc["generator"], str) else None, base, r,
-                             f"{key}.generator")
+    function = load_function(doc["generator"] if isinstance(doc["generator"], str) else None, r, f"{key}.generator")
     return MemoryBlock(name, address, None, function, 0)
 
 
-def _missing(r: _Reader, key: str):
-    raise r.fail(key, "missing")
-
-
-def _fits(r: _Reader, key: str, address: int, size: int) -> None:
+def _fits(r: Fields, key: str, address: int, size: int) -> None:
     if address + size > 0x10000:
-        raise r.fail(key, f"{size} bytes from ${address:04X} run past $FFFF")
+        raise r.error(key, f"{size} bytes from ${address:04X} run past $FFFF")
 
 
-def _byte_list(r: _Reader, value, key: str) -> tuple[int, ...]:
+def _byte_list(r: Fields, value, key: str) -> tuple[int, ...]:
+    """A list of bytes, or a string of hex bytes ("a9 00 60", "$a9,$00")."""
     if isinstance(value, str):
         parts = value.replace(",", " ").split()
         if len(parts) > MAX_TABLE:
-            raise r.fail(key, f"more than {MAX_TABLE} bytes")
-        return tuple(r.number(p if p[:1] in "$%" or p.lower().startswith("0x") else f"${p}", key, 0, 0xFF)
-                     for p in parts)
-    if isinstance(value, list):
-        if len(value) > MAX_TABLE:
-            raise r.fail(key, f"more than {MAX_TABLE} bytes")
-        return tuple(r.number(v, key, 0, 0xFF) for v in value)
-    raise r.fail(key, "expected a list of bytes or a string of hex bytes")
+            raise r.error(key, f"more than {MAX_TABLE} bytes")
+        return tuple(r.byte(p if p[:1] in "$%" or p.lower().startswith("0x") else f"${p}", f"{key}[{i}]")
+                     for i, p in enumerate(parts))
+    return tuple(r.byte_list(value, key, most=MAX_TABLE))
 
 
-def _no_overlap_memory(r: _Reader, memory: tuple[MemoryBlock, ...], inputs: tuple[Port, ...]) -> None:
+def _no_overlap_memory(r: Fields, memory: tuple[MemoryBlock, ...], inputs: tuple[Port, ...]) -> None:
     fixed = sorted((m.address, m.address + m.size, m.name) for m in memory if m.size)
     for (start, end, name), (next_start, _, next_name) in zip(fixed, fixed[1:]):
         if next_start < end:
-            raise r.fail(f"memory.{next_name}.at", f"overlaps memory.{name} (${start:04X}-${end - 1:04X})")
+            raise r.error(f"memory.{next_name}.at", f"overlaps memory.{name} (${start:04X}-${end - 1:04X})")
     for port in inputs:
         for place in port.places:
             if place.kind != "memory":
                 continue
             for start, end, name in fixed:
                 if start <= place.address < end:
-                    raise r.fail(f"inputs.{port.name}.at",
-                                 f"{place.describe()} lies inside memory.{name}: an input is set for every case")
+                    raise r.error(f"inputs.{port.name}.at",
+                                  f"{place.describe()} lies inside memory.{name}: an input is set for every case")
 
 
 # ---- Python functions named by a spec -------------------------------------------------------------
 
-def load_function(text: str | None, base: Path, r: _Reader, key: str) -> Callable:
+def load_function(text: str | None, r: Fields, key: str) -> Callable:
     """`file.py:function` (a path relative to the spec) or `package.module:function`."""
     if not text or ":" not in text:
-        raise r.fail(key, "expected FILE.py:FUNCTION (relative to the spec) or MODULE:FUNCTION")
+        raise r.error(key, "expected FILE.py:FUNCTION (relative to the spec) or MODULE:FUNCTION")
     module_text, _, function_name = text.rpartition(":")
     if not function_name.isidentifier():
-        raise r.fail(key, f"{function_name!r} is not a function name")
+        raise r.error(key, f"{function_name!r} is not a function name")
     if module_text.endswith(".py"):
-        module = _module_from_file(r.path(base, module_text, key), r, key)
+        module = _module_from_file(r.file(module_text, key, resolve=True), r, key)
     else:
         try:
             module = importlib.import_module(module_text)
         except ImportError as exc:
-            raise r.fail(key, f"cannot import {module_text}: {exc}") from None
+            raise r.error(key, f"cannot import {module_text}: {exc}") from None
     function = getattr(module, function_name, None)
     if not callable(function):
-        raise r.fail(key, f"{module_text} has no function {function_name!r}")
+        raise r.error(key, f"{module_text} has no function {function_name!r}")
     return function
 
 
@@ -625,7 +550,7 @@ def import_user_module(path: str, mtime: float):
     return module
 
 
-def _module_from_file(path: Path, r: _Reader, key: str):
+def _module_from_file(path: Path, r: Fields, key: str):
     try:
         return import_user_module(str(path), path.stat().st_mtime)
     except Exception as exc:  # the user's module failed to import: one line, whatever it raised
@@ -635,10 +560,10 @@ def _module_from_file(path: Path, r: _Reader, key: str):
             if tb.tb_frame.f_code.co_filename == str(path):
                 line = f" (line {tb.tb_lineno})"
             tb = tb.tb_next
-        raise r.fail(key, f"{path.name} failed to import{line}: {type(exc).__name__}: {exc}") from None
+        raise r.error(key, f"{path.name} failed to import{line}: {type(exc).__name__}: {exc}") from None
 
 
-def _reference_signature(r: _Reader, function: Callable, text: str, inputs: tuple[Port, ...],
+def _reference_signature(r: Fields, function: Callable, text: str, inputs: tuple[Port, ...],
                          memory: tuple[MemoryBlock, ...]) -> tuple[str, ...]:
     """Check the reference takes every input by name; return the memory blocks it also takes."""
     try:
@@ -650,14 +575,14 @@ def _reference_signature(r: _Reader, function: Callable, text: str, inputs: tupl
     names = set(parameters)
     for port in inputs:
         if port.name not in names and not takes_any:
-            raise r.fail("reference.function", f"{text} takes no argument {port.name!r} (it is called with the "
+            raise r.error("reference.function", f"{text} takes no argument {port.name!r} (it is called with the "
                                                "inputs by name)")
     required = [p.name for p in parameters.values() if p.default is inspect.Parameter.empty
                 and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
     known = {port.name for port in inputs} | {m.name for m in memory}
     for name in required:
         if name not in known:
-            raise r.fail("reference.function", f"{text} needs argument {name!r}, which is neither an input nor a "
+            raise r.error("reference.function", f"{text} needs argument {name!r}, which is neither an input nor a "
                                                "memory block")
     return tuple(m.name for m in memory if m.name in names or takes_any)
 

@@ -2,8 +2,8 @@
 
 `load_scene(path)` reads the TOML, looks at its `chip` key and hands the document to the module for
 that chip (`retro.scenes.vic` for "vic-ii", `retro.scenes.nes` for "nes"), which validates it into
-plain dataclasses. Every scene object has `cpu_variant` ("6510" or "2a03") and
-`attach(machine) -> device`, which maps the chip onto the machine's bus.
+plain dataclasses. Every scene object has a `cpu_variant` field ("6510" or "2a03"). A scene only
+says what the chip holds; `retro.machines.build_machine(scene)` puts the chip on a machine's bus.
 """
 
 from __future__ import annotations

@@ -40,8 +40,8 @@ from retro.chips.vic.constants import (
 from retro.chips.vic.graphics import VicMemory
 from retro.chips.vic.model import VicState
 from retro.errors import InputError
-from retro.fileio import is_dir, is_file, read_bytes
-from retro.numbers import parse_int
+from retro.fields import Fields
+from retro.fileio import read_bytes
 from retro.scenes import earlier_spelling
 from retro.loaders.gfx_charpad import read_ctm
 from retro.loaders.gfx_koala import koala_from_bytes
@@ -52,6 +52,9 @@ TOP_KEYS = {"chip", "video", "registers", "sprite", "memory", "cpu"}
 CPU_KEYS = {"start_line", "start_cycle", "irq_vector"}  # where the beam is when the routine starts
 SPRITE_KEYS = {"index", "x", "y", "enabled", "multicolor", "expand_x", "expand_y", "behind", "color", "data",
                "rows", "file", "frame", "palette", "velocity"}
+IRQ_VECTOR_HARDWARE = "$fffe"  # the program puts its handler's address at $FFFE/$FFFF in RAM
+IRQ_VECTOR_KERNAL = "$0314"  # the program puts it at $0314/$0315; the KERNAL entry saves A, X, Y first
+IRQ_VECTORS = (IRQ_VECTOR_HARDWARE, IRQ_VECTOR_KERNAL)
 MAX_SPEED = 255  # pixels a frame, either axis: faster than anything on screen
 MEMORY_KEYS = {"screen", "color", "charset", "bitmap", "idle", "charpad", "koala"}
 FILL_KEYS = {"fill", "cells", "file"}
@@ -87,69 +90,10 @@ class VicScene:
     cpu_variant: str = "6510"
     start_line: int = 0  # [cpu] start_line / start_cycle: the beam when the routine is entered
     start_cycle: int = 1
-    irq_vector: str = "$fffe"  # or "$0314": the KERNAL's IRQ entry is put in RAM (retro.machines.c64)
-
-    def attach(self, machine):
-        """Map a VIC-II device for this scene at $D000-$D3FF with the beam at the scene's start position now."""
-        from retro.chips.vic.constants import VIC_LAST
-        from retro.chips.vic.device import VicDevice
-        from retro.machines.c64 import IRQ_VECTOR_KERNAL, install_kernal_irq_entry
-
-        device = VicDevice.at_beam(self.state, machine.cycle, self.start_line, self.start_cycle)
-        if self.irq_vector == IRQ_VECTOR_KERNAL:
-            install_kernal_irq_entry(machine)
-        return machine.attach(device, VIC_BASE, VIC_LAST)
+    irq_vector: str = IRQ_VECTOR_HARDWARE  # or IRQ_VECTOR_KERNAL (retro.machines.c64 puts the KERNAL's entry in RAM)
 
 
-class _Where:
-    def __init__(self, source: str):
-        self.source = source
-
-    def error(self, field_name: str, message: str) -> InputError:
-        return InputError(f"{self.source}: {field_name}: {message}")
-
-    def table(self, value, field_name: str, allowed: set[str]) -> dict:
-        if not isinstance(value, dict):
-            raise self.error(field_name, f"expected a table, got {type(value).__name__}")
-        unknown = sorted(set(value) - allowed)
-        if unknown:
-            raise self.error(f"{field_name}.{unknown[0]}" if field_name else unknown[0],
-                             f"unknown key (known: {', '.join(sorted(allowed))})")
-        return value
-
-    def number(self, value, field_name: str, lo: int, hi: int) -> int:
-        if isinstance(value, float) or isinstance(value, (list, dict)):
-            raise self.error(field_name, f"expected an integer, got {value!r}")
-        try:
-            return parse_int(value, field=field_name, lo=lo, hi=hi)
-        except InputError as exc:
-            raise InputError(f"{self.source}: {exc}") from None
-
-    def flag(self, value, field_name: str) -> bool:
-        if not isinstance(value, bool):
-            raise self.error(field_name, f"expected true or false, got {value!r}")
-        return value
-
-    def byte_list(self, value, field_name: str, length: int) -> list[int]:
-        if not isinstance(value, list) or len(value) != length:
-            got = len(value) if isinstance(value, list) else type(value).__name__
-            raise self.error(field_name, f"expected a list of {length} bytes, got {got}")
-        return [self.number(v, f"{field_name}[{i}]", 0, 0xFF) for i, v in enumerate(value)]
-
-    def file(self, value, field_name: str, what: str) -> Path:
-        if not isinstance(value, str) or not value:
-            raise self.error(field_name, f"expected a file name, got {value!r}")
-        path = Path(value)
-        if not path.is_absolute():
-            path = Path(self.source).parent / path
-        if is_dir(path):
-            raise self.error(field_name, f"{what} {value!r} is a folder, not a file ({path})")
-        if not is_file(path):
-            raise self.error(field_name, f"{what} {value!r} not found (looked for {path})")
-        return path
-
-
-def register_offset(key: str, where: _Where) -> int:
+def register_offset(key: str, where: Fields) -> int:
     text = str(key).strip().lower()
     digits = text[1:] if text.startswith("$") else text[2:] if text.startswith("0x") else text
     try:
@@ -164,43 +108,39 @@ def register_offset(key: str, where: _Where) -> int:
     return offset
 
 
-def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: _Where) -> SpriteSpec:
+def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: Fields) -> SpriteSpec:
     name = f"sprite[{i}]"
     entry = where.table(entry, name, SPRITE_KEYS)
-    if "index" not in entry:
-        raise where.error(f"{name}.index", "missing (0-7)")
-    n = where.number(entry["index"], f"{name}.index", 0, SPRITE_COUNT - 1)
+    n = where.integer(where.required(entry, "index", name, f"the sprite's number, 0-{SPRITE_COUNT - 1}"),
+                      f"{name}.index", 0, SPRITE_COUNT - 1)
     if n in seen:
         raise where.error(f"{name}.index", f"sprite {n} is declared twice")
     seen.add(n)
     bit = 1 << n
     if "x" in entry:
-        x = where.number(entry["x"], f"{name}.x", 0, X_BITS_MASK)
+        x = where.integer(entry["x"], f"{name}.x", 0, X_BITS_MASK)
         registers[REG_SPRITE_X0 + 2 * n] = x & 0xFF
         registers[REG_SPRITE_X_MSB] = (registers[REG_SPRITE_X_MSB] & ~bit) | (bit if x >> 8 else 0)
     if "y" in entry:
-        registers[REG_SPRITE_Y0 + 2 * n] = where.number(entry["y"], f"{name}.y", 0, Y_COMPARE_MASK)
+        registers[REG_SPRITE_Y0 + 2 * n] = where.integer(entry["y"], f"{name}.y", 0, Y_COMPARE_MASK)
     flags = {"enabled": True, **{k: entry[k] for k in SPRITE_FLAGS if k in entry}}
     for key, value in flags.items():
         on = where.flag(value, f"{name}.{key}")
         register = SPRITE_FLAGS[key]
         registers[register] = (registers[register] & ~bit) | (bit if on else 0)
     if "color" in entry:
-        registers[REG_SPRITE_COLOR0 + n] = where.number(entry["color"], f"{name}.color", 0, COLOR_MASK)
+        registers[REG_SPRITE_COLOR0 + n] = where.integer(entry["color"], f"{name}.color", 0, COLOR_MASK)
     velocity = (0, 0)
     if "velocity" in entry:
         value = entry["velocity"]
         if not isinstance(value, list) or len(value) != 2:
             raise where.error(f"{name}.velocity", "expected [dx, dy]: pixels added to X and Y every frame")
-        velocity = tuple(where.number(v, f"{name}.velocity", -MAX_SPEED, MAX_SPEED) for v in value)
+        velocity = tuple(where.integer(v, f"{name}.velocity", -MAX_SPEED, MAX_SPEED) for v in value)
     multicolor = bool(registers[REG_SPRITE_MULTICOLOR] & bit)
-    given = [k for k in ("data", "rows", "file") if k in entry]
-    if len(given) != 1:
-        raise where.error(name, f"give exactly one of data, rows, file (got {', '.join(given) or 'none'})")
+    kind = where.exactly_one(entry, ("data", "rows", "file"), name)
     for key in ("frame", "palette"):
-        if key in entry and given[0] != "file":
+        if key in entry and kind != "file":
             raise where.error(f"{name}.{key}", "goes with file")
-    kind = given[0]
     try:
         if kind == "data":
             data = parse_hex(entry["data"], field="data")
@@ -210,7 +150,7 @@ def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: _Where) 
             source = "rows"
         else:
             path = where.file(entry["file"], f"{name}.file", "sprite file")
-            frame = where.number(entry.get("frame", 0), f"{name}.frame", 0, 1 << 16)
+            frame = where.integer(entry.get("frame", 0), f"{name}.frame", 0, 1 << 16)
             # any sprite file, by content (retro/sprites.py); a PNG is read in this sprite's colours
             data = read_sprite(path, frame, multicolor, scene_colours(registers, n), entry.get("palette"))
             source = f"file {entry['file']}"
@@ -224,25 +164,23 @@ def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: _Where) 
     return SpriteSpec(n, data[:SPRITE_BYTES], source, velocity)
 
 
-def _fill_cells(spec, name: str, where: _Where, hi: int, given: tuple | None) -> np.ndarray:
+def _fill_cells(spec, name: str, where: Fields, hi: int, given: tuple | None) -> np.ndarray:
     """memory.screen / memory.color: `fill`, then a `file` (or the part a whole-file key gave), then `cells`."""
     spec = where.table(spec if spec is not None else {}, f"memory.{name}", FILL_KEYS)
-    values = np.full(SCREEN_CELLS, where.number(spec.get("fill", 0), f"memory.{name}.fill", 0, hi), np.uint8)
+    values = np.full(SCREEN_CELLS, where.integer(spec.get("fill", 0), f"memory.{name}.fill", 0, hi), np.uint8)
     part = _part_file(spec, name, where, given)
     if part is not None:
         covered = part.covered if part.covered is not None else slice(None)
         values[covered] = part.values[covered]
-    cells = spec.get("cells", [])
-    if not isinstance(cells, list):
-        raise where.error(f"memory.{name}.cells", "expected a list of {col, row, value} tables")
+    cells = where.array(spec.get("cells", []), f"memory.{name}.cells", "{col, row, value} tables")
     for i, cell in enumerate(cells):
         field_name = f"memory.{name}.cells[{i}]"
         cell, index = _cell(cell, field_name, SCREEN_CELL_KEYS, where)
-        values[index] = where.number(cell["value"], f"{field_name}.value", 0, hi)
+        values[index] = where.integer(cell["value"], f"{field_name}.value", 0, hi)
     return values
 
 
-def _part_file(table: dict, part: str, where: _Where, given: tuple | None):
+def _part_file(table: dict, part: str, where: Fields, given: tuple | None):
     """The part (gfx_screen.Part) a `file` key in memory.PART gives, or the one a whole-file key
     (memory.charpad, memory.koala) gave; both is an error."""
     if "file" not in table:
@@ -257,7 +195,7 @@ def _part_file(table: dict, part: str, where: _Where, given: tuple | None):
         raise where.error(field_name, str(exc)) from None
 
 
-def _whole_files(spec: dict, where: _Where) -> dict[str, tuple]:
+def _whole_files(spec: dict, where: Fields) -> dict[str, tuple]:
     """memory.charpad and memory.koala: {part: (gfx_screen.Part, key)} for every part they give."""
     given: dict[str, tuple] = {}
     for key, parts in WHOLE_FILE_PARTS.items():
@@ -268,8 +206,8 @@ def _whole_files(spec: dict, where: _Where) -> dict[str, tuple]:
         field_name = f"memory.{key}" if isinstance(value, str) else f"memory.{key}.file"
         if "file" not in table:
             raise where.error(field_name, "missing: the file to read")
-        col = where.number(table.get("col", 0), f"memory.{key}.col", 0, MAX_MAP_CELL)
-        row = where.number(table.get("row", 0), f"memory.{key}.row", 0, MAX_MAP_CELL)
+        col = where.integer(table.get("col", 0), f"memory.{key}.col", 0, MAX_MAP_CELL)
+        row = where.integer(table.get("row", 0), f"memory.{key}.row", 0, MAX_MAP_CELL)
         for part in parts:
             if part in given:
                 raise where.error(f"memory.{key}", f"memory.{given[part][1]} gives the {part} already; give one of them")
@@ -294,18 +232,17 @@ def _whole_files(spec: dict, where: _Where) -> dict[str, tuple]:
     return given
 
 
-def _cell(cell, field_name: str, keys, where: _Where) -> tuple[dict, int]:
+def _cell(cell, field_name: str, keys, where: Fields) -> tuple[dict, int]:
     """A {col, row, ...} table with all its keys: (the table, the cell's index in the 40 x 25 screen)."""
     cell = where.table(cell, field_name, keys)
-    for key in keys:
-        if key not in cell:
-            raise where.error(f"{field_name}.{key}", "missing")
-    col = where.number(cell["col"], f"{field_name}.col", 0, TEXT_COLUMNS - 1)
-    row = where.number(cell["row"], f"{field_name}.row", 0, TEXT_ROWS - 1)
+    for key in sorted(keys):
+        where.required(cell, key, field_name)
+    col = where.integer(cell["col"], f"{field_name}.col", 0, TEXT_COLUMNS - 1)
+    row = where.integer(cell["row"], f"{field_name}.row", 0, TEXT_ROWS - 1)
     return cell, row * TEXT_COLUMNS + col
 
 
-def _memory(doc, where: _Where) -> VicMemory:
+def _memory(doc, where: Fields) -> VicMemory:
     spec = where.table(doc, "memory", MEMORY_KEYS)
     memory = VicMemory.blank()
     given = _whole_files(spec, where)
@@ -327,7 +264,7 @@ def _memory(doc, where: _Where) -> VicMemory:
         for key, glyph in table.items():
             if key == "file":
                 continue
-            code = where.number(key, f"memory.charset.{key}", 0, 0xFF)
+            code = where.integer(key, f"memory.charset.{key}", 0, 0xFF)
             if earlier := earlier_spelling(spelled, code, key):
                 raise where.error(f"memory.charset.{key}", f"the same character code as {earlier!r}; give it once")
             charset[code * CHAR_HEIGHT:(code + 1) * CHAR_HEIGHT] = where.byte_list(glyph, f"memory.charset.{key}",
@@ -338,24 +275,21 @@ def _memory(doc, where: _Where) -> VicMemory:
         part = _part_file(table, "bitmap", where, given.get("bitmap"))
         if part is not None:
             bitmap = part.values
-        cells = table.get("cells", [])
-        if not isinstance(cells, list):
-            raise where.error("memory.bitmap.cells", "expected a list of {col, row, bytes} tables")
+        cells = where.array(table.get("cells", []), "memory.bitmap.cells", "{col, row, bytes} tables")
         for i, cell in enumerate(cells):
             field_name = f"memory.bitmap.cells[{i}]"
             cell, index = _cell(cell, field_name, BITMAP_CELL_KEYS, where)
             start = index * CHAR_HEIGHT
             bitmap[start:start + CHAR_HEIGHT] = where.byte_list(cell["bytes"], f"{field_name}.bytes", CHAR_HEIGHT)
-    idle = where.number(spec.get("idle", 0), "memory.idle", 0, 0xFF)
+    idle = where.integer(spec.get("idle", 0), "memory.idle", 0, 0xFF)
     return VicMemory(screen, color, charset, bitmap, idle)
 
 
 def parse(doc: dict, source: str) -> VicScene:
-    where = _Where(source)
+    where = Fields(source)
     where.table(doc, "", TOP_KEYS)
-    video = doc.get("video", "pal")
-    if not isinstance(video, str) or video not in VIDEOS:
-        raise where.error("video", f"expected \"pal\" (6569) or \"ntsc\" (6567R8), got {video!r}")
+    video = where.choice(doc.get("video", "pal"), "video", VIDEOS,
+                         labels={name: f"{name!r} ({standard.chip})" for name, standard in VIDEOS.items()})
     registers = bytearray(REGISTER_COUNT)
     table = doc.get("registers", {})
     if not isinstance(table, dict):
@@ -365,10 +299,8 @@ def parse(doc: dict, source: str) -> VicScene:
         offset = register_offset(key, where)
         if earlier := earlier_spelling(spelled, offset, key):
             raise where.error(f"registers.{key}", f"the same register as {earlier!r}; give it once")
-        registers[offset] = where.number(value, f"registers.{key}", 0, 0xFF)
-    entries = doc.get("sprite", [])
-    if not isinstance(entries, list):
-        raise where.error("sprite", "expected [[sprite]] tables")
+        registers[offset] = where.integer(value, f"registers.{key}", 0, 0xFF)
+    entries = where.array_of_tables(doc.get("sprite", []), "sprite", SPRITE_KEYS)
     seen: set[int] = set()
     specs = [_sprite(entry, i, registers, seen, where) for i, entry in enumerate(entries)]
     data = [bytes(SPRITE_BYTES)] * SPRITE_COUNT
@@ -377,11 +309,9 @@ def parse(doc: dict, source: str) -> VicScene:
     memory = _memory(doc.get("memory", {}), where)
     state = VicState(VIDEOS[video], bytes(registers), tuple(data), memory)
     cpu = where.table(doc.get("cpu", {}), "cpu", CPU_KEYS)
-    start_line = where.number(cpu.get("start_line", 0), "cpu.start_line", 0, VIDEOS[video].lines - 1)
-    start_cycle = where.number(cpu.get("start_cycle", 1), "cpu.start_cycle", 1, VIDEOS[video].cycles_per_line)
-    irq_vector = str(cpu.get("irq_vector", "$fffe")).lower()
-    if irq_vector not in ("$fffe", "$0314"):
-        raise where.error("cpu.irq_vector", f"expected \"$fffe\" or \"$0314\", got {cpu.get('irq_vector')!r}")
+    start_line = where.integer(cpu.get("start_line", 0), "cpu.start_line", 0, VIDEOS[video].lines - 1)
+    start_cycle = where.integer(cpu.get("start_cycle", 1), "cpu.start_cycle", 1, VIDEOS[video].cycles_per_line)
+    irq_vector = where.choice(cpu.get("irq_vector", IRQ_VECTORS[0]), "cpu.irq_vector", IRQ_VECTORS, fold_case=True)
     return VicScene(source, video, bytes(registers), tuple(specs), memory, state, start_line=start_line,
                     start_cycle=start_cycle, irq_vector=irq_vector)
 

@@ -375,13 +375,14 @@ def test_nes_nmi_at_vblank_when_2000_bit_7_is_set():
     # CPU cycle ceil(82182 / 3) = 27394. Polls: LDA zp at s+1, the taken branch at s+3 (its first
     # cycle). s = 27390 polls at 27391 and 27393: not yet; s = 27396 polls at 27397: NMI after the
     # LDA (ends 27398), sequence 27399-27405, handler at 27406.
-    from retro.chips.ppu.device import PpuDevice, attach_ppu
+    from retro.machines.nes import build_nes
 
     code = {ORIGIN: [0xA9, 0x80, 0x8D, 0x00, 0x20, 0xA5, 0x10, 0xF0, 0xFC, 0x60],
             0xC100: [0xE6, 0x10, 0x40],  # INC $10, RTI
             0xFFFA: [0x00, 0xC1]}
-    machine = machine_with(code, "2a03")
-    attach_ppu(machine, PpuDevice())
+    machine = build_nes()
+    for address, data in code.items():
+        machine.poke(address, data)
     result = machine.call(ORIGIN, trace=True)
     at = 0
     for entry in result.trace:

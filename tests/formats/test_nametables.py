@@ -135,7 +135,7 @@ def test_attribute_bytes_from_the_file_show_at_y_scroll_240(tmp_path):
 @pytest.mark.parametrize("content, table, field, message", [
     (bytes(1000), 'file = "screen.nam"', "nametable[0].file", "'screen.nam': file size: 1000 bytes"),
     (nam(), 'file = "screen.nam"\nfill = 3', "nametable[0].fill", "give fill or file, not both"),
-    (nam(), 'file = "missing.nam"', "nametable[0].file", "nametable file not found"),
+    (nam(), 'file = "missing.nam"', "nametable[0].file", "nametable file 'missing.nam' not found"),
     (nam(), "file = 3", "nametable[0].file", "expected a file name, got 3"),
     (nam() * 2, 'file = "screen.nam"', "nametable[0].file", "'screen.nam': file size: 2048 bytes hold 2 nametables"),
 ])

@@ -13,17 +13,17 @@ from nes_build import make_state
 
 from retro.assembler import assemble_text
 from retro.chips.ppu.constants import PAL
-from retro.chips.ppu.device import PpuDevice, attach_ppu
+from retro.chips.ppu.device import PpuDevice
 from retro.cpu.machine import Machine
+from retro.machines.nes import build_nes, ppu_of
 
 FULL_FRAME = 262 * 341          # 89342
 SHORT_FRAME = FULL_FRAME - 1
 
 
 def ppu_machine(state=None) -> tuple[Machine, PpuDevice]:
-    machine = Machine("2a03")
-    device = attach_ppu(machine, PpuDevice(state or make_state(mask=0)))
-    return machine, device
+    machine = build_nes(state or make_state(mask=0))
+    return machine, ppu_of(machine)
 
 
 def status(device: PpuDevice, cycle: int) -> int:

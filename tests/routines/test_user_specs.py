@@ -133,7 +133,7 @@ BAD_SPECS = [
     ({'where = "aw': 'where = "zz >= 1 and aw'}, "cases.where: unknown name 'zz'"),
     ({'"../foreign/acme_boxhit.prg"': '"../foreign/nothing.prg"'}, "program.file: "),
     ({'entry = "boxhit"': 'entry = "boxhit"\ncpu = "z80"'}, "program.cpu: expected one of"),
-    ({'[cycles]': '[cycles]\nloops = { boxhit = 0 }'}, "cycles.loops.boxhit: expected a number in 1.."),
+    ({'[cycles]': '[cycles]\nloops = { boxhit = 0 }'}, "cycles.loops.boxhit: 0 is out of range 1.."),
     ({'boxhit_refs.py:boxhit': 'boxhit_refs.py:nothing'}, "reference.function: boxhit_refs.py has no function"),
     ({'max = 80': 'max = 80\n[cycles.extra]'}, "cycles.extra: unknown key"),
     ({'[inputs]': '[inputs\n'}, "not valid TOML"),

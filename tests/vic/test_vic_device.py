@@ -15,6 +15,7 @@ from retro.app.run import run_routine
 from retro.assembler import assemble_text
 from retro.chips.vic.device import VicDevice
 from retro.cpu import Machine
+from retro.machines import build_machine
 
 PAL_LINE = 63
 OVERLAP_LINE = 101  # sprites 0 (X 100) and 1 (X 110), both full at Y 100: first common pixel (101, 110)
@@ -27,8 +28,7 @@ def two_sprites(**kw):
 
 
 def machine_with(scene_obj, source: str) -> Machine:
-    machine = Machine("6510")
-    scene_obj.attach(machine)
+    machine = build_machine(scene_obj)
     machine.load(assemble_text(source))
     return machine
 

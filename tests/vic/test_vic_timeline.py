@@ -14,11 +14,12 @@ from __future__ import annotations
 import pytest
 
 from retro.assembler import assemble_text
-from retro.chips.vic.constants import NTSC, PAL, REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT, VIC_BASE, VIC_LAST
+from retro.chips.vic.constants import NTSC, PAL, REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT
 from retro.chips.vic.device import VicDevice
 from retro.chips.vic.model import VicState
 from retro.cpu.machine import Machine
-from retro.machines.c64 import call_budget, install_kernal_irq_entry
+from retro.machines import build_machine
+from retro.machines.c64 import build_c64, call_budget, install_kernal_irq_entry, vic_of
 
 FULL_SPRITE = bytes([0xFF] * SPRITE_BYTES)
 DEN_OFF = 0x0B  # $D011: RSEL, YSCROLL 3, display off (no Bad Lines)
@@ -39,10 +40,9 @@ def vic_state(video, registers: dict[int, int], sprites: dict[int, tuple[int, in
 
 
 def machine_at(source: str, state: VicState, line: int, cycle: int = 1) -> tuple[Machine, VicDevice]:
-    machine = Machine()
+    machine = build_c64(state, start_line=line, start_cycle=cycle)
     machine.load(assemble_text(source))
-    device = machine.attach(VicDevice.at_beam(state, machine.cycle, line, cycle), VIC_BASE, VIC_LAST)
-    return machine, device
+    return machine, vic_of(machine)
 
 
 # X counts iterations until $D012 shows the next line: INX (2), LDA $D012 (4, reads in its 4th
@@ -350,8 +350,8 @@ def test_scene_cpu_keys_place_the_beam_and_install_the_kernal_entry():
 
     scene = parse({"chip": "vic-ii", "video": "ntsc", "cpu": {"start_line": 200, "start_cycle": 65,
                                                               "irq_vector": "$0314"}}, "x.toml")
-    machine = Machine()
-    device = scene.attach(machine)
+    machine = build_machine(scene)
+    device = vic_of(machine)
     assert device.beam(machine.cycle)[1:] == (200, 65)
     assert machine.peek(0xFFFE, 2) == [0x48, 0xFF]
     assert machine.peek(0xFF48) == [0x48]  # PHA

@@ -110,9 +110,10 @@ def scene_objects(path: str) -> SceneObjects:
     """The scene's machine, frame budget, objects and collision hardware (VIC-II or NES scenes)."""
     from retro.analysis.study.per_frame import c64_budget, nes_budget
     from retro.scenes import load_scene
+    from retro.scenes.nes import NesScene
 
     scene = load_scene(path)
-    if getattr(scene, "cpu_variant", "") == "2a03":
+    if isinstance(scene, NesScene):
         shapes = nes_shapes(scene)
         if len(shapes) < 2:
             raise InputError(f"{path}: oam: need at least 2 sprites on screen with opaque pixels (found {len(shapes)})")

@@ -49,11 +49,12 @@ def scene_shapes(path: str, minimum: int = 0) -> list[tuple[int, object]]:
         SPRITE_COUNT,
     )
     from retro.scenes import load_scene
+    from retro.scenes.vic import VicScene
 
     scene = load_scene(path)
-    state = getattr(scene, "state", None)
-    if state is None or not hasattr(state, "sprite_data"):
+    if not isinstance(scene, VicScene):
         raise InputError(f"{path}: chip: a VIC-II scene is needed here (chip = \"vic-ii\")")
+    state = scene.state
     stem = Path(path).stem
     shapes = []
     for n in range(SPRITE_COUNT):

@@ -51,7 +51,6 @@ from retro.chips.ppu.constants import (
     PALETTE_SHADOW_OFFSET,
     PALETTE_SIZE,
     PPU_REGISTER_BASE,
-    PPU_REGISTER_END,
     PPU_REGISTER_MASK,
     PPUADDR,
     PPUADDR_HIGH_BITS,
@@ -91,7 +90,7 @@ PALETTE_MIRRORED = 0x10
 
 
 class PpuDevice:
-    """The PPU on the bus. Create it from a PpuState (the scene), then `attach_ppu(machine, device)`."""
+    """The PPU on the bus, created from a PpuState; `retro.machines.nes.build_nes` maps it on a 2A03's bus."""
 
     drives_cpu_lines = True
     irq_next = NEVER  # the PPU has no IRQ output
@@ -207,6 +206,11 @@ class PpuDevice:
         self._refresh_nmi_next()
 
     # ---- the CPU's lines ---------------------------------------------------------------------
+
+    def start_clock(self, cycle: int) -> None:
+        """Line 0, dot 0 of the first frame is machine cycle `cycle` (the machine's clock when mapped)."""
+        self.origin = cycle
+        self._refresh_nmi_next()
 
     def _refresh_nmi_next(self) -> None:
         """A lower bound on the CPU cycle of the next NMI edge (the next vblank flag)."""
@@ -386,15 +390,3 @@ class PpuDevice:
         for i in range(OAM_SIZE):
             self.oam[(self.oam_addr + i) & 0xFF] = self.read_memory(base + i)
         self.stall(OAM_DMA_CYCLES + (OAM_DMA_ODD_EXTRA if cycle % 2 else 0))
-
-
-def attach_ppu(machine, device: PpuDevice) -> PpuDevice:
-    """Map the PPU onto a 2A03 machine ($2000-$3FFF and $4014); its clock starts at the machine's now."""
-    device.origin = machine.cycle
-    device._refresh_nmi_next()
-    device.read_memory = machine.bus.peek
-    device.stall = machine.mpu.stall
-    machine.attach(device, PPU_REGISTER_BASE, PPU_REGISTER_END)
-    machine.attach(device, OAMDMA, OAMDMA)
-    return device
-

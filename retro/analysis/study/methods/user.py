@@ -36,7 +36,8 @@ from retro.analysis.study.corpus import Pair, Shape
 from retro.analysis.study.fits import Box, Circle, fitted_circle, full_box, tight_box
 from retro.analysis.study.methods.base import ORIGIN, Method
 from retro.errors import InputError, RunError
-from retro.fileio import is_file, parse_toml, read_bytes
+from retro.fields import Fields
+from retro.fileio import parse_toml, read_bytes
 from retro.routines.spec import import_user_module
 
 
@@ -47,6 +48,7 @@ SHAPE_KEYS = {"box": {"shape", "fit", "inset", "touching"}, "circle": {"shape", 
 FITS = {"tight": tight_box, "full": full_box}
 NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]{0,31}$")
 MAX_INSET = 24
+MAX_TEXT = 200  # characters of a name, label, colour or marker
 
 # What an input expression may name: the offset, and per sprite (a_ and b_) its sprite box's position,
 # the method's box, the method's circle and the opacity mask, in screen coordinates with sprite a at
@@ -56,10 +58,6 @@ PER_SPRITE = ("sx", "sy", "x", "y", "w", "h", "right", "right1", "bottom", "bott
 NAMES = ("dx", "dy") + tuple(f"{s}_{n}" for s in "ab" for n in PER_SPRITE)
 DEFAULT_COLOURS = ("#e377c2", "#7f7f7f", "#bcbd22", "#393b79", "#637939", "#843c39", "#7b4173")
 DEFAULT_MARKERS = ("v", "<", ">", "p", "8", "H", "1")
-
-
-def _fail(path: str, key: str, message: str) -> InputError:
-    return InputError(f"{path}: {key}: {message}")
 
 
 @dataclass(frozen=True)
@@ -218,78 +216,48 @@ def _checked(value, bits: int, field_name: str, where: str):
 
 # ---- reading the file ------------------------------------------------------------------------------
 
-def _load_function(path: Path, shown: str, text) -> object:
+def _load_function(fields: Fields, text) -> object:
     key = "hitbox.function"
     if not isinstance(text, str) or ":" not in text:
-        raise _fail(shown, key, "expected FILE.py:NAME (relative to the method file)")
+        raise fields.error(key, "expected FILE.py:NAME (relative to the method file)")
     file_text, _, name = text.rpartition(":")
     if not file_text.endswith(".py") or not name.isidentifier():
-        raise _fail(shown, key, f"{text!r}: expected FILE.py:NAME (relative to the method file)")
-    file = (path.parent / file_text).resolve()
-    if not is_file(file):
-        raise _fail(shown, key, f"{file_text}: file not found")
+        raise fields.error(key, f"{text!r}: expected FILE.py:NAME (relative to the method file)")
+    file = fields.file(file_text, key, resolve=True)
     try:
         module = import_user_module(str(file), file.stat().st_mtime)
     except Exception as exc:  # the user's module failed to import: one line, whatever it raised
-        raise _fail(shown, key, f"{file.name} failed to import: {type(exc).__name__}: {exc}") from None
+        raise fields.error(key, f"{file.name} failed to import: {type(exc).__name__}: {exc}") from None
     function = getattr(module, name, None)
     if not callable(function):
-        raise _fail(shown, key, f"{file_text} has no function {name!r}")
+        raise fields.error(key, f"{file_text} has no function {name!r}")
     return function
 
 
-def _int_list(shown: str, key: str, value, count: int, lo: int, hi: int) -> tuple[int, ...]:
-    values = [value] * count if isinstance(value, int) and not isinstance(value, bool) else value
-    if not isinstance(values, list) or len(values) != count or not all(
-            isinstance(v, int) and not isinstance(v, bool) for v in values):
-        raise _fail(shown, key, f"expected a whole number or a list of {count}, got {value!r}")
-    for v in values:
-        if not lo <= v <= hi:
-            raise _fail(shown, key, f"{v} is outside {lo}..{hi}")
-    return tuple(values)
-
-
-def _hitbox(path: Path, shown: str, doc) -> Hitbox:
-    if not isinstance(doc, dict):
-        raise _fail(shown, "hitbox", "expected a table: [hitbox] shape = \"box\" (or circle, mask, function)")
-    shape = doc.get("shape")
-    if not isinstance(shape, str) or shape not in SHAPE_KEYS:
-        raise _fail(shown, "hitbox.shape", f"expected one of box, circle, mask, function, got {shape!r}")
-    for key in doc:
-        if key not in SHAPE_KEYS[shape]:
-            raise _fail(shown, f"hitbox.{key}", f"unknown for shape {shape!r} (known: "
-                                                f"{', '.join(sorted(SHAPE_KEYS[shape]))})")
-    fit = doc.get("fit", "tight")
-    if not isinstance(fit, str) or fit not in FITS:
-        raise _fail(shown, "hitbox.fit", f"expected \"tight\" or \"full\", got {fit!r}")
-    touching = doc.get("touching", False)
-    if not isinstance(touching, bool):
-        raise _fail(shown, "hitbox.touching", f"expected true or false, got {touching!r}")
-    if shape == "circle":
-        radius_inset = doc.get("inset", 0)
-        if not isinstance(radius_inset, int) or isinstance(radius_inset, bool):
-            raise _fail(shown, "hitbox.inset", f"a circle's inset is one whole number (pixels off the radius), "
-                                               f"got {radius_inset!r}")
-        inset = _int_list(shown, "hitbox.inset", radius_inset, 4, -MAX_INSET, MAX_INSET)
-    else:
-        inset = _int_list(shown, "hitbox.inset", doc.get("inset", 0), 4, -MAX_INSET, MAX_INSET)
+def _hitbox(fields: Fields, doc) -> Hitbox:
+    doc = fields.table(doc, "hitbox")
+    shape = fields.choice(doc.get("shape"), "hitbox.shape", SHAPE_KEYS)
+    fields.known(doc, "hitbox", SHAPE_KEYS[shape])
+    fit = fields.choice(doc.get("fit", "tight"), "hitbox.fit", FITS)
+    touching = fields.flag(doc.get("touching", False), "hitbox.touching")
+    inset = doc.get("inset", 0)
+    if shape == "circle" and isinstance(inset, list):
+        raise fields.error("hitbox.inset", f"a circle's inset is one integer (pixels off the radius), got {inset}")
+    # TOML integers only: an inset is a small count of pixels, never an address in $hex
+    inset = fields.integers(inset, "hitbox.inset", 4, -MAX_INSET, MAX_INSET, strings=False)
     function, text = None, ""
     if shape == "function":
-        if "function" not in doc:
-            raise _fail(shown, "hitbox.function", "missing: FILE.py:NAME, hit(a, b, dx, dy) -> a verdict per offset")
-        text = doc["function"]
-        function = _load_function(path, shown, text)
+        text = fields.required(doc, "function", "hitbox", "FILE.py:NAME, hit(a, b, dx, dy) -> a verdict per offset")
+        function = _load_function(fields, text)
     return Hitbox(shape=shape, fit=fit, inset=inset, touching=touching, function=function, function_text=text)
 
 
-def _string(shown: str, doc: dict, key: str, default: str | None = None) -> str | None:
+def _string(fields: Fields, doc: dict, key: str, default: str | None = None) -> str | None:
     value = doc.get(key, default)
-    if value is not None and (not isinstance(value, str) or not value.strip() or len(value) > 200):
-        raise _fail(shown, key, f"expected a non-empty string of at most 200 characters, got {value!r}")
-    return value
+    return None if value is None else fields.string(value, key, most=MAX_TEXT)
 
 
-def _spec_name(path: Path, shown: str, key: str, text: str | None) -> str | None:
+def _spec_name(path: Path, fields: Fields, key: str, text: str | None) -> str | None:
     """A built-in routine's name as given; a spec path made relative to the method file; checked."""
     if text is None:
         return None
@@ -300,33 +268,26 @@ def _spec_name(path: Path, shown: str, key: str, text: str | None) -> str | None
     try:
         routine_spec(name)
     except InputError as exc:
-        raise _fail(shown, key, str(exc)) from None
+        raise fields.error(key, str(exc)) from None
     return name
 
 
-def _inputs(shown: str, doc, routine) -> tuple[tuple, tuple]:
+def _inputs(fields: Fields, doc, routine) -> tuple[tuple, tuple]:
     from retro.routines.where import parse_where
 
-    if not isinstance(doc, dict):
-        raise _fail(shown, "inputs", f"expected a table of the routine's inputs ({', '.join(routine.input_names)}), "
-                                     "each an expression such as \"a_x\" or \"b_x & 255\"")
-    for name in doc:
-        if name not in routine.input_names:
-            raise _fail(shown, f"inputs.{name}", f"routine {routine.name} has no input {name!r} "
-                                                 f"(its inputs: {', '.join(routine.input_names)})")
+    # each input is an expression such as "a_x" or "b_x & 255"
+    doc = fields.table(doc, "inputs", routine.input_names)
     compiled, bits = [], []
     for port in routine.inputs:
-        if port.name not in doc:
-            raise _fail(shown, f"inputs.{port.name}", f"missing: routine {routine.name} needs it "
-                                                      f"(names: dx, dy, a_x, b_right1, a_mask, ... see docs/methods.md)")
-        text = doc[port.name]
+        text = fields.required(doc, port.name, "inputs", f"routine {routine.name} needs it (names: dx, dy, a_x, "
+                                                        "b_right1, a_mask, ... see docs/methods.md)")
         if isinstance(text, int) and not isinstance(text, bool):
             text = str(text)
         if not isinstance(text, str):
-            raise _fail(shown, f"inputs.{port.name}", f"expected an expression as a string, got {text!r}")
-        terms = parse_where(text, NAMES, f"{shown}: inputs.{port.name}")
+            raise fields.error(f"inputs.{port.name}", f"expected an expression as a string, got {text!r}")
+        terms = parse_where(text, NAMES, f"{fields.source}: inputs.{port.name}")
         if len(terms) != 1:
-            raise _fail(shown, f"inputs.{port.name}", "one value, not a condition joined by `and`")
+            raise fields.error(f"inputs.{port.name}", "one value, not a condition joined by `and`")
         compiled.append((port.name, text, terms[0].test))
         bits.append(-len(port.places) if port.table else port.bits)
     return tuple(compiled), tuple(bits)
@@ -338,53 +299,44 @@ def load_method_file(path_text: str, index: int = 0) -> UserMethod:
     shown = str(path_text)
     raw = read_bytes(path, "method file", limit=MAX_METHOD_BYTES)
     doc = parse_toml(raw, shown)
-    for key in doc:
-        if key not in TOP_KEYS:
-            raise _fail(shown, key, f"unknown key (known: {', '.join(sorted(TOP_KEYS))})")
-    name = _string(shown, doc, "name", path.stem)
+    fields = Fields(shown)
+    fields.table(doc, "", TOP_KEYS)
+    name = _string(fields, doc, "name", path.stem)
     if not NAME.match(name):
-        raise _fail(shown, "name", f"{name!r}: a letter, then letters, digits, _ or - (at most 32)")
-    label = _string(shown, doc, "label", name)
-    if "hitbox" not in doc:
-        raise _fail(shown, "hitbox", "missing: [hitbox] shape = \"box\" (or circle, mask, function)")
-    hitbox = _hitbox(path, shown, doc["hitbox"])
-    routine_name = _spec_name(path, shown, "routine", _string(shown, doc, "routine"))
-    prepare = _spec_name(path, shown, "prepare", _string(shown, doc, "prepare"))
+        raise fields.error("name", f"{name!r}: a letter, then letters, digits, _ or - (at most 32)")
+    label = _string(fields, doc, "label", name)
+    hitbox = _hitbox(fields, fields.required(doc, "hitbox", "", "[hitbox] shape = \"box\" (or circle, mask, function)"))
+    routine_name = _spec_name(path, fields, "routine", _string(fields, doc, "routine"))
+    prepare = _spec_name(path, fields, "prepare", _string(fields, doc, "prepare"))
     from retro.analysis.study.methods.base import OBJECT, PREPARE_SCOPES
 
-    prepare_per = _string(shown, doc, "prepare_per", OBJECT)
-    if prepare_per not in PREPARE_SCOPES:
-        raise _fail(shown, "prepare_per", f"expected one of {', '.join(PREPARE_SCOPES)}, got {prepare_per!r}")
+    prepare_per = fields.choice(_string(fields, doc, "prepare_per", OBJECT), "prepare_per", PREPARE_SCOPES)
     if "prepare_per" in doc and prepare is None:
-        raise _fail(shown, "prepare_per", "needs a prepare routine (prepare = \"aabb_edges_prepare\" or a spec file)")
+        raise fields.error("prepare_per", "needs a prepare routine (prepare = \"aabb_edges_prepare\" or a spec file)")
     inputs, bits, domain, hit = (), (), (), 0
     if routine_name is None:
         for key in ("inputs", "hit", "prepare"):
             if key in doc:
-                raise _fail(shown, key, "needs a routine (routine = \"aabb8\" or a spec file)")
+                raise fields.error(key, "needs a routine (routine = \"aabb8\" or a spec file)")
     else:
         from retro.analysis.study.methods.base import routine_spec
 
         routine = routine_spec(routine_name)
-        if "inputs" not in doc:
-            raise _fail(shown, "inputs", f"missing: the routine's inputs {', '.join(routine.input_names)} as "
-                                         "expressions over the case (docs/methods.md)")
-        inputs, bits = _inputs(shown, doc["inputs"], routine)
+        inputs, bits = _inputs(fields, fields.required(doc, "inputs", "", (
+            f"the routine's inputs {', '.join(routine.input_names)} as expressions over the case (docs/methods.md)")),
+            routine)
         domain = routine.domain
-        hit_name = _string(shown, doc, "hit", routine.output_names[0])
-        if hit_name not in routine.output_names:
-            raise _fail(shown, "hit", f"routine {routine.name} has no output {hit_name!r} "
-                                      f"(its outputs: {', '.join(routine.output_names)})")
+        hit_name = fields.choice(_string(fields, doc, "hit", routine.output_names[0]), "hit", routine.output_names)
         hit = routine.output_names.index(hit_name)
-    colour = _string(shown, doc, "colour", DEFAULT_COLOURS[index % len(DEFAULT_COLOURS)])
-    marker = _string(shown, doc, "marker", DEFAULT_MARKERS[index % len(DEFAULT_MARKERS)])
+    colour = _string(fields, doc, "colour", DEFAULT_COLOURS[index % len(DEFAULT_COLOURS)])
+    marker = _string(fields, doc, "marker", DEFAULT_MARKERS[index % len(DEFAULT_MARKERS)])
     from matplotlib.colors import is_color_like
     from matplotlib.lines import Line2D
 
     if not is_color_like(colour):
-        raise _fail(shown, "colour", f"{colour!r} is not a colour (e.g. \"#e377c2\" or \"purple\")")
+        raise fields.error("colour", f"{colour!r} is not a colour (e.g. \"#e377c2\" or \"purple\")")
     if marker not in Line2D.markers:
-        raise _fail(shown, "marker", f"{marker!r} is not a matplotlib marker (e.g. \"v\", \"p\", \"h\")")
+        raise fields.error("marker", f"{marker!r} is not a matplotlib marker (e.g. \"v\", \"p\", \"h\")")
     rule = _describe(hitbox)
     counted = (f"{Path(routine_name).name if routine_name else ''} called through its spec with the inputs of "
                f"{path.name}" if routine_name else "host only: no routine given")
