@@ -8,6 +8,7 @@ import re
 from pathlib import Path
 
 import pytest
+from test_layers import package_imports
 
 from retro.chips.vic.constants import VIDEOS
 from retro.errors import InputError
@@ -23,6 +24,10 @@ def message(call, *args, **kw) -> str:
     with pytest.raises(InputError) as caught:
         call(*args, **kw)
     return str(caught.value)
+
+
+def test_the_toolkit_stands_on_errors_numbers_and_fileio_only():
+    assert package_imports()["fields"] <= {"errors", "numbers", "fileio"}
 
 
 # ---- unknown keys ------------------------------------------------------------------------------------
