@@ -342,11 +342,12 @@ def response_picture() -> None:
 
 
 def parry_picture() -> None:
-    from retro.geometry.parry import DEFAULT_FRAMES, DEFAULT_SCRIPT, simulate
+    from retro.commands.parry import DEFAULT_SCRIPT, parse_script
+    from retro.geometry.parry import DEFAULT_FRAMES, simulate
     from retro.render.images import png_bytes
     from retro.render.parry import render_frame
 
-    states = simulate(DEFAULT_SCRIPT, DEFAULT_FRAMES)
+    states = simulate(parse_script(DEFAULT_SCRIPT), DEFAULT_FRAMES)
     for state in states:
         if any(e.kind == "parry" for e in state.events):
             write_atomic(OUT / "parry_frame.png", png_bytes(render_frame(states, state.frame).convert("RGB")))

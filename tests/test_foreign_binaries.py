@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from retro.app.run import run_routine
+from retro.commands.run import run as run_routine
 
 FOREIGN = Path(__file__).resolve().parent / "data" / "foreign"
 

@@ -23,9 +23,10 @@ from __future__ import annotations
 import math
 import os
 import time
-from collections.abc import Callable, Iterator
 from collections import deque
+from collections.abc import Callable, Iterator
 from concurrent.futures import Future
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from itertools import islice
 
@@ -53,7 +54,7 @@ from retro.workers import worker_pool
 EXAMPLES_KEPT = 5
 JSON_EXACT = 1 << 53  # larger whole numbers lose digits in JSON readers that use doubles
 ENGINES = ("auto", "scalar", "batch")
-DEFAULT_ENGINE = "auto"  # what engine=None means; the study commands' --engine sets it
+DEFAULT_ENGINE = "auto"  # what engine=None means, here and in the study's method runs: see engine_default
 BATCH_LANES = 65_536  # cases the batched core runs at once (memory stays bounded: see LaneMemory)
 AUTO_BATCH_CASES = 20_000  # planned cases from which engine="auto" takes the batched core
 AGREEMENT_PER_PART = 2_000  # cases of each part also run on Machine when the batched core runs the check
@@ -603,6 +604,20 @@ def _run_work(work: Iterator[tuple], jobs: int, report: Callable[[ChunkResult], 
 def _chunks(parts: list[case_sets.Part]) -> Iterator[list[tuple]]:
     for part in parts:
         yield from case_sets.chunks(part.cases)
+
+
+@contextmanager
+def engine_default(engine: str) -> Iterator[None]:
+    """Make `engine` what engine=None means while the block runs: the study's commands reach routine
+    runs through many layers, and workers forked inside the block inherit the setting."""
+    global DEFAULT_ENGINE
+    if engine not in ENGINES:
+        raise InputError(f"--engine: {engine!r} is not one of {', '.join(ENGINES)}")
+    before, DEFAULT_ENGINE = DEFAULT_ENGINE, engine
+    try:
+        yield
+    finally:
+        DEFAULT_ENGINE = before
 
 
 def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | None = None,

@@ -18,27 +18,24 @@ Two pentagons: the player on the left, an enemy that spins and lunges from the r
 The window covers exactly `window_frames` frames: opened on frame f, a contact on frames
 f .. f + window_frames - 1 is inside it.
 
-Pure: `simulate(script, frames, params)` returns one FrameState per frame; rendering lives in
-retro.render.parry.
+Pure: `simulate(inputs, frames, params)` returns one FrameState per frame; the script format is
+read by retro.commands.parry, pictures are drawn by retro.render.parry.
 """
 
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field
 
 from retro.errors import InputError
 from retro.geometry.aabb import aabb_overlap, points_bounds
 from retro.geometry.polygon import regular_polygon
 from retro.geometry.sat import sat
-from retro.numbers import parse_int
 
 ACTIONS = ("parry", "left", "right", "stop")
 EVENT_KINDS = ("window", "press", "whiff", "parry", "hit", "expired")
 MAX_FRAMES = 10_000
 
-DEFAULT_SCRIPT = "40:parry 106:parry 150:left 170:stop 192:parry"
 DEFAULT_FRAMES = 230
 
 
@@ -84,36 +81,13 @@ class FrameState:
     events: list[Event] = field(default_factory=list)
 
 
-def parse_script(text: str, source: str = "script") -> list[tuple[int, str]]:
-    """Parse 'FRAME:ACTION' tokens separated by spaces, commas or new lines ('#' starts a comment).
-    FRAME is any number parse_int accepts; ACTION is parry, left, right or stop. Returns the
-    (frame, action) list sorted by frame (stable). Errors name the source, line and token."""
-    steps: list[tuple[int, str]] = []
-    for line_no, line in enumerate(text.splitlines(), start=1):
-        line = line.split("#", 1)[0]
-        for token in re.split(r"[\s,]+", line.strip()):
-            if not token:
-                continue
-            where = f"{source}:{line_no}: {token!r}" if "\n" in text.strip() else f"{source}: {token!r}"
-            frame_text, sep, action = token.partition(":")
-            if not sep:
-                raise InputError(f"{where}: expected FRAME:ACTION, e.g. 40:parry")
-            action = action.lower()
-            if action not in ACTIONS:
-                raise InputError(f"{where}: unknown action {action!r} (expected {', '.join(ACTIONS)})")
-            frame = parse_int(frame_text, field=f"{where}: frame", lo=0, hi=MAX_FRAMES - 1)
-            steps.append((frame, action))
-    steps.sort(key=lambda s: s[0])
-    return steps
-
-
-def simulate(script: list[tuple[int, str]] | str, frames: int = DEFAULT_FRAMES,
+def simulate(script: list[tuple[int, str]], frames: int = DEFAULT_FRAMES,
              params: ParryParams = ParryParams(), source: str = "script") -> list[FrameState]:
-    """Run the parry loop for `frames` frames under the scripted input (a parsed list, or text for
-    `parse_script`). Inputs scheduled at or after `frames` are an error."""
+    """Run the parry loop for `frames` frames under the scripted input: (frame, action) pairs (the
+    text format is read by retro.commands.parry). Inputs scheduled at or after `frames` are an error."""
     if isinstance(frames, bool) or not isinstance(frames, int) or not 1 <= frames <= MAX_FRAMES:
         raise InputError(f"frames: must be an integer in 1..{MAX_FRAMES}, got {frames!r}")
-    steps = parse_script(script) if isinstance(script, str) else list(script)
+    steps = sorted(script, key=lambda step: step[0])
     for frame, action in steps:
         if action not in ACTIONS:
             raise InputError(f"{source}: unknown action {action!r} (expected {', '.join(ACTIONS)})")

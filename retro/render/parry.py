@@ -8,22 +8,12 @@ run underneath (window spans in yellow, events as coloured ticks, the current fr
 from __future__ import annotations
 
 import io
-from dataclasses import dataclass
 from pathlib import Path
 
 from PIL import Image, ImageDraw
 
-from retro.fileio import output_folder, read_text, write_atomic
-from retro.geometry.parry import (
-    DEFAULT_FRAMES,
-    DEFAULT_SCRIPT,
-    Event,
-    FrameState,
-    ParryParams,
-    events_of,
-    parse_script,
-    simulate,
-)
+from retro.fileio import output_folder, write_atomic
+from retro.geometry.parry import FrameState, ParryParams, events_of
 from retro.render.images import label_font, save_png
 
 SCALE = 2
@@ -40,27 +30,6 @@ PALETTE = [(18, 18, 28), (60, 60, 76), (36, 78, 150), (130, 185, 255), (130, 36,
            (120, 120, 130), (96, 92, 60), (255, 210, 60), (230, 230, 230), (90, 230, 120), (255, 80, 80),
            (255, 255, 255), (110, 240, 240), (150, 150, 150)]
 EVENT_COLOURS = {"window": PAD_OPEN, "press": ARMED, "whiff": GREY, "parry": PARRY, "hit": HIT, "expired": GREY}
-
-
-@dataclass(frozen=True)
-class ParryRun:
-    states: list[FrameState]
-    events: list[Event]
-    files: list[Path]
-
-
-def load_script(spec: str | None, frames: int = DEFAULT_FRAMES) -> tuple[str, str]:
-    """(script text, source name): '@FILE' reads a script file, anything else is the script itself,
-    None gives the built-in script, cut to the inputs that fall within `frames`."""
-    if spec is None:
-        kept = [token for frame, token in zip(parse_script(DEFAULT_SCRIPT), DEFAULT_SCRIPT.split())
-                if frame[0] < frames]
-        return " ".join(kept), "built-in script"
-    if spec.startswith("@"):
-        path = spec[1:]
-        return read_text(path, "parry script"), path
-    return spec, "--script"
-
 
 
 def _poly(draw: ImageDraw.ImageDraw, points, fill: int, outline: int) -> None:
@@ -160,11 +129,9 @@ def render_frame(states: list[FrameState], index: int, params: ParryParams = Par
     return image
 
 
-def write_parry(out_dir: str | Path, script: str = DEFAULT_SCRIPT, frames: int = DEFAULT_FRAMES,
-                source: str = "script", params: ParryParams = ParryParams()) -> ParryRun:
-    """Simulate the script and write parry.gif, parry_FFF_EVENT.png for each event frame and
-    parry_events.txt into out_dir."""
-    states = simulate(parse_script(script, source), frames, params, source)
+def write_parry(out_dir: str | Path, states: list[FrameState], params: ParryParams = ParryParams()) -> list[Path]:
+    """Write parry.gif (every frame), parry_FFF_EVENT.png for each event frame and parry_events.txt
+    into out_dir; returns the files in that order."""
     out = output_folder(out_dir)
     images = [render_frame(states, i, params) for i in range(len(states))]
     buffer = io.BytesIO()
@@ -175,7 +142,6 @@ def write_parry(out_dir: str | Path, script: str = DEFAULT_SCRIPT, frames: int =
         if state.events:
             kinds = "_".join(e.kind for e in state.events)
             files.append(save_png(images[state.frame].convert("RGB"), out / f"parry_{state.frame:03d}_{kinds}.png"))
-    events = events_of(states)
-    text = "".join(f"{e.frame} {e.kind}\n" for e in events)
+    text = "".join(f"{e.frame} {e.kind}\n" for e in events_of(states))
     files.append(write_atomic(out / "parry_events.txt", text))
-    return ParryRun(states, events, files)
+    return files

@@ -256,7 +256,7 @@ def tile_box_sweep() -> Iterator[dict]:
     """Every 9-bit X and every Y for a sprite-sized box; every width at a few heights and back."""
     names = "x xh y w h"
     x, y = _grid(X_POSITIONS, BYTE)
-    yield _block(names, x=x & 0xFF, xh=x >> 8, y=y, w=24, h=21)
+    yield _block(names, x=x & 0xFF, xh=x >> 8, y=y, w=SPRITE_WIDTH, h=SPRITE_HEIGHT)
     size = np.arange(BYTE)
     for other in (0, 1, 8, 21, 255):
         yield _block(names, x=20, xh=0, y=45, w=size, h=other)

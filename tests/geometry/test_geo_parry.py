@@ -12,9 +12,15 @@ from shapely.geometry import Polygon
 
 from retro.cli import main
 from retro.errors import InputError
-from retro.geometry.parry import ParryParams, events_of, parse_script, simulate
+from retro.commands.parry import DEFAULT_SCRIPT, parse_script
+from retro.geometry.parry import DEFAULT_FRAMES, ParryParams, events_of, simulate
 
 PARAMS = ParryParams()
+
+
+def play(script: str, frames: int, params: ParryParams = ParryParams()):
+    """The simulation under a script in the text format of `retro parry`."""
+    return simulate(parse_script(script), frames, params)
 
 
 def kinds(states):
@@ -38,7 +44,7 @@ def touching_interiors(s):
 
 @pytest.fixture(scope="module")
 def idle():
-    return simulate("", 100)
+    return play("", 100)
 
 
 def test_no_input_means_window_then_hit(idle):
@@ -52,7 +58,7 @@ def test_press_inside_window_parries(idle):
     opened = next(e.frame for e in events_of(idle) if e.kind == "window")
     contact = next(e.frame for e in events_of(idle) if e.kind == "hit")
     for press in (opened, contact):  # first frame of the window, and the contact frame itself
-        states = simulate(f"{press}:parry", 100)
+        states = play(f"{press}:parry", 100)
         assert [(e.frame, e.kind) for e in events_of(states)[:3]] == [
             (opened, "window"), (press, "press"), (contact, "parry")]
 
@@ -60,7 +66,7 @@ def test_press_inside_window_parries(idle):
 def test_press_before_window_is_a_whiff_then_hit(idle):
     opened = next(e.frame for e in events_of(idle) if e.kind == "window")
     contact = next(e.frame for e in events_of(idle) if e.kind == "hit")
-    states = simulate(f"{opened - 1}:parry", 100)
+    states = play(f"{opened - 1}:parry", 100)
     assert [(e.frame, e.kind) for e in events_of(states)[:3]] == [
         (opened - 1, "whiff"), (opened, "window"), (contact, "hit")]
 
@@ -69,10 +75,10 @@ def test_window_lasts_exactly_n_frames(idle):
     opened = next(e.frame for e in events_of(idle) if e.kind == "window")
     contact = next(e.frame for e in events_of(idle) if e.kind == "hit")
     just_enough = replace(PARAMS, window_frames=contact - opened + 1)  # contact on the last window frame
-    states = simulate(f"{opened}:parry", 100, just_enough)
+    states = play(f"{opened}:parry", 100, just_enough)
     assert kinds(states)[:3] == ["window", "press", "parry"]
     too_short = replace(PARAMS, window_frames=contact - opened)  # window closes the frame before
-    states = simulate(f"{opened}:parry", 100, too_short)
+    states = play(f"{opened}:parry", 100, too_short)
     assert [(e.frame, e.kind) for e in events_of(states)[:4]] == [
         (opened, "window"), (opened, "press"), (contact - 1, "expired"), (contact, "hit")]
 
@@ -87,9 +93,7 @@ def test_knockback_separates_along_the_mtv(idle):
 
 
 def test_default_script_shows_every_event():
-    from retro.geometry.parry import DEFAULT_FRAMES, DEFAULT_SCRIPT
-
-    assert set(kinds(simulate(DEFAULT_SCRIPT, DEFAULT_FRAMES))) == {"window", "press", "whiff", "parry", "hit", "expired"}
+    assert set(kinds(play(DEFAULT_SCRIPT, DEFAULT_FRAMES))) == {"window", "press", "whiff", "parry", "hit", "expired"}
 
 
 def test_script_parsing():
@@ -101,7 +105,7 @@ def test_script_parsing():
     with pytest.raises(InputError, match=r"s.txt:2: 'x:parry': frame: not a number"):
         parse_script("1:parry\nx:parry", "s.txt")
     with pytest.raises(InputError, match="outside 0..9"):
-        simulate("10:parry", 10)
+        play("10:parry", 10)
 
 
 def test_cli_writes_gif_and_pngs(tmp_path, capsys):
@@ -113,7 +117,7 @@ def test_cli_writes_gif_and_pngs(tmp_path, capsys):
         assert gif.n_frames == 70
     assert len(list(out.glob("parry_*_*.png"))) >= 2
     lines = (out / "parry_events.txt").read_text().splitlines()
-    assert [line.split()[1] for line in lines] == kinds(simulate("55:parry", 70))
+    assert [line.split()[1] for line in lines] == kinds(play("55:parry", 70))
 
 
 def test_cli_bad_input_is_one_line(tmp_path, capsys):

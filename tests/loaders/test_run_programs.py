@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from retro.app.run import run_routine
+from retro.commands.run import run as run_routine
 from retro.cli import main
 from retro.errors import InputError
 

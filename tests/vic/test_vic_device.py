@@ -11,7 +11,7 @@ from pathlib import Path
 
 from vic_scenes import rows_with, scene, sprite
 
-from retro.app.run import run_routine
+from retro.commands.run import run as run_routine
 from retro.assembler import assemble_text
 from retro.chips.vic.device import VicDevice
 from retro.cpu import Machine

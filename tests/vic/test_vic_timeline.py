@@ -263,7 +263,7 @@ def test_no_vic_means_no_timed_loop():
 
 
 def test_readme_example_raster_irq_at_line_250_ends_before_260():
-    from retro.app.run import run_routine
+    from retro.commands.run import run as run_routine
     from retro.machines.c64 import interrupt_budgets
     from retro.paths import EXAMPLES_DIR
 

@@ -28,9 +28,10 @@ from itertools import combinations
 from retro.analysis.study.accuracy import Confusion, pooled
 from retro.analysis.study.corpus import Shape
 from retro.analysis.study.costs import CycleStats
-from retro.analysis.study.evaluate import Progress, evaluate, quiet
+from retro.analysis.study.evaluate import evaluate
+from retro.progress import Progress, quiet
 from retro.analysis.study.methods import METHODS, Method
-from retro.analysis.study.per_frame import MAX_OBJECTS, ONCE, PAL_BUDGET, PHASE_LABELS, Budget, FrameRow
+from retro.analysis.study.per_frame import ONCE, PAL_BUDGET, PHASE_LABELS, Budget, FrameRow
 from retro.errors import InputError
 
 ADVICE_COST_SAMPLES = 48
@@ -129,10 +130,7 @@ def _shape_key(shape: Shape) -> tuple:
 def advise(path: str, target: float, workers: int | None = None, progress: Progress = quiet,
            samples: int = ADVICE_COST_SAMPLES, methods: tuple[Method, ...] = METHODS, software: bool = False,
            objects: int | None = None) -> Advice:
-    if not 0 < target <= 1:
-        raise InputError(f"--accuracy: {target} is outside (0, 1] (e.g. 0.99 for 99%)")
-    if objects is not None and not 1 <= objects <= MAX_OBJECTS:
-        raise InputError(f"--objects: {objects} is outside 1..{MAX_OBJECTS}")
+    """`target` in (0, 1] and `objects` in 1..MAX_OBJECTS are checked by retro.commands.advise."""
     from retro.analysis.study.cost_runs import measure_costs
 
     scene = scene_objects(path)

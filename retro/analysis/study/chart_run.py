@@ -9,7 +9,8 @@ from pathlib import Path
 
 from retro.analysis.study import report
 from retro.analysis.study.corpus import DEFAULT_SHAPES, REDUCED_SHAPES, load_shapes
-from retro.analysis.study.evaluate import Progress, evaluate, quiet
+from retro.analysis.study.evaluate import evaluate
+from retro.progress import Progress, quiet
 from retro.analysis.study.methods import METHODS, Method
 from retro.fileio import output_folder, write_atomic
 

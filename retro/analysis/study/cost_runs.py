@@ -14,7 +14,8 @@ from itertools import combinations_with_replacement
 
 from retro.analysis.study.corpus import Pair, Shape, make_pair
 from retro.analysis.study.costs import CycleStats, MethodCost
-from retro.analysis.study.evaluate import Progress, default_workers, quiet
+from retro.analysis.study.evaluate import default_workers
+from retro.progress import Progress, quiet
 from retro.analysis.study.host_timing import host_microseconds
 from retro.analysis.study.methods import METHODS, Method, sub_pair
 from retro.errors import RunError

@@ -3,24 +3,13 @@
 from __future__ import annotations
 
 import os
-import sys
-from collections.abc import Callable
 from dataclasses import dataclass
 
 from retro.analysis.study.accuracy import Confusion, confusion, pooled
 from retro.analysis.study.corpus import Shape, make_pair
 from retro.analysis.study.methods import METHODS, Method
+from retro.progress import Progress, quiet
 from retro.workers import worker_pool
-
-Progress = Callable[[str], None]
-
-
-def stderr_progress(message: str) -> None:
-    print(message, file=sys.stderr, flush=True)
-
-
-def quiet(message: str) -> None:
-    pass
 
 
 @dataclass(frozen=True)

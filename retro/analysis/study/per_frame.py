@@ -44,7 +44,8 @@ from retro.analysis.study.broad_phase import (
 )
 from retro.analysis.study.corpus import Shape
 from retro.analysis.study.costs import CycleStats
-from retro.analysis.study.evaluate import Progress, default_workers, quiet
+from retro.analysis.study.evaluate import default_workers
+from retro.progress import Progress, quiet
 from retro.analysis.study.methods.base import KIND_PAIR, Method
 from retro.chips.vic import constants as vic
 from retro.errors import RunError

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from retro.analysis.study.corpus import load_shapes
 from retro.analysis.study.csvdata import csv_text
-from retro.analysis.study.evaluate import Progress, quiet
+from retro.progress import Progress, quiet
 from retro.fileio import output_folder, write_atomic
 
 REDUCED_SPEEDS = tuple(range(1, 25))

@@ -1,7 +1,4 @@
-"""`retro vic` as functions: run a scene through the collision model, describe it, draw it.
-
-The CLI and the demo call these; they only parse arguments and print.
-"""
+"""`retro vic`: run a VIC-II scene through the collision model, describe its latches, draw the overlaps."""
 
 from __future__ import annotations
 
@@ -23,12 +20,13 @@ from retro.chips.vic.constants import (
     Y_COMPARE_MASK,
 )
 from retro.chips.vic.model import LatchReport, frame_collisions, run_frames
+from retro.chips.palettes import C64_DEFAULT_PALETTE, PALETTES
 from retro.errors import InputError
-from retro.chips.palettes import C64_DEFAULT_PALETTE
+from retro.numbers import parse_int
 from retro.scenes.vic import VicScene, load
 
-DEMO_SCENE = "vic_two_balls.toml"
 MAX_SCALE = 8
+C64_PALETTES = tuple(name for name in PALETTES if name.startswith("c64-"))
 MAX_FRAMES = 10_000  # each moving frame is a full collision pass (about a millisecond)
 
 
@@ -41,13 +39,13 @@ class VicRun:
     per_frame: list[dict] | None = None  # with moving sprites and --frames N: what each frame showed
 
 
-def run_scene(path: str | Path, frames: int = 1, png: str | Path | None = None, scale: int = 2,
-              palette_name: str = C64_DEFAULT_PALETTE, pixels: bool = False) -> VicRun:
+def vic(path: str | Path, *, frames: int | str = 1, png: str | Path | None = None, scale: int | str = 2,
+        palette: str = C64_DEFAULT_PALETTE, pixels: bool = False) -> VicRun:
     """Load a scene, compute the latches after `frames` frames, optionally write the overlap PNG."""
-    if not 1 <= frames <= MAX_FRAMES:
-        raise InputError(f"--frames: {frames} is out of range 1..{MAX_FRAMES}")
-    if not 1 <= scale <= MAX_SCALE:
-        raise InputError(f"--scale: {scale} is out of range 1..{MAX_SCALE}")
+    frames = parse_int(frames, field="--frames", lo=1, hi=MAX_FRAMES)
+    scale = parse_int(scale, field="--scale", lo=1, hi=MAX_SCALE)
+    if palette not in C64_PALETTES:
+        raise InputError(f"--palette: {palette!r} is not a C64 palette (known: {', '.join(C64_PALETTES)})")
     scene = load(path)
     per_frame = None
     if frames > 1 and any(spec.velocity != (0, 0) for spec in scene.sprites):
@@ -61,7 +59,7 @@ def run_scene(path: str | Path, frames: int = 1, png: str | Path | None = None, 
         from retro.render.images import save_png
         from retro.render.vic_image import overlap_image
 
-        written = save_png(overlap_image(scene.state, report.collisions, scale, palette_name), png)
+        written = save_png(overlap_image(scene.state, report.collisions, scale, palette), png)
     return VicRun(scene, report, written, pixels, per_frame)
 
 
@@ -144,7 +142,8 @@ def _pixel_list(lines, xs) -> list[list[int]]:
     return [[int(lines[i]), int(xs[i])] for i in order]
 
 
-def report_json(run: VicRun) -> dict:
+def as_json(run: VicRun) -> dict:
+    """The object `retro vic --json` prints (its keys are a contract)."""
     r = run.report
     out = {"d01e": r.d01e, "d01f": r.d01f, "d019": r.d019,
            "first": {"d01e": _first(r.first_d01e), "d01f": _first(r.first_d01f)},
@@ -163,7 +162,7 @@ def _where(position: tuple[int, int] | None) -> str:
     return "" if position is None else f"; first set on raster line {position[0]} at X {position[1]}"
 
 
-def report_lines(run: VicRun) -> list[str]:
+def lines(run: VicRun) -> list[str]:
     r = run.report
     video = run.scene.state.video
     d019_sources = [name for bit, name in ((IRQ_SPRITE_SPRITE, "sprite-sprite"),

@@ -1,0 +1,9 @@
+"""What each `retro` command does, one function per command, taking plain arguments and returning data.
+
+Each module is named after its command and holds that function (`asm.asm`, `run.run`, `vic.vic`,
+`nes.nes`, `check.check`, `check.cycles`, `chart.chart`, `stability.stability`, `advise.advise`,
+`parry.parry`, `demo.demo`) and the text (`lines`) and, where the command has one, the JSON
+(`as_json`) of its result. Numbers may be given as ints or as the text a user typed ("$C000",
+"0x10"): each function checks its own arguments, once, and names the option in its error.
+`retro.cli` parses, calls one of these and prints; `retro demo` is a list of calls to them.
+"""

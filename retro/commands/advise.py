@@ -1,0 +1,48 @@
+"""`retro advise`: the cheapest collision method (in 6502 cycles) good enough for a VIC-II or NES
+scene's sprites, per test or, with `objects`, per frame."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from retro.analysis.check import engine_default
+from retro.analysis.study.advisor import Advice, advice_lines
+from retro.analysis.study.advisor import advise as advise_scene
+from retro.analysis.study.broad_phase import MAX_OBJECTS
+from retro.analysis.study.methods import with_user_methods
+from retro.commands.chart import DEFAULT_JOBS, MAX_JOBS
+from retro.errors import InputError
+from retro.numbers import parse_int
+from retro.progress import Progress, quiet
+
+DEFAULT_ACCURACY = 0.99
+
+
+def accuracy_target(value: float | str) -> float:
+    """--accuracy: a share in (0, 1] or a percentage ("99%")."""
+    text = str(value).strip()
+    try:
+        target = float(text.rstrip("%")) / (100 if text.endswith("%") else 1)
+    except ValueError:
+        raise InputError(f"--accuracy: not a number: {text!r} (use 0.99 or 99%)") from None
+    if not 0 < target <= 1:  # also refuses nan
+        raise InputError(f"--accuracy: {text!r} is outside (0, 1] (use 0.99 or 99%)")
+    return target
+
+
+def advise(scene: str | Path, *, accuracy: float | str = DEFAULT_ACCURACY, methods: list[str] = (),
+           software: bool = False, objects: int | str | None = None, jobs: int | str = DEFAULT_JOBS,
+           engine: str = "auto", progress: Progress = quiet) -> Advice:
+    """Every method (built-in and the user's method files `methods`; without the hardware latch when
+    `software`) measured on the scene's sprites; the cheapest one that decides at least `accuracy` of
+    the cases correctly, per test or, for `objects` objects, per frame."""
+    target = accuracy_target(accuracy)
+    workers = parse_int(jobs, field="--jobs", lo=1, hi=MAX_JOBS)
+    count = None if objects is None else parse_int(objects, field="--objects", lo=1, hi=MAX_OBJECTS)
+    with engine_default(engine):
+        return advise_scene(str(scene), target, workers=workers, progress=progress,
+                            methods=with_user_methods(methods), software=software, objects=count)
+
+
+def lines(advice: Advice) -> list[str]:
+    return advice_lines(advice)

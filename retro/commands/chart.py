@@ -1,0 +1,43 @@
+"""`retro chart`: 6502 cycles against accuracy of every collision method (PNG, CSV, Markdown), and
+with `per_frame` each method's cost per frame for 1-64 objects."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from retro.analysis.check import engine_default
+from retro.analysis.study.chart_run import AUTO, ChartOutput, run_chart, summary_lines
+from retro.analysis.study.methods import with_user_methods
+from retro.numbers import parse_int
+from retro.progress import Progress, quiet
+
+DEFAULT_OUT = "retro-out/chart"
+DEFAULT_JOBS = 2
+MAX_JOBS = 64
+MAX_SAMPLES = 1_000_000
+
+
+def samples_count(samples: int | str | None) -> int | str | None:
+    """--samples: a count, `all` (None: every case) or `auto` (every case; fewer with --reduced)."""
+    if samples in ("auto", AUTO):
+        return AUTO
+    if samples in ("all", None):
+        return None
+    return parse_int(samples, field="--samples", lo=1, hi=MAX_SAMPLES)
+
+
+def chart(out: str | Path = DEFAULT_OUT, *, reduced: bool = False, methods: list[str] = (), sprites: list[str] = (),
+          samples: int | str | None = "auto", per_frame: bool = False, jobs: int | str = DEFAULT_JOBS,
+          engine: str = "auto", progress: Progress = quiet, shapes: tuple[str, ...] | None = None) -> ChartOutput:
+    """The speed/accuracy study of the built-in methods and the user's method files `methods` on the
+    corpus (the named `shapes` of sprites/, all by default, then every sprite of the files `sprites`)."""
+    workers = parse_int(jobs, field="--jobs", lo=1, hi=MAX_JOBS)
+    cost_samples = samples_count(samples)
+    with engine_default(engine):
+        return run_chart(Path(out), reduced=reduced, workers=workers, progress=progress, shape_names=shapes,
+                         cost_samples=cost_samples, methods=with_user_methods(methods), sprite_files=tuple(sprites),
+                         per_frame=per_frame)
+
+
+def lines(output: ChartOutput) -> list[str]:
+    return summary_lines(output)

@@ -1,0 +1,55 @@
+"""`retro nes`: load an NES scene, predict its sprite-zero hit, draw it."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from retro.chips.ppu.constants import VBLANK_LINE, VBLANK_DOT
+from retro.chips.ppu.hit import SpriteZeroHit, sprite_zero_hit
+from retro.errors import InputError
+from retro.numbers import parse_int
+from retro.scenes import load_scene
+from retro.scenes.nes import NesScene
+
+MAX_SCALE = 16
+
+
+@dataclass(frozen=True)
+class NesRun:
+    scene: NesScene
+    hit: SpriteZeroHit
+    png: Path | None  # the picture written, if one was asked for
+
+
+def nes(path: str | Path, *, png: str | Path | None = None, scale: int | str = 2) -> NesRun:
+    """The sprite-zero hit of the scene at path; with png, also write its picture there."""
+    scale = parse_int(scale, field="--scale", lo=1, hi=MAX_SCALE)
+    scene = load_scene(path)
+    if not isinstance(scene, NesScene):
+        raise InputError(f"{path}: chip: expected 'nes' for `retro nes`")
+    state = scene.ppu_state()
+    result = sprite_zero_hit(state)
+    written = None
+    if png is not None:
+        from retro.render.images import save_png
+        from retro.render.nes_image import sprite_zero_image
+        written = save_png(sprite_zero_image(state, result, scale), png)
+    return NesRun(scene, result, written)
+
+
+def as_json(run: NesRun) -> dict:
+    """The object `retro nes --json` prints (its keys are a contract)."""
+    return run.hit.as_json()
+
+
+def lines(run: NesRun) -> list[str]:
+    return [_describe(run.hit)] + ([f"wrote {run.png}"] if run.png is not None else [])
+
+
+def _describe(result: SpriteZeroHit) -> str:
+    if not result.hit:
+        return f"no sprite-zero hit: {result.reason}"
+    return (f"sprite-zero hit at pixel x={result.x}, line {result.line}: $2002 bit 6 set at line {result.line} "
+            f"dot {result.dot}, {result.dots_after_vblank} PPU dots ({result.cpu_cycles_after_vblank:g} CPU cycles) "
+            f"after the vblank flag (line {VBLANK_LINE} dot {VBLANK_DOT})")

@@ -1,0 +1,150 @@
+"""`retro run`: load a program (source, PRG, raw binary or iNES image) into a machine, with a chip
+scene if one is given, call a routine and report registers, cycles, memory and raster position."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from retro.cpu.machine import DEFAULT_BUDGET, DEFAULT_FLAGS, JSR_CYCLES, MAX_BUDGET, CallResult, Machine
+from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z
+from retro.errors import InputError
+from retro.loaders import load_program
+from retro.numbers import parse_int
+from retro.machines import build_machine
+from retro.machines.c64 import RasterBudget, call_budget
+from retro.program import Program
+from retro.scenes import load_scene
+
+# the status flags a caller may set for the call (B and bit 5 are not flags the CPU keeps)
+SETTABLE_FLAGS = {"n": FLAG_N, "v": FLAG_V, "d": FLAG_D, "i": FLAG_I, "z": FLAG_Z, "c": FLAG_C}
+STATUS_BITS_HEADER = "N V - B D I Z C"  # P from bit 7 down to bit 0, as the 6502 manuals draw it
+
+
+@dataclass
+class RunReport:
+    program: Program
+    entry: int
+    result: CallResult
+    peeks: dict[str, list[int]]  # TARGET as the user gave it (without :N) -> byte values
+    machine: Machine
+    raster: RasterBudget | None  # where on the beam the call ran, with a VIC-II scene
+
+
+def status_with_flags(flags: dict[str, int | str] | None) -> int:
+    """The P register to enter with: the default, with each named flag (n v d i z c) set to 0 or 1."""
+    p = DEFAULT_FLAGS
+    for name, value in (flags or {}).items():
+        bit = SETTABLE_FLAGS.get(name.lower())
+        if bit is None:
+            raise InputError(f"--{name}: not a settable flag (known: {', '.join(SETTABLE_FLAGS)})")
+        p = p | bit if parse_int(value, field=f"--{name}", lo=0, hi=1) else p & ~bit
+    return p
+
+
+def _is_label(target: str) -> bool:
+    """Whether --entry names a label rather than giving a number."""
+    try:
+        parse_int(target)
+    except InputError:
+        return True
+    return False
+
+
+def parse_assignment(text: str) -> tuple[str, list[int]]:
+    """'TARGET=V' or 'TARGET=V,V,...' -> (target, bytes)."""
+    target, sep, values = text.partition("=")
+    if not sep or not target.strip() or not values.strip():
+        raise InputError(f"--set {text!r}: expected TARGET=VALUE[,VALUE...]")
+    return target.strip(), [parse_int(v, field=f"--set {target.strip()}", lo=0, hi=0xFF) for v in values.split(",")]
+
+
+def parse_peek(text: str) -> tuple[str, int]:
+    """'TARGET' or 'TARGET:N' -> (target, count)."""
+    target, sep, count = text.rpartition(":") if ":" in text else (text, "", "1")
+    if not target.strip():
+        raise InputError(f"--peek {text!r}: expected TARGET[:N]")
+    return target.strip(), parse_int(count, field=f"--peek {text} count", lo=1, hi=0x10000)
+
+
+def _peek_counts(peeks: list[str]) -> dict[str, int]:
+    """--peek arguments -> {TARGET as given: byte count}; one count per target."""
+    counts: dict[str, int] = {}
+    for given in peeks:
+        target, count = parse_peek(given)
+        if counts.get(target, count) != count:
+            raise InputError(f"--peek {given!r}: {target} is already peeked with count {counts[target]}")
+        counts[target] = count
+    return counts
+
+
+def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None, load: int | str | None = None,
+        a: int | str = 0, x: int | str = 0, y: int | str = 0, flags: dict[str, int | str] | None = None,
+        sets: list[str] = (), peeks: list[str] = (), budget: int | str = DEFAULT_BUDGET,
+        scene: str | Path | None = None, trace: bool = False) -> RunReport:
+    """Call `entry` of the program at `path` (as by JSR, through its RTS). `sets` are TARGET=V[,V...]
+    stores before the call, `peeks` TARGET[:N] reads after it; `scene` attaches a VIC-II or NES scene."""
+    registers = {name: parse_int(value, field=f"--{name}", lo=0, hi=0xFF) for name, value in (("a", a), ("x", x), ("y", y))}
+    budget = parse_int(budget, field="--budget", lo=1, hi=MAX_BUDGET)
+    status = status_with_flags(flags)
+    program = load_program(path, symbols=labels, load=load)
+    from_binary_without_symbols = labels is None and not program.listing
+    if from_binary_without_symbols and _is_label(str(entry)) and str(entry).strip() not in program.symbols:
+        raise InputError(f"{path} has no symbols: pass --labels with the symbol file your assembler wrote, "
+                         f"or give --entry as an address")
+    loaded_scene = None if scene is None else load_scene(scene)
+    if loaded_scene is not None and program.cpu and loaded_scene.cpu_variant != program.cpu:
+        raise InputError(f"--scene {scene}: a scene for the {loaded_scene.cpu_variant.upper()}, "
+                         f"but {path} is a program for the {program.cpu.upper()}")
+    machine = build_machine(loaded_scene, cpu=program.cpu)
+    machine.load(program)
+    memory = dict(parse_assignment(s) for s in sets)
+    for target in memory:
+        machine.resolve(target, f"--set {target}")
+    peek_counts = _peek_counts(peeks)
+    for target in peek_counts:
+        machine.resolve(target, f"--peek {target}")
+    entry_address = machine.resolve(entry, "--entry")
+    result = machine.call(entry_address, **registers, p=status, memory=memory, budget=budget, trace=trace)
+    values = {target: machine.peek(target, count) for target, count in peek_counts.items()}
+    return RunReport(program=program, entry=entry_address, result=result, peeks=values, machine=machine,
+                     raster=call_budget(machine, result))
+
+
+def as_json(report: RunReport) -> dict:
+    """The object `retro run --json` prints (its keys are a contract: no trace in it)."""
+    r = report.result
+    return {"cycles": r.cycles, "instructions": r.instructions, "a": r.a, "x": r.x, "y": r.y, "s": r.s, "p": r.p,
+            "peek": report.peeks, **({"raster": report.raster.as_dict()} if report.raster else {})}
+
+
+def trace_lines(report: RunReport) -> list[str]:
+    """Every instruction executed (and every interrupt taken), with its cycles and the running total."""
+    out = ["address  instruction    cycles  total  read       notes"]
+    total = 0
+    for e in report.result.trace or ():
+        total += e.cycles
+        notes = " ".join(n for n, on in (("taken", e.branch_taken), ("page+1", e.page_crossed)) if on)
+        if e.stolen:
+            notes = f"{notes} stolen {e.stolen}".strip()
+        text = e.mnemonic if e.mode == "int" else report.machine.disassemble_at(e.address)
+        read = f"${e.read:02X}@${e.operand:04X}" if e.read is not None else ""
+        out.append(f"${e.address:04X}    {text:<14} {e.cycles:>6}  {total:>5}  {read:<10} {notes}".rstrip())
+    return out
+
+
+def lines(report: RunReport) -> list[str]:
+    r = report.result
+    out = trace_lines(report) if r.trace else []
+    out += [f"A=${r.a:02X} X=${r.x:02X} Y=${r.y:02X} S=${r.s:02X} P=${r.p:02X}",
+            STATUS_BITS_HEADER,
+            " ".join(str(r.p >> bit & 1) for bit in range(7, -1, -1)),
+            f"{r.cycles} cycles, {r.instructions} instructions (from the entry ${report.entry:04X} through its RTS; "
+            f"the caller's JSR, {JSR_CYCLES} cycles, is not included)"]
+    budget = report.raster
+    if budget is not None:
+        out.append(f"raster: line {budget.start_line} cycle {budget.start_cycle} -> line {budget.end_line} cycle "
+                   f"{budget.end_cycle}, {budget.lines} lines ({budget.stolen} of the cycles stolen by the VIC-II"
+                   f"{'; crosses a frame end' if budget.frames else ''})")
+    out += [f"{target}: " + " ".join(f"${v:02X}" for v in values) for target, values in report.peeks.items()]
+    return out

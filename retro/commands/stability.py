@@ -1,0 +1,26 @@
+"""`retro stability`: where each collision method breaks (tunnelling, coordinate wrap, arithmetic
+range, edge conventions, latch pitfalls): charts, CSVs and a Markdown report."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from retro.analysis.check import engine_default
+from retro.analysis.study.methods import with_user_methods
+from retro.analysis.study.stability.run import StabilityOutput, run_stability
+from retro.progress import Progress, quiet
+
+DEFAULT_OUT = "retro-out/stability"
+
+
+def stability(out: str | Path = DEFAULT_OUT, *, reduced: bool = False, methods: list[str] = (),
+              engine: str = "auto", progress: Progress = quiet) -> StabilityOutput:
+    """The stability study of the built-in methods and the user's method files `methods`;
+    `reduced`: fewer speeds and bounded searches (seconds)."""
+    with engine_default(engine):
+        return run_stability(Path(out), reduced=reduced, progress=progress, methods=with_user_methods(methods))
+
+
+def lines(output: StabilityOutput) -> list[str]:
+    return output.lines + [f"wrote {', '.join(p.name for p in output.files)} to {output.files[0].parent} "
+                           f"in {output.seconds:.1f} s"]
