@@ -19,7 +19,8 @@ Format (see docs/nes.md):
     tiles = { "0:3" = ["33333333", ...] }   # "table:index": 8 rows of 8 values 0-3 ('.' = 0), or 16 bytes
     [[nametable]]                      # 32x30 tiles; index 0-3; anything not given is tile 0
     index = 0
-    fill = 0                           # or file = "title.nam" (1024 bytes: 960 tiles + 64 attribute bytes)
+    fill = 0                           # or file = "title.nam" (1024 bytes: 960 tiles + 64 attribute bytes;
+                                       # a file of 2 or 4 nametables also needs part = 0-3)
     cells = [{ col = 16, row = 15, tile = 3 }]
 
 OAM entries not given are $FF (off screen); nametable cells not given are 0, and so are the
@@ -53,7 +54,7 @@ from retro.chips.ppu.state import PpuState
 from retro.errors import InputError
 from retro.fields import Fields
 from retro.loaders.gfx_chr import chr_from_bytes
-from retro.loaders.gfx_nametable import ATTRIBUTE_BYTES, NAMETABLE_TILES, nametable_from_bytes
+from retro.loaders.gfx_nametable import ATTRIBUTE_BYTES, NAMETABLE_TILES, PPU_ADDRESSES, nametables_from_bytes
 from retro.scenes import earlier_spelling
 
 DEFAULT_MASK = 0x1E          # background and sprites on, left columns shown
@@ -63,7 +64,7 @@ TOP_KEYS = {"chip", "video", "ppu", "oam", "chr", "nametable"}
 PPU_KEYS = {"ctrl", "mask", "scroll_x", "scroll_y", "mirroring"}
 OAM_KEYS = {"y", "tile", "attr", "x"}
 CHR_KEYS = {"file", "table", "tiles"}
-NAMETABLE_KEYS = {"index", "fill", "file", "cells"}
+NAMETABLE_KEYS = {"index", "fill", "file", "part", "cells"}
 CELL_KEYS = {"col", "row", "tile"}
 
 
@@ -250,10 +251,17 @@ def _parse_nametables(value, fields: Fields, mirroring: str) -> tuple[Nametable,
                 raise fields.error(f"{field}.fill", "give fill or file, not both (the file gives every tile)")
             content = fields.read_file(table["file"], f"{field}.file", "nametable file")
             try:
-                loaded = nametable_from_bytes(content, repr(table["file"]))
+                in_file = nametables_from_bytes(content, repr(table["file"]))
             except InputError as exc:
                 raise fields.error(f"{field}.file", str(exc)) from None
-            tiles, attributes = loaded.tiles, loaded.attributes
+            if "part" not in table and len(in_file) > 1:
+                where = ", ".join(f"{n}: ${a:04X}" for n, a in enumerate(PPU_ADDRESSES[:len(in_file)]))
+                raise fields.error(f"{field}.part", f"{table['file']!r} holds {len(in_file)} nametables ({where}); "
+                                   f"say which with part = 0-{len(in_file) - 1}")
+            part = fields.integer(table.get("part", 0), f"{field}.part", 0, len(in_file) - 1)
+            tiles, attributes = in_file[part].tiles, in_file[part].attributes
+        elif "part" in table:
+            raise fields.error(f"{field}.part", "part picks a nametable of a file: give file too")
         result.append(Nametable(index=index, fill=fields.byte(table.get("fill", 0), f"{field}.fill"),
                                 cells=tuple(cells), tiles=tiles, attributes=attributes))
     return tuple(result)

@@ -137,7 +137,11 @@ def test_attribute_bytes_from_the_file_show_at_y_scroll_240(tmp_path):
     (nam(), 'file = "screen.nam"\nfill = 3', "nametable[0].fill", "give fill or file, not both"),
     (nam(), 'file = "missing.nam"', "nametable[0].file", "nametable file 'missing.nam' not found"),
     (nam(), "file = 3", "nametable[0].file", "expected a file name, got 3"),
-    (nam() * 2, 'file = "screen.nam"', "nametable[0].file", "'screen.nam': file size: 2048 bytes hold 2 nametables"),
+    (nam() * 2, 'file = "screen.nam"', "nametable[0].part",
+     "'screen.nam' holds 2 nametables (0: $2000, 1: $2400); say which with part = 0-1"),
+    (nam() * 4, 'file = "screen.nam"\npart = 4', "nametable[0].part", "4 is out of range 0..3"),
+    (nam(), 'file = "screen.nam"\npart = 1', "nametable[0].part", "1 is out of range 0..0"),
+    (nam(), "part = 0", "nametable[0].part", "part picks a nametable of a file: give file too"),
 ])
 def test_scene_errors_are_one_line(tmp_path, content, table, field, message):
     with pytest.raises(InputError) as info:
@@ -157,3 +161,13 @@ def test_cli(tmp_path):
     done = subprocess.run([sys.executable, "-m", "retro", "nes", str(tmp_path / "s.toml")], capture_output=True, text=True)
     assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
     assert "nametable[0].file" in done.stderr
+
+
+@pytest.mark.parametrize("count", [2, 4])
+def test_part_picks_one_nametable_of_a_file_of_several(tmp_path, count):
+    # only table 1 has the solid tile under sprite 0 (tile (16, 15): lines 120-127, x 128-135)
+    content = b"".join(nam({(16, 15): SOLID}) if n == 1 else nam({(2, 2): SOLID}) for n in range(count))
+    for part in range(count):
+        result = hit(tmp_path, content, y=119, table=f'file = "screen.nam"\npart = {part}')
+        assert result.hit == (part == 1), part
+    assert hit(tmp_path, content, y=119, table='file = "screen.nam"\npart = 1').line == 120
