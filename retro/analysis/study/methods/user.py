@@ -35,6 +35,7 @@ import numpy as np
 from retro.analysis.study.corpus import Pair, Shape
 from retro.analysis.study.fits import Box, Circle, fitted_circle, full_box, tight_box
 from retro.analysis.study.methods.base import ORIGIN, Method
+from retro.chips.vic.constants import SPRITE_BYTES, SPRITE_HEIGHT, SPRITE_WIDTH
 from retro.errors import InputError, RunError
 from retro.fields import Fields
 from retro.fileio import parse_toml, read_bytes
@@ -47,7 +48,8 @@ SHAPE_KEYS = {"box": {"shape", "fit", "inset", "touching"}, "circle": {"shape", 
               "mask": {"shape"}, "function": {"shape", "function"}}
 FITS = {"tight": tight_box, "full": full_box}
 NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]{0,31}$")
-MAX_INSET = 24
+MAX_INSET = SPRITE_WIDTH  # an inset beyond a whole sprite width moves the hitbox off the sprite
+SPRITE_SHAPE = (SPRITE_HEIGHT, SPRITE_WIDTH)  # a mask's (rows, columns) when unexpanded
 MAX_TEXT = 200  # characters of a name, label, colour or marker
 
 # What an input expression may name: the offset, and per sprite (a_ and b_) its sprite box's position,
@@ -160,7 +162,7 @@ class UserMethod(Method):
 
         x0, y0, x1, y1 = self.box(shape) if self.hitbox.shape == "box" else tight_box(shape.mask)
         c = self.circle(shape) if self.hitbox.shape == "circle" else fitted_circle(shape.mask)
-        mask = opacity_bytes(shape) if shape.mask.shape == (21, 24) else ()
+        mask = opacity_bytes(shape) if shape.mask.shape == SPRITE_SHAPE else ()
         return [sx, sy, sx + x0, sy + y0, x1 - x0, y1 - y0, sx + x1, sx + x1 - 1, sy + y1, sy + y1 - 1,
                 sx + c.cx, sy + c.cy, c.r, mask]
 
@@ -192,8 +194,8 @@ class UserMethod(Method):
         return case
 
     def unmeasurable(self, pair: Pair) -> str:
-        if any(bits < 0 for bits in self.input_bits) and {pair.a.mask.shape, pair.b.mask.shape} != {(21, 24)}:
-            return "its 63-byte mask inputs need unexpanded 24x21 sprites"
+        if any(bits < 0 for bits in self.input_bits) and {pair.a.mask.shape, pair.b.mask.shape} != {SPRITE_SHAPE}:
+            return f"its {SPRITE_BYTES}-byte mask inputs need unexpanded {SPRITE_WIDTH}x{SPRITE_HEIGHT} sprites"
         return ""
 
     def session(self, pair: Pair):
