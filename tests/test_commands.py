@@ -171,3 +171,19 @@ def test_the_demo_is_the_command_functions(monkeypatch, tmp_path):
         with pytest.raises(Called):
             step(tmp_path)
     assert called == ["asm", "vic", "run", "parry", "nes", "cycles", "chart"]
+
+
+def test_the_readme_command_table_lists_every_option():
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    rows = {line.split("`")[1].split()[1]: line for line in readme.splitlines() if line.startswith("| `retro ")}
+    assert set(rows) == set(COMMANDS)
+    for name, parser in subparsers().items():
+        for action in parser._actions:
+            if not action.option_strings or "--help" in action.option_strings:
+                continue
+            shown = [f"{option} " for option in action.option_strings] + [f"{option}]" for option in action.option_strings]
+            if name == "run" and action.dest in run.SETTABLE_FLAGS:  # listed together: --c/--z/--i/--d/--v/--n
+                shown += [f"--{action.dest}/", f"/--{action.dest} "]
+            if name == "run" and action.dest in ("a", "x", "y"):
+                shown.append("[--a/--x/--y V]")
+            assert any(text in rows[name] for text in shown), (name, action.option_strings)
