@@ -407,11 +407,14 @@ def _pairs(bit_sets: np.ndarray) -> tuple[tuple[int, int], ...]:
     return tuple(sorted(found))
 
 
-def _events(video: Video, lines: np.ndarray, xs: np.ndarray, bits: np.ndarray):
+def _events(video: Video, lines: np.ndarray, xs: np.ndarray, bits: np.ndarray, places: np.ndarray | None = None):
+    """(latch times, the sprite bits latched at each, (line, X) of the first pixel in beam order).
+    A pixel latches in the cycle of its sequencer slot (`places`), which on the 6567R8 also counts
+    the cycle that draws X $180-$187 a second time; without places, by its X (beam.pixel_time)."""
     if lines.size == 0:
         empty = np.zeros(0, np.int64)
         return empty, np.zeros(0, np.uint8), None
-    times = pixel_time(video, lines, xs)
+    times = pixel_time(video, lines, xs) if places is None else places // PIXELS_PER_CYCLE % video.frame_cycles
     order = np.argsort(times, kind="stable")  # the pixels come nearly in time order: a cheap sort
     times, bits = times[order], bits[order]
     start = np.flatnonzero(np.concatenate(([True], times[1:] != times[:-1])))  # first of each time
@@ -430,8 +433,8 @@ def frame_collisions(state: VicState) -> FrameCollisions:
     sb = foreground_points(video, state.memory, state.registers[REG_CONTROL1], state.registers[REG_CONTROL2],
                            lines, xs)
     sbl, sbx, sbb = lines[sb], xs[sb], bits[sb]
-    ss_times, ss_merged, first_ss = _events(video, ssl, ssx, ssb)
-    sb_times, sb_merged, first_sb = _events(video, sbl, sbx, sbb)
+    ss_times, ss_merged, first_ss = _events(video, ssl, ssx, ssb, places[ss])
+    sb_times, sb_merged, first_sb = _events(video, sbl, sbx, sbb, places[sb])
     return FrameCollisions(video, ss_times, ss_merged, sb_times, sb_merged, (ssl, ssx), (sbl, sbx),
                            first_ss, first_sb, _pairs(ssb) if ssb.size else (), ssb, sbb)
 
