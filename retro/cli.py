@@ -42,13 +42,13 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
-def _show(lines: list[str]) -> None:
-    for line in lines:
-        print(line)
-
-
-def _show_json(data: object) -> None:
-    print(json.dumps(data, indent=1))
+def _print(command, result, as_json: bool = False, indent: int | None = None) -> None:
+    """A command's result as its module shows it: `as_json(result)` as JSON, or `lines(result)`."""
+    if as_json:
+        print(json.dumps(command.as_json(result), indent=indent))
+    else:
+        for line in command.lines(result):
+            print(line)
 
 
 # Options shared by several commands: one definition each, so each means the same everywhere.
@@ -89,7 +89,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _cmd_asm(args: argparse.Namespace) -> int:
-    _show(asm.lines(asm.asm(args.source, output=args.output, labels=args.labels, listing=args.listing)))
+    _print(asm, asm.asm(args.source, output=args.output, labels=args.labels, listing=args.listing))
     return 0
 
 
@@ -98,29 +98,18 @@ def _cmd_run(args: argparse.Namespace) -> int:
     report = run.run(args.program, args.entry, labels=args.labels, load=args.load, a=args.a, x=args.x, y=args.y,
                      flags=flags, sets=args.sets, peeks=args.peeks, budget=args.budget, scene=args.scene,
                      trace=args.trace)
-    if args.json:
-        print(json.dumps(run.as_json(report)))
-    else:
-        _show(run.lines(report))
+    _print(run, report, args.json)
     return 0
 
 
 def _cmd_vic(args: argparse.Namespace) -> int:
-    result = vic.vic(args.scene, frames=args.frames, png=args.png, scale=args.scale, palette=args.palette,
-                     pixels=args.pixels)
-    if args.json:
-        print(json.dumps(vic.as_json(result)))
-    else:
-        _show(vic.lines(result))
+    _print(vic, vic.vic(args.scene, frames=args.frames, png=args.png, scale=args.scale, palette=args.palette,
+                        pixels=args.pixels), args.json)
     return 0
 
 
 def _cmd_nes(args: argparse.Namespace) -> int:
-    result = nes.nes(args.scene, png=args.png, scale=args.scale)
-    if args.json:
-        print(json.dumps(nes.as_json(result)))
-    else:
-        _show(nes.lines(result))
+    _print(nes, nes.nes(args.scene, png=args.png, scale=args.scale), args.json)
     return 0
 
 
@@ -132,44 +121,38 @@ def _checks(args: argparse.Namespace) -> list:
 
 def _cmd_check(args: argparse.Namespace) -> int:
     checks = _checks(args)
-    if args.json:
-        _show_json(check.as_json(checks))
-    else:
-        _show(check.lines(checks))
+    _print(check, checks, args.json, indent=1)
     return 1 if check.failed(checks) else 0
 
 
 def _cmd_cycles(args: argparse.Namespace) -> int:
     checks = _checks(args)
-    if args.json:
-        _show_json(cycles.as_json(checks))
-    else:
-        _show(cycles.lines(checks))
+    _print(cycles, checks, args.json, indent=1)
     return 1 if cycles.failed(checks) else 0
 
 
 def _cmd_chart(args: argparse.Namespace) -> int:
-    _show(chart.lines(chart.chart(args.out, reduced=args.reduced, methods=args.methods, sprites=args.sprites,
-                                  samples=args.samples, per_frame=args.per_frame, jobs=args.jobs, engine=args.engine,
-                                  progress=progress_printer(args.quiet))))
+    _print(chart, chart.chart(args.out, reduced=args.reduced, methods=args.methods, sprites=args.sprites,
+                              samples=args.samples, per_frame=args.per_frame, jobs=args.jobs, engine=args.engine,
+                              progress=progress_printer(args.quiet)))
     return 0
 
 
 def _cmd_stability(args: argparse.Namespace) -> int:
-    _show(stability.lines(stability.stability(args.out, reduced=args.reduced, methods=args.methods,
-                                              engine=args.engine, progress=progress_printer(args.quiet))))
+    _print(stability, stability.stability(args.out, reduced=args.reduced, methods=args.methods, engine=args.engine,
+                                          progress=progress_printer(args.quiet)))
     return 0
 
 
 def _cmd_advise(args: argparse.Namespace) -> int:
-    _show(advise.lines(advise.advise(args.scene, accuracy=args.accuracy, methods=args.methods, software=args.software,
-                                     objects=args.objects, jobs=args.jobs, engine=args.engine,
-                                     progress=progress_printer(args.quiet))))
+    _print(advise, advise.advise(args.scene, accuracy=args.accuracy, methods=args.methods, software=args.software,
+                                 objects=args.objects, jobs=args.jobs, engine=args.engine,
+                                 progress=progress_printer(args.quiet)))
     return 0
 
 
 def _cmd_parry(args: argparse.Namespace) -> int:
-    _show(parry.lines(parry.parry(args.script, out=args.out, frames=args.frames)))
+    _print(parry, parry.parry(args.script, out=args.out, frames=args.frames))
     return 0
 
 
