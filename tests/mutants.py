@@ -21,6 +21,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 TIMEOUT_SECONDS = 900
+PYTEST_NOT_RUN = (3, 4, 5)  # internal error, usage error (a missing test path), no tests collected
 
 
 @dataclass(frozen=True)
@@ -38,6 +39,13 @@ CPU_TESTS = ("tests/cpu",)
 BATCH_TESTS = ("tests/cpu/test_batch_vectors.py", "tests/routines/test_batch_check.py")
 CHECK_TESTS = ("tests/routines/test_user_specs.py", "tests/routines/test_routines_cli.py",
                "tests/routines/test_routines_exhaustive.py")
+TIMELINE_TESTS = ("tests/vic", "tests/cpu/test_machine.py")
+NES_TESTS = ("tests/cpu/test_machine.py", "tests/nes")
+BUDGET_TESTS = ("tests/vic", "tests/test_machines.py", "tests/test_commands.py")
+STABILITY_TESTS = ("tests/study/test_stability_pinned.py", "tests/study/test_stability_report_pinned.py",
+                   "tests/study/test_study_cli.py")
+FIELD_TESTS = ("tests/test_fields.py",)
+COMMAND_TESTS = ("tests/test_commands.py", "tests/test_cli_foundation.py", "tests/routines/test_routines_cli.py")
 
 MUTANTS = [
     # ---- VIC-II --------------------------------------------------------------------------------
@@ -122,6 +130,167 @@ MUTANTS = [
            BATCH_TESTS),
     Mutant("agreement-run-skipped", "retro/analysis/check.py",
            "agreement.merge(agreement_chunk(spec, seed, chunk))", "pass", BATCH_TESTS),
+    # ---- the CPU's timeline on a C64: sprite DMA, Bad Lines, BA (retro/chips/vic) ------------------
+    Mutant("sprite-dma-retriggers-while-on", "retro/chips/vic/model.py",
+           "if (line % video.lines) & Y_COMPARE_MASK == y and line >= free_from:",
+           "if (line % video.lines) & Y_COMPARE_MASK == y:", TIMELINE_TESTS),
+    Mutant("sprite0-fetch-cycle-6569-59", "retro/chips/vic/constants.py",
+           "sprite0_fetch_cycle=58, display_check_cycle=58)", "sprite0_fetch_cycle=59, display_check_cycle=58)",
+           TIMELINE_TESTS),
+    Mutant("sprite0-fetch-cycle-6567r8-60", "retro/chips/vic/constants.py",
+           "sprite0_fetch_cycle=59, display_check_cycle=59, repeated_x_cycle=63)",
+           "sprite0_fetch_cycle=60, display_check_cycle=59, repeated_x_cycle=63)", TIMELINE_TESTS),
+    Mutant("sprite0-fetch-cycle-6567r56a-60", "retro/chips/vic/constants.py",
+           "sprite0_fetch_cycle=59, display_check_cycle=59)", "sprite0_fetch_cycle=60, display_check_cycle=59)",
+           TIMELINE_TESTS),
+    Mutant("ba-lead-2", "retro/chips/vic/constants.py", "BA_LEAD = 3", "BA_LEAD = 2", TIMELINE_TESTS),
+    Mutant("sprite-dma-one-cycle", "retro/chips/vic/dma.py",
+           "for offset in range(-BA_LEAD, SPRITE_DMA_CYCLES):", "for offset in range(-BA_LEAD, 1):", TIMELINE_TESTS),
+    Mutant("sprite-dma-ignores-y-expansion", "retro/chips/vic/dma.py",
+           "registers[REG_SPRITE_Y0 + 2 * n], bool(expanded >> n & 1))",
+           "registers[REG_SPRITE_Y0 + 2 * n], False)", TIMELINE_TESTS),
+    Mutant("bad-line-yscroll-off-by-one", "retro/chips/vic/dma.py",
+           "and (line & CONTROL1_YSCROLL) == (control1 & CONTROL1_YSCROLL))",
+           "and ((line + 1) & CONTROL1_YSCROLL) == (control1 & CONTROL1_YSCROLL))", TIMELINE_TESTS),
+    Mutant("bad-line-without-den", "retro/chips/vic/dma.py",
+           "    control1 = registers[REG_CONTROL1]\n", "    control1 = registers[REG_CONTROL1] | CONTROL1_DEN\n",
+           TIMELINE_TESTS),
+    Mutant("bad-line-range-without-f7", "retro/chips/vic/dma.py",
+           "GRAPHICS_FIRST_LINE <= line <= BAD_LINE_LAST", "GRAPHICS_FIRST_LINE <= line < BAD_LINE_LAST",
+           TIMELINE_TESTS),
+    Mutant("bad-line-range-without-30", "retro/chips/vic/dma.py",
+           "GRAPHICS_FIRST_LINE <= line <= BAD_LINE_LAST", "GRAPHICS_FIRST_LINE < line <= BAD_LINE_LAST",
+           TIMELINE_TESTS),
+    Mutant("bad-line-stolen-from-14", "retro/chips/vic/constants.py",
+           "BAD_LINE_FIRST_STOLEN = 15", "BAD_LINE_FIRST_STOLEN = 14", TIMELINE_TESTS),
+    Mutant("bad-line-cache-key-without-den", "retro/chips/vic/dma.py",
+           "_BAD_LINE_BITS = CONTROL1_DEN | CONTROL1_YSCROLL", "_BAD_LINE_BITS = CONTROL1_YSCROLL", TIMELINE_TESTS),
+    Mutant("d011-write-keeps-the-old-ba", "retro/chips/vic/device.py",
+           "            self._bus = bus_schedule(self.video, self.registers)", "            pass", TIMELINE_TESTS),
+    Mutant("ba-known-high-kept-after-an-access", "retro/cpu/mpu.py",
+           "        self.ba_high_until = -1  # the access may change when the bus is taken", "        pass",
+           TIMELINE_TESTS),
+    Mutant("cpu-stops-on-writes-too", "retro/cpu/mpu.py",
+           "            if not writes >> i & 1:", "            if True:", TIMELINE_TESTS),
+    Mutant("rmw-writes-only-last-cycle", "retro/cpu/mpu.py",
+           "from_end = (1, 2) if op in self.RMW_OPCODES", "from_end = (1,) if op in self.RMW_OPCODES", TIMELINE_TESTS),
+    Mutant("interrupt-pushes-stop-on-ba", "retro/cpu/mpu.py",
+           "INTERRUPT_WRITES = (3, 4, 5)", "INTERRUPT_WRITES = ()", TIMELINE_TESTS),
+    # ---- interrupts: the 6502's latency and I flag, the VIC-II's IRQ output, the NES NMI ------------
+    Mutant("interrupt-sequence-6-cycles", "retro/cpu/mpu.py",
+           "INTERRUPT_CYCLES = 7", "INTERRUPT_CYCLES = 6", TIMELINE_TESTS),
+    Mutant("poll-in-last-cycle", "retro/cpu/mpu.py",
+           "if op in BRANCH_OPCODES and self.excycles == 1 else end - 2",
+           "if op in BRANCH_OPCODES and self.excycles == 1 else end - 1", TIMELINE_TESTS),
+    Mutant("taken-branch-polls-as-usual", "retro/cpu/mpu.py",
+           "poll = end - 3 if op in BRANCH_OPCODES and self.excycles == 1 else end - 2", "poll = end - 2",
+           TIMELINE_TESTS),
+    Mutant("page-crossing-branch-polls-early-too", "retro/cpu/mpu.py",
+           "if op in BRANCH_OPCODES and self.excycles == 1 else", "if op in BRANCH_OPCODES and self.excycles >= 1 else",
+           TIMELINE_TESTS),
+    Mutant("cli-sei-plp-act-before-the-poll", "retro/cpu/mpu.py",
+           "masked = (i_before if op in I_CHANGED_AFTER_POLL else self.p & FLAG_I)", "masked = self.p & FLAG_I",
+           TIMELINE_TESTS),
+    Mutant("plp-acts-before-the-poll", "retro/cpu/mpu.py",
+           "I_CHANGED_AFTER_POLL = frozenset({OPCODE_CLI, OPCODE_SEI, OPCODE_PLP})",
+           "I_CHANGED_AFTER_POLL = frozenset({OPCODE_CLI, OPCODE_SEI})", TIMELINE_TESTS),
+    Mutant("rti-acts-after-the-poll", "retro/cpu/mpu.py",
+           "I_CHANGED_AFTER_POLL = frozenset({OPCODE_CLI, OPCODE_SEI, OPCODE_PLP})",
+           "I_CHANGED_AFTER_POLL = frozenset({OPCODE_CLI, OPCODE_SEI, OPCODE_PLP, 0x40})", TIMELINE_TESTS),
+    Mutant("interrupt-leaves-i-clear", "retro/cpu/mpu.py", "        self.p |= FLAG_I\n", "        pass\n",
+           TIMELINE_TESTS),
+    Mutant("interrupt-pushes-b-set", "retro/cpu/mpu.py",
+           "self.stPush((self.p | FLAG_U) & ~FLAG_B)", "self.stPush(self.p | FLAG_U | FLAG_B)", TIMELINE_TESTS),
+    Mutant("nmi-through-the-irq-vector", "retro/cpu/mpu.py",
+           "vector = NMI_VECTOR if kind == \"NMI\" else IRQ_VECTOR", "vector = IRQ_VECTOR", NES_TESTS),
+    Mutant("nmi-masked-by-i", "retro/cpu/mpu.py",
+           "if poll >= lines.nmi_next and lines.nmi_edge(poll):",
+           "if not masked and poll >= lines.nmi_next and lines.nmi_edge(poll):", NES_TESTS),
+    Mutant("vic-irq-ignores-d01a", "retro/chips/vic/device.py",
+           "return bool(self.irq_latch & self.registers[REG_IRQ_ENABLE] & IRQ_SOURCES)",
+           "return bool(self.irq_latch & IRQ_SOURCES)", TIMELINE_TESTS),
+    Mutant("d019-bit7-ignores-d01a", "retro/chips/vic/model.py",
+           "return value | (IRQ_ANY if latched & enabled & IRQ_SOURCES else 0)",
+           "return value | (IRQ_ANY if latched & IRQ_SOURCES else 0)", TIMELINE_TESTS),
+    Mutant("vic-irq-next-a-cycle-late", "retro/chips/vic/device.py",
+           "candidates.append(after + (raster - after) % frame_cycles)",
+           "candidates.append(after + (raster - after) % frame_cycles + 1)", TIMELINE_TESTS),
+    Mutant("raster-compare-without-bit-8", "retro/chips/vic/model.py",
+           "return (registers[REG_CONTROL1] & CONTROL1_RST8) << 1 | registers[REG_RASTER]",
+           "return registers[REG_RASTER]", TIMELINE_TESTS),
+    Mutant("raster-compare-a-line-late", "retro/chips/vic/model.py",
+           "return line * video.cycles_per_line + (RASTER_IRQ_LINE0_DELAY if line == 0 else 0)",
+           "return (line + 1) % video.lines * video.cycles_per_line + (RASTER_IRQ_LINE0_DELAY if line == 0 else 0)",
+           TIMELINE_TESTS),
+    Mutant("nes-no-nmi-at-vblank", "retro/chips/ppu/device.py",
+           "        if self.ctrl & CTRL_NMI:\n            self.nmi_pending = True", 
+           "        if False:\n            self.nmi_pending = True", NES_TESTS),
+    Mutant("nes-nmi-enabled-in-vblank-ignored", "retro/chips/ppu/device.py",
+           "if self.vblank and value & CTRL_NMI and not self.ctrl & CTRL_NMI:", "if False:", NES_TESTS),
+    # ---- the raster budget (retro/machines/c64.py) -------------------------------------------------
+    Mutant("budget-end-a-cycle-late", "retro/machines/c64.py",
+           "position(video, device.time(start + cycles - 1))", "position(video, device.time(start + cycles))",
+           BUDGET_TESTS),
+    Mutant("budget-frames-not-counted", "retro/machines/c64.py",
+           "frames=last_frame - first_frame)", "frames=0)", BUDGET_TESTS),
+    Mutant("interrupt-budget-from-the-handler", "retro/machines/c64.py",
+           "            opened.append((at, stolen))", "            opened.append((at + entry.cycles, stolen))",
+           BUDGET_TESTS),
+    Mutant("interrupt-budget-stolen-from-the-call-start", "retro/machines/c64.py",
+           "at - first, stolen - stolen_before))", "at - first, stolen))", BUDGET_TESTS),
+    Mutant("nested-interrupts-budgeted-apart", "retro/machines/c64.py",
+           "            if not opened:\n", "            if True:\n", BUDGET_TESTS),
+    # ---- the stability study (retro/analysis/study/stability) ------------------------------------
+    Mutant("stability-full-speeds-to-40", "retro/analysis/study/stability/run.py",
+           "FULL_SPEEDS = tuple(range(1, 65))", "FULL_SPEEDS = tuple(range(1, 41))", STABILITY_TESTS),
+    Mutant("stability-reduced-speeds-to-16", "retro/analysis/study/stability/run.py",
+           "REDUCED_SPEEDS = tuple(range(1, 25))", "REDUCED_SPEEDS = tuple(range(1, 17))", STABILITY_TESTS,
+           explained="a size knob, not a rule: `--reduced` is documented only as fewer speeds; the report states "
+                     "the highest speed tried and the tests derive every reduced figure from it"),
+    Mutant("stability-wall-8-becomes-6", "retro/analysis/study/stability/tunnelling.py",
+           "THICKNESSES = (1, 2, 4, 8)", "THICKNESSES = (1, 2, 4, 6)", STABILITY_TESTS),
+    Mutant("stability-wall-off-centre", "retro/analysis/study/stability/tunnelling.py",
+           "left = (width - thickness) // 2", "left = 0", STABILITY_TESTS),
+    Mutant("stability-wrap-x-range-511", "retro/analysis/study/stability/wrap.py",
+           "X_RANGE = 512  #", "X_RANGE = 511  #", STABILITY_TESTS),
+    Mutant("stability-touching-is-one-apart", "retro/analysis/study/stability/edges.py",
+           "BOX_CASES = {\"boxes touching (adjacent columns)\": SPRITE_W,",
+           "BOX_CASES = {\"boxes touching (adjacent columns)\": SPRITE_W + 1,", STABILITY_TESTS),
+    Mutant("stability-disc-radius2-56", "retro/analysis/study/stability/edges.py",
+           "DISC_RADIUS2 = 49", "DISC_RADIUS2 = 56", STABILITY_TESTS),
+    Mutant("stability-latch-read-line-250", "retro/analysis/study/stability/latch_pitfalls.py",
+           "READ_LINE = 260", "READ_LINE = 250", STABILITY_TESTS),
+    Mutant("stability-wrap-routine-truth-inclusive", "retro/analysis/study/stability/ranges.py",
+           "truth = a < b + WRAP_W and b < a + WRAP_W", "truth = a <= b + WRAP_W and b <= a + WRAP_W",
+           STABILITY_TESTS),
+    Mutant("stability-report-safe-speed-off-by-one", "retro/analysis/study/stability/run.py",
+           "body = [[charts.group_label(g, methods)] + [tunnelling.safe_speed(tunnel, g, t) for t",
+           "body = [[charts.group_label(g, methods)] + [tunnelling.safe_speed(tunnel, g, t) + 1 for t",
+           STABILITY_TESTS),
+    Mutant("stability-report-wrap-columns-swapped", "retro/analysis/study/stability/run.py",
+           "[[r.video.upper(), r.test, r.software_only, r.hardware_only,",
+           "[[r.video.upper(), r.test, r.hardware_only, r.software_only,", STABILITY_TESTS),
+    Mutant("stability-summary-wrap-software-only", "retro/analysis/study/stability/run.py",
+           "{pal9.software_only + pal9.hardware_only}", "{pal9.software_only}", STABILITY_TESTS),
+    Mutant("stability-report-range-wrong-column", "retro/analysis/study/stability/run.py",
+           "[[r.routine, r.searched, r.cases, r.wrong, r.domain] for r in range_rows]",
+           "[[r.routine, r.searched, r.cases, 0, r.domain] for r in range_rows]", STABILITY_TESTS),
+    # ---- the field toolkit and the commands ------------------------------------------------------
+    Mutant("fields-floats-are-integers", "retro/fields.py",
+           "if isinstance(value, bool) or not isinstance(value, (int, str)) or",
+           "if isinstance(value, bool) or not isinstance(value, (int, float, str)) or", FIELD_TESTS),
+    Mutant("fields-bools-are-integers", "retro/fields.py",
+           "if isinstance(value, bool) or not isinstance(value, (int, str)) or",
+           "if not isinstance(value, (int, str)) or", FIELD_TESTS),
+    Mutant("fields-unknown-keys-accepted", "retro/fields.py",
+           "        if unknown:\n            raise self.error(join(field, unknown[0])",
+           "        if False:\n            raise self.error(join(field, unknown[0])", FIELD_TESTS),
+    Mutant("fields-flag-accepts-integers", "retro/fields.py",
+           "        if not isinstance(value, bool):\n", "        if not isinstance(value, (bool, int)):\n", FIELD_TESTS),
+    Mutant("check-exit-ignores-mismatches", "retro/commands/check.py",
+           "return any(c.mismatches for c in checks)", "return False", COMMAND_TESTS),
+    Mutant("run-json-drops-p", "retro/commands/run.py",
+           "\"y\": r.y, \"s\": r.s, \"p\": r.p,", "\"y\": r.y, \"s\": r.s,", COMMAND_TESTS),
 ]
 
 
@@ -145,7 +314,10 @@ def run_mutant(mutant: Mutant, tree: Path) -> tuple[str, float]:
         done = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", *mutant.tests],
                               cwd=tree, env=env, capture_output=True, text=True, timeout=TIMEOUT_SECONDS)
         failed = [line.split(" ", 2)[1] for line in done.stdout.splitlines() if line.startswith(("FAILED ", "ERROR "))]
-        verdict = (f"killed by {failed[0].split('::')[-1][:60]}" if failed else "killed") if done.returncode else "SURVIVED"
+        if done.returncode in PYTEST_NOT_RUN:  # a usage error or no test collected proves nothing
+            verdict = f"BROKEN (pytest exit {done.returncode}: {(done.stderr or done.stdout).strip()[-120:]})"
+        else:
+            verdict = (f"killed by {failed[0].split('::')[-1][:60]}" if failed else "killed") if done.returncode else "SURVIVED"
     except subprocess.TimeoutExpired:
         verdict = "killed (timeout)"
     finally:
@@ -166,6 +338,10 @@ def main(argv: list[str] | None = None) -> int:
     unknown = set(args.names) - {m.name for m in MUTANTS}
     if unknown:
         print(f"mutants: unknown mutant {sorted(unknown)[0]!r} (see --list)", file=sys.stderr)
+        return 2
+    missing = sorted({t for m in chosen for t in m.tests if not (ROOT / t.split("::")[0]).exists()})
+    if missing:
+        print(f"mutants: test path {missing[0]!r} does not exist", file=sys.stderr)
         return 2
     failures = 0
     with tempfile.TemporaryDirectory(prefix="retro-mutants-") as tmp:
