@@ -1,5 +1,6 @@
-"""Mutation testing: named one-line changes to the rules of the CPU, the chips and the checker; each
-must make a test fail ("killed"). Run: `python tests/mutants.py [NAME ...] [--list]`.
+"""Mutation testing: named one-line changes to the rules of the CPU, the chips, the raster budget, the checker, the
+stability study, the field toolkit and the commands; each must make a test fail ("killed").
+Run: `python tests/mutants.py [NAME ...] [--list]`.
 
 Every mutant is applied to a private copy of the tree (so other work in the checkout is never
 disturbed), then the tests that guard its rule run against that copy. A mutant that survives is a
@@ -223,7 +224,7 @@ MUTANTS = [
            "return (line + 1) % video.lines * video.cycles_per_line + (RASTER_IRQ_LINE0_DELAY if line == 0 else 0)",
            TIMELINE_TESTS),
     Mutant("nes-no-nmi-at-vblank", "retro/chips/ppu/device.py",
-           "        if self.ctrl & CTRL_NMI:\n            self.nmi_pending = True", 
+           "        if self.ctrl & CTRL_NMI:\n            self.nmi_pending = True",
            "        if False:\n            self.nmi_pending = True", NES_TESTS),
     Mutant("nes-nmi-enabled-in-vblank-ignored", "retro/chips/ppu/device.py",
            "if self.vblank and value & CTRL_NMI and not self.ctrl & CTRL_NMI:", "if False:", NES_TESTS),
