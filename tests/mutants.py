@@ -228,6 +228,8 @@ MUTANTS = [
            "        if False:\n            self.nmi_pending = True", NES_TESTS),
     Mutant("nes-nmi-enabled-in-vblank-ignored", "retro/chips/ppu/device.py",
            "if self.vblank and value & CTRL_NMI and not self.ctrl & CTRL_NMI:", "if False:", NES_TESTS),
+    Mutant("nes-nmi-edge-seen-by-the-writes-own-poll", "retro/chips/ppu/device.py",
+           "self.nmi_next = self.nmi_edge_cycle  #", "self.nmi_next = -NEVER  #", NES_TESTS),
     # ---- the raster budget (retro/machines/c64.py) -------------------------------------------------
     Mutant("budget-end-a-cycle-late", "retro/machines/c64.py",
            "position(video, device.time(start + cycles - 1))", "position(video, device.time(start + cycles))",

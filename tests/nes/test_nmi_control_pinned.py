@@ -11,8 +11,6 @@ ends at cycle 4 + 22 x 1,284 - 1 = 28,251: inside the vblank, with NMI still dis
 
 from __future__ import annotations
 
-import pytest
-
 from retro.machines.nes import build_nes
 
 ORIGIN = 0xC000
@@ -59,8 +57,6 @@ def test_no_nmi_once_a_2002_read_cleared_the_flag():
     assert count == 0
 
 
-@pytest.mark.xfail(strict=True, reason="known bug: the PPU's nmi_edge reports an edge made by the STA's own "
-                                       "write (its last cycle) to the STA's poll, so the NMI follows the STA")
 def test_the_immediate_nmi_comes_after_the_next_instruction():
     # blargg test 11: LDX #0, LDA #$80, STA $2000 (writes in its last cycle, after its poll), STX $10
     # (polls with the edge seen: the NMI follows it), LDA $10 reads the handler's count: 1.

@@ -129,6 +129,7 @@ class PpuDevice:
         self._candidates: np.ndarray | None = None
         self.hits: list[tuple[int, int, int]] = []   # (frame, line, dot) of each hit, for inspection
         self.nmi_pending = False        # an NMI edge the CPU has not taken yet
+        self.nmi_edge_cycle = -NEVER    # the CPU cycle of that edge: a poll before it does not see it
         self.nmi_next = NEVER
         pre = self.video.pre_render_line
         self._fixed_events = [
@@ -203,6 +204,7 @@ class PpuDevice:
         self.vblank = True
         if self.ctrl & CTRL_NMI:
             self.nmi_pending = True
+            self.nmi_edge_cycle = -NEVER  # reached by catching up to a poll: that poll sees it
         self._refresh_nmi_next()
 
     # ---- the CPU's lines ---------------------------------------------------------------------
@@ -213,9 +215,10 @@ class PpuDevice:
         self._refresh_nmi_next()
 
     def _refresh_nmi_next(self) -> None:
-        """A lower bound on the CPU cycle of the next NMI edge (the next vblank flag)."""
+        """The first CPU cycle whose poll can see an NMI edge: a pending edge's own cycle, else a lower
+        bound on the next vblank flag's."""
         if self.nmi_pending:
-            self.nmi_next = -NEVER
+            self.nmi_next = self.nmi_edge_cycle  # a poll before the edge's own cycle does not see it
         elif not self.ctrl & CTRL_NMI:
             self.nmi_next = NEVER
         else:
@@ -225,6 +228,7 @@ class PpuDevice:
             self.nmi_next = first_cycle_seeing(dot, self.origin, self.video)
 
     def nmi_edge(self, cycle: int) -> bool:
+        """Whether the CPU's poll at `cycle` (never before `nmi_next`) sees an NMI edge; it is taken."""
         self.advance(self.dot_of(cycle))
         taken, self.nmi_pending = self.nmi_pending, False
         self._refresh_nmi_next()
@@ -295,7 +299,11 @@ class PpuDevice:
         register = PPU_REGISTER_BASE | (address & PPU_REGISTER_MASK)
         if register == PPUCTRL:
             if self.vblank and value & CTRL_NMI and not self.ctrl & CTRL_NMI:
-                self.nmi_pending = True  # the NMI output falls now
+                # the NMI output falls in the write's cycle: after the poll of the writing instruction
+                # (its penultimate cycle), so the NMI follows the next instruction [blargg ppu_vbl_nmi
+                # 04-nmi_control, test 11: "immediate occurrence should be after NEXT instruction"]
+                self.nmi_pending = True
+                self.nmi_edge_cycle = cycle
             self.ctrl = value
             self._refresh_nmi_next()
             self.t = (self.t & ~V_NAMETABLE) | ((value & CTRL_NAMETABLE) << V_NAMETABLE_SHIFT)
