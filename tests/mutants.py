@@ -109,7 +109,8 @@ MUTANTS = [
            "            if case[index]:\n                p |= bit", "            if False:\n                p |= bit",
            ("tests/routines",)),
     Mutant("high-byte-of-output-dropped", "retro/routines/runner.py",
-           "value |= byte << (8 * shift)", "value |= byte if shift == 0 else 0", ("tests/routines",)),
+           "value = value | widen(byte) << (8 * shift)", "value = value | (widen(byte) if shift == 0 else widen(0))",
+           ("tests/routines",)),
     # ---- the batched core and its checks --------------------------------------------------------
     Mutant("batch-branch-page-costs-nothing", "retro/cpu/batch.py",
            "extra = extra_taken + crossed * BRANCH_PAGE_CYCLES", "extra = extra_taken", BATCH_TESTS),

@@ -16,7 +16,7 @@ only on some paths reads the same on both engines); the `[memory]` blocks once a
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -304,37 +304,14 @@ class RoutineRunner:
                 cpu.memory.fill(address, columns[index][:, byte])
         cpu.sp[:] = stack_pointer
         cpu.call(self.entry, self.limit, RETURN_TRAP, CALL_STACK_TOP)
-        lanes = {"a": cpu.a, "x": cpu.x, "y": cpu.y}
-        outputs = []
-        for port in self.routine.outputs:
-            if port.flag:
-                outputs.append(((cpu.p & port.places[0].bit) != 0).astype(np.int64))
-            elif port.table:
-                outputs.append(np.stack([cpu.read(place.address) for place in port.places], axis=1).astype(np.int64))
-            else:
-                value = np.zeros(n, dtype=np.int64)
-                for shift, place in enumerate(port.places):
-                    byte = lanes[place.register] if place.kind == "register" else cpu.read(place.address)
-                    value |= byte.astype(np.int64) << (8 * shift)
-                outputs.append(value)
+        outputs = port_values(self.routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,
+                              widen=lambda lanes: np.asarray(lanes, dtype=np.int64),
+                              table=lambda columns: np.stack(columns, axis=1).astype(np.int64))
         return BatchOutcome(outputs, cpu.cycles, cpu.error)
 
     def outputs(self, a: int, x: int, y: int, p: int) -> tuple:
-        registers = {"a": a, "x": x, "y": y}
-        memory = self.machine.memory
-        values = []
-        for port in self.routine.outputs:
-            if port.flag:
-                values.append(1 if p & port.places[0].bit else 0)
-            elif port.table:
-                values.append(tuple(memory[place.address] for place in port.places))
-            else:
-                value = 0
-                for shift, place in enumerate(port.places):
-                    byte = registers[place.register] if place.kind == "register" else memory[place.address]
-                    value |= byte << (8 * shift)
-                values.append(value)
-        return tuple(values)
+        return tuple(port_values(self.routine.outputs, {"a": a, "x": x, "y": y}, p, self.machine.memory.__getitem__,
+                                 widen=int, table=tuple))
 
     def traced(self, case: Sequence) -> CallResult:
         """The same call with the instruction trace (for the report of a failing case)."""
@@ -350,6 +327,26 @@ class RoutineRunner:
         text = read_text(source, "source file") if source.suffix.lower() in (".s", ".asm", ".oph") else None
         entries = [self.entry] + ([self.machine.resolve(self.routine.init)] if self.routine.init else [])
         return program_size(self.program, text, entries, self.code_image.__getitem__)
+
+
+def port_values(ports: Sequence[Port], registers: dict, p, read: Callable, widen: Callable, table: Callable) -> list:
+    """The outputs of a call, one value per port in the spec's order, read from the registers, P and
+    memory (`read(address)`): the same code for one call (ints) and for lanes of the batched core
+    (arrays), which differ only in `widen` (a byte or a flag as the output's number type) and
+    `table` (bytes of a table output together)."""
+    values = []
+    for port in ports:
+        if port.flag:
+            values.append(widen((p & port.places[0].bit) != 0))
+        elif port.table:
+            values.append(table([read(place.address) for place in port.places]))
+        else:
+            value = widen(0)
+            for shift, place in enumerate(port.places):
+                byte = registers[place.register] if place.kind == "register" else read(place.address)
+                value = value | widen(byte) << (8 * shift)
+            values.append(value)
+    return values
 
 
 def describe_value(port: Port, value) -> str:
