@@ -348,14 +348,20 @@ def _v1(r: _Reader, version: int) -> CharpadProject:
                     _map(r, map_w, map_h, 1))
 
 
-def _v2(r: _Reader, version: int) -> CharpadProject:
-    """[CP23] version 2: header 20 bytes, chars of 9 bytes (the 9th the material), square tiles."""
+def _square_tile_header(r: _Reader) -> tuple:
+    """[CP23] the header fields versions 2 and 3 share, up to the tile size: (colours, colouring,
+    mode, map width, map height, chars, tiles, tile size)."""
     colours = _colours(r)
     colouring = _colouring(r, OLD_COLOURING)
     mode = "multicolor" if r.byte("MCMODE") == 1 else "hires"
     map_w, map_h = r.word("MAP_WID"), r.word("MAP_HEI")
     n_chars, n_tiles = r.word("NUM_CHARS") + 1, r.byte("NUM_TILES") + 1
-    size = r.byte("TILE_SZ")
+    return colours, colouring, mode, map_w, map_h, n_chars, n_tiles, r.byte("TILE_SZ")
+
+
+def _v2(r: _Reader, version: int) -> CharpadProject:
+    """[CP23] version 2: header 20 bytes, chars of 9 bytes (the 9th the material), square tiles."""
+    colours, colouring, mode, map_w, map_h, n_chars, n_tiles, size = _square_tile_header(r)
     r.take(2, "RESERVED")
     data = r.array(n_chars * (CHAR_HEIGHT + 1), 1, "CHAR_DATA").astype(np.uint8).reshape(n_chars, CHAR_HEIGHT + 1)
     tiles = _tiles(r, n_tiles, size, size, 2)
@@ -368,12 +374,7 @@ def _v2(r: _Reader, version: int) -> CharpadProject:
 
 def _v3(r: _Reader, version: int) -> CharpadProject:
     """[CP23] version 3: header 20 bytes, square tiles, tile-cell attributes MMMMCCCC, no char attributes."""
-    colours = _colours(r)
-    colouring = _colouring(r, OLD_COLOURING)
-    mode = "multicolor" if r.byte("MCMODE") == 1 else "hires"
-    map_w, map_h = r.word("MAP_WID"), r.word("MAP_HEI")
-    n_chars, n_tiles = r.word("NUM_CHARS") + 1, r.byte("NUM_TILES") + 1
-    size = r.byte("TILE_SZ")
+    colours, colouring, mode, map_w, map_h, n_chars, n_tiles, size = _square_tile_header(r)
     if r.byte("CHAREX"):
         _no_charex(r, "CHAREX")
     r.take(1, "RESERVED")
