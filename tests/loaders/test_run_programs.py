@@ -16,6 +16,7 @@ import pytest
 from retro.commands.run import run as run_routine
 from retro.cli import main
 from retro.errors import InputError
+from retro.paths import EXAMPLES_DIR
 
 FOREIGN = Path(__file__).resolve().parent.parent / "data" / "foreign"
 
@@ -134,3 +135,12 @@ def test_asm_refuses_foreign_and_binary_files(capsys, tmp_path):
                                  f"assemble it with your assembler and pass the .prg and --labels\n")
     code, _, err = run_cli(capsys, "asm", FOREIGN / "acme_boxhit.prg", "-o", out_prg)
     assert code == 2 and "not Ophis source (a binary file)" in err and not out_prg.exists()
+
+
+def test_a_scene_for_another_cpu_than_the_programs_is_one_line(capsys):
+    scene = EXAMPLES_DIR / "vic_two_balls.toml"
+    code, _, err = run_cli(capsys, "run", FOREIGN / "nes_boxhit.nes", "--labels", FOREIGN / "nes_boxhit.lbl",
+                           "--entry", "boxhit", "--scene", scene)
+    assert code == 2
+    assert err == (f"retro run: --scene {scene}: a scene for the 6510, but {FOREIGN / 'nes_boxhit.nes'} is a program "
+                   f"for the 2A03\n")
