@@ -314,6 +314,22 @@ def _tiles(r: _Reader, count: int, h: int, w: int, width: int, field: str = "TIL
     return r.array(count * h * w, width, field).reshape(count, h, w)
 
 
+def _tile_block(r: _Reader, blocks) -> np.ndarray:
+    """The TILEDAT block of versions 7-9: tile count, width and height, then 16-bit char numbers."""
+    r.block(next(blocks), "TILEDAT")
+    n_tiles = r.word("TILECNT") + 1
+    tile_w, tile_h = r.byte("TILEWID"), r.byte("TILEHEI")
+    return _tiles(r, n_tiles, tile_h, tile_w, 2, "TILEDAT")
+
+
+def _tile_tags_and_names(r: _Reader, blocks, n_tiles: int) -> None:
+    """The TILETAGS and TILENAMES blocks of versions 7-9: read past (nothing collides by them)."""
+    r.block(next(blocks), "TILETAGS")
+    r.take(n_tiles, "TILETAGS")
+    r.block(next(blocks), "TILENAMES")
+    _names(r, n_tiles)
+
+
 def _map(r: _Reader, w: int, h: int, width: int, field: str = "MAP_DATA") -> np.ndarray:
     return r.array(w * h, width, field).reshape(h, w)
 
@@ -465,17 +481,12 @@ def _v6(r: _Reader, version: int) -> CharpadProject:
     materials, char_colours = _nibbles(r.array(n_chars, 1, "CHARATTS"))
     tiles = tile_colours = None
     if tile_system:
-        r.block(next(blocks), "TILEDAT")
-        n_tiles = r.word("TILECNT") + 1
-        tile_w, tile_h = r.byte("TILEWID"), r.byte("TILEHEI")
-        tiles = _tiles(r, n_tiles, tile_h, tile_w, 2, "TILEDAT")
+        tiles = _tile_block(r, blocks)
+        n_tiles = len(tiles)
         if colouring == "per-tile":
             r.block(next(blocks), "TILECOLRS")
             tile_colours = r.array(n_tiles, 1, "TILECOLRS")
-        r.block(next(blocks), "TILETAGS")
-        r.take(n_tiles, "TILETAGS")
-        r.block(next(blocks), "TILENAMES")
-        _names(r, n_tiles)
+        _tile_tags_and_names(r, blocks, n_tiles)
     _tile_colouring(r, colouring, tile_system)
     r.block(next(blocks), "MAP")
     map_w, map_h = r.word("MAPWID"), r.word("MAPHEI")
@@ -518,17 +529,12 @@ def _v8(r: _Reader, version: int) -> CharpadProject:
         r.block(next(blocks), "CHARCOLRS")
         char_colours, char_screen = _entries(r, n_chars, entry, "CHARCOLRS")
     if tile_system:
-        r.block(next(blocks), "TILEDAT")
-        n_tiles = r.word("TILECNT") + 1
-        tile_w, tile_h = r.byte("TILEWID"), r.byte("TILEHEI")
-        tiles = _tiles(r, n_tiles, tile_h, tile_w, 2, "TILEDAT")
+        tiles = _tile_block(r, blocks)
+        n_tiles = len(tiles)
         if colouring == "per-tile":
             r.block(next(blocks), "TILECOLRS")
             tile_colours, tile_screen = _entries(r, n_tiles, entry, "TILECOLRS")
-        r.block(next(blocks), "TILETAGS")
-        r.take(n_tiles, "TILETAGS")
-        r.block(next(blocks), "TILENAMES")
-        _names(r, n_tiles)
+        _tile_tags_and_names(r, blocks, n_tiles)
     _tile_colouring(r, colouring, tile_system)
     r.block(next(blocks), "MAP")
     map_w, map_h = r.word("MAPWID"), r.word("MAPHEI")
