@@ -13,7 +13,9 @@ Timing model (docs/vic.md):
 - A collision at pixel X is latched COLLISION_LATCH_DELAY (4) X coordinates later than that, in
   cycle 1 + ((X + 4 - first_x) mod x_positions) // 8 (measured by the VICE test programs
   VICII/spritecollisions/*-collision-cycle; see constants.py). On the 6569 the last four X
-  coordinates of a line ($190-$193) therefore latch in cycle 1 of the next line.
+  coordinates of a line ($190-$193) therefore latch in cycle 1 of the next line. The model
+  (model.sequencer_slots, model._events) takes that cycle from the sprite sequencer's slot, which
+  also counts the 6567R8's cycle that draws X $180-$187 a second time.
 - "Frame time" of a latch = line * cycles_per_line + (its cycle - 1), modulo the frame. A collision
   latch bit set at frame time p is seen by a read at frame time t > p. A register write at t changes
   what is drawn from t + 1 on.
@@ -23,18 +25,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from retro.chips.vic.constants import COLLISION_LATCH_DELAY, PIXELS_PER_CYCLE, Video
+from retro.chips.vic.constants import Video
 
 
 def beam_order(video: Video, x: np.ndarray | int) -> np.ndarray | int:
     """Index of X coordinate x in the drawing order of a line (0 = drawn first)."""
     return (x - video.first_x) % video.x_positions
-
-
-def pixel_time(video: Video, line: np.ndarray | int, x: np.ndarray | int) -> np.ndarray | int:
-    """Frame time (0-based cycle index in the frame) at which a collision at pixel (line, x) latches."""
-    cycle = (beam_order(video, x) + COLLISION_LATCH_DELAY) // PIXELS_PER_CYCLE
-    return (line * video.cycles_per_line + cycle) % video.frame_cycles
 
 
 def beam_key(video: Video, line: np.ndarray | int, x: np.ndarray | int) -> np.ndarray | int:

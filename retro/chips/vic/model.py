@@ -29,7 +29,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from retro.chips.vic.beam import beam_key, pixel_time
+from retro.chips.vic.beam import beam_key
 from retro.chips.vic.constants import (
     COLLISION_LATCH_DELAY,
     CONTROL1_RST8,
@@ -286,7 +286,7 @@ def _columns(video: Video, n: int, slot: int, width: int) -> _Columns:
         columns = np.concatenate([np.arange(to_halt), np.full(gap.drop - gap.halt, to_halt - 1)])
     slots = np.arange(slot, slot + columns.size)
     # The model's raster line of a pixel is the one in which Bauer's counter shows its X, which runs
-    # COLLISION_LATCH_DELAY ahead of the sequencer (beam.pixel_time): the first slots of a line
+    # COLLISION_LATCH_DELAY ahead of the sequencer (see sequencer_slots): the first slots of a line
     # belong to the line before, and a row running past the line's last slot to the next line.
     line_shift = np.zeros(columns.size, dtype=np.int64)
     line_shift[:max(0, COLLISION_LATCH_DELAY - slot)] = -1
@@ -407,14 +407,14 @@ def _pairs(bit_sets: np.ndarray) -> tuple[tuple[int, int], ...]:
     return tuple(sorted(found))
 
 
-def _events(video: Video, lines: np.ndarray, xs: np.ndarray, bits: np.ndarray, places: np.ndarray | None = None):
+def _events(video: Video, lines: np.ndarray, xs: np.ndarray, bits: np.ndarray, places: np.ndarray):
     """(latch times, the sprite bits latched at each, (line, X) of the first pixel in beam order).
     A pixel latches in the cycle of its sequencer slot (`places`), which on the 6567R8 also counts
-    the cycle that draws X $180-$187 a second time; without places, by its X (beam.pixel_time)."""
+    the cycle that draws X $180-$187 a second time."""
     if lines.size == 0:
         empty = np.zeros(0, np.int64)
         return empty, np.zeros(0, np.uint8), None
-    times = pixel_time(video, lines, xs) if places is None else places // PIXELS_PER_CYCLE % video.frame_cycles
+    times = places // PIXELS_PER_CYCLE % video.frame_cycles
     order = np.argsort(times, kind="stable")  # the pixels come nearly in time order: a cheap sort
     times, bits = times[order], bits[order]
     start = np.flatnonzero(np.concatenate(([True], times[1:] != times[:-1])))  # first of each time
