@@ -57,9 +57,10 @@ def _out(p: argparse.ArgumentParser, default: str) -> None:
     p.add_argument("--out", default=default, metavar="DIR", help=f"output folder (default: {default})")
 
 
-def _jobs(p: argparse.ArgumentParser, default: str) -> None:
-    p.add_argument("--jobs", default=None if default == "auto" else default, metavar="N",
-                   help=f"worker processes (default: {'up to 2' if default == 'auto' else default})")
+def _jobs(p: argparse.ArgumentParser, default: int | None) -> None:
+    """--jobs; default None leaves the count to the command (the checker: up to 2)."""
+    p.add_argument("--jobs", default=default, metavar="N",
+                   help=f"worker processes (default: {'up to 2' if default is None else default})")
 
 
 def _quiet(p: argparse.ArgumentParser) -> None:
@@ -173,7 +174,7 @@ def _routine_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", help="seed of the random cases and of random memory (default: the spec's, 0)")
     p.add_argument("--random", metavar="N",
                    help="random cases per routine (default: the spec's count, at most 2,000 without --exhaustive)")
-    _jobs(p, "auto")
+    _jobs(p, None)
     p.add_argument("--scene", metavar="SCENE.toml", help="run every call on a C64 with this VIC-II scene: the CPU "
                    "stalls on Bad Lines and sprite DMA, and the report gives raster lines from the start line")
     p.add_argument("--at-line", metavar="L", help="with --scene: the raster line each call starts at "
@@ -267,7 +268,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--per-frame", action="store_true",
                    help="also chart 6502 cycles per frame against the number of objects (1-64) for each method, "
                         "with its preparation and a broad phase (every pair, sort along X): per_frame.png/.csv/.md")
-    _jobs(p, str(chart.DEFAULT_JOBS))
+    _jobs(p, chart.DEFAULT_JOBS)
     _quiet(p)
 
     p = _add(sub, "stability", _cmd_stability, help="tunnelling, coordinate wrap, arithmetic range, edge conventions, "
@@ -293,7 +294,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--objects", metavar="N",
                    help="choose by 6502 cycles per frame for N objects (1-64, the scene's sprites in turn): "
                         "preparation, the cheaper broad phase (every pair or a sort along X) and the tests")
-    _jobs(p, str(chart.DEFAULT_JOBS))
+    _jobs(p, chart.DEFAULT_JOBS)
     _quiet(p)
 
     p = _add(sub, "parry", _cmd_parry, help="run the Sekiro-style parry loop on a scripted input; writes a GIF and PNGs",
