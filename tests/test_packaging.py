@@ -30,7 +30,8 @@ def test_wheel_runs_demo_and_check(tmp_path):
     built = _run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(wheels),
                   str(source)], cwd=tmp_path)
     assert built.returncode == 0, built.stderr[-2000:]
-    (wheel,) = wheels.glob("retro-*.whl")
+    # the distribution is "retro-collision" (PyPI's "retro" is another project); the import name stays retro
+    (wheel,) = wheels.glob("retro_collision-*.whl")
     target = tmp_path / "site"
     installed = _run([sys.executable, "-m", "pip", "install", "-q", "--no-deps", "--target", str(target), str(wheel)],
                      cwd=tmp_path)
