@@ -147,4 +147,5 @@ def lines(report: RunReport) -> list[str]:
                    f"{budget.end_cycle}, {budget.lines} lines ({budget.stolen} of the cycles stolen by the VIC-II"
                    f"{'; crosses a frame end' if budget.frames else ''})")
     out += [f"{target}: " + " ".join(f"${v:02X}" for v in values) for target, values in report.peeks.items()]
+    out += [f"note: {note}" for note in report.program.notes]  # e.g. a symbol file's skipped lines
     return out
