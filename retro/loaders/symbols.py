@@ -267,6 +267,7 @@ _DBG_FIELD = re.compile(r'(?P<key>\w+)=(?P<value>"[^"]*"|[^,]*)')
 # bits, so a negative one reads 0xFFFFFFF0): never a sign
 _DBG_NUMBER = re.compile(r"^(?:0[xX](?P<hex>[0-9A-Fa-f]+)|(?P<decimal>[0-9]+))$")
 _DBG_DIGITS = 16
+_DBG_DECIMAL_DIGITS = 20  # ids and counts: `%u` of at most 64 bits
 
 
 def _dbg_fields(line: str, source: str, number: int) -> tuple[str, dict[str, str]]:
@@ -284,7 +285,10 @@ def _dbg_int(fields: dict[str, str], key: str, source: str, number: int) -> int:
                          f"(ld65 writes 0x1234 or 1234, never a sign)")
     if match.group("hex") is not None:
         return _bounded_hex(match.group("hex"), _DBG_DIGITS, f"field {key!r}", source, number)
-    return unsigned_value(match.group("decimal"), 10)
+    if len(match.group("decimal")) > _DBG_DECIMAL_DIGITS:
+        raise InputError(f"{source}:{number}: {len(match.group('decimal'))}-digit number in field {key!r}; "
+                         f"ld65 writes at most {_DBG_DECIMAL_DIGITS} decimal digits")
+    return int(match.group("decimal"))
 
 
 def _parse_dbg(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> list[Symbol]:
