@@ -460,9 +460,16 @@ def _parse_dasm(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> 
 # label given with -L and never defined.
 _XA_LINE = re.compile(r"^(?P<name>[A-Za-z_@][\w]*),\s*0x(?P<address>[0-9A-Fa-f]+),\s*(?P<block>\d+),"
                       r"\s*0x(?P<segment>[0-9A-Fa-f]+)$")
-_XA_REFERENCES = re.compile(r"^[^,\s][^,]*?(?:\s+\d+)+$")  # a file name (no comma) and line numbers
 _XA_DIGITS = 8  # a C int
 _XA_UNDEFINED_SEGMENT = 1
+
+
+def _is_xa_references(line: str) -> bool:
+    """`file.asm 7 9`: a file name (no comma) and one or more line numbers (split, not a regex: a
+    pattern for it backtracks quadratically on a long line of numbers)."""
+    words = line.split()
+    numbers = len(words) - next((i for i, word in enumerate(reversed(words)) if not word.isdigit()), len(words))
+    return 0 < numbers < len(words) and "," not in line
 
 
 def _parse_xa(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> list[Symbol]:
@@ -470,7 +477,7 @@ def _parse_xa(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> li
     for number, line in lines:
         match = _XA_LINE.match(line)
         if not match:
-            if after_symbol and _XA_REFERENCES.match(line):
+            if after_symbol and _is_xa_references(line):
                 continue  # -r: where the symbol above is used
             raise _malformed(source, number, line, "'name, 0xADDR, BLOCK, 0xSEG'")
         after_symbol = True

@@ -253,3 +253,14 @@ def test_retro_check_of_a_dasm_build_with_every_line_kind(capsys):
     assert code == 0 and err == ""
     assert lines[0].startswith("boxhit_dasm_kinds: ") and ", OK; " in lines[0]
     assert lines[1] == f"  note: {KINDS / 'dasm_kinds.sym'}: {DASM_NOTE}"
+
+
+def test_long_hostile_lines_are_read_in_linear_time():
+    # a regular expression for xa's reference lines once backtracked quadratically here (27 s at
+    # 20,000 numbers): these return at once, a regression hangs
+    numbers = "1 " * 100_000
+    with pytest.raises(InputError, match="f:2: expected 'name, 0xADDR, BLOCK, 0xSEG'"):
+        parse_symbol_file(f"ok, 0xc000, 0, 0x0000\nf {numbers}x\n", "f")
+    assert len(parse_symbol_file(f"ok, 0xc000, 0, 0x0000\nf.asm {numbers}\n", "f").symbols) == 1
+    with pytest.raises(InputError, match="f:1: expected 'name = \\$ADDR'"):
+        parse_symbol_file("x = $1" + " ; ?" * 100_000 + " ; z\n", "f")
