@@ -255,6 +255,12 @@ def test_retro_check_of_a_dasm_build_with_every_line_kind(capsys):
     assert lines[1] == f"  note: {KINDS / 'dasm_kinds.sym'}: {DASM_NOTE}"
 
 
+def test_retro_cycles_says_a_shared_symbol_files_note_once(capsys):
+    code, out, _ = run_cli(capsys, "cycles", SPEC, SPEC, "--quiet")
+    assert code == 0 and out.count("skipped") == 1
+    assert out.splitlines()[-1] == f"note: {KINDS / 'dasm_kinds.sym'}: {DASM_NOTE}"
+
+
 def test_long_hostile_lines_are_read_in_linear_time():
     # a regular expression for xa's reference lines once backtracked quadratically here (27 s at
     # 20,000 numbers): these return at once, a regression hangs
