@@ -800,7 +800,7 @@ def check_record(check: RoutineCheck) -> dict:
               "engine_agreement": None if check.agreement is None else {
                   "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
                   "timing_model_mismatches": check.agreement.cycle_mismatches},
-              "first_failure": None}
+              "notes": list(check.routine.notes), "first_failure": None}
     failure = t.failure
     if failure is not None:
         routine = check.routine

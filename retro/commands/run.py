@@ -115,7 +115,8 @@ def as_json(report: RunReport) -> dict:
     """The object `retro run --json` prints (its keys are a contract: no trace in it)."""
     r = report.result
     return {"cycles": r.cycles, "instructions": r.instructions, "a": r.a, "x": r.x, "y": r.y, "s": r.s, "p": r.p,
-            "peek": report.peeks, **({"raster": report.raster.as_dict()} if report.raster else {})}
+            "peek": report.peeks, **({"raster": report.raster.as_dict()} if report.raster else {}),
+            **({"notes": list(report.program.notes)} if report.program.notes else {})}
 
 
 def trace_lines(report: RunReport) -> list[str]:

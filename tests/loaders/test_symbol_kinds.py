@@ -238,6 +238,7 @@ def test_retro_run_reads_a_dasm_build_and_says_what_it_skipped(capsys):
                            "--entry", "wait", "--peek", "3.done", "--json")
     report = json.loads(out)
     assert code == 0 and (report["x"], report["cycles"], report["peek"]["3.done"]) == (0, 27, [0x60])  # RTS
+    assert report["notes"] == [f"{KINDS / 'dasm_kinds.sym'}: {DASM_NOTE}"]  # only when something was skipped
 
 
 @pytest.mark.parametrize("name", ["PLAYER_Y", "TITLE", "PAL", "DELTA"])
@@ -253,6 +254,8 @@ def test_retro_check_of_a_dasm_build_with_every_line_kind(capsys):
     assert code == 0 and err == ""
     assert lines[0].startswith("boxhit_dasm_kinds: ") and ", OK; " in lines[0]
     assert lines[1] == f"  note: {KINDS / 'dasm_kinds.sym'}: {DASM_NOTE}"
+    code, out, _ = run_cli(capsys, "check", SPEC, "--quiet", "--json")
+    assert json.loads(out)[0]["notes"] == [f"{KINDS / 'dasm_kinds.sym'}: {DASM_NOTE}"]
 
 
 def test_retro_cycles_says_a_shared_symbol_files_note_once(capsys):
