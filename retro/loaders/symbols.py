@@ -309,35 +309,36 @@ def _parse_dbg(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> l
             raise InputError(f"{source}: truncated: its info line promises {promised[kind]} {kind} records, "
                              f"the file has {found}")
 
-    def scope_path(scope_id: int, number: int) -> list[str]:
-        path, seen = [], set()
-        while scope_id is not None:
+    scope_paths: dict[int, tuple[str, ...]] = {}  # each scope's path is walked once, however deep
+
+    def scope_path(scope_id: int, number: int) -> tuple[str, ...]:
+        chain, seen = [], set()
+        while scope_id is not None and scope_id not in scope_paths:
             if scope_id in seen or scope_id not in scopes:
                 raise InputError(f"{source}:{number}: scope {scope_id} is not defined in the file")
             seen.add(scope_id)
-            name, scope_id = scopes[scope_id]
-            if name:
-                path.append(name)
-        return path[::-1]
+            chain.append(scope_id)
+            scope_id = scopes[scope_id][1]
+        path = scope_paths[scope_id] if scope_id is not None else ()
+        for walked in reversed(chain):
+            name = scopes[walked][0]
+            path = (*path, name) if name else path
+            scope_paths[walked] = path
+        return path
 
     by_id = {_dbg_int(fields, "id", source, number): (number, fields) for number, fields in records}
-    qualified_paths: dict[int, list[str]] = {}
 
-    def symbol_path(symbol_id: int, number: int, depth: int = 0) -> list[str]:
-        """Scope path of a symbol: its scope's, or for a cheap local (`@loop`) its parent label's."""
-        if symbol_id in qualified_paths:
-            return qualified_paths[symbol_id]
-        if symbol_id not in by_id or depth > len(by_id):
-            raise InputError(f"{source}:{number}: symbol {symbol_id} is not defined in the file")
-        line_number, fields = by_id[symbol_id]
-        if "parent" in fields:
-            parent = _dbg_int(fields, "parent", source, line_number)
-            path = [*symbol_path(parent, line_number, depth + 1), by_id[parent][1].get("name", "")] \
-                if parent in by_id else []
-        else:
-            path = scope_path(_dbg_int(fields, "scope", source, line_number), line_number)
-        qualified_paths[symbol_id] = path
-        return path
+    def symbol_path(fields: dict[str, str], number: int) -> tuple[str, ...]:
+        """Scope path of a symbol: its scope's, or for a cheap local (`@loop`) its parent label's
+        path and name (ca65 hangs a cheap local off a normal label, never off another cheap local)."""
+        if "parent" not in fields:
+            return scope_path(_dbg_int(fields, "scope", source, number), number)
+        parent = _dbg_int(fields, "parent", source, number)
+        if parent not in by_id or "parent" in by_id[parent][1]:
+            raise InputError(f"{source}:{number}: the parent of this cheap local, symbol {parent}, "
+                             f"is not a label defined in the file")
+        parent_number, parent_fields = by_id[parent]
+        return (*symbol_path(parent_fields, parent_number), parent_fields.get("name", ""))
 
     symbols = []
     for number, fields in records:
@@ -346,7 +347,7 @@ def _parse_dbg(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> l
         address = _address_or_skip(_dbg_int(fields, "val", source, number), skipped)
         if address is None:
             continue
-        path = symbol_path(_dbg_int(fields, "id", source, number), number)
+        path = symbol_path(fields, number)
         symbols.append(Symbol(name=fields.get("name", ""), address=address, scope=SCOPE_SEPARATOR.join(path)))
     return symbols
 

@@ -273,3 +273,16 @@ def test_long_hostile_lines_are_read_in_linear_time():
     assert len(parse_symbol_file(f"ok, 0xc000, 0, 0x0000\nf.asm {numbers}\n", "f").symbols) == 1
     with pytest.raises(InputError, match="f:1: expected 'name = \\$ADDR'"):
         parse_symbol_file("x = $1" + " ; ?" * 100_000 + " ; z\n", "f")
+
+
+def test_dbg_cheap_local_must_hang_off_a_label_and_deep_scopes_are_walked_once():
+    head = 'version\tmajor=2,minor=0\nscope\tid=0,name=""\n'
+    chained = head + ('sym\tid=0,name="@a",parent=1,val=0xC000,type=lab\n'
+                      'sym\tid=1,name="@b",parent=0,val=0xC001,type=lab\n')
+    with pytest.raises(InputError, match="t.dbg:3: the parent of this cheap local, symbol 1, is not a label"):
+        parse_symbol_file(chained, "t.dbg")
+    depth = 5000  # deeper than Python's recursion limit
+    scopes = "".join(f'scope\tid={i},name="s{i}",parent={i - 1}\n' for i in range(1, depth))
+    syms = "".join(f'sym\tid={i},name="x{i}",scope={depth - 1},val=0x{i:X},type=equ\n' for i in range(200))
+    symbols = parse_symbol_file(head + scopes + syms, "t.dbg").symbols
+    assert len(symbols) == 200 and symbols[7].scope.count("::") == depth - 2 and symbols[7].address == 7
