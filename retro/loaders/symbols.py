@@ -129,14 +129,14 @@ def _scoped(qualified: str, separators: str, address: int) -> Symbol:
 # never converted (Python refuses decimal strings past 4,300 digits, and a huge hex number costs
 # time for nothing): it is only known to be out of range.
 _ADDRESS_DIGITS = 8
-ABOVE_ADDRESSES = ADDRESS_LIMIT + 1  # stands for any number too long to be converted
+_ABOVE_ADDRESSES = ADDRESS_LIMIT + 1  # stands for any number too long to be converted
 
 
-def unsigned_value(digits: str, base: int) -> int:
-    """Digits (no sign) -> their value, or ABOVE_ADDRESSES when they cannot be an address."""
+def _unsigned_value(digits: str, base: int) -> int:
+    """Digits (no sign) -> their value, or _ABOVE_ADDRESSES when they cannot be an address."""
     significant = digits.lstrip("0")
     if len(significant) > _ADDRESS_DIGITS:
-        return ABOVE_ADDRESSES
+        return _ABOVE_ADDRESSES
     return int(significant or "0", base)
 
 
@@ -145,7 +145,7 @@ def _bounded_hex(digits: str, widest: int, what: str, source: str, number: int) 
     if len(digits) > widest:
         raise InputError(f"{source}:{number}: {len(digits)}-digit number in {what}; "
                          f"the assembler writes at most {widest} hex digits")
-    return unsigned_value(digits, 16)
+    return _unsigned_value(digits, 16)
 
 
 def _address_or_skip(value: int, skipped: Skipped) -> int | None:
@@ -167,13 +167,13 @@ _WORD_VALUES = {"true", "false"}
 _GAP = "?"  # 64tass: a name reserved without a value; ACME: a symbol never defined
 
 
-def classify_value(text: str) -> int | SkipKind | None:
-    """An assembler's printed value -> an integer (any size: ABOVE_ADDRESSES when it is too long,
+def _classify_value(text: str) -> int | SkipKind | None:
+    """An assembler's printed value -> an integer (any size: _ABOVE_ADDRESSES when it is too long,
     negative when signed), the kind of non-address it is, or None when no assembler prints it so."""
     match = _INTEGER_VALUE.match(text)
     if match:
         digits, base = (match.group("hex"), 16) if match.group("hex") is not None else (match.group("decimal"), 10)
-        value = unsigned_value(digits, base)
+        value = _unsigned_value(digits, base)
         if match.group("sign") == "-":
             return -value
         return ~value if match.group("sign") == "~" else value  # 64tass prints a negative bit string as ~$7f
@@ -189,7 +189,7 @@ def classify_value(text: str) -> int | SkipKind | None:
 
 def _value_address(text: str, skipped: Skipped, source: str, number: int, line: str, expected: str) -> int | None:
     """A printed value -> its address, or None after counting why it gives none."""
-    value = classify_value(text)
+    value = _classify_value(text)
     if value is None:
         raise _malformed(source, number, line, expected)
     if isinstance(value, SkipKind):
