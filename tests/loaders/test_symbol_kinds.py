@@ -286,3 +286,14 @@ def test_dbg_cheap_local_must_hang_off_a_label_and_deep_scopes_are_walked_once()
     syms = "".join(f'sym\tid={i},name="x{i}",scope={depth - 1},val=0x{i:X},type=equ\n' for i in range(200))
     symbols = parse_symbol_file(head + scopes + syms, "t.dbg").symbols
     assert len(symbols) == 200 and symbols[7].scope.count("::") == depth - 2 and symbols[7].address == 7
+
+
+def test_the_projects_aabb8_built_by_dasm_checks_against_its_reference(capsys):
+    # dasm_aabb8.prg is byte for byte `retro asm asm/aabb8.s` (tests/data/symbols/README.md); asm/aabb8.s
+    # states its cost as 20-34 cycles, static 20-34
+    code, out, _ = run_cli(capsys, "check", KINDS.parent / "specs" / "aabb8_dasm.toml", "--quiet", "--json")
+    (record,) = json.loads(out)
+    assert code == 0 and record["mismatches"] == 0 and record["cases"] > 3000
+    assert (record["static_min"], record["static_max"], record["min"], record["max"]) == (20, 34, 20, 34)
+    assert record["notes"] == [f"{KINDS / 'dasm_aabb8.sym'}: 12 symbols read; skipped 1 string macro, "
+                               f"1 constant outside $0000-$FFFF (lines without an address)"]
