@@ -469,8 +469,8 @@ def _is_xa_references(line: str) -> bool:
     """`file.asm 7 9`: a file name (no comma) and one or more line numbers (split, not a regex: a
     pattern for it backtracks quadratically on a long line of numbers)."""
     words = line.split()
-    numbers = len(words) - next((i for i, word in enumerate(reversed(words)) if not word.isdigit()), len(words))
-    return 0 < numbers < len(words) and "," not in line
+    line_numbers = next((i for i, word in enumerate(reversed(words)) if not word.isdecimal()), len(words))
+    return 0 < line_numbers < len(words) and "," not in line
 
 
 def _parse_xa(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> list[Symbol]:
