@@ -26,6 +26,7 @@ class Program:
     # scopes): a name defined twice is never resolved silently to one of them
     ambiguous: dict[str, tuple[str, ...]] = field(default_factory=dict)
     cpu: str | None = None  # the CPU the file implies ("2a03" for an iNES image), None when it does not say
+    notes: tuple[str, ...] = ()  # what loading it left out, one line each (a symbol file's skipped lines)
 
     @property
     def end(self) -> int:

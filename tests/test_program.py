@@ -67,9 +67,9 @@ def test_malformed_label_file_names_file_and_line(tmp_path):
     assert str(error.value).startswith(f"{labels}:3: ")
 
 
-def test_label_address_above_ffff():
-    with pytest.raises(InputError, match="lbl:2: value \\$10000 of .far. is above \\$FFFF"):
-        parse_vice_labels("al C:c000 .ok\nal 010000 .far\n", source="lbl")
+def test_label_address_above_ffff_is_left_out_never_wrapped():
+    # ld65 -Ln writes a constant wider than 16 bits (or a negative, FFFFFFF0) like any label
+    assert parse_vice_labels("al C:c000 .ok\nal 010000 .far\nal FFFFFFF0 .neg\n", source="lbl") == {"ok": 0xC000}
 
 
 def test_loading_a_prg_with_labels(tmp_path):

@@ -800,7 +800,7 @@ def check_record(check: RoutineCheck) -> dict:
               "engine_agreement": None if check.agreement is None else {
                   "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
                   "timing_model_mismatches": check.agreement.cycle_mismatches},
-              "first_failure": None}
+              "notes": list(check.routine.notes), "first_failure": None}
     failure = t.failure
     if failure is not None:
         routine = check.routine
@@ -848,6 +848,7 @@ def format_check(check: RoutineCheck) -> list[str]:
                    f"{a.engine_cases - a.engine_mismatches} and the timing model on "
                    f"{a.cases - a.cycle_mismatches - a.run_errors}")
     lines = [f"{routine.name}: {t.cases} cases, {verdict}; {cost}, {static}; {checked}"]
+    lines += [f"  note: {note}" for note in routine.notes]
     if check.parts:
         lines.append(f"  cases: {format_coverage(check)}; input space {format_space(check.routine.input_space())}")
     if routine.coverage:

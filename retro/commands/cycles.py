@@ -18,4 +18,5 @@ def as_json(checks: list[RoutineCheck]) -> list[dict]:
 
 
 def lines(checks: list[RoutineCheck]) -> list[str]:
-    return format_cost_table(checks)
+    notes = dict.fromkeys(note for c in checks for note in c.routine.notes)  # a symbol file shared by specs: once
+    return format_cost_table(checks) + [f"note: {note}" for note in notes]

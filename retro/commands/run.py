@@ -115,7 +115,8 @@ def as_json(report: RunReport) -> dict:
     """The object `retro run --json` prints (its keys are a contract: no trace in it)."""
     r = report.result
     return {"cycles": r.cycles, "instructions": r.instructions, "a": r.a, "x": r.x, "y": r.y, "s": r.s, "p": r.p,
-            "peek": report.peeks, **({"raster": report.raster.as_dict()} if report.raster else {})}
+            "peek": report.peeks, **({"raster": report.raster.as_dict()} if report.raster else {}),
+            **({"notes": list(report.program.notes)} if report.program.notes else {})}
 
 
 def trace_lines(report: RunReport) -> list[str]:
@@ -147,4 +148,5 @@ def lines(report: RunReport) -> list[str]:
                    f"{budget.end_cycle}, {budget.lines} lines ({budget.stolen} of the cycles stolen by the VIC-II"
                    f"{'; crosses a frame end' if budget.frames else ''})")
     out += [f"{target}: " + " ".join(f"${v:02X}" for v in values) for target, values in report.peeks.items()]
+    out += [f"note: {note}" for note in report.program.notes]  # e.g. a symbol file's skipped lines
     return out

@@ -25,7 +25,7 @@ from retro.chips.ines import (
 )
 from retro.errors import InputError
 from retro.fileio import read_bytes
-from retro.loaders.symbols import load_symbol_tables
+from retro.loaders.symbols import read_symbol_file, symbol_tables
 from retro.numbers import parse_address
 from retro.program import ADDRESS_LIMIT, Program, parse_prg
 
@@ -129,13 +129,15 @@ def _raw_program(data: bytes, load: int | str, source: str) -> Program:
 
 
 def _with_symbols(program: Program, symbols: str | Path | None, vectors: dict[str, int]) -> Program:
-    table, ambiguous = load_symbol_tables(symbols) if symbols else ({}, {})
+    symbol_file = read_symbol_file(symbols) if symbols else None
+    table, ambiguous = symbol_tables(symbol_file.symbols) if symbol_file else ({}, {})
     for name, address in vectors.items():
         table[VECTOR_PREFIX + name] = address
         if name not in table and name not in ambiguous:
             table[name] = address
     return Program(code=program.code, origin=program.origin, symbols=table, ambiguous=ambiguous,
-                   source=program.source, cpu=program.cpu)
+                   source=program.source, cpu=program.cpu,
+                   notes=(symbol_file.note,) if symbol_file and symbol_file.note else ())
 
 
 def load_program(path: str | Path, *, symbols: str | Path | None = None, load: int | str | None = None) -> Program:

@@ -1,21 +1,31 @@
 """Symbol files of the common 6502 assemblers -> plain `Symbol`s -> the tables a `Program` holds.
 
 The format is recognised from the content, never from the file name (docs/symbols.md lists each
-assembler's command line and what it writes):
+assembler's command line, every kind of line it writes, and what retro does with each):
 
 - VICE labels, `al C:c000 .name` / `al c000 .name` / `al 00C000 .name`: ACME --vicelabels,
-  64tass --vice-labels(-numeric) (scopes spelt `proc:loop`), ld65 -Ln (no scopes), Kick -vicesymbols.
+  64tass --vice-labels(-numeric) (scopes spelt `proc:loop`), ld65 -Ln (no scopes), Kick -vicesymbols
+  (which may add `break`/`watch`/`trace` monitor commands).
 - Kick Assembler -symbolfile `.sym`: `.label name=$1000`, `.const name=$fb`, `.namespace x { ... }`.
 - ca65/ld65 `--dbgfile`: `scope` and `sym` lines (cc65 doc "dbginfo"); scopes give `proc::loop`.
-- An equate list, `name = $c000` a line: ACME --symbollist (`; ?` remarks) and 64tass --labels.
+- An equate list, `name = $c000` a line: ACME --symbollist (`!addr` prefix, `+2` suffix, `; ?` and
+  `; unused` remarks) and 64tass --labels (any 64tass value: strings, floats, lists, `:=` variables).
 - 64tass --dump-labels: `file:line:col: scope.name = $c000`.
 - DASM -s: `name  c000  (R )` between `--- Symbol List` lines; `N.name` is a local of SUBROUTINE N.
-- xa -l: `name, 0xc000, block, 0x0000`; the block is a number, not a name.
+- xa -l: `name, 0xc000, block, 0xseg`, with -r each followed by `file line line ...` references.
+
+Every line an assembler writes is understood. A line that gives an address (0..$FFFF) is a symbol;
+the others (DASM string macros and unresolved names, strings, floats, constants outside 0..$FFFF
+such as negatives written as 32- or 64-bit values) are counted by kind and said once in the
+`SymbolFile.note`. A line no assembler writes is a one-line error naming the file and the line.
+Numbers are read strictly: no digit string is ever converted whole when it is longer than an
+address can be, and a negative value is never wrapped into the address space.
 """
 
 from __future__ import annotations
 
 import re
+from collections import Counter
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,10 +51,49 @@ class Symbol:
 
 
 @dataclass(frozen=True)
+class SkipKind:
+    """A kind of line an assembler writes that names no address."""
+    singular: str
+    plural: str
+
+    def counted(self, count: int) -> str:
+        return f"{count} {self.singular if count == 1 else self.plural}"
+
+
+STRING_MACRO = SkipKind("string macro", "string macros")  # DASM EQM
+STRING = SkipKind("string constant", "string constants")  # DASM `str`, 64tass and Kick strings
+UNRESOLVED = SkipKind("unresolved name", "unresolved names")  # DASM `????`, ACME `?`, 64tass gaps, xa imports
+OUT_OF_RANGE = SkipKind("constant outside $0000-$FFFF", "constants outside $0000-$FFFF")  # negatives too
+NOT_INTEGER = SkipKind("non-integer value", "non-integer values")  # floats, lists, booleans, bytes, ...
+MONITOR_COMMAND = SkipKind("monitor command", "monitor commands")  # `break`/`watch`/`trace` in a .vs file
+SKIP_KINDS = (STRING_MACRO, STRING, UNRESOLVED, OUT_OF_RANGE, NOT_INTEGER, MONITOR_COMMAND)
+
+Skipped = Counter  # SkipKind -> number of lines of that kind
+
+
+@dataclass(frozen=True)
+class SymbolFile:
+    source: str
+    format: str  # the SymbolFormat's name; "" for an empty file
+    symbols: tuple[Symbol, ...]
+    skipped: tuple[tuple[SkipKind, int], ...] = ()  # in SKIP_KINDS order, kinds that occur only
+
+    @property
+    def note(self) -> str:
+        """One line for the report when lines were skipped ("" when none was)."""
+        if not self.skipped:
+            return ""
+        kinds = ", ".join(kind.counted(count) for kind, count in self.skipped)
+        read = f"{len(self.symbols)} symbol{'' if len(self.symbols) == 1 else 's'}"
+        return f"{self.source}: {read} read; skipped {kinds} (lines without an address)"
+
+
+@dataclass(frozen=True)
 class SymbolFormat:
     name: str
     detect: Callable[[str], bool]  # the first significant line -> is it this format?
-    parse: Callable[[list[tuple[int, str]], str], list[Symbol]]  # (line number, line) pairs, source
+    # (line number, line) pairs, source, the skip counter to add to -> symbols
+    parse: Callable[[list[tuple[int, str]], str, Skipped], list[Symbol]]
 
 
 # ---- helpers ---------------------------------------------------------------------------------
@@ -55,12 +104,6 @@ _COMMENT_PREFIXES = ("#", ";", "//")
 def _significant_lines(text: str) -> list[tuple[int, str]]:
     return [(number, line.strip()) for number, line in enumerate(text.splitlines(), start=1)
             if line.strip() and not line.strip().startswith(_COMMENT_PREFIXES)]
-
-
-def _checked_address(value: int, name: str, source: str, number: int) -> int:
-    if value > ADDRESS_LIMIT:
-        raise InputError(f"{source}:{number}: value ${value:X} of {name!r} is above ${ADDRESS_LIMIT:04X}")
-    return value
 
 
 def _malformed(source: str, number: int, line: str, expected: str) -> InputError:
@@ -80,34 +123,105 @@ def _scoped(qualified: str, separators: str, address: int) -> Symbol:
     return Symbol(name=name, address=address, scope=scope, spelling=qualified if scope else "")
 
 
-# Integer values as the formats write them; anything else (strings, floats, lists) is a constant that
-# cannot be an address, and is left out.
-_HEX_DOLLAR = re.compile(r"^\$([0-9A-Fa-f]+)$")
-_DECIMAL = re.compile(r"^([0-9]+)$")
+# ---- numbers ---------------------------------------------------------------------------------
+
+# A number with more significant digits than this is above $FFFF in base 10 and 16 alike; it is
+# never converted (Python refuses decimal strings past 4,300 digits, and a huge hex number costs
+# time for nothing): it is only known to be out of range.
+_ADDRESS_DIGITS = 8
+_ABOVE_ADDRESSES = ADDRESS_LIMIT + 1  # stands for any number too long to be converted
 
 
-def _integer(text: str) -> int | None:
-    match = _HEX_DOLLAR.match(text)
+def _unsigned_value(digits: str, base: int) -> int:
+    """Digits (no sign) -> their value, or _ABOVE_ADDRESSES when they cannot be an address."""
+    significant = digits.lstrip("0")
+    if len(significant) > _ADDRESS_DIGITS:
+        return _ABOVE_ADDRESSES
+    return int(significant or "0", base)
+
+
+def _bounded_hex(digits: str, widest: int, what: str, source: str, number: int) -> int:
+    """Hex digits of a format that writes at most `widest` of them (a C `%x` of its integer type)."""
+    if len(digits) > widest:
+        raise InputError(f"{source}:{number}: {len(digits)}-digit number in {what}; "
+                         f"the assembler writes at most {widest} hex digits")
+    return _unsigned_value(digits, 16)
+
+
+def _address_or_skip(value: int, skipped: Skipped) -> int | None:
+    if 0 <= value <= ADDRESS_LIMIT:
+        return value
+    skipped[OUT_OF_RANGE] += 1
+    return None
+
+
+# Values as 64tass and Kick Assembler print them (their own expression syntax). ACME's symbol list
+# shares the line format and writes a subset: `$hex`, floats and `?`.
+_INTEGER_VALUE = re.compile(r"^(?P<sign>[-~]?)(?:\$(?P<hex>[0-9A-Fa-f]+)|(?P<decimal>[0-9]+))$")
+_FLOAT_VALUE = re.compile(r"^-?(?:[0-9]+\.[0-9]*(?:[eE][-+]?[0-9]+)?|[0-9]+[eE][-+]?[0-9]+|inf|nan)$")
+_STRING_VALUE = re.compile(r"""^(?:"(?:[^"]|"")*"|'(?:[^']|'')*')$""")
+_BYTES_VALUE = re.compile(r"""^[A-Za-z](?:"(?:[^"]|"")*"|'(?:[^']|'')*')$""")  # 64tass bytes: z'0S*', x"12"
+_CALL_VALUE = re.compile(r"^[A-Za-z_]\w*\(.*\)$")  # 64tass objects: register("a")
+_BRACKETS = {"[": "]", "(": ")", "{": "}"}  # 64tass lists, tuples, dictionaries
+_WORD_VALUES = {"true", "false"}
+_GAP = "?"  # 64tass: a name reserved without a value; ACME: a symbol never defined
+
+
+def _classify_value(text: str) -> int | SkipKind | None:
+    """An assembler's printed value -> an integer (any size: _ABOVE_ADDRESSES when it is too long,
+    negative when signed), the kind of non-address it is, or None when no assembler prints it so."""
+    match = _INTEGER_VALUE.match(text)
     if match:
-        return int(match.group(1), 16)
-    match = _DECIMAL.match(text)
-    return int(text) if match else None
+        digits, base = (match.group("hex"), 16) if match.group("hex") is not None else (match.group("decimal"), 10)
+        value = _unsigned_value(digits, base)
+        if match.group("sign") == "-":
+            return -value
+        return ~value if match.group("sign") == "~" else value  # 64tass prints a negative bit string as ~$7f
+    if _STRING_VALUE.match(text):
+        return STRING
+    if text == _GAP:
+        return UNRESOLVED
+    if (_FLOAT_VALUE.match(text) or _BYTES_VALUE.match(text) or _CALL_VALUE.match(text) or text in _WORD_VALUES
+            or (text[:1] in _BRACKETS and text.endswith(_BRACKETS[text[:1]]))):
+        return NOT_INTEGER
+    return None
+
+
+def _value_address(text: str, skipped: Skipped, source: str, number: int, line: str, expected: str) -> int | None:
+    """A printed value -> its address, or None after counting why it gives none."""
+    value = _classify_value(text)
+    if value is None:
+        raise _malformed(source, number, line, expected)
+    if isinstance(value, SkipKind):
+        skipped[value] += 1
+        return None
+    return _address_or_skip(value, skipped)
 
 
 # ---- VICE labels -----------------------------------------------------------------------------
 
-_VICE_LINE = re.compile(r"^al\s+(?:[Cc]:)?(?P<address>[0-9A-Fa-f]{1,6})\s+\.?(?P<name>\S+)$")
+# ACME writes `%04x` of a 32-bit value (a negative as ffffff80), ld65 `%06lX` (FFFFFFF0), 64tass
+# `%x` of up to 24 bits (ffff80): 16 digits is room for a 64-bit value, more is no assembler's
+_VICE_DIGITS = 16
+_VICE_LINE = re.compile(r"^al\s+(?:[Cc]:)?(?P<address>[0-9A-Fa-f]+)\s+\.?(?P<name>\S+)$")
+# Kick Assembler's .vs carries its .break/.watch directives as VICE monitor commands
+_VICE_COMMAND = re.compile(r"^(?:break|watch|trace)(?:\s.*)?$")
 
 
-def _parse_vice(lines: list[tuple[int, str]], source: str) -> list[Symbol]:
+def _parse_vice(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> list[Symbol]:
     symbols = []
     for number, line in lines:
         match = _VICE_LINE.match(line)
         if not match:
+            if _VICE_COMMAND.match(line):
+                skipped[MONITOR_COMMAND] += 1
+                continue
             raise _malformed(source, number, line, "'al C:ADDR .name'")
         name = match.group("name")
-        address = _checked_address(int(match.group("address"), 16), name, source, number)
-        symbols.append(_scoped(name, ":.", address))  # 64tass writes `proc:loop`, Kick `ns.label`
+        address = _address_or_skip(_bounded_hex(match.group("address"), _VICE_DIGITS, f"the address of {name!r}",
+                                                source, number), skipped)
+        if address is not None:
+            symbols.append(_scoped(name, ":.", address))  # 64tass writes `proc:loop`, Kick `ns.label`
     return symbols
 
 
@@ -116,9 +230,10 @@ def _parse_vice(lines: list[tuple[int, str]], source: str) -> list[Symbol]:
 # a name may also carry its scopes itself (`fill.loop`), besides sitting in a .namespace block
 _KICK_SYMBOL = re.compile(r"^\.(?:label|const|var)\s+(?P<name>[A-Za-z_@][\w@.]*)\s*=\s*(?P<value>.+?)\s*$")
 _KICK_NAMESPACE = re.compile(r"^\.namespace\s+(?P<name>[A-Za-z_@][\w@]*)\s*\{$")
+_KICK_EXPECTED = "'.label name=$ADDR', '.const', '.namespace name {' or '}'"
 
 
-def _parse_kick(lines: list[tuple[int, str]], source: str) -> list[Symbol]:
+def _parse_kick(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> list[Symbol]:
     symbols, scopes = [], []
     for number, line in lines:
         if line == "}":
@@ -132,12 +247,11 @@ def _parse_kick(lines: list[tuple[int, str]], source: str) -> list[Symbol]:
             continue
         match = _KICK_SYMBOL.match(line)
         if not match:
-            raise _malformed(source, number, line, "'.label name=$ADDR', '.const', '.namespace name {' or '}'")
-        value = _integer(match.group("value"))
-        if value is None:
-            continue  # a string or float constant: not an address
+            raise _malformed(source, number, line, _KICK_EXPECTED)
+        address = _value_address(match.group("value"), skipped, source, number, line, _KICK_EXPECTED)
+        if address is None:
+            continue
         path = [*scopes, *match.group("name").split(".")]
-        address = _checked_address(value, match.group("name"), source, number)
         symbols.append(Symbol(name=path[-1], address=address, scope=SCOPE_SEPARATOR.join(path[:-1]),
                               spelling=".".join(path) if len(path) > 1 else ""))
     if scopes:
@@ -149,6 +263,11 @@ def _parse_kick(lines: list[tuple[int, str]], source: str) -> list[Symbol]:
 
 _DBG_RECORD = re.compile(r"^(?P<kind>[a-z]+)\s+(?P<fields>.*)$")
 _DBG_FIELD = re.compile(r'(?P<key>\w+)=(?P<value>"[^"]*"|[^,]*)')
+# ld65 writes ids and counts in decimal and values as `0x%lX` of a long (cc65's own values are 32
+# bits, so a negative one reads 0xFFFFFFF0): never a sign
+_DBG_NUMBER = re.compile(r"^(?:0[xX](?P<hex>[0-9A-Fa-f]+)|(?P<decimal>[0-9]+))$")
+_DBG_DIGITS = 16
+_DBG_DECIMAL_DIGITS = 20  # ids and counts: `%u` of at most 64 bits
 
 
 def _dbg_fields(line: str, source: str, number: int) -> tuple[str, dict[str, str]]:
@@ -160,13 +279,19 @@ def _dbg_fields(line: str, source: str, number: int) -> tuple[str, dict[str, str
 
 
 def _dbg_int(fields: dict[str, str], key: str, source: str, number: int) -> int:
-    try:
-        return int(fields[key], 0)
-    except (KeyError, ValueError):
-        raise InputError(f"{source}:{number}: field {key!r} missing or not a number") from None
+    match = _DBG_NUMBER.match(fields.get(key, ""))
+    if not match:
+        raise InputError(f"{source}:{number}: field {key!r} missing or not a number "
+                         f"(ld65 writes 0x1234 or 1234, never a sign)")
+    if match.group("hex") is not None:
+        return _bounded_hex(match.group("hex"), _DBG_DIGITS, f"field {key!r}", source, number)
+    if len(match.group("decimal")) > _DBG_DECIMAL_DIGITS:
+        raise InputError(f"{source}:{number}: {len(match.group('decimal'))}-digit number in field {key!r}; "
+                         f"ld65 writes at most {_DBG_DECIMAL_DIGITS} decimal digits")
+    return int(match.group("decimal"))
 
 
-def _parse_dbg(lines: list[tuple[int, str]], source: str) -> list[Symbol]:
+def _parse_dbg(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> list[Symbol]:
     scopes: dict[int, tuple[str, int | None]] = {}  # id -> (name, parent id)
     records: list[tuple[int, dict[str, str]]] = []
     promised: dict[str, int] = {}  # the `info` line counts every kind of record: a cut file is caught
@@ -184,134 +309,189 @@ def _parse_dbg(lines: list[tuple[int, str]], source: str) -> list[Symbol]:
             raise InputError(f"{source}: truncated: its info line promises {promised[kind]} {kind} records, "
                              f"the file has {found}")
 
-    def scope_path(scope_id: int, number: int) -> list[str]:
-        path, seen = [], set()
-        while scope_id is not None:
+    scope_paths: dict[int, tuple[str, ...]] = {}  # each scope's path is walked once, however deep
+
+    def scope_path(scope_id: int, number: int) -> tuple[str, ...]:
+        chain, seen = [], set()
+        while scope_id is not None and scope_id not in scope_paths:
             if scope_id in seen or scope_id not in scopes:
                 raise InputError(f"{source}:{number}: scope {scope_id} is not defined in the file")
             seen.add(scope_id)
-            name, scope_id = scopes[scope_id]
-            if name:
-                path.append(name)
-        return path[::-1]
+            chain.append(scope_id)
+            scope_id = scopes[scope_id][1]
+        path = scope_paths[scope_id] if scope_id is not None else ()
+        for walked in reversed(chain):
+            name = scopes[walked][0]
+            path = (*path, name) if name else path
+            scope_paths[walked] = path
+        return path
 
     by_id = {_dbg_int(fields, "id", source, number): (number, fields) for number, fields in records}
-    qualified_paths: dict[int, list[str]] = {}
 
-    def symbol_path(symbol_id: int, number: int, depth: int = 0) -> list[str]:
-        """Scope path of a symbol: its scope's, or for a cheap local (`@loop`) its parent label's."""
-        if symbol_id in qualified_paths:
-            return qualified_paths[symbol_id]
-        if symbol_id not in by_id or depth > len(by_id):
-            raise InputError(f"{source}:{number}: symbol {symbol_id} is not defined in the file")
-        line_number, fields = by_id[symbol_id]
-        if "parent" in fields:
-            parent = _dbg_int(fields, "parent", source, line_number)
-            path = [*symbol_path(parent, line_number, depth + 1), by_id[parent][1].get("name", "")] \
-                if parent in by_id else []
-        else:
-            path = scope_path(_dbg_int(fields, "scope", source, line_number), line_number)
-        qualified_paths[symbol_id] = path
-        return path
+    def symbol_path(fields: dict[str, str], number: int) -> tuple[str, ...]:
+        """Scope path of a symbol: its scope's, or for a cheap local (`@loop`) its parent label's
+        path and name (ca65 hangs a cheap local off a normal label, never off another cheap local)."""
+        if "parent" not in fields:
+            return scope_path(_dbg_int(fields, "scope", source, number), number)
+        parent = _dbg_int(fields, "parent", source, number)
+        if parent not in by_id or "parent" in by_id[parent][1]:
+            raise InputError(f"{source}:{number}: the parent of this cheap local, symbol {parent}, "
+                             f"is not a label defined in the file")
+        parent_number, parent_fields = by_id[parent]
+        return (*symbol_path(parent_fields, parent_number), parent_fields.get("name", ""))
 
     symbols = []
     for number, fields in records:
         if fields.get("type") == "imp" or "val" not in fields:
             continue  # an import names a symbol defined (with its value) elsewhere in the file
-        name = fields.get("name", "")
-        path = symbol_path(_dbg_int(fields, "id", source, number), number)
-        address = _checked_address(_dbg_int(fields, "val", source, number), name, source, number)
-        symbols.append(Symbol(name=name, address=address, scope=SCOPE_SEPARATOR.join(path)))
+        address = _address_or_skip(_dbg_int(fields, "val", source, number), skipped)
+        if address is None:
+            continue
+        path = symbol_path(fields, number)
+        symbols.append(Symbol(name=fields.get("name", ""), address=address, scope=SCOPE_SEPARATOR.join(path)))
     return symbols
 
 
 # ---- equate lists: ACME --symbollist, 64tass --labels ----------------------------------------
 
-_EQUATE_LINE = re.compile(r"^(?P<name>[A-Za-z_.@][\w.@]*)\s*=\s*(?P<value>[^;]*?)\s*(?:;.*)?$")
+# ACME: `[!addr]\tname[+2|+3]\t= value[\t; ?][\t; unused]` (`!addr` with -Wtype-mismatch, `+2` a
+# forced width, `; ?` a forward reference, `; unused` never read); 64tass: `name\t\t= value`, or
+# `:=` for a variable, with any 64tass value up to the end of the line.
+_EQUATE_LINE = re.compile(r"^(?:!addr\s*)?(?P<name>[A-Za-z_.@][\w.@]*)(?:\+[23])?\s*:?=\s*(?P<value>.*)$")
+_ACME_VALUE = re.compile(r"^(?P<value>[^\s;]+)(?P<remarks>(?:\s*;\s*(?:\?|unused))*)$")
+_WHOLE_LINE_VALUE = re.compile(r"""^(?:["'\[({]|[A-Za-z_]\w*\(|[A-Za-z]["'])""")  # may hold spaces and `;`
+_EQUATE_EXPECTED = "'name = $ADDR'"
 
 
-def _parse_equates(lines: list[tuple[int, str]], source: str) -> list[Symbol]:
+def _equate_value(text: str) -> str | None:
+    """The value part of an equate (without ACME's remarks), None when the remarks are not ACME's."""
+    if _WHOLE_LINE_VALUE.match(text):
+        return text
+    match = _ACME_VALUE.match(text)
+    return match.group("value") if match else None
+
+
+def _parse_equates(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> list[Symbol]:
     symbols = []
     for number, line in lines:
         match = _EQUATE_LINE.match(line)
-        if not match:
-            raise _malformed(source, number, line, "'name = $ADDR'")
-        value = _integer(match.group("value"))
+        value = _equate_value(match.group("value")) if match else None
         if value is None:
-            continue  # 64tass lists strings, floats, lists and negative numbers too: none is an address
-        name = match.group("name")
-        symbols.append(_scoped(name, ".", _checked_address(value, name, source, number)))
+            raise _malformed(source, number, line, _EQUATE_EXPECTED)
+        address = _value_address(value, skipped, source, number, line, _EQUATE_EXPECTED)
+        if address is not None:
+            symbols.append(_scoped(match.group("name"), ".", address))
     return symbols
 
 
 # ---- 64tass --dump-labels --------------------------------------------------------------------
 
-_DUMP_LINE = re.compile(r"^(?P<file>.+?):(?P<line>\d+):(?P<column>\d+):\s+(?P<name>\S+)\s*=\s*(?P<value>.*?)\s*$")
+_DUMP_LINE = re.compile(r"^(?P<file>.+?):(?P<line>\d+):(?P<column>\d+):\s+(?P<name>\S+)\s*:?=\s*(?P<value>.*?)\s*$")
+_DUMP_EXPECTED = "'FILE:LINE:COLUMN: name = $ADDR'"
 
 
-def _parse_tass_dump(lines: list[tuple[int, str]], source: str) -> list[Symbol]:
+def _parse_tass_dump(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> list[Symbol]:
     symbols = []
     for number, line in lines:
         match = _DUMP_LINE.match(line)
         if not match:
-            raise _malformed(source, number, line, "'FILE:LINE:COLUMN: name = $ADDR'")
-        value = _integer(match.group("value"))
-        if value is None:
-            continue
-        name = match.group("name")
-        symbols.append(_scoped(name, ".", _checked_address(value, name, source, number)))
+            raise _malformed(source, number, line, _DUMP_EXPECTED)
+        address = _value_address(match.group("value"), skipped, source, number, line, _DUMP_EXPECTED)
+        if address is not None:
+            symbols.append(_scoped(match.group("name"), ".", address))
     return symbols
 
 
 # ---- DASM -s ---------------------------------------------------------------------------------
 
-_DASM_HEADER = "--- Symbol List"
+# DASM's symbol dump (main.c ShowSymbols/sftos): `%-24s %-12s` of the name and of
+# `%04lx ` + `???? ` (unresolved) + `str ` + `eqm ` + `(R )`/`( S)`/`(RS)`, then ` "text"` for a
+# string. The value is a C long: a negative is 16 hex digits (ffffffffffffff80; 8 where long is 32
+# bits), a string's is its bytes (616263 for "abc"), an EQM macro's 0000.
+_DASM_HEADER = "--- Symbol List"  # then " (sorted by symbol)", " (sorted by address)", " (unsorted ...)"
 _DASM_FOOTER = "--- End of Symbol List"
-_DASM_LINE = re.compile(r'^(?P<name>\S+)\s+(?P<value>[0-9A-Fa-f]+|"[^"]*"|\S+)(?:\s+\((?P<flags>[^)]*)\))?$')
-_DASM_LOCAL = re.compile(r"^(?P<subroutine>\d+)\.(?P<name>.+)$")
+_DASM_LINE = re.compile(r'^(?P<name>\S+)\s+(?P<value>[0-9A-Fa-f]+)(?P<unresolved>\s+\?\?\?\?)?(?P<string>\s+str)?'
+                        r'(?P<macro>\s+eqm)?(?:\s+\([R ][S ]\))?(?:\s+"(?P<text>.*)")?$')
+_DASM_DIGITS = 16
+_DASM_LOCAL = re.compile(r"^(?P<subroutine>\d+)(?P<separator>[.$])(?P<name>.+)$")  # `1.loop`, `1$1$`
 
 
-def _parse_dasm(lines: list[tuple[int, str]], source: str) -> list[Symbol]:
-    symbols = []
+def _dasm_symbol(name: str, address: int) -> Symbol:
+    local = _DASM_LOCAL.match(name)
+    if not local:
+        return Symbol(name=name, address=address)
+    # `.loop` of the first SUBROUTINE is `1.loop`; a `1$` label of the first block of `$` locals is
+    # `1$1$`: DASM writes the block's number, not a name
+    return Symbol(name=local.group("name"), address=address, scope=local.group("subroutine"), spelling=name)
+
+
+def _parse_dasm(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> list[Symbol]:
+    symbols, ended = [], False
     for number, line in lines:
         if line.startswith("---"):
-            if not line.startswith((_DASM_HEADER, _DASM_FOOTER)):
-                raise _malformed(source, number, line, f"'{_DASM_HEADER} ...' or '{_DASM_FOOTER}.'")
+            if line.startswith(_DASM_FOOTER) and not ended:
+                ended = True
+            elif not line.startswith(_DASM_HEADER) or number != lines[0][0]:
+                raise _malformed(source, number, line, f"one '{_DASM_HEADER} ...' and one '{_DASM_FOOTER}.'")
             continue
         match = _DASM_LINE.match(line)
-        if not match:
-            raise _malformed(source, number, line, "'name  ADDR  (flags)'")
-        value = match.group("value")
-        if not re.fullmatch(r"[0-9A-Fa-f]+", value):
-            continue  # a string value or an unresolved symbol
+        if not match or ended or bool(match.group("string")) != (match.group("text") is not None):
+            raise _malformed(source, number, line, "'name  ADDR  (flags)' before the end of the list")
         name = match.group("name")
-        address = _checked_address(int(value, 16), name, source, number)
-        local = _DASM_LOCAL.match(name)
-        if local:  # `1.loop`: the local `.loop` of the first SUBROUTINE; DASM writes the number, not a name
-            symbols.append(Symbol(name=local.group("name"), address=address, scope=local.group("subroutine"),
-                                  spelling=name))
+        value = _bounded_hex(match.group("value"), _DASM_DIGITS, f"the value of {name!r}", source, number)
+        if match.group("macro"):
+            skipped[STRING_MACRO] += 1
+        elif match.group("unresolved"):
+            skipped[UNRESOLVED] += 1
+        elif match.group("string"):
+            skipped[STRING] += 1
         else:
-            symbols.append(Symbol(name=name, address=address))
-    # -T1 sorts by address and writes every symbol again: one copy is enough
+            address = _address_or_skip(value, skipped)
+            if address is not None:
+                symbols.append(_dasm_symbol(name, address))
+    if not ended:
+        raise InputError(f"{source}: truncated: no '{_DASM_FOOTER}.' line (DASM always ends the list with it)")
     return list(dict.fromkeys(symbols))
 
 
 # ---- xa -l -----------------------------------------------------------------------------------
 
-_XA_LINE = re.compile(r"^(?P<name>[A-Za-z_][\w]*),\s*0x(?P<address>[0-9A-Fa-f]+),\s*(?P<block>\d+),\s*0x[0-9A-Fa-f]+$")
+# xa's printllist: `%s, 0x%04x, %d, 0x%04x` (name, value, block, segment), and with -r after each
+# symbol the lines that reference it, `    FILE LINE LINE ...`. The segment 1 is "undefined": a
+# label given with -L and never defined.
+_XA_LINE = re.compile(r"^(?P<name>[A-Za-z_@][\w]*),\s*0x(?P<address>[0-9A-Fa-f]+),\s*(?P<block>\d+),"
+                      r"\s*0x(?P<segment>[0-9A-Fa-f]+)$")
+_XA_DIGITS = 8  # a C int
+_XA_UNDEFINED_SEGMENT = 1
 
 
-def _parse_xa(lines: list[tuple[int, str]], source: str) -> list[Symbol]:
-    symbols = []
+def _is_xa_references(line: str) -> bool:
+    """`file.asm 7 9`: a file name (no comma) and one or more line numbers (split, not a regex: a
+    pattern for it backtracks quadratically on a long line of numbers)."""
+    words = line.split()
+    line_numbers = next((i for i, word in enumerate(reversed(words)) if not word.isdecimal()), len(words))
+    return 0 < line_numbers < len(words) and "," not in line
+
+
+def _parse_xa(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> list[Symbol]:
+    symbols, after_symbol = [], False
     for number, line in lines:
         match = _XA_LINE.match(line)
         if not match:
+            if after_symbol and _is_xa_references(line):
+                continue  # -r: where the symbol above is used
             raise _malformed(source, number, line, "'name, 0xADDR, BLOCK, 0xSEG'")
+        after_symbol = True
         name = match.group("name")
+        value = _bounded_hex(match.group("address"), _XA_DIGITS, f"the value of {name!r}", source, number)
+        if _bounded_hex(match.group("segment"), _XA_DIGITS, "the segment", source, number) == _XA_UNDEFINED_SEGMENT:
+            skipped[UNRESOLVED] += 1
+            continue
+        address = _address_or_skip(value, skipped)
         # the block is xa's internal number for a `.(` ... `.)` block, which sources never name:
         # a name defined in two blocks is told apart by its address instead
-        symbols.append(Symbol(name=name, address=_checked_address(int(match.group("address"), 16), name, source,
-                                                                  number)))
+        if address is not None:
+            symbols.append(Symbol(name=name, address=address))
     return symbols
 
 
@@ -339,19 +519,27 @@ def detect_format(text: str) -> SymbolFormat | None:
     return None
 
 
-def parse_symbols(text: str, source: str = "symbols") -> list[Symbol]:
-    """A symbol file's text in any known format -> its symbols, in file order."""
+def parse_symbol_file(text: str, source: str = "symbols") -> SymbolFile:
+    """A symbol file's text in any known format -> its symbols (in file order) and what was skipped."""
     lines = _significant_lines(text)
     if not lines:
-        return []
+        return SymbolFile(source=source, format="", symbols=())
     symbol_format = detect_format(text)
     if symbol_format is None:
         tried = ", ".join(f.name for f in FORMATS)
         raise InputError(f"{source}: not a symbol file in a known format (tried {tried})")
-    return symbol_format.parse(lines, source)
+    skipped: Skipped = Counter()
+    symbols = symbol_format.parse(lines, source, skipped)
+    return SymbolFile(source=source, format=symbol_format.name, symbols=tuple(symbols),
+                      skipped=tuple((kind, skipped[kind]) for kind in SKIP_KINDS if skipped[kind]))
 
 
-def read_symbols(path: str | Path) -> list[Symbol]:
+def parse_symbols(text: str, source: str = "symbols") -> list[Symbol]:
+    """A symbol file's text in any known format -> its symbols, in file order."""
+    return list(parse_symbol_file(text, source).symbols)
+
+
+def read_symbol_file(path: str | Path) -> SymbolFile:
     """Read and parse a symbol file; binary junk is an error naming the file."""
     data = read_bytes(path, "symbol file")
     if b"\0" in data:
@@ -360,7 +548,11 @@ def read_symbols(path: str | Path) -> list[Symbol]:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
         text = data.decode("latin-1")  # older tools write 8-bit names; the names that matter are ASCII
-    return parse_symbols(text, source=str(path))
+    return parse_symbol_file(text, source=str(path))
+
+
+def read_symbols(path: str | Path) -> list[Symbol]:
+    return list(read_symbol_file(path).symbols)
 
 
 def symbol_tables(symbols: Iterable[Symbol]) -> tuple[dict[str, int], dict[str, tuple[str, ...]]]:

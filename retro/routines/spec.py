@@ -164,6 +164,7 @@ class Routine:
     static: bool = True
     summary: str = ""
     coverage: str = ""  # why the cases cover the input space (an argument the report quotes)
+    notes: tuple[str, ...] = ()  # what loading the program left out (a symbol file's skipped lines)
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -296,7 +297,8 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
         reference_name=reference_name, reference_memory=reference_memory, reference_arrays=reference_arrays, exhaustive=tuple(exhaustive),
         random=random_count, seed=seed, domain=domain, boundary=generators.get("boundary"),
         sweep=generators.get("sweep"), random_generator=generators.get("random_generator"), budget=budget,
-        loop_bounds=loop_bounds, limit=limit, static=static, summary=summary, coverage=coverage)
+        loop_bounds=loop_bounds, limit=limit, static=static, summary=summary, coverage=coverage,
+        notes=program.notes)
     if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep):
         raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary or sweep")
     if routine.exhaustive_count() > MAX_EXHAUSTIVE:
