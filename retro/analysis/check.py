@@ -871,7 +871,8 @@ def format_check(check: RoutineCheck) -> list[str]:
     routine = check.routine
     verdict = "OK" if not check.mismatches else f"{check.mismatches} MISMATCH(ES)"
     static = (f"static {check.static.best}-{check.static.worst}, worst case "
-              f"{'reached' if check.worst_reached else 'not reached'}" if check.static else "static analysis off")
+              f"{'reached' if check.worst_reached else 'not reached'}" if check.static else
+              "static bounds unknown" if check.rows is not None and check.rows.static_note else "static analysis off")
     cost = (f"cycles {t.cycles_min}-{t.cycles_max} (mean {check.mean:.2f})" if t.cycles_count
             else "no case inside the domain")
     if check.agreement is None:

@@ -212,8 +212,8 @@ def rows_only_static(routine: Routine, runner: RoutineRunner) -> tuple[Bounds | 
     try:
         return static_bounds(routine, runner), ""
     except InputError as exc:
-        reason = str(exc).removeprefix(f"{routine.spec_path}: ")
-        return None, f"{reason.split(' ([cycles]')[0]}; give [cycles] loops to bound them"
+        reason = str(exc).removeprefix(f"{routine.spec_path}: ").removeprefix("static analysis: ")
+        return None, reason.split(" ([cycles] static = false")[0]
 
 
 # ---- reports ---------------------------------------------------------------------------------------

@@ -15,7 +15,9 @@ A spec's `rows` is an array of tables, written either way (TOML reads both as th
 A row names every input and the outputs it states (an output it leaves out is not compared),
 with optional `cycles` (exact), `max_cycles` (a per-row budget) and `note` (shown when the row
 fails). A name that is both an input and an output is written `in.NAME` / `out.NAME` (TOML's dotted
-keys: `{ in.a = 3, out.a = 4 }`), as is an input or output named like one of the row's own keys.
+keys: `{ in.a = 3, out.a = 4 }`), as is an input or output named `cycles`, `max_cycles` or `note`
+(a bare key of those names is the row's own); an input or output named `in` or `out` is written bare,
+unless its value is a table.
 Numbers take every notation retro reads (`$C0`, `0xc0`, `%1010`, `192`, TOML's `0xC0`, `0b1010`);
 a flag takes 0/1 or true/false; a table a list of bytes or a string of hex bytes.
 
@@ -71,10 +73,10 @@ def _row(r: Fields, index: int, doc: dict, inputs: tuple[Port, ...], outputs: tu
     key = f"rows[{index}]"
     input_names = {p.name for p in inputs}
     output_names = {p.name for p in outputs}
-    given_in: dict[str, object] = {}
-    given_out: dict[str, object] = {}
+    given_in: dict[str, tuple] = {}  # name -> (value, its key as written: rows[i].in.a or rows[i].a)
+    given_out: dict[str, tuple] = {}
     for name, item in doc.items():
-        if name in ("in", "out"):
+        if name in ("in", "out") and (isinstance(item, dict) or name not in input_names | output_names):
             names, target = (input_names, given_in) if name == "in" else (output_names, given_out)
             what = "input" if name == "in" else "output"
             for inner, inner_value in r.table(item, f"{key}.{name}").items():
@@ -82,8 +84,8 @@ def _row(r: Fields, index: int, doc: dict, inputs: tuple[Port, ...], outputs: tu
                     raise r.error(f"{key}.{name}.{inner}", f"no {what} of that name ({what}s: {', '.join(sorted(names))})")
                 if inner in target:
                     raise r.error(f"{key}.{name}.{inner}", "given twice (bare and under in/out)")
-                target[inner] = inner_value
-        elif name in ROW_KEYS:
+                target[inner] = (inner_value, f"{key}.{name}.{inner}")
+        elif name in ROW_KEYS and name not in ("in", "out"):
             continue
         elif name in input_names and name in output_names:
             raise r.error(f"{key}.{name}", f"{name!r} is both an input and an output: write in.{name} or out.{name}")
@@ -91,7 +93,7 @@ def _row(r: Fields, index: int, doc: dict, inputs: tuple[Port, ...], outputs: tu
             target = given_in if name in input_names else given_out
             if name in target:
                 raise r.error(f"{key}.{name}", "given twice (bare and under in/out)")
-            target[name] = item
+            target[name] = (item, f"{key}.{name}")
         else:
             raise r.error(f"{key}.{name}", f"neither an input nor an output (inputs: {', '.join(p.name for p in inputs)}; "
                                            f"outputs: {', '.join(p.name for p in outputs)}; a row's own keys: "
@@ -99,9 +101,8 @@ def _row(r: Fields, index: int, doc: dict, inputs: tuple[Port, ...], outputs: tu
     missing = [p.name for p in inputs if p.name not in given_in]
     if missing:
         raise r.error(f"{key}.{missing[0]}", f"missing: a row gives every input ({', '.join(p.name for p in inputs)})")
-    case = tuple(port_value(r, port, given_in[port.name], f"{key}.{port.name}") for port in inputs)
-    expected = tuple(port_value(r, port, given_out[port.name], f"{key}.{port.name}") if port.name in given_out else None
-                     for port in outputs)
+    case = tuple(port_value(r, port, *given_in[port.name]) for port in inputs)  # (value, key as written)
+    expected = tuple(port_value(r, port, *given_out[port.name]) if port.name in given_out else None for port in outputs)
     cycles = r.integer(doc["cycles"], f"{key}.cycles", 1, MAX_ROW_CYCLES) if "cycles" in doc else None
     max_cycles = r.integer(doc["max_cycles"], f"{key}.max_cycles", 1, MAX_ROW_CYCLES) if "max_cycles" in doc else None
     note = doc.get("note", "")
