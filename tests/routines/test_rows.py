@@ -289,3 +289,8 @@ def test_without_rows_a_reference_is_required_and_without_one_no_cases(tmp_path,
     assert "reference: missing: the [reference] table, or [[rows]]" in _error(capsys, spec)
     spec = _sum3(tmp_path, 'rows = [{ in.a = 1, t = [1, 2, 3], c = 0 }]', rest="[cases]\nrandom = 10\n", name="cases")
     assert "cases: without a [reference] no answer is known for generated cases" in _error(capsys, spec)
+
+
+def test_a_rows_only_spec_runs_its_rows_whatever_random_and_exhaustive_say(capsys):
+    code, (record,) = _check_json(capsys, EXAMPLE, "--random", "50", "--exhaustive")
+    assert code == 0 and record["cases"] == 4 and record["coverage"] == [{"part": "rows", "cases": 4}]
