@@ -55,7 +55,7 @@ class RowOutcome:
 
     @property
     def holds(self) -> bool:
-        return not self.problems
+        return self.checked and not self.problems
 
 
 @dataclass
@@ -66,12 +66,17 @@ class RowsCheck:
 
     @property
     def failing(self) -> list[RowOutcome]:
-        return [o for o in self.outcomes if o.problems]
+        """Rows checked and found wrong (a call that stopped included)."""
+        return [o for o in self.outcomes if o.problems and o.checked]
+
+    @property
+    def unchecked(self) -> list[RowOutcome]:
+        return [o for o in self.outcomes if not o.checked]
 
     @property
     def wrong(self) -> int:
         """Rows whose call returned something other than stated (a call that stopped is a run error)."""
-        return sum(1 for o in self.outcomes if o.problems and not o.stopped and o.checked)
+        return sum(1 for o in self.failing if not o.stopped)
 
 
 @dataclass(frozen=True)
@@ -115,9 +120,7 @@ def check_rows(spec: str, seed: int, start: SceneStart | None, batched: bool) ->
         if outcomes[-1].problems and not call.error:
             totals.failure = totals.failure or Failure(row.case, "row", call.outputs, row.expected,
                                                        f"{row.label}: {'; '.join(outcomes[-1].problems)}")
-    stopper = next((o.row.key for o in outcomes if o.stopped), "")
-    outcomes += [RowOutcome(row, None, None, (f"not checked: the call of {stopper} stopped the check",), checked=False)
-                 for row in rows[len(calls):]]
+    outcomes += [RowOutcome(row, None, None, checked=False) for row in rows[len(calls):]]
     return RowsCheck(outcomes, agreement=agreement), totals
 
 
@@ -221,8 +224,8 @@ def rows_only_static(routine: Routine, runner: RoutineRunner) -> tuple[Bounds | 
 def rows_record(routine: Routine, rows: RowsCheck) -> dict:
     """The rows' part of `retro check --json`: counts, and every failing row with what it stated."""
     return {"rows": len(rows.outcomes), "held": sum(1 for o in rows.outcomes if o.holds),
-            "failed": len(rows.failing), "static_note": rows.static_note or None,
-            "failures": [_failure_record(routine, o) for o in rows.failing]}
+            "failed": len(rows.failing), "not_checked": [o.row.index for o in rows.unchecked],
+            "static_note": rows.static_note or None, "failures": [_failure_record(routine, o) for o in rows.failing]}
 
 
 def _failure_record(routine: Routine, outcome: RowOutcome) -> dict:
@@ -233,14 +236,15 @@ def _failure_record(routine: Routine, outcome: RowOutcome) -> dict:
             "outputs": None if outcome.outputs is None else {
                 port.name: list(value) if port.table else value for port, value in zip(routine.outputs, outcome.outputs)},
             "cycles": outcome.cycles, "expected_cycles": row.cycles, "max_cycles": row.max_cycles,
-            "checked": outcome.checked, "problems": list(outcome.problems)}
+            "problems": list(outcome.problems)}
 
 
 def rows_lines(routine: Routine, rows: RowsCheck) -> list[str]:
     """The rows' lines of the text report: a count, then each failing row (inputs, stated, got)."""
-    failing = rows.failing
-    lines = [f"  rows: {len(rows.outcomes)}, {len(rows.outcomes) - len(failing)} hold"
-             + (f", {len(failing)} fail" if failing else "")]
+    failing, unchecked = rows.failing, rows.unchecked
+    lines = [f"  rows: {len(rows.outcomes)}, {len(rows.outcomes) - len(failing) - len(unchecked)} hold"
+             + (f", {len(failing)} fail" if failing else "")
+             + (f", {len(unchecked)} not checked (after the call of {failing[-1].row.key} stopped)" if unchecked else "")]
     if rows.static_note:
         lines.append(f"  static bounds unknown (a spec of rows only): {rows.static_note}")
     for outcome in failing[:ROWS_SHOWN]:

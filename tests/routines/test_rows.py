@@ -151,7 +151,7 @@ def test_a_failing_row_is_reported_with_inputs_expected_and_got(tmp_path, capsys
     wrong, slow = rows["failures"]
     assert wrong == {"row": 1, "note": "off by one", "inputs": {"a": 3, "b": 5}, "expected": {"product": 16},
                      "outputs": {"product": 15}, "cycles": 142, "expected_cycles": None, "max_cycles": None,
-                     "checked": True, "problems": ["product: expected 16, got 15"]}
+                     "problems": ["product: expected 16, got 15"]}
     # a row that states no output compares none; a = 1 has one 1 bit: 138 cycles
     assert slow["expected"] == {} and slow["outputs"] == {"product": 1} and slow["cycles"] == 138
     assert slow["problems"] == ["cycles: expected 139, got 138", "cycles: 138 is over max_cycles 137"]
@@ -188,13 +188,13 @@ def test_a_call_that_stops_stops_the_rows_on_both_engines(tmp_path, capsys):
         records.append(record)
     assert records[0]["rows"] == records[1]["rows"]
     rows = records[0]["rows"]
-    assert rows["held"] == 1 and rows["failed"] == 2
-    stopped, skipped = rows["failures"]
+    assert (rows["held"], rows["failed"], rows["not_checked"]) == (1, 1, [2])
+    (stopped,) = rows["failures"]
     assert stopped["row"] == 1 and "BRK" in stopped["problems"][0] and stopped["outputs"] is None
-    assert skipped == {**skipped, "row": 2, "checked": False, "problems": ["not checked: the call of rows[1] stopped "
-                                                                          "the check"]}
     assert records[0]["first_failure"]["kind"] == records[1]["first_failure"]["kind"] == "run"
     assert records[0]["mismatches"] == 1  # the stopped call is the run error, counted once
+    main(["check", str(spec)])
+    assert "  rows: 3, 1 hold, 1 fail, 1 not checked (after the call of rows[1] stopped)" in capsys.readouterr().out
 
 
 # ---- rows beside a reference -------------------------------------------------------------------------
