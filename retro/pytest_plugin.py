@@ -103,10 +103,11 @@ class SpecItem(pytest.Item):
         self.add_marker(MARKER)
 
     def _shown(self) -> str:
-        """The spec as its messages name it: relative to where pytest was started, when under it."""
+        """The spec as its messages name it: relative to the working folder (as `retro check` would be
+        given it there), which a test may have changed since pytest started."""
         try:
-            return os.path.relpath(self.path, self.config.invocation_params.dir)
-        except ValueError:  # another drive
+            return os.path.relpath(self.path, os.getcwd())
+        except (ValueError, OSError):  # another drive, or the working folder is gone
             return str(self.path)
 
     def runtest(self) -> None:
