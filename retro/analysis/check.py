@@ -839,7 +839,8 @@ def check_record(check: RoutineCheck) -> dict:
             "kind": failure.kind, "inputs": inputs_by_name(routine, failure.case),
             "outputs": None if failure.outputs is None else dict(zip(routine.output_names, _plain(failure.outputs))),
             "expected": None if failure.expected is None else {  # None: an output an expected row does not state
-                name: value for name, value in zip(routine.output_names, _plain(failure.expected)) if value is not None},
+                name: value for name, value in zip(routine.output_names, _plain(failure.expected))
+                if value is not None},
             "message": failure.message, "trace": check.trace}
     if check.rows is not None:
         from retro.analysis.row_check import rows_record

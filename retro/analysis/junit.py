@@ -70,8 +70,8 @@ def junit_xml(checks: list[RoutineCheck], *, timestamp: float | None = None, hos
     for check in checks:
         report = format_check(check)
         reports.extend(report)
-        case = ET.SubElement(suite, "testcase", {"name": xml_text(check.routine.name), "classname": xml_text(classname(check)),
-                                                 "time": f"{check.seconds:.3f}"})
+        case = ET.SubElement(suite, "testcase", {"name": xml_text(check.routine.name),
+                                                 "classname": xml_text(classname(check)), "time": f"{check.seconds:.3f}"})
         if check.mismatches:
             failure = ET.SubElement(case, "failure", {"message": xml_text(report[0]), "type": FAILURE_TYPE})
             failure.text = xml_text("\n".join(report))

@@ -161,8 +161,9 @@ def _agree(agreement: ChunkResult, routine: Routine, row: Row, machine: _Call, b
             (stopped or (machine.outputs == batch.outputs and machine.cycles == batch.cycles)))
     if not same:
         agreement.engine_mismatches += 1
+        returned = not machine.error and not stopped
         text = (f"Machine: {describe_outputs(routine, machine.outputs)} in {machine.cycles} cycles; batched core: "
-                f"{describe_outputs(routine, batch.outputs)} in {batch.cycles} cycles" if not machine.error and not stopped
+                f"{describe_outputs(routine, batch.outputs)} in {batch.cycles} cycles" if returned
                 else "one engine stopped the call, the other returned")
         message = f"the engines disagree on {row.key}: {text}"
         agreement.failure = agreement.failure or Failure(row.case, "engine", machine.outputs, None, message)
@@ -233,8 +234,8 @@ def _failure_record(routine: Routine, outcome: RowOutcome) -> dict:
     return {"row": row.index, "note": row.note or None, "inputs": inputs_by_name(routine, row.case),
             "expected": {port.name: list(value) if port.table else value
                          for port, value in zip(routine.outputs, row.expected) if value is not None},
-            "outputs": None if outcome.outputs is None else {
-                port.name: list(value) if port.table else value for port, value in zip(routine.outputs, outcome.outputs)},
+            "outputs": None if outcome.outputs is None else {port.name: list(value) if port.table else value
+                                                             for port, value in zip(routine.outputs, outcome.outputs)},
             "cycles": outcome.cycles, "expected_cycles": row.cycles, "max_cycles": row.max_cycles,
             "problems": list(outcome.problems)}
 
@@ -244,7 +245,8 @@ def rows_lines(routine: Routine, rows: RowsCheck) -> list[str]:
     failing, unchecked = rows.failing, rows.unchecked
     lines = [f"  rows: {len(rows.outcomes)}, {len(rows.outcomes) - len(failing) - len(unchecked)} hold"
              + (f", {len(failing)} fail" if failing else "")
-             + (f", {len(unchecked)} not checked (after the call of {failing[-1].row.key} stopped)" if unchecked else "")]
+             + (f", {len(unchecked)} not checked (after the call of {failing[-1].row.key} stopped)"
+                if unchecked else "")]
     if rows.static_note:
         lines.append(f"  static bounds unknown (a spec of rows only): {rows.static_note}")
     for outcome in failing[:ROWS_SHOWN]:

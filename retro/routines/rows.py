@@ -81,7 +81,8 @@ def _row(r: Fields, index: int, doc: dict, inputs: tuple[Port, ...], outputs: tu
             what = "input" if name == "in" else "output"
             for inner, inner_value in r.table(item, f"{key}.{name}").items():
                 if inner not in names:
-                    raise r.error(f"{key}.{name}.{inner}", f"no {what} of that name ({what}s: {', '.join(sorted(names))})")
+                    raise r.error(f"{key}.{name}.{inner}",
+                                  f"no {what} of that name ({what}s: {', '.join(sorted(names))})")
                 if inner in target:
                     raise r.error(f"{key}.{name}.{inner}", "given twice (bare and under in/out)")
                 target[inner] = (inner_value, f"{key}.{name}.{inner}")
@@ -95,9 +96,9 @@ def _row(r: Fields, index: int, doc: dict, inputs: tuple[Port, ...], outputs: tu
                 raise r.error(f"{key}.{name}", "given twice (bare and under in/out)")
             target[name] = (item, f"{key}.{name}")
         else:
-            raise r.error(f"{key}.{name}", f"neither an input nor an output (inputs: {', '.join(p.name for p in inputs)}; "
-                                           f"outputs: {', '.join(p.name for p in outputs)}; a row's own keys: "
-                                           f"{', '.join(ROW_KEYS)})")
+            raise r.error(f"{key}.{name}", f"neither an input nor an output (inputs: "
+                                           f"{', '.join(p.name for p in inputs)}; outputs: "
+                                           f"{', '.join(p.name for p in outputs)}; a row's own keys: {', '.join(ROW_KEYS)})")
     missing = [p.name for p in inputs if p.name not in given_in]
     if missing:
         raise r.error(f"{key}.{missing[0]}", f"missing: a row gives every input ({', '.join(p.name for p in inputs)})")

@@ -278,7 +278,8 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
             raise r.error("cases.exhaustive", f"unknown input {n!r} (inputs: {', '.join(names)})")
     if len(set(exhaustive)) != len(exhaustive):
         raise r.error("cases.exhaustive", "an input is named twice")
-    random_count = r.integer(cases_doc.get("random", DEFAULT_RANDOM if reference is not None else 0), "cases.random", 0, MAX_RANDOM)
+    random_default = DEFAULT_RANDOM if reference is not None else 0  # rows only: no generated cases
+    random_count = r.integer(cases_doc.get("random", random_default), "cases.random", 0, MAX_RANDOM)
     seed = r.integer(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1)
     where = cases_doc.get("where")
     coverage = _text(r, cases_doc, "coverage", "cases.coverage") or ""
