@@ -670,6 +670,14 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
             progress(f"check {routine.name}: {done:,} cases ({known:,} planned, plus the sweep)" if unknown else
                      f"check {routine.name}: {done:,}/{known:,} cases")
 
+    rows = None
+    if routine.rows:  # the spec's expected rows run first, in this process (retro.analysis.row_check)
+        from retro.analysis.row_check import check_rows
+
+        rows, rows_totals = check_rows(spec, seed, start, batched)
+        report(rows_totals)
+        if totals.run_errors:  # a row's call that stopped stops the check
+            parts = []
     agreement = None
     if batched:
         agreement = ChunkResult()
@@ -681,13 +689,6 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         work = ((check_batch, (spec, seed, block)) for block in case_sets.batches(parts, BATCH_LANES))
     else:
         work = ((check_chunk, (spec, seed, chunk, start)) for chunk in _chunks(parts))
-    rows = None
-    if routine.rows:  # the spec's expected rows run first, in this process (retro.analysis.row_check)
-        from retro.analysis.row_check import check_rows
-
-        rows, rows_totals = check_rows(spec, seed, start, batched)
-        report(rows_totals)
-        work = iter(()) if totals.run_errors else work  # a call that stopped stops the check
     _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
     part_runs = [PartRun(p.name, p.count if p.count is not None else 0, p.total) for p in parts]
     if rows is not None:

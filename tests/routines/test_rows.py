@@ -294,3 +294,17 @@ def test_without_rows_a_reference_is_required_and_without_one_no_cases(tmp_path,
 def test_a_rows_only_spec_runs_its_rows_whatever_random_and_exhaustive_say(capsys):
     code, (record,) = _check_json(capsys, EXAMPLE, "--random", "50", "--exhaustive")
     assert code == 0 and record["cases"] == 4 and record["coverage"] == [{"part": "rows", "cases": 4}]
+
+
+@pytest.mark.parametrize("engine", ["scalar", "batch"])
+def test_a_row_whose_call_stops_stops_the_generated_cases_too(tmp_path, capsys, engine):
+    (tmp_path / "breaks.s").write_text(BREAKS)
+    (tmp_path / "ref.py").write_text("def same(a):\n    return a\n")
+    spec = tmp_path / "breaks.toml"
+    spec.write_text(BREAKS_SPEC + '\n[reference]\nfunction = "ref.py:same"\n\n[cases]\nrandom = 100\n'
+                                  'where = "a != 0"\n\n[cycles]\nstatic = false\n')
+    code, (record,) = _check_json(capsys, spec, "--engine", engine)
+    assert code == 1 and record["run_errors"] == 1 and record["cases"] == 2
+    assert record["coverage"] == [{"part": "rows", "cases": 2}]
+    if engine == "batch":  # no Machine run of the generated cases either
+        assert record["engine_agreement"]["cases"] == 2
