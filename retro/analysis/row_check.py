@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 from retro.analysis.check import (
     AGREEMENT_PER_PART,
+    BATCH_LANES,
     ChunkResult,
     Failure,
     SceneStart,
@@ -128,18 +129,20 @@ def _batched(runner: RoutineRunner, rows: tuple[Row, ...]) -> tuple[list[_Call],
     """The rows on the batched core, up to the first call that stops; the first AGREEMENT_PER_PART
     of them also on Machine (with the timing model), compared call for call."""
     routine = runner.routine
-    outcome = runner.run_batch(cases_to_columns(routine, [row.case for row in rows]))
     agreement = ChunkResult()
     calls = []
+    outcome, first = None, 0
     for i, row in enumerate(rows):
-        stopped = bool(outcome.error[i])
+        if i % BATCH_LANES == 0:  # a batch at most as wide as the check's (memory stays bounded)
+            outcome, first = runner.run_batch(cases_to_columns(routine, [r.case for r in rows[i:i + BATCH_LANES]])), i
+        stopped = bool(outcome.error[i - first])
         machine = _on_machine(runner, row.case) if i < AGREEMENT_PER_PART or stopped else None
         if stopped:  # Machine's message names the address (as check_batch reports a stopped lane)
             message = machine.error or (f"the engines disagree: the batched core stopped the call "
-                                        f"({LaneError(int(outcome.error[i])).name}), Machine returned")
+                                        f"({LaneError(int(outcome.error[i - first])).name}), Machine returned")
             calls.append(_Call(None, None, error=message))
         else:
-            calls.append(_Call(outcome.case_outputs(i), int(outcome.cycles[i])))
+            calls.append(_Call(outcome.case_outputs(i - first), int(outcome.cycles[i - first])))
         if i < AGREEMENT_PER_PART:
             _agree(agreement, routine, row, machine, calls[-1], stopped)
         if stopped:

@@ -308,3 +308,22 @@ def test_a_row_whose_call_stops_stops_the_generated_cases_too(tmp_path, capsys, 
     assert record["coverage"] == [{"part": "rows", "cases": 2}]
     if engine == "batch":  # no Machine run of the generated cases either
         assert record["engine_agreement"]["cases"] == 2
+
+
+def test_many_rows_run_in_batches_of_bounded_width(monkeypatch):
+    import tomllib
+
+    import retro.analysis.row_check as row_check
+
+    monkeypatch.setattr(row_check, "BATCH_LANES", 7)  # 156 rows: 23 batches, the last one short
+    doc = tomllib.loads(EXAMPLE.read_text())
+    doc["rows"] = [{"a": a, "b": b, "product": a * b, "cycles": 134 + 4 * bin(a).count("1")}
+                   for a in range(0, 256, 5) for b in (0, 7, 255)]
+    doc["rows"][40]["product"] += 1
+    results = []
+    for engine in ("scalar", "batch"):
+        report = check(spec_from_dict(doc, base=EXAMPLE.parent), engine=engine)
+        assert report.totals.cases == 156 and report.mismatches == 1
+        results.append([(o.outputs, o.cycles, o.problems) for o in report.rows.outcomes])
+    assert results[0] == results[1]
+    assert results[0][40][2] == (f"product: expected {doc['rows'][40]['product']}, got {doc['rows'][40]['product'] - 1}",)
