@@ -2,7 +2,8 @@
 
 Each row's call must give the outputs the row states, its exact `cycles` and stay within its
 `max_cycles`; what it gives is compared with the row only, never with the reference (a row the
-reference disagrees with makes one of the two fail). Rows run before the generated cases, as a
+reference disagrees with makes one of the two fail; a wrong row shows the reference's answer, to
+say which). Rows run before the generated cases, as a
 part of the check named "rows": they count among its cases and in its cycle figures (inside the
 domain), and on `Machine` every call is held against the timing model. On the batched core the rows
 run in one batch and, as every part, the first AGREEMENT_PER_PART of them also on `Machine`, which
@@ -17,7 +18,9 @@ refusing the spec for want of loop bounds it need not give.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+
+import numpy as np
 
 from retro.analysis.check import (
     AGREEMENT_PER_PART,
@@ -27,6 +30,7 @@ from retro.analysis.check import (
     SceneStart,
     describe_case,
     describe_outputs,
+    expected_columns,
     inputs_by_name,
     runner_for,
     static_bounds,
@@ -37,7 +41,7 @@ from retro.cpu.timing import model_cycles
 from retro.errors import InputError, RunError
 from retro.routines.cases import cases_to_columns
 from retro.routines.rows import Row
-from retro.routines.runner import RoutineRunner, describe_value
+from retro.routines.runner import RoutineRunner, describe_value, row_of
 from retro.routines.spec import Routine
 
 ROWS_SHOWN = 10  # failing rows listed in the text report (JSON lists every one)
@@ -53,6 +57,7 @@ class RowOutcome:
     problems: tuple[str, ...] = ()
     stopped: bool = False  # the call did not return (a run error, counted with the check's run errors)
     checked: bool = True  # False: an earlier row's call stopped the check
+    reference: tuple | None = None  # a wrong row of a spec with a reference: what the reference answers
 
     @property
     def holds(self) -> bool:
@@ -122,7 +127,24 @@ def check_rows(spec: str, seed: int, start: SceneStart | None, batched: bool) ->
             totals.failure = totals.failure or Failure(row.case, "row", call.outputs, row.expected,
                                                        f"{row.label}: {'; '.join(outcomes[-1].problems)}")
     outcomes += [RowOutcome(row, None, None, checked=False) for row in rows[len(calls):]]
+    if routine.reference is not None:  # say who is wrong, the row or the routine, when the row's outputs differ
+        outcomes = [replace(o, reference=_reference_answer(runner, o.row))
+                    if o.outputs is not None and o.outputs != _stated(o) else o for o in outcomes]
     return RowsCheck(outcomes, agreement=agreement), totals
+
+
+def _stated(outcome: RowOutcome) -> tuple:
+    """The call's outputs with the row's stated values in place (equal to them: the outputs hold)."""
+    return tuple(got if want is None else want for want, got in zip(outcome.row.expected, outcome.outputs))
+
+
+def _reference_answer(runner: RoutineRunner, row: Row) -> tuple | None:
+    """The reference's answer for a row's inputs; None when it gives none (it may refuse inputs
+    outside its domain: a row is not held to the domain)."""
+    routine = runner.routine
+    columns = cases_to_columns(routine, [row.case])
+    answers, answered = expected_columns(routine, columns, [row.case], runner.memory_values, np.zeros(1, dtype=bool))
+    return row_of(answers, 0) if answered[0] else None
 
 
 def _batched(runner: RoutineRunner, rows: tuple[Row, ...]) -> tuple[list[_Call], ChunkResult]:
@@ -235,12 +257,17 @@ def rows_record(routine: Routine, rows: RowsCheck) -> dict:
 def _failure_record(routine: Routine, outcome: RowOutcome) -> dict:
     row = outcome.row
     return {"row": row.index, "note": row.note or None, "inputs": inputs_by_name(routine, row.case),
-            "expected": {port.name: list(value) if port.table else value
-                         for port, value in zip(routine.outputs, row.expected) if value is not None},
-            "outputs": None if outcome.outputs is None else {port.name: list(value) if port.table else value
-                                                             for port, value in zip(routine.outputs, outcome.outputs)},
+            "expected": _by_name(routine, row.expected), "outputs": _by_name(routine, outcome.outputs),
             "cycles": outcome.cycles, "expected_cycles": row.cycles, "max_cycles": row.max_cycles,
-            "problems": list(outcome.problems)}
+            "reference": _by_name(routine, outcome.reference), "problems": list(outcome.problems)}
+
+
+def _by_name(routine: Routine, values: tuple | None) -> dict | None:
+    """Output values by name (tables as lists), leaving out those a row does not state (None)."""
+    if values is None:
+        return None
+    return {port.name: list(value) if port.table else value
+            for port, value in zip(routine.outputs, values) if value is not None}
 
 
 def rows_lines(routine: Routine, rows: RowsCheck) -> list[str]:
@@ -258,7 +285,9 @@ def rows_lines(routine: Routine, rows: RowsCheck) -> list[str]:
         got = describe_outputs(routine, outcome.outputs) if outcome.outputs is not None else "-"
         lines.append(f"  ROW {row.label}: {describe_case(routine, row.case)}"
                      + (f" -> expected {stated}, got {got}" if stated and outcome.outputs is not None else "")
-                     + f": {'; '.join(outcome.problems)}")
+                     + f": {'; '.join(outcome.problems)}"
+                     + (f" (the reference says {describe_outputs(routine, outcome.reference)})"
+                        if outcome.reference is not None else ""))
     if len(failing) > ROWS_SHOWN:
         lines.append(f"  ... {len(failing) - ROWS_SHOWN} more failing rows (--json lists every one)")
     return lines

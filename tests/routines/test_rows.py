@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from retro.cli import main
-from retro.testing import check, spec_from_dict
+from retro.testing import check, report_text, spec_from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "rows_only" / "mulshift.toml"
@@ -151,7 +151,7 @@ def test_a_failing_row_is_reported_with_inputs_expected_and_got(tmp_path, capsys
     wrong, slow = rows["failures"]
     assert wrong == {"row": 1, "note": "off by one", "inputs": {"a": 3, "b": 5}, "expected": {"product": 16},
                      "outputs": {"product": 15}, "cycles": 142, "expected_cycles": None, "max_cycles": None,
-                     "problems": ["product: expected 16, got 15"]}
+                     "reference": None, "problems": ["product: expected 16, got 15"]}
     # a row that states no output compares none; a = 1 has one 1 bit: 138 cycles
     assert slow["expected"] == {} and slow["outputs"] == {"product": 1} and slow["cycles"] == 138
     assert slow["problems"] == ["cycles: expected 139, got 138", "cycles: 138 is over max_cycles 137"]
@@ -217,7 +217,9 @@ def test_rows_run_beside_the_reference_and_fail_on_their_own():
     # the reference agrees with the routine; a row that states otherwise fails by itself
     report = check(spec_from_dict(_boxhit_with_rows([{**touching, "hit": 1}]), base=BOXHIT))
     assert report.mismatches == 1 and report.totals.result_mismatches == 0
-    assert report.rows.failing[0].problems == ("hit: expected 1, got 0",)
+    (wrong,) = report.rows.failing
+    assert wrong.problems == ("hit: expected 1, got 0",) and wrong.reference == (0,)  # the row is what is wrong
+    assert "hit: expected 1, got 0 (the reference says hit=0)" in report_text(report)
 
 
 # ---- the notation --------------------------------------------------------------------------------------
@@ -327,3 +329,18 @@ def test_many_rows_run_in_batches_of_bounded_width(monkeypatch):
         results.append([(o.outputs, o.cycles, o.problems) for o in report.rows.outcomes])
     assert results[0] == results[1]
     assert results[0][40][2] == (f"product: expected {doc['rows'][40]['product']}, got {doc['rows'][40]['product'] - 1}",)
+
+
+def test_a_wrong_row_shows_the_references_answer_unless_it_refuses(tmp_path, capsys):
+    (tmp_path / "breaks.s").write_text(BREAKS)
+    (tmp_path / "ref.py").write_text("def same(a):\n    if a == 2:\n        raise ValueError('not mine')\n    return a\n")
+    spec = tmp_path / "refused.toml"
+    spec.write_text('rows = [{ a = 1, out = 5 }, { a = 2, out = 7 }]\n'
+                    + BREAKS_SPEC[BREAKS_SPEC.index("[program]"):]
+                    + '\n[reference]\nfunction = "ref.py:same"\n\n[cases]\nrandom = 20\nwhere = "a != 0 and a != 2"\n'
+                      '\n[cycles]\nstatic = false\n')
+    records = [_check_json(capsys, spec, "--engine", engine)[1][0] for engine in ("scalar", "batch")]
+    assert records[0]["rows"] == records[1]["rows"]
+    first, second = records[0]["rows"]["failures"]
+    assert first["reference"] == {"out": 1} and first["outputs"] == {"out": 1}
+    assert second["reference"] is None and second["outputs"] == {"out": 2}
