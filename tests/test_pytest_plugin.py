@@ -110,3 +110,20 @@ def test_the_plugin_is_installed_by_its_entry_point_and_off_in_this_project():
     assert pyproject["project"]["entry-points"]["pytest11"] == {PLUGIN: PLUGIN}
     # this project's own run collects no spec: its configuration names none
     assert "retro_specs" not in pyproject["tool"]["pytest"]["ini_options"]
+
+
+def test_retro_exhaustive_runs_the_full_check(project):
+    # a sweep runs only in the full check: this one leaves a mark when it is called
+    (project.path / "specs" / "cases.py").write_text(
+        "from pathlib import Path\n\n"
+        "def mul(a, b):\n    return a * b\n\n"
+        "def sweep():\n    (Path(__file__).parent / 'swept').write_text('yes')\n    return [(3, 5), (255, 255)]\n")
+    (project.path / "specs" / "swept.toml").write_text(
+        (project.path / "specs" / "good.toml").read_text()
+        + '\n[reference]\nfunction = "cases.py:mul"\n\n[cases]\nsweep = "cases.py:sweep"\nrandom = 0\n'
+          '\n[cycles]\nloops = { loop = 8 }\n')
+    project.makeini("[pytest]\nretro_specs = specs/swept.toml\n")
+    _run(project).assert_outcomes(passed=1)
+    assert not (project.path / "specs" / "swept").exists()
+    _run(project, "--retro-exhaustive").assert_outcomes(passed=1)
+    assert (project.path / "specs" / "swept").read_text() == "yes"
