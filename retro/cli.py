@@ -123,6 +123,8 @@ def _checks(args: argparse.Namespace) -> list:
 def _cmd_check(args: argparse.Namespace) -> int:
     checks = _checks(args)
     _print(check, checks, args.json, indent=1)
+    if args.junit:
+        check.write_junit(checks, args.junit, scene=args.scene)
     return 1 if check.failed(checks) else 0
 
 
@@ -247,6 +249,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = _add(sub, "check", _cmd_check, help="cross-check 6502 routines (built-in or your own spec) against their "
                                             "references (results and cycles); exit 1 on any mismatch or broken budget")
     _routine_options(p)
+    p.add_argument("--junit", metavar="FILE.xml", help="also write the results as JUnit XML for CI: one testcase per "
+                                                       "routine, a failure carrying its report")
 
     p = _add(sub, "cycles", _cmd_cycles, help="bytes of code and tables, measured and static cycles, raster lines of "
                                               "routines (built-in or your own spec)",

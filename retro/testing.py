@@ -39,10 +39,11 @@ def spec_from_dict(doc: dict, base: str | Path = ".", name: str = "spec") -> Rou
 
 
 def check(spec: str | Path | Routine, *, exhaustive: bool = False, random: int | None = None,
-          seed: int | None = None, jobs: int = 1) -> RoutineCheck:
-    """Run a routine's check; the report is plain data (see retro.analysis.check.RoutineCheck)."""
+          seed: int | None = None, jobs: int = 1, engine: str | None = None) -> RoutineCheck:
+    """Run a routine's check; the report is plain data (see retro.analysis.check.RoutineCheck).
+    `engine`: "scalar", "batch" or "auto" (the default), as `retro check --engine`."""
     return check_routine(spec if isinstance(spec, Routine) else str(spec), exhaustive=exhaustive, seed=seed,
-                         random_count=random, jobs=jobs)
+                         random_count=random, jobs=jobs, engine=engine)
 
 
 def assert_routine(spec: str | Path | Routine, **options) -> RoutineCheck:

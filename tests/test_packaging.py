@@ -47,3 +47,11 @@ def test_wheel_runs_demo_and_check(tmp_path):
     assert (elsewhere / "out" / "vic_two_balls.png").is_file() and (elsewhere / "out" / "routine_cycles.json").is_file()
     check = _run([sys.executable, "-m", "retro", "check", "aabb8"], cwd=elsewhere, env=env)
     assert check.returncode == 0 and check.stdout.startswith("aabb8: 3808 cases, OK"), check.stdout + check.stderr
+    # the pytest plugin comes with the wheel: its entry point loads it with no -p, from the installed copy
+    (entry_points,) = target.glob("retro_collision-*.dist-info/entry_points.txt")
+    assert "[pytest11]\nretro.pytest_plugin = retro.pytest_plugin" in entry_points.read_text()
+    specs = elsewhere / "specs"
+    shutil.copytree(ROOT / "examples" / "rows_only", specs, ignore=shutil.ignore_patterns("*.py", "__pycache__"))
+    (elsewhere / "pytest.ini").write_text("[pytest]\nretro_specs = specs/*.toml\n")
+    collected = _run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-v", "specs"], cwd=elsewhere, env=env)
+    assert collected.returncode == 0 and "specs/mulshift.toml::mulshift PASSED" in collected.stdout, collected.stdout

@@ -29,6 +29,7 @@ from concurrent.futures import Future
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from itertools import islice
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -50,6 +51,9 @@ from retro.routines.runner import (
 )
 from retro.routines.spec import Routine, load_spec
 from retro.workers import worker_pool
+
+if TYPE_CHECKING:
+    from retro.analysis.row_check import RowsCheck
 
 EXAMPLES_KEPT = 5
 JSON_EXACT = 1 << 53  # larger whole numbers lose digits in JSON readers that use doubles
@@ -147,6 +151,8 @@ class RoutineCheck:
     start: RasterStart | None = None  # with --scene: the beam position every call started at
     engine: str = "scalar"  # which engine ran the cases: "scalar" (Machine) or "batch"
     agreement: ChunkResult | None = None  # with the batched core: the cases also run on Machine
+    rows: "RowsCheck | None" = None  # the spec's expected rows (retro.analysis.row_check)
+    seconds: float = 0.0  # wall time of the check (JUnit reports)
 
     @property
     def mismatches(self) -> int:
@@ -155,6 +161,8 @@ class RoutineCheck:
                  + len(self.budget_violations))
         if self.agreement is not None:  # its result mismatches and run errors are among the batch's own
             found += self.agreement.engine_mismatches + self.agreement.cycle_mismatches
+        if self.rows is not None:  # rows whose call returned something else (a stopped call is a run error)
+            found += self.rows.wrong
         return found
 
     @property
@@ -187,7 +195,8 @@ def describe_case(routine: Routine, case: tuple) -> str:
 
 
 def describe_outputs(routine: Routine, values: tuple) -> str:
-    return ", ".join(f"{port.name}={describe_value(port, value)}" for port, value in zip(routine.outputs, values))
+    return ", ".join(f"{port.name}={describe_value(port, value)}" for port, value in zip(routine.outputs, values)
+                     if value is not None)  # None: an output an expected row does not state
 
 
 def expected_outputs(routine: Routine, case: tuple, memory: dict) -> tuple:
@@ -627,6 +636,7 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     """Check one routine: a spec path, or a Routine built in Python (then in this process only).
     `engine`: "scalar" (Machine), "batch" (the batched core, checked against Machine on the first
     AGREEMENT_PER_PART cases of each part) or "auto" (batch from AUTO_BATCH_CASES planned cases)."""
+    began = time.monotonic()
     engine = DEFAULT_ENGINE if engine is None else engine
     if engine not in ENGINES:
         raise InputError(f"--engine: {engine!r} is not one of {', '.join(ENGINES)}")
@@ -635,6 +645,8 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     spec = routine_key(spec)
     routine = routine_of(spec)
     seed = routine.seed if seed is None else seed
+    if routine.reference is None:  # rows only: no answer is known for a generated case, whatever --random says
+        random_count = 0
     parts = case_sets.plan(routine, exhaustive=exhaustive, seed=seed, random=random_count,
                            bounded_product=bounded_product)
     known = sum(p.count for p in parts if p.count is not None)
@@ -658,6 +670,14 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
             progress(f"check {routine.name}: {done:,} cases ({known:,} planned, plus the sweep)" if unknown else
                      f"check {routine.name}: {done:,}/{known:,} cases")
 
+    rows = None
+    if routine.rows:  # the spec's expected rows run first, in this process (retro.analysis.row_check)
+        from retro.analysis.row_check import check_rows
+
+        rows, rows_totals = check_rows(spec, seed, start, batched)
+        report(rows_totals)
+        if totals.run_errors:  # a row's call that stopped stops the check
+            parts = []
     agreement = None
     if batched:
         agreement = ChunkResult()
@@ -671,11 +691,18 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         work = ((check_chunk, (spec, seed, chunk, start)) for chunk in _chunks(parts))
     _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
     part_runs = [PartRun(p.name, p.count if p.count is not None else 0, p.total) for p in parts]
+    if rows is not None:
+        part_runs.insert(0, PartRun("rows", sum(o.checked for o in rows.outcomes), len(rows.outcomes)))
     if unknown:  # the sweep's count is whatever was left after the counted parts
         counted = sum(p.cases for p in part_runs if p.name != "sweep")
         part_runs = [PartRun(p.name, max(totals.cases - counted, 0), max(totals.cases - counted, 0))
                      if p.name == "sweep" else p for p in part_runs]
-    static = static_bounds(routine, runner)
+    if routine.reference is None:  # rows only: unknown static bounds are said, not an error
+        from retro.analysis.row_check import rows_only_static
+
+        static, rows.static_note = rows_only_static(routine, runner)
+    else:
+        static = static_bounds(routine, runner)
     violations = []
     t = totals
     if static is not None and t.cycles_count and t.cpu_min < static.best:
@@ -691,11 +718,16 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
             budget_violations.append(f"{routine.name}: the static worst case {static.worst} cycles is over the budget "
                                      f"of {routine.budget}")
     check = RoutineCheck(routine, runner.size(), static, totals, violations, budget_violations, part_runs,
-                         start=runner.start, engine="batch" if batched else "scalar", agreement=agreement)
+                         start=runner.start, engine="batch" if batched else "scalar", agreement=agreement, rows=rows)
+    if rows is not None and rows.agreement is not None:
+        from retro.analysis.row_check import merged_agreement
+
+        check.agreement = agreement = merged_agreement(agreement, rows)
     if agreement is not None and agreement.failure is not None and totals.failure is None:
         totals.failure = agreement.failure  # the timing model or the engines disagreed on a call
     if totals.failure is not None:
         check.trace = failure_trace(spec, seed, totals.failure.case, start)
+    check.seconds = time.monotonic() - began
     return check
 
 
@@ -800,15 +832,21 @@ def check_record(check: RoutineCheck) -> dict:
               "engine_agreement": None if check.agreement is None else {
                   "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
                   "timing_model_mismatches": check.agreement.cycle_mismatches},
-              "notes": list(check.routine.notes), "first_failure": None}
+               "notes": list(check.routine.notes), "first_failure": None, "rows": None}
     failure = t.failure
     if failure is not None:
         routine = check.routine
         record["first_failure"] = {
             "kind": failure.kind, "inputs": inputs_by_name(routine, failure.case),
             "outputs": None if failure.outputs is None else dict(zip(routine.output_names, _plain(failure.outputs))),
-            "expected": None if failure.expected is None else dict(zip(routine.output_names, _plain(failure.expected))),
+            "expected": None if failure.expected is None else {  # None: an output an expected row does not state
+                name: value for name, value in zip(routine.output_names, _plain(failure.expected))
+                if value is not None},
             "message": failure.message, "trace": check.trace}
+    if check.rows is not None:
+        from retro.analysis.row_check import rows_record
+
+        record["rows"] = rows_record(check.routine, check.rows)
     return record
 
 
@@ -837,7 +875,8 @@ def format_check(check: RoutineCheck) -> list[str]:
     routine = check.routine
     verdict = "OK" if not check.mismatches else f"{check.mismatches} MISMATCH(ES)"
     static = (f"static {check.static.best}-{check.static.worst}, worst case "
-              f"{'reached' if check.worst_reached else 'not reached'}" if check.static else "static analysis off")
+              f"{'reached' if check.worst_reached else 'not reached'}" if check.static else
+              "static bounds unknown" if check.rows is not None and check.rows.static_note else "static analysis off")
     cost = (f"cycles {t.cycles_min}-{t.cycles_max} (mean {check.mean:.2f})" if t.cycles_count
             else "no case inside the domain")
     if check.agreement is None:
@@ -871,6 +910,10 @@ def format_check(check: RoutineCheck) -> list[str]:
     if t.outside:
         lines.append(f"  outside the stated domain: {t.outside} cases, {t.outside_wrong} wrong"
                      + (f", e.g. {t.outside_examples[0]}" if t.outside_examples else ""))
+    if check.rows is not None:
+        from retro.analysis.row_check import rows_lines
+
+        lines += rows_lines(routine, check.rows)
     lines += [f"  MISMATCH {example}" for example in t.examples]
     lines += [f"  MISMATCH {violation}" for violation in check.bounds_violations]
     lines += [f"  BUDGET {violation}" for violation in check.budget_violations]
@@ -879,7 +922,8 @@ def format_check(check: RoutineCheck) -> list[str]:
         if t.failure.outputs is not None:
             lines.append(f"    routine:   {describe_outputs(routine, t.failure.outputs)}")
         if t.failure.expected is not None:
-            lines.append(f"    reference: {describe_outputs(routine, t.failure.expected)}")
+            stated = "the row:  " if t.failure.kind == "row" else "reference:"
+            lines.append(f"    {stated} {describe_outputs(routine, t.failure.expected)}")
         if t.failure.message:
             lines.append(f"    {t.failure.message}")
         lines.append("    trace (address, instruction, cycles, running total):")

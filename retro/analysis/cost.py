@@ -45,7 +45,8 @@ def format_cost_table(checks: list[RoutineCheck]) -> list[str]:
     rows = []
     for check in checks:
         r = cost_row(check)
-        static = f"{r['static_min']}-{r['static_max']}" if check.static else "off"
+        static = f"{r['static_min']}-{r['static_max']}" if check.static else (
+            "unknown" if check.rows is not None and check.rows.static_note else "off")
         timelines = r["raster"]
         lines_at_most = timelines.get("scene", next(iter(timelines.values()), {})).get("max_lines")
         rows.append((r["routine"], str(r["code_bytes"]), str(r["table_bytes"]), str(r["min"]), f"{r['mean']:.2f}",

@@ -3,10 +3,13 @@ results, cycles (against the timing model) and static bounds; exit 1 on any mism
 
 from __future__ import annotations
 
+import inspect
 from pathlib import Path
 
 from retro.analysis.check import RoutineCheck, SceneStart, check_record, format_check, run_checks
+from retro.analysis.junit import junit_xml
 from retro.errors import InputError
+from retro.fileio import write_atomic
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
 from retro.routines import cases as case_sets
@@ -52,3 +55,26 @@ def as_json(checks: list[RoutineCheck]) -> list[dict]:
 
 def lines(checks: list[RoutineCheck]) -> list[str]:
     return [line for c in checks for line in format_check(c)]
+
+
+def write_junit(checks: list[RoutineCheck], path: str | Path, *, scene: str | Path | None = None) -> Path:
+    """`--junit FILE`: the checks as JUnit XML (retro.analysis.junit), written atomically and never
+    over one of the check's inputs."""
+    return write_atomic(path, junit_xml(checks), inputs=input_files(checks, scene))
+
+
+def input_files(checks: list[RoutineCheck], scene: str | Path | None = None) -> list[Path]:
+    """The files the checks read: specs, programs, symbol files, the Python files of their
+    references and case functions, the scene."""
+    files = [Path(scene)] if scene is not None else []
+    for c in checks:
+        routine = c.routine
+        files += [routine.spec_path, routine.program_file] + ([routine.symbols_file] if routine.symbols_file else [])
+        for function in (routine.reference, routine.boundary, routine.sweep, routine.random_generator):
+            try:
+                source = inspect.getsourcefile(function) if function is not None else None
+            except TypeError:  # a builtin or a C function: no file
+                source = None
+            if source:
+                files.append(Path(source))
+    return files

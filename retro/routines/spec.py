@@ -30,6 +30,7 @@ from retro.fields import Fields, describe
 from retro.fileio import is_dir, parse_toml, read_bytes
 from retro.loaders import load_program
 from retro.program import Program
+from retro.routines.rows import Row, misplaced_rows, parse_rows
 from retro.routines.where import Condition, parse_where
 
 BYTE_VALUES = 256
@@ -44,7 +45,7 @@ REGISTERS = ("A", "X", "Y")
 FLAGS = {"C": FLAG_C, "Z": FLAG_Z, "I": FLAG_I, "D": FLAG_D, "V": FLAG_V, "N": FLAG_N}
 CPUS = tuple(VARIANTS)
 
-TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles"}
+TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows"}
 PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "init", "load"}
 PORT_KEYS = {"at", "size", "values", "table"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
@@ -147,7 +148,7 @@ class Routine:
     inputs: tuple[Port, ...]
     outputs: tuple[Port, ...]
     memory: tuple[MemoryBlock, ...]
-    reference: Callable
+    reference: Callable | None  # None: a spec of rows only
     reference_name: str
     reference_memory: tuple[str, ...]  # memory blocks the reference takes by name
     reference_arrays: bool = False  # the reference takes numpy arrays (one element per case) and answers so
@@ -165,6 +166,7 @@ class Routine:
     summary: str = ""
     coverage: str = ""  # why the cases cover the input space (an argument the report quotes)
     notes: tuple[str, ...] = ()  # what loading the program left out (a symbol file's skipped lines)
+    rows: tuple[Row, ...] = ()  # expected rows written in the spec (retro.routines.rows)
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -223,6 +225,7 @@ def load_spec(path: str | Path) -> Routine:
 def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     r = Fields(shown or str(path), folder=path.parent, number_characters=NUMBER_CHARACTERS)
     r.table(doc, "", TOP_KEYS)
+    misplaced_rows(r, doc)
     program_doc = r.table(r.required(doc, "program", hint="the [program] table"), "program", PROGRAM_KEYS)
     program_file = r.file(_text(r, program_doc, "file", "program.file", required=True), "program.file", resolve=True)
     symbols_name = _text(r, program_doc, "symbols", "program.symbols")
@@ -251,12 +254,20 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
                    for name, value in r.table(doc.get("memory", {}), "memory").items())
     _no_overlap_memory(r, memory, inputs)
 
-    reference_doc = r.table(r.required(doc, "reference", hint="the [reference] table"), "reference", REFERENCE_KEYS)
-    reference_name = _text(r, reference_doc, "function", "reference.function", required=True)
-    reference = load_function(reference_name, r, "reference.function")
-    reference_memory = _reference_signature(r, reference, reference_name, inputs, memory)
-    # true: the function takes numpy arrays, one element per case
-    reference_arrays = r.flag(reference_doc.get("arrays", False), "reference.arrays")
+    rows = parse_rows(r, doc["rows"], inputs, outputs) if "rows" in doc else ()
+    if rows and "reference" not in doc:  # a spec of rows only: the rows say what the routine must answer
+        if "cases" in doc:
+            raise r.error("cases", "without a [reference] no answer is known for generated cases: write them as rows, "
+                                   "or add a [reference]")
+        reference, reference_name, reference_memory, reference_arrays = None, "", (), False
+    else:
+        reference_doc = r.table(r.required(doc, "reference", hint="the [reference] table, or [[rows]]"), "reference",
+                                REFERENCE_KEYS)
+        reference_name = _text(r, reference_doc, "function", "reference.function", required=True)
+        reference = load_function(reference_name, r, "reference.function")
+        reference_memory = _reference_signature(r, reference, reference_name, inputs, memory)
+        # true: the function takes numpy arrays, one element per case
+        reference_arrays = r.flag(reference_doc.get("arrays", False), "reference.arrays")
 
     cases_doc = r.table(doc.get("cases", {}), "cases", CASES_KEYS)
     names = tuple(p.name for p in inputs)
@@ -268,7 +279,8 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
             raise r.error("cases.exhaustive", f"unknown input {n!r} (inputs: {', '.join(names)})")
     if len(set(exhaustive)) != len(exhaustive):
         raise r.error("cases.exhaustive", "an input is named twice")
-    random_count = r.integer(cases_doc.get("random", DEFAULT_RANDOM), "cases.random", 0, MAX_RANDOM)
+    random_default = DEFAULT_RANDOM if reference is not None else 0  # rows only: no generated cases
+    random_count = r.integer(cases_doc.get("random", random_default), "cases.random", 0, MAX_RANDOM)
     seed = r.integer(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1)
     where = cases_doc.get("where")
     coverage = _text(r, cases_doc, "coverage", "cases.coverage") or ""
@@ -297,10 +309,10 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
         reference_name=reference_name, reference_memory=reference_memory, reference_arrays=reference_arrays, exhaustive=tuple(exhaustive),
         random=random_count, seed=seed, domain=domain, boundary=generators.get("boundary"),
         sweep=generators.get("sweep"), random_generator=generators.get("random_generator"), budget=budget,
-        loop_bounds=loop_bounds, limit=limit, static=static, summary=summary, coverage=coverage,
+        loop_bounds=loop_bounds, limit=limit, static=static, summary=summary, coverage=coverage, rows=rows,
         notes=program.notes)
-    if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep):
-        raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary or sweep")
+    if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep or routine.rows):
+        raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary, sweep or [[rows]]")
     if routine.exhaustive_count() > MAX_EXHAUSTIVE:
         raise r.error("cases.exhaustive", f"{routine.exhaustive_count():,} cases is more than 2^32: "
                                          "narrow the inputs' values or sweep fewer inputs")
