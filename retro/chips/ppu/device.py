@@ -97,8 +97,9 @@ class PpuDevice:
 
     def __init__(self, state: PpuState | None = None, *, origin: int = 0,
                  read_memory: Callable[[int], int] | None = None,
-                 stall: Callable[[int], None] | None = None) -> None:
+                 stall: Callable[[int], None] | None = None, chr_writable: bool = True) -> None:
         state = state or PpuState()
+        self.chr_writable = chr_writable  # False for a cartridge's CHR ROM: $2007 writes there do nothing
         self.video: VideoStandard = state.video
         self.mirroring = state.mirroring
         self.ctrl = state.ctrl
@@ -387,7 +388,8 @@ class PpuDevice:
     def _vram_write(self, address: int, value: int) -> None:
         address &= VRAM_ADDRESS_MASK
         if address < CHR_SIZE:
-            self.chr[address] = value
+            if self.chr_writable:
+                self.chr[address] = value
         elif address < PALETTE_BASE:
             self.ciram[self._ciram_index(address)] = value
         else:
