@@ -39,17 +39,6 @@ ROMS = {
 
 NO_APU = "needs the APU (frame IRQ, DMC): not modelled"
 NOT_YET = {
-    "ppu_vbl_nmi/rom_singles/02-vbl_set_time.nes": "the $2002 read racing the vblank flag",
-    "ppu_vbl_nmi/rom_singles/05-nmi_timing.nes": "NMI timing to the dot",
-    "ppu_vbl_nmi/rom_singles/06-suppression.nes": "the $2002 read racing the vblank flag: flag and NMI suppression",
-    "ppu_vbl_nmi/rom_singles/07-nmi_on_timing.nes": "NMI enabled near the vblank clear",
-    "ppu_vbl_nmi/rom_singles/08-nmi_off_timing.nes": "NMI disabled just after vblank",
-    "ppu_vbl_nmi/rom_singles/10-even_odd_timing.nes": "odd-frame dot skip vs a $2001 write",
-    "vbl_nmi_timing/2.vbl_timing.nes": "the $2002 read racing the vblank flag",
-    "vbl_nmi_timing/3.even_odd_frames.nes": "odd-frame dot skip vs a $2001 write",
-    "vbl_nmi_timing/5.nmi_suppression.nes": "the $2002 read racing the vblank flag: NMI suppression",
-    "vbl_nmi_timing/6.nmi_disable.nes": "NMI disabled just after vblank",
-    "vbl_nmi_timing/7.nmi_timing.nes": "NMI timing to the dot",
     **{f"sprite_overflow_tests/{name}.nes": "sprite overflow is not modelled" for name in (
         "1.Basics", "2.Details", "3.Timing", "4.Obscure", "5.Emulator")},
     "cpu_interrupts_v2/rom_singles/1-cli_latency.nes": NO_APU,

@@ -8,8 +8,8 @@ The convention (ours; the real console powers up at an unknown CPU/PPU phase):
 - A bus access in CPU cycle c sees every PPU event whose dot is <= that dot. So a flag set at
   absolute dot E is first visible to a read in cycle ceil(E / 3) (NTSC).
 - Frames are numbered from 0; frame f runs from line 0 to the pre-render line (261 NTSC, 311 PAL),
-  a full frame being lines x 341 dots. On NTSC, when rendering ($2001 bit 3 or 4) is on at dot 339
-  of the pre-render line of an odd frame, the PPU jumps from that dot to dot 0 of line 0 of the next
+  a full frame being lines x 341 dots. On NTSC, when rendering ($2001 bit 3 or 4) is on at dot 338
+  of the pre-render line of an odd frame (`ODD_FRAME_DECISION_DOT`), the PPU jumps from dot 339 to dot 0 of line 0 of the next
   frame: that frame is 341 x 262 - 1 dots long (nesdev wiki "PPU frame timing"). PAL never skips.
 """
 

@@ -39,6 +39,7 @@ from retro.chips.ppu.constants import (
     MASK_RENDERING,
     MIRRORING,
     NAMETABLE_SIZE,
+    NMI_SAMPLE_DOT_OFFSET,
     NAMETABLE_SPACE_MASK,
     OAM_DMA_CYCLES,
     OAM_DMA_ODD_EXTRA,
@@ -46,7 +47,7 @@ from retro.chips.ppu.constants import (
     OAMADDR,
     OAMDATA,
     OAMDMA,
-    ODD_FRAME_SKIP_DOT,
+    ODD_FRAME_DECISION_DOT,
     PALETTE_BASE,
     PALETTE_SHADOW_OFFSET,
     PALETTE_SIZE,
@@ -72,6 +73,7 @@ from retro.chips.ppu.constants import (
     V_NAMETABLE,
     V_NAMETABLE_SHIFT,
     VBLANK_DOT,
+    VBLANK_SUPPRESSING_READ,
     VBLANK_LINE,
     VRAM_ADDRESS_MASK,
     VideoStandard,
@@ -129,14 +131,19 @@ class PpuDevice:
         self._state_from = -1           # absolute dot of the last change that can move the hit
         self._candidates: np.ndarray | None = None
         self.hits: list[tuple[int, int, int]] = []   # (frame, line, dot) of each hit, for inspection
-        self.nmi_pending = False        # an NMI edge the CPU has not taken yet
-        self.nmi_edge_cycle = -NEVER    # the CPU cycle of that edge: a poll before it does not see it
+        # The NMI output is low while the vblank flag and $2000 bit 7 are both set. The CPU samples it
+        # once a cycle (NMI_SAMPLE_DOT_OFFSET dots after the dot its reads see); an edge counts once a
+        # sample sees the output low, so output that goes high again at or before that sample is lost.
+        self.nmi_pending = False        # an edge the CPU has sampled (or will, unless the output goes high first)
+        self.nmi_edge_cycle = -NEVER    # the CPU cycle whose sample sees it: a poll before it does not
+        self._nmi_sample_dot = -NEVER   # the absolute dot of that sample
+        self._vblank_suppressed = False  # a $2002 read just before the vblank dot keeps the flag from being set
         self.nmi_next = NEVER
         pre = self.video.pre_render_line
         self._fixed_events = [
             (VBLANK_LINE * DOTS_PER_LINE + VBLANK_DOT, self._set_vblank),
             (pre * DOTS_PER_LINE + FLAG_CLEAR_DOT, self._clear_flags),
-            (pre * DOTS_PER_LINE + ODD_FRAME_SKIP_DOT, self._decide_frame_length),
+            (pre * DOTS_PER_LINE + ODD_FRAME_DECISION_DOT, self._decide_frame_length),
             (None, self._next_frame),   # at frame_length
         ]
 
@@ -202,11 +209,30 @@ class PpuDevice:
         self.position = max(self.position, target)
 
     def _set_vblank(self, dot: int) -> None:
+        if self._vblank_suppressed:
+            self._vblank_suppressed = False
+            return
         self.vblank = True
         if self.ctrl & CTRL_NMI:
-            self.nmi_pending = True
-            self.nmi_edge_cycle = -NEVER  # reached by catching up to a poll: that poll sees it
+            self._nmi_output_low(dot)
+
+    def _nmi_output_low(self, dot: int) -> None:
+        """The NMI output fell at absolute dot `dot`: the first CPU sample at or after it sees the edge."""
+        cycle = first_cycle_seeing(dot - NMI_SAMPLE_DOT_OFFSET, self.origin, self.video)
+        self.nmi_pending = True
+        self.nmi_edge_cycle = cycle
+        self._nmi_sample_dot = self.dot_of(cycle) + NMI_SAMPLE_DOT_OFFSET
         self._refresh_nmi_next()
+
+    def _nmi_output_high(self, dot: int) -> None:
+        """The NMI output rose at `dot` (flag cleared or NMI disabled): an edge not sampled by then is lost."""
+        if self.nmi_pending and dot <= self._nmi_sample_dot:
+            self.nmi_pending = False
+            self._refresh_nmi_next()
+
+    def _vblank_dot(self) -> int:
+        """The absolute dot of this frame's vblank flag."""
+        return self.frame_start + VBLANK_LINE * DOTS_PER_LINE + VBLANK_DOT
 
     # ---- the CPU's lines ---------------------------------------------------------------------
 
@@ -223,17 +249,18 @@ class PpuDevice:
         elif not self.ctrl & CTRL_NMI:
             self.nmi_next = NEVER
         else:
-            vblank = VBLANK_LINE * DOTS_PER_LINE + VBLANK_DOT
-            # this frame's, or (past it) the next frame's, at most one dot early (the odd-frame skip)
-            dot = self.frame_start + vblank if self._event == 0 else self.frame_start + self.frame_length - 1 + vblank
-            self.nmi_next = first_cycle_seeing(dot, self.origin, self.video)
+            # this frame's vblank, or (past it) the next frame's, at most one dot early (the odd-frame skip)
+            dot = self._vblank_dot() + (0 if self._event == 0 else self.frame_length - 1)
+            self.nmi_next = first_cycle_seeing(dot - NMI_SAMPLE_DOT_OFFSET, self.origin, self.video)
 
     def nmi_edge(self, cycle: int) -> bool:
         """Whether the CPU's poll at `cycle` (never before `nmi_next`) sees an NMI edge; it is taken."""
-        self.advance(self.dot_of(cycle))
-        taken, self.nmi_pending = self.nmi_pending, False
+        self.advance(self.dot_of(cycle) + NMI_SAMPLE_DOT_OFFSET)
+        if not self.nmi_pending or self.nmi_edge_cycle > cycle:
+            return False
+        self.nmi_pending = False
         self._refresh_nmi_next()
-        return taken
+        return True
 
     def irq_low(self, cycle: int) -> bool:
         return False
@@ -247,6 +274,8 @@ class PpuDevice:
     def _clear_flags(self, dot: int) -> None:
         self.vblank = False
         self.sprite0_hit = False
+        self._vblank_suppressed = False
+        self._nmi_output_high(dot)
 
     def _decide_frame_length(self, dot: int) -> None:
         self.frame_length = frame_dots(self.frame, bool(self.mask & MASK_RENDERING), self.video)
@@ -262,11 +291,16 @@ class PpuDevice:
     def read(self, address: int, cycle: int) -> int:
         if address == OAMDMA:
             return self.latch
-        self.advance(self.dot_of(cycle))
+        dot = self.dot_of(cycle)
+        self.advance(dot)
         register = PPU_REGISTER_BASE | (address & PPU_REGISTER_MASK)
         if register == PPUSTATUS:
             value = self._status()
-            self.vblank = False
+            if self.vblank:
+                self.vblank = False
+                self._nmi_output_high(dot)
+            elif self._event == 0 and dot == self._vblank_dot() - VBLANK_SUPPRESSING_READ:
+                self._vblank_suppressed = True
             self.w = 0
         elif register == OAMDATA:
             value = self.oam[self.oam_addr]
@@ -299,13 +333,14 @@ class PpuDevice:
             return
         register = PPU_REGISTER_BASE | (address & PPU_REGISTER_MASK)
         if register == PPUCTRL:
-            if self.vblank and value & CTRL_NMI and not self.ctrl & CTRL_NMI:
+            enabled, self.ctrl = self.ctrl & CTRL_NMI, value
+            if self.vblank and value & CTRL_NMI and not enabled:
                 # the NMI output falls in the write's cycle: after the poll of the writing instruction
                 # (its penultimate cycle), so the NMI follows the next instruction [blargg ppu_vbl_nmi
                 # 04-nmi_control, test 11: "immediate occurrence should be after NEXT instruction"]
-                self.nmi_pending = True
-                self.nmi_edge_cycle = cycle
-            self.ctrl = value
+                self._nmi_output_low(dot)
+            elif enabled and not value & CTRL_NMI:
+                self._nmi_output_high(dot)
             self._refresh_nmi_next()
             self.t = (self.t & ~V_NAMETABLE) | ((value & CTRL_NAMETABLE) << V_NAMETABLE_SHIFT)
         elif register == PPUMASK:
