@@ -39,8 +39,6 @@ ROMS = {
 
 NO_APU = "needs the APU (frame IRQ, DMC): not modelled"
 NOT_YET = {
-    **{f"sprite_overflow_tests/{name}.nes": "sprite overflow is not modelled" for name in (
-        "1.Basics", "2.Details", "3.Timing", "4.Obscure", "5.Emulator")},
     "cpu_interrupts_v2/rom_singles/1-cli_latency.nes": NO_APU,
     "cpu_interrupts_v2/rom_singles/2-nmi_and_brk.nes": "NMI hijacking BRK",
     "cpu_interrupts_v2/rom_singles/3-nmi_and_irq.nes": NO_APU,

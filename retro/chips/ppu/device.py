@@ -33,6 +33,7 @@ from retro.chips.ppu.constants import (
     CTRL_INCREMENT_32,
     CTRL_NAMETABLE,
     CTRL_NMI,
+    CTRL_SPRITE_8X16,
     DOTS_PER_LINE,
     FINE_SCROLL,
     FLAG_CLEAR_DOT,
@@ -62,6 +63,7 @@ from retro.chips.ppu.constants import (
     PPUSTATUS,
     SCREEN_HEIGHT,
     STATUS_OPEN_BUS,
+    STATUS_OVERFLOW,
     STATUS_SPRITE0_HIT,
     STATUS_VBLANK,
     V_BITS,
@@ -78,6 +80,7 @@ from retro.chips.ppu.constants import (
     VRAM_ADDRESS_MASK,
     VideoStandard,
 )
+from retro.chips.ppu.overflow import overflow_dots
 from retro.chips.ppu.hit import hit_dot, hit_pixels, rendering_enabled_for_hits
 from retro.chips.ppu.state import PpuState
 from retro.cpu.bus import NEVER
@@ -119,6 +122,7 @@ class PpuDevice:
         self.latch = 0
         self.vblank = False
         self.sprite0_hit = False
+        self.sprite_overflow = False
         self.read_memory = read_memory or (lambda address: 0)
         self.stall = stall or (lambda cycles: None)
         # clock
@@ -131,6 +135,7 @@ class PpuDevice:
         self._state_from = -1           # absolute dot of the last change that can move the hit
         self._candidates: np.ndarray | None = None
         self.hits: list[tuple[int, int, int]] = []   # (frame, line, dot) of each hit, for inspection
+        self.overflows: list[tuple[int, int, int]] = []  # (frame, line, dot) of each overflow flag
         # The NMI output is low while the vblank flag and $2000 bit 7 are both set. The CPU samples it
         # once a cycle (NMI_SAMPLE_DOT_OFFSET dots after the dot its reads see); an edge counts once a
         # sample sees the output low, so output that goes high again at or before that sample is lost.
@@ -190,6 +195,13 @@ class PpuDevice:
         later = self._candidates[self._candidates > self._state_from - self.frame_start]
         return int(later[0]) + self.frame_start if later.size else None
 
+    def _next_overflow(self) -> int | None:
+        if self.sprite_overflow or self._event > 0 or not self.mask & MASK_RENDERING:
+            return None
+        dots = overflow_dots(bytes(self.oam), bool(self.ctrl & CTRL_SPRITE_8X16))
+        later = dots[dots > self._state_from - self.frame_start]
+        return int(later[0]) + self.frame_start if later.size else None
+
     def advance(self, target: int) -> None:
         """Apply every PPU event at absolute dots <= target."""
         while True:
@@ -201,6 +213,13 @@ class PpuDevice:
                     break
                 self.sprite0_hit = True
                 self.hits.append((self.frame, *line_and_dot(hit_at - self.frame_start)))
+                continue
+            overflow_at = self._next_overflow()
+            if overflow_at is not None and overflow_at <= fixed_at:
+                if overflow_at > target:
+                    break
+                self.sprite_overflow = True
+                self.overflows.append((self.frame, *line_and_dot(overflow_at - self.frame_start)))
                 continue
             if fixed_at > target:
                 break
@@ -274,6 +293,7 @@ class PpuDevice:
     def _clear_flags(self, dot: int) -> None:
         self.vblank = False
         self.sprite0_hit = False
+        self.sprite_overflow = False
         self._vblank_suppressed = False
         self._nmi_output_high(dot)
 
@@ -366,6 +386,7 @@ class PpuDevice:
 
     def _status(self) -> int:
         return ((STATUS_VBLANK if self.vblank else 0) | (STATUS_SPRITE0_HIT if self.sprite0_hit else 0)
+                | (STATUS_OVERFLOW if self.sprite_overflow else 0)
                 | (self.latch & STATUS_OPEN_BUS))
 
     def _write_scroll(self, value: int) -> None:
