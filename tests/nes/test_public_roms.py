@@ -40,7 +40,6 @@ ROMS = {
 NO_APU = "needs the APU (frame IRQ, DMC): not modelled"
 NOT_YET = {
     "cpu_interrupts_v2/rom_singles/1-cli_latency.nes": NO_APU,
-    "cpu_interrupts_v2/rom_singles/2-nmi_and_brk.nes": "NMI hijacking BRK",
     "cpu_interrupts_v2/rom_singles/3-nmi_and_irq.nes": NO_APU,
     "cpu_interrupts_v2/rom_singles/4-irq_and_dma.nes": NO_APU,
     "cpu_interrupts_v2/rom_singles/5-branch_delays_irq.nes": NO_APU,

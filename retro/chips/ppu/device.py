@@ -2,7 +2,7 @@
 
 What a program sees (nesdev wiki "PPU registers", "PPU scrolling", "PPU frame timing"):
 - $2000-$2007 repeat every 8 bytes up to $3FFF.
-- $2002 returns vblank (bit 7), sprite-zero hit (bit 6), overflow (bit 5, not modelled: 0) and the
+- $2002 returns vblank (bit 7), sprite-zero hit (bit 6), sprite overflow (bit 5) and the
   I/O latch in bits 0-4. Reading it clears bit 7 and the $2005/$2006 write toggle, never bit 6.
   The vblank flag is set at line 241 dot 1; vblank and hit are cleared at dot 1 of the pre-render
   line. The hit flag is set at the dot the hit model (`retro.chips.ppu.hit`) gives.
@@ -16,8 +16,10 @@ What a program sees (nesdev wiki "PPU registers", "PPU scrolling", "PPU frame ti
 The PPU clock follows `retro.chips.ppu.clock`. The frame's scroll is taken from t and x, which the
 real PPU copies into v during the pre-render line (vertical) and at dot 257 of each line
 (horizontal); writes during lines 0-239 take effect for the pixels after the write, as if the new
-state held for the whole frame (the real PPU's mid-frame v/t details are not modelled), nor are
-NMI, sprite overflow, the $2002 read/vblank race, or the power-up write lock-out.
+state held for the whole frame (the real PPU's mid-frame v/t details are not modelled, nor is the
+power-up write lock-out). The NMI output, the $2002 read racing the vblank flag and the odd-frame
+skip follow the rules of docs/nes.md, "The vblank and NMI timeline"; sprite overflow follows
+`retro.chips.ppu.overflow`, recomputed like the hit whenever OAM, $2000 or $2001 change.
 """
 
 from __future__ import annotations
