@@ -15,19 +15,19 @@ The convention (ours; the real console powers up at an unknown CPU/PPU phase):
 
 from __future__ import annotations
 
-import math
-
 from retro.chips.ppu.constants import DOTS_PER_LINE, VideoStandard
 
 
 def dots_at_cycle(cycle: int, origin: int, video: VideoStandard) -> int:
     """Absolute PPU dot (from frame 0, line 0, dot 0) at which CPU cycle `cycle` begins."""
-    return math.floor((cycle - origin) * video.dots_per_cpu_cycle)
+    ratio = video.dots_per_cpu_cycle  # integer arithmetic: Fraction's operators cost more than the CPU step
+    return (cycle - origin) * ratio.numerator // ratio.denominator
 
 
 def first_cycle_seeing(dot: int, origin: int, video: VideoStandard) -> int:
     """The first CPU cycle whose accesses see an event at absolute PPU dot `dot`."""
-    return origin + math.ceil(dot / video.dots_per_cpu_cycle)
+    ratio = video.dots_per_cpu_cycle
+    return origin - (-dot * ratio.denominator // ratio.numerator)
 
 
 def line_and_dot(dot_in_frame: int) -> tuple[int, int]:

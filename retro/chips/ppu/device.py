@@ -136,6 +136,8 @@ class PpuDevice:
         self._event = 0                 # index into _fixed_events of the next one
         self._state_from = -1           # absolute dot of the last change that can move the hit
         self._candidates: np.ndarray | None = None
+        # ((frame_start, _state_from), the next overflow dot): valid until OAM, $2000/$2001 or the frame change
+        self._overflow_next: tuple[tuple[int, int], int | None] | None = None
         self.hits: list[tuple[int, int, int]] = []   # (frame, line, dot) of each hit, for inspection
         self.overflows: list[tuple[int, int, int]] = []  # (frame, line, dot) of each overflow flag
         # The NMI output is low while the vblank flag and $2000 bit 7 are both set. The CPU samples it
@@ -173,6 +175,7 @@ class PpuDevice:
     def _changed(self, dot: int) -> None:
         self._state_from = dot
         self._candidates = None
+        self._overflow_next = None
 
     # ---- clock -------------------------------------------------------------------------------
 
@@ -200,9 +203,12 @@ class PpuDevice:
     def _next_overflow(self) -> int | None:
         if self.sprite_overflow or self._event > 0 or not self.mask & MASK_RENDERING:
             return None
-        dots = overflow_dots(bytes(self.oam), bool(self.ctrl & CTRL_SPRITE_8X16))
-        later = dots[dots > self._state_from - self.frame_start]
-        return int(later[0]) + self.frame_start if later.size else None
+        key = (self.frame_start, self._state_from)
+        if self._overflow_next is None or self._overflow_next[0] != key:
+            dots = overflow_dots(bytes(self.oam), bool(self.ctrl & CTRL_SPRITE_8X16))
+            later = dots[dots > self._state_from - self.frame_start]
+            self._overflow_next = (key, int(later[0]) + self.frame_start if later.size else None)
+        return self._overflow_next[1]
 
     def advance(self, target: int) -> None:
         """Apply every PPU event at absolute dots <= target."""
