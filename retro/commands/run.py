@@ -213,7 +213,8 @@ def console_lines(report: ConsoleRun) -> list[str]:
     out += [f"{target}: " + " ".join(f"${v:02X}" for v in values) for target, values in report.peeks.items()]
     if report.verdict is not None:
         out.append(f"verdict: {report.verdict.summary()}")
-        out += [f"  {line}" for line in report.verdict.text.splitlines()] if report.verdict.protocol == "$6000" else []
+        if report.verdict.protocol == "$6000":
+            out += [f"  {line}".rstrip() for line in report.verdict.text.splitlines()]
     return out
 
 

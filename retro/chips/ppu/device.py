@@ -215,19 +215,15 @@ class PpuDevice:
         while True:
             offset, action = self._fixed_events[self._event]
             fixed_at = self.frame_start + (self.frame_length if offset is None else offset)
-            hit_at = self._next_hit()
-            if hit_at is not None and hit_at <= fixed_at:
-                if hit_at > target:
+            flag_at, flag = min(((at, flag) for at, flag in ((self._next_hit(), "sprite0_hit"),
+                                                             (self._next_overflow(), "sprite_overflow"))
+                                 if at is not None), default=(None, None))
+            if flag_at is not None and flag_at <= fixed_at:
+                if flag_at > target:
                     break
-                self.sprite0_hit = True
-                self.hits.append((self.frame, *line_and_dot(hit_at - self.frame_start)))
-                continue
-            overflow_at = self._next_overflow()
-            if overflow_at is not None and overflow_at <= fixed_at:
-                if overflow_at > target:
-                    break
-                self.sprite_overflow = True
-                self.overflows.append((self.frame, *line_and_dot(overflow_at - self.frame_start)))
+                setattr(self, flag, True)   # a sprite flag raised mid-frame: (frame, line, dot) kept for inspection
+                (self.hits if flag == "sprite0_hit" else self.overflows).append(
+                    (self.frame, *line_and_dot(flag_at - self.frame_start)))
                 continue
             if fixed_at > target:
                 break
