@@ -139,3 +139,21 @@ def test_other_mappers_are_refused_naming_the_file(tmp_path, capsys):
     path.write_bytes(bytes(data))
     code, _, err = cli(path, capsys=capsys)
     assert code == 2 and "mapper 1" in err and str(path) in err
+
+
+def test_ctrl_c_ends_the_run_with_the_report_so_far(tmp_path, monkeypatch):
+    from retro.cpu.machine import Machine
+    calls = []
+    original = Machine.run_on
+
+    def interrupted(self, cycles, **kwargs):
+        if calls:
+            raise KeyboardInterrupt
+        calls.append(cycles)
+        return original(self, cycles, **kwargs)
+
+    monkeypatch.setattr(Machine, "run_on", interrupted)
+    report = run.run_console(cartridge(tmp_path, [0xE6, 0x10, 0x4C, 0x00, 0xC0]), frames=10)
+    assert report.stopped == "interrupted"
+    assert 29780 <= report.cycles < 2 * 29781
+    assert "interrupted (Ctrl-C)" in "\n".join(run.lines(report))
