@@ -95,6 +95,14 @@ def _cmd_asm(args: argparse.Namespace) -> int:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    console = {"frames": args.frames, "until": args.until, "until_value": args.until_value, "result": args.result}
+    if args.entry is None:
+        report = run.run_console_or_refuse(args.program, labels=args.labels, peeks=args.peeks, load=args.load,
+                                           scene=args.scene, trace=args.trace,
+                                           **{k: v for k, v in console.items() if v is not None})
+        _print(run, report, args.json)
+        return 1 if report.verdict is not None and report.verdict.passed is False else 0
+    run.refuse_console_options(console)
     flags = {flag: getattr(args, flag) for flag in run.SETTABLE_FLAGS if getattr(args, flag) is not None}
     report = run.run(args.program, args.entry, labels=args.labels, load=args.load, a=args.a, x=args.x, y=args.y,
                      flags=flags, sets=args.sets, peeks=args.peeks, budget=args.budget, scene=args.scene,
@@ -209,7 +217,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--labels", metavar="F", help="symbol file of a .prg, .bin or .nes, in any supported format "
                                                    "(docs/symbols.md)")
     p.add_argument("--load", metavar="ADDR", help="load address of a raw binary")
-    p.add_argument("--entry", required=True, metavar="LABEL|ADDR", help="where the routine starts (called as by JSR)")
+    p.add_argument("--entry", metavar="LABEL|ADDR", help="where the routine starts (called as by JSR); without it "
+                   "an iNES image runs on a console from its reset vector (--frames, --until, --until-value, --result)")
+    p.add_argument("--frames", metavar="N", help=f"iNES image from reset: frames to run (default {run.DEFAULT_FRAMES}, "
+                   f"at most {run.MAX_FRAMES:,}); the run also stops when the program halts (JMP * with the NMI off)")
+    p.add_argument("--until", metavar="LABEL|ADDR", help="iNES image from reset: stop when the PC reaches this address")
+    p.add_argument("--until-value", metavar="TARGET=V", help="iNES image from reset: stop when this byte holds V")
+    p.add_argument("--result", metavar="ADDR", help="iNES image from reset: a test ROM's result byte (blargg's 2005 "
+                   "ROMs: $F8, 1 = passed); the $6000 protocol is read without it; exit 1 on a failed verdict")
     for register in ("a", "x", "y"):
         p.add_argument(f"--{register}", default="0", metavar="V", help=f"{register.upper()} on entry (default 0)")
     for flag in run.SETTABLE_FLAGS:

@@ -1,4 +1,4 @@
-"""`retro nes`: load an NES scene, predict its sprite-zero hit, draw it."""
+"""`retro nes`: load an NES scene, predict its sprite-zero hit and sprite overflow, draw the hit."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ from pathlib import Path
 
 from retro.chips.ppu.constants import VBLANK_LINE, VBLANK_DOT
 from retro.chips.ppu.hit import SpriteZeroHit, sprite_zero_hit
+from retro.chips.ppu.overflow import SpriteOverflow, sprite_overflow
 from retro.errors import InputError
 from retro.numbers import parse_int
 from retro.scenes import load_scene
@@ -19,6 +20,7 @@ MAX_SCALE = 16
 class NesRun:
     scene: NesScene
     hit: SpriteZeroHit
+    overflow: SpriteOverflow
     png: Path | None  # the picture written, if one was asked for
 
 
@@ -35,16 +37,25 @@ def nes(path: str | Path, *, png: str | Path | None = None, scale: int | str = 2
         from retro.render.images import save_png
         from retro.render.nes_image import sprite_zero_image
         written = save_png(sprite_zero_image(state, result, scale), png)
-    return NesRun(scene, result, written)
+    return NesRun(scene, result, sprite_overflow(state), written)
 
 
 def as_json(run: NesRun) -> dict:
     """The object `retro nes --json` prints (its keys are a contract)."""
-    return run.hit.as_json()
+    return {**run.hit.as_json(), "sprite_overflow": run.overflow.as_json()}
 
 
 def lines(run: NesRun) -> list[str]:
-    return [_describe(run.hit)] + ([f"wrote {run.png}"] if run.png is not None else [])
+    return [_describe(run.hit), _describe_overflow(run.overflow)] + ([f"wrote {run.png}"] if run.png is not None else [])
+
+
+def _describe_overflow(result: SpriteOverflow) -> str:
+    if not result.set:
+        return f"no sprite overflow: {result.reason}"
+    what = (f"{result.sprites_on_line} sprites on the line" if result.sprites_on_line > 8
+            else f"a false overflow: {result.sprites_on_line} sprites on the line, the evaluation bug reads another byte as a Y")
+    return (f"sprite overflow: $2002 bit 5 set at line {result.line} dot {result.dot}, {result.dots_after_vblank} PPU "
+            f"dots after the vblank flag ({what})")
 
 
 def _describe(result: SpriteZeroHit) -> str:

@@ -1,14 +1,21 @@
 """`retro run`: load a program (source, PRG, raw binary or iNES image) into a machine, with a chip
-scene if one is given, call a routine and report registers, cycles, memory and raster position."""
+scene if one is given, call a routine and report registers, cycles, memory and raster position.
+Or, for an iNES image without `--entry`, run the cartridge on a console from its reset vector for
+N frames or until a condition, and report the state after the run and a test ROM's verdict
+(`retro.analysis.console_run`; docs/nes.md "Running a cartridge")."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
 
+from retro.analysis.console_run import MAX_FRAMES, ConsoleRun, ppu_registers, run_cartridge
+from retro.chips.cartridge import read_nrom
+from retro.chips.ines import INES_MAGIC
 from retro.cpu.machine import DEFAULT_BUDGET, DEFAULT_FLAGS, JSR_CYCLES, MAX_BUDGET, CallResult, Machine
-from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z
+from retro.cpu.mpu import FLAG_B, FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_U, FLAG_V, FLAG_Z
 from retro.errors import InputError
+from retro.fileio import read_bytes
 from retro.loaders import load_program
 from retro.numbers import parse_int
 from retro.machines import build_machine
@@ -78,6 +85,65 @@ def _peek_counts(peeks: list[str]) -> dict[str, int]:
     return counts
 
 
+DEFAULT_FRAMES = 600  # ten seconds of NES time: every blargg ROM of the standard suites reports within it
+RAM_END = 0x0800
+PRG_RAM_START, PRG_RAM_END = 0x6000, 0x8000
+
+
+def is_cartridge(path: str | Path) -> bool:
+    """Whether the file is an iNES image (by content)."""
+    return read_bytes(path, "program file")[:len(INES_MAGIC)] == INES_MAGIC
+
+
+def run_console(path: str | Path, *, frames: int | str = DEFAULT_FRAMES, until: str | int | None = None,
+                until_value: str | None = None, result: str | int | None = None, labels: str | Path | None = None,
+                peeks: list[str] = ()) -> ConsoleRun:
+    """Run the cartridge at `path` from its reset vector for `frames` frames, or until the PC reaches
+    `until`, the byte `until_value` ("TARGET=V") holds its value, or the program halts; `result` is
+    the address of a result byte (blargg's 2005 ROMs: $F8); `peeks` TARGET[:N] reads after the run."""
+    frames = parse_int(frames, field="--frames", lo=1, hi=MAX_FRAMES)
+    data = read_bytes(path, "program file")
+    cartridge = read_nrom(data, str(path))
+    program = load_program(path, symbols=labels)
+    resolver = Machine("2a03")
+    resolver.load(program)
+    stop_pc = None if until is None else resolver.resolve(until, "--until")
+    value = None
+    if until_value is not None:
+        target, values = parse_assignment(until_value)
+        if len(values) != 1:
+            raise InputError(f"--until-value {until_value!r}: one byte value, not {len(values)}")
+        value = (resolver.resolve(target, f"--until-value {target}"), values[0])
+    result_at = None if result is None else resolver.resolve(result, "--result")
+    peek_counts = _peek_counts(peeks)
+    for target in peek_counts:
+        resolver.resolve(target, f"--peek {target}")
+    report = run_cartridge(cartridge, frames=frames, until=stop_pc, until_value=value, result_at=result_at)
+    report.machine.symbols.update(program.symbols)
+    report.peeks = {target: report.machine.peek(target, count) for target, count in peek_counts.items()}
+    return report
+
+
+CONSOLE_OPTIONS = {"frames": "--frames", "until": "--until", "until_value": "--until-value", "result": "--result"}
+
+
+def refuse_console_options(given: dict) -> None:
+    """--frames, --until, --until-value and --result belong to a cartridge run from reset, not to a call."""
+    used = [CONSOLE_OPTIONS[name] for name, value in given.items() if value is not None]
+    if used:
+        raise InputError(f"{', '.join(used)}: only for an iNES image run from its reset vector (without --entry)")
+
+
+def run_console_or_refuse(path: str | Path, *, load=None, scene=None, trace: bool = False, **options) -> ConsoleRun:
+    """`retro run FILE` without --entry: a cartridge from reset, or a one-line error saying what is missing."""
+    if not is_cartridge(path):
+        raise InputError(f"--entry: required for {path} (only an iNES image runs from its reset vector)")
+    for name, value in (("--load", load), ("--scene", scene), ("--trace", trace or None)):
+        if value is not None:
+            raise InputError(f"{name}: not for a cartridge run from reset ({path} is an iNES image run without --entry)")
+    return run_console(path, **options)
+
+
 def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None, load: int | str | None = None,
         a: int | str = 0, x: int | str = 0, y: int | str = 0, flags: dict[str, int | str] | None = None,
         sets: list[str] = (), peeks: list[str] = (), budget: int | str = DEFAULT_BUDGET,
@@ -111,8 +177,51 @@ def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None,
                      raster=call_budget(machine, result))
 
 
-def as_json(report: RunReport) -> dict:
+STOP_REASONS = {
+    "frames": "the frame count ran out",
+    "until": "the PC reached --until",
+    "until-value": "the --until-value byte took its value",
+    "halted": "the program halted (an instruction jumping to itself with the NMI off)",
+    "verdict": "the test ROM reported its result",
+    "interrupted": "interrupted (Ctrl-C)",
+}
+
+
+def console_json(report: ConsoleRun) -> dict:
+    """The object `retro run CART.nes --json` prints: the state after the run and the verdict."""
+    mpu = report.machine.mpu
+    memory = report.machine.memory
+    return {"entry": report.entry, "stopped": report.stopped, "frames": round(report.frames_run, 3),
+            "cycles": report.cycles, "instructions": report.instructions, "halt_pc": report.halt_pc,
+            "cpu": {"pc": mpu.pc, "a": mpu.a, "x": mpu.x, "y": mpu.y, "s": mpu.sp, "p": (mpu.p | FLAG_U) & ~FLAG_B},
+            "ppu": ppu_registers(report.ppu),
+            "ram": bytes(memory[:RAM_END]).hex(), "prg_ram": bytes(memory[PRG_RAM_START:PRG_RAM_END]).hex(),
+            "peek": report.peeks, "verdict": report.verdict.as_dict() if report.verdict else None}
+
+
+def console_lines(report: ConsoleRun) -> list[str]:
+    mpu = report.machine.mpu
+    ppu = ppu_registers(report.ppu)
+    p = (mpu.p | FLAG_U) & ~FLAG_B
+    out = [f"ran {report.frames_run:.2f} of {report.frames_asked} frames ({report.cycles} cycles, "
+           f"{report.instructions} instructions) from the reset vector ${report.entry:04X}",
+           f"stopped: {STOP_REASONS[report.stopped]}"
+           + (f" at ${report.halt_pc:04X}" if report.halt_pc is not None else ""),
+           f"PC=${mpu.pc:04X} A=${mpu.a:02X} X=${mpu.x:02X} Y=${mpu.y:02X} S=${mpu.sp:02X} P=${p:02X}",
+           f"PPU: frame {ppu['frame']} line {ppu['line']} dot {ppu['dot']}, $2000=${ppu['ctrl']:02X} "
+           f"$2001=${ppu['mask']:02X} $2002=${ppu['status']:02X}"]
+    out += [f"{target}: " + " ".join(f"${v:02X}" for v in values) for target, values in report.peeks.items()]
+    if report.verdict is not None:
+        out.append(f"verdict: {report.verdict.summary()}")
+        if report.verdict.protocol == "$6000":
+            out += [f"  {line}".rstrip() for line in report.verdict.text.splitlines()]
+    return out
+
+
+def as_json(report: RunReport | ConsoleRun) -> dict:
     """The object `retro run --json` prints (its keys are a contract: no trace in it)."""
+    if isinstance(report, ConsoleRun):
+        return console_json(report)
     r = report.result
     return {"cycles": r.cycles, "instructions": r.instructions, "a": r.a, "x": r.x, "y": r.y, "s": r.s, "p": r.p,
             "peek": report.peeks, **({"raster": report.raster.as_dict()} if report.raster else {}),
@@ -134,7 +243,9 @@ def trace_lines(report: RunReport) -> list[str]:
     return out
 
 
-def lines(report: RunReport) -> list[str]:
+def lines(report: RunReport | ConsoleRun) -> list[str]:
+    if isinstance(report, ConsoleRun):
+        return console_lines(report)
     r = report.result
     out = trace_lines(report) if r.trace else []
     out += [f"A=${r.a:02X} X=${r.x:02X} Y=${r.y:02X} S=${r.s:02X} P=${r.p:02X}",

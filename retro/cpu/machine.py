@@ -241,6 +241,13 @@ class Machine:
             self._over_budget(cycles, count)
         return count
 
+    def run_on(self, cycles: int, *, until: int | None = None, observer=None) -> int:
+        """Go on from the current state (PC, registers, a pending interrupt) for `cycles` cycles or
+        until the PC reaches `until`; returns the instructions executed. For whole programs run in
+        slices (`retro run` of a cartridge); `observer` as in `MPU6510.run`."""
+        stop = NO_ADDRESS if until is None else until
+        return self._execute(stop, ANY_STACK, self.mpu.processorCycles + cycles, observer)
+
     def _execute(self, stop_pc: int, stop_sp: int, limit: int, observer=None) -> int:
         """Run to stop_pc (and stop_sp) or the limit (the MPU's one run loop); a CpuHalt becomes a
         RunError saying where."""

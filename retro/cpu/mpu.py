@@ -67,6 +67,14 @@ I_CHANGED_AFTER_POLL = frozenset({OPCODE_CLI, OPCODE_SEI, OPCODE_PLP})
 IRQ_VECTOR = 0xFFFE
 NMI_VECTOR = 0xFFFA
 INTERRUPT_CYCLES = 7
+# Interrupt hijacking [blargg's cpu_interrupts_v2, 2-nmi_and_brk and 3-nmi_and_irq; visual6502 wiki
+# "6502 Timing of Interrupt Handling"]: the vector of BRK (and of an IRQ sequence) is chosen late in
+# the sequence; an NMI edge a poll in cycle HIJACK_POLL of it (0 = its first) sees takes the NMI
+# vector instead (BRK's pushed P keeps B set). The sequence itself does not poll at its end: an NMI
+# that comes later is taken after the handler's first instruction. 3 is fitted to 2-nmi_and_brk (its
+# ten lines step the NMI one CPU cycle later each: "interrupts BRK for 5 clocks, and occurs after SEC
+# in BRK handler for last 2 clocks"); 2 or 4 fail it.
+HIJACK_POLL = 3
 # 64doc: the cycles in which an instruction writes, counted back from its last cycle (1 = last).
 # Every other cycle is a read, dummy reads included, and stops the CPU while BA is low.
 _STORES = (0x85, 0x95, 0x8D, 0x9D, 0x99, 0x81, 0x91, 0x86, 0x96, 0x8E, 0x84, 0x94, 0x8C,
@@ -235,10 +243,13 @@ class MPU6510(_Py65MPU):
         self.processorCycles = end
         self.stolen += delay
         self.last_stolen = delay
+        lines = self.lines
+        if op == OPCODE_BRK:
+            self._hijack(start + delay)
+            return True
         # the poll: penultimate cycle; a taken branch within its page polls a cycle earlier
         poll = end - 3 if op in BRANCH_OPCODES and self.excycles == 1 else end - 2
         masked = (i_before if op in I_CHANGED_AFTER_POLL else self.p & FLAG_I)
-        lines = self.lines
         if poll >= lines.nmi_next and lines.nmi_edge(poll):
             self.pending_interrupt = "NMI"
         elif not masked and poll >= lines.irq_next and lines.irq_low(poll):
@@ -253,9 +264,19 @@ class MPU6510(_Py65MPU):
         self.p |= FLAG_I
         vector = NMI_VECTOR if kind == "NMI" else IRQ_VECTOR
         self.pc = self.memory[vector] | self.memory[vector + 1] << 8
+        if kind == "IRQ":
+            self._hijack(start + delay)
         self.processorCycles = start + INTERRUPT_CYCLES + delay
         self.stolen += delay
         self.last_stolen = delay
+
+    def _hijack(self, start: int) -> None:
+        """After BRK or an IRQ sequence begun at `start` (stalls before it counted): an NMI seen by
+        cycle HIJACK_POLL takes the vector (HIJACK_POLL above)."""
+        poll = start + HIJACK_POLL
+        lines = self.lines
+        if poll >= lines.nmi_next and lines.nmi_edge(poll):
+            self.pc = self.memory[NMI_VECTOR] | self.memory[NMI_VECTOR + 1] << 8
 
     def run(self, stop_pc: int, stop_sp: int, limit: int, observer=None) -> int:
         """The run loop: execute until PC == stop_pc (and SP == stop_sp, unless stop_sp < 0) or the clock

@@ -1,29 +1,121 @@
 """A NES as far as timing needs one: the 2A03 and the PPU, with OAM DMA at $4014.
 
-`build_nes` is the one place a NES is put together; an NES scene only says what the PPU holds
-(`retro.machines.build_machine` reads it). No APU, controllers or mapper: the program runs from RAM.
+`build_nes` is the one place a NES is put together. An NES scene only says what the PPU holds
+(`retro.machines.build_machine` reads it); the program then runs from RAM. With a cartridge
+(`retro.chips.cartridge.NromCartridge`) the machine is a console: PRG ROM at $8000-$FFFF, CHR ROM or
+RAM in the PPU, the board's mirroring, the 2 KiB of RAM mirrored up to $1FFF, PRG RAM at
+$6000-$7FFF, and the APU and controller ports at $4000-$4017 reading as an idle console's (no APU is
+modelled: sound registers ignore writes; `$4015` reads $00: no channel playing, no frame or DMC
+interrupt; `$4016`/`$4017` read $40: no button pressed, the upper bits the open bus's $40 left by
+the address; nesdev wiki "APU", "Standard controller", "Open bus behavior").
 """
 
 from __future__ import annotations
 
+from retro.chips.cartridge import PRG_START, RESET_VECTOR, NromCartridge
 from retro.chips.ppu.constants import OAMDMA, PPU_REGISTER_BASE, PPU_REGISTER_END
 from retro.chips.ppu.device import PpuDevice
 from retro.chips.ppu.state import PpuState
 from retro.cpu.machine import Machine
+from retro.cpu.mpu import FLAG_I, FLAG_U
 
 CPU = "2a03"
+RAM_SIZE = 0x800                # 2 KiB at $0000-$07FF ...
+RAM_MIRRORS_START = 0x0800      # ... seen again at $0800-$1FFF
+RAM_MIRRORS_END = 0x1FFF
+IO_START = 0x4000               # APU and I/O registers $4000-$4017 (+ $4018-$401F, test mode, unused)
+IO_END = 0x401F
+APU_STATUS = 0x4015
+CONTROLLER_PORTS = (0x4016, 0x4017)
+IDLE_APU_STATUS = 0x00          # no length counter running, no frame or DMC interrupt
+IDLE_CONTROLLER = 0x40          # no button (bit 0 = 0); bits 5-7 the open bus's $40
+OPEN_BUS_IO = 0x40              # what a write-only register at $40xx reads back
+PRG_END = 0xFFFF
+RESET_SP = 0xFD                 # the 6502's reset sequence leaves S three pushes below $00
 
 
-def build_nes(state: PpuState | None = None) -> Machine:
+class _RamMirror:
+    """$0800-$1FFF: the console's 2 KiB of RAM again (the address lines above A10 are not decoded)."""
+
+    def __init__(self, memory: list[int]) -> None:
+        self.memory = memory
+
+    def read(self, address: int, cycle: int) -> int:
+        return self.memory[address & (RAM_SIZE - 1)]
+
+    def write(self, address: int, value: int, cycle: int) -> None:
+        self.memory[address & (RAM_SIZE - 1)] = value
+
+    def peek(self, address: int) -> int:
+        return self.memory[address & (RAM_SIZE - 1)]
+
+
+class _IdleIo:
+    """$4000-$401F but $4014: the APU and the controller ports of a console nobody plays."""
+
+    def read(self, address: int, cycle: int) -> int:
+        return self.peek(address)
+
+    def write(self, address: int, value: int, cycle: int) -> None:
+        pass
+
+    def peek(self, address: int) -> int:
+        if address == APU_STATUS:
+            return IDLE_APU_STATUS
+        if address in CONTROLLER_PORTS:
+            return IDLE_CONTROLLER
+        return OPEN_BUS_IO
+
+
+class _Rom:
+    """PRG ROM: data reads see the loaded bytes, writes do nothing (NROM has no mapper registers)."""
+
+    def __init__(self, memory: list[int]) -> None:
+        self.memory = memory
+
+    def read(self, address: int, cycle: int) -> int:
+        return self.memory[address]
+
+    def write(self, address: int, value: int, cycle: int) -> None:
+        pass
+
+    def peek(self, address: int) -> int:
+        return self.memory[address]
+
+
+def build_nes(state: PpuState | None = None, cartridge: NromCartridge | None = None) -> Machine:
     """A fresh NES: a 2A03 with a PPU holding `state` (power-on state without one) at $2000-$3FFF
-    (8-byte mirrors) and $4014, its clock at line 0, dot 0 now."""
+    (8-byte mirrors) and $4014, its clock at line 0, dot 0 now. With `cartridge`, the console
+    around it (module docstring); `state` then defaults to the cartridge's CHR and mirroring."""
     machine = Machine(CPU)
+    if cartridge is not None and state is None:
+        state = PpuState(mirroring=cartridge.mirroring, chr=cartridge.chr)
     # OAM DMA copies a page of the CPU's memory and holds the CPU meanwhile: the PPU needs both
-    device = PpuDevice(state, read_memory=machine.bus.peek, stall=machine.mpu.stall)
+    device = PpuDevice(state, read_memory=machine.bus.peek, stall=machine.mpu.stall,
+                       chr_writable=cartridge is None or cartridge.chr_ram)
     device.start_clock(machine.cycle)
     machine.attach(device, PPU_REGISTER_BASE, PPU_REGISTER_END)
     machine.attach(device, OAMDMA, OAMDMA)
+    if cartridge is not None:
+        memory = machine.bus.memory
+        machine.attach(_RamMirror(memory), RAM_MIRRORS_START, RAM_MIRRORS_END)
+        io = _IdleIo()
+        machine.attach(io, IO_START, OAMDMA - 1)
+        machine.attach(io, OAMDMA + 1, IO_END)
+        machine.bus.load(PRG_START, cartridge.prg)
+        machine.attach(_Rom(memory), PRG_START, PRG_END)
+        machine.mpu.stop_on_brk = False  # BRK is an instruction of the program, not the end of a call
     return machine
+
+
+def reset(machine: Machine) -> int:
+    """The CPU's reset sequence: PC from $FFFC, S = $FD, I set; returns the entry address."""
+    mpu = machine.mpu
+    mpu.pc = machine.bus.peek(RESET_VECTOR) | machine.bus.peek(RESET_VECTOR + 1) << 8
+    mpu.sp = RESET_SP
+    mpu.p = FLAG_U | FLAG_I
+    mpu.pending_interrupt = None
+    return mpu.pc
 
 
 def ppu_of(machine: Machine) -> PpuDevice | None:

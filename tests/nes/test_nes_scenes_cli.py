@@ -57,16 +57,20 @@ def test_issue_scene_json(tmp_path, capsys):
     # Sprite at Y 119 -> line 120, x 128, both solid tiles: (21 + 120) * 341 + 128 = 48209.
     # NTSC: 3 PPU dots a CPU cycle, so 48209 / 3 = 16069.6667 CPU cycles after the vblank flag.
     assert data == {"hit": True, "line": 120, "dot": 129, "x": 128, "dots_after_vblank": 48209,
-                    "cpu_cycles_after_vblank": 16069.6667}
-    assert list(data) == ["hit", "line", "dot", "x", "dots_after_vblank", "cpu_cycles_after_vblank"]
+                    "cpu_cycles_after_vblank": 16069.6667,
+                    "sprite_overflow": {"set": False, "line": None, "dot": None, "dots_after_vblank": None,
+                                        "sprites_on_line": None}}
+    assert list(data) == ["hit", "line", "dot", "x", "dots_after_vblank", "cpu_cycles_after_vblank", "sprite_overflow"]
 
 
 def test_no_hit_json_has_nulls(tmp_path, capsys):
     code, out, _ = run_cli("nes", str(write(tmp_path, SCENE.replace("mask = 0x1e", "mask = 0x0e"))), "--json",
                            capsys=capsys)
     assert code == 0
-    assert json.loads(out) == {"hit": False, "line": None, "dot": None, "x": None, "dots_after_vblank": None,
-                               "cpu_cycles_after_vblank": None}
+    data = json.loads(out)
+    assert data == {"hit": False, "line": None, "dot": None, "x": None, "dots_after_vblank": None,
+                    "cpu_cycles_after_vblank": None, "sprite_overflow": data["sprite_overflow"]}
+    assert data["sprite_overflow"]["set"] is False
 
 
 def test_tile_as_16_chr_bytes_equals_rows(tmp_path):

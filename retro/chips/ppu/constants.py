@@ -23,7 +23,18 @@ SCREEN_HEIGHT = 240             # visible lines 0-239
 VBLANK_LINE = 241
 VBLANK_DOT = 1                  # the vblank flag is set at dot 1 of line 241
 FLAG_CLEAR_DOT = 1              # vblank, sprite-0 hit and overflow are cleared at dot 1 of the pre-render line
-ODD_FRAME_SKIP_DOT = 339        # with rendering on, odd NTSC frames jump from this dot of the pre-render line to (0, 0)
+# With rendering on, odd NTSC frames jump from dot 339 of the pre-render line to (0, 0): one dot shorter.
+# Whether rendering is on is decided with $2001 as written up to dot 338 of that line (a write the CPU
+# makes at dot 339 is too late): blargg's ppu_vbl_nmi 10-even_odd_timing, tests 2-5, in the convention
+# that a CPU access in cycle c sees the PPU at dot 3c (retro.chips.ppu.clock).
+ODD_FRAME_DECISION_DOT = 338
+# The CPU samples its NMI input one dot after the dot its reads see (a read in CPU cycle c sees the PPU
+# at dot 3c, the NMI input is sampled at 3c + 1): fitted to blargg's ppu_vbl_nmi 05 (NMI timing), 07
+# (NMI enabled near the vblank clear), 08 and vbl_nmi_timing 6 (NMI disabled near the vblank set).
+NMI_SAMPLE_DOT_OFFSET = 1
+# A $2002 read this many dots before the vblank dot reads the flag clear and keeps it from being set
+# for the frame (no NMI either): nesdev wiki "PPU frame timing", blargg's vbl_nmi_timing 2 and 5.
+VBLANK_SUPPRESSING_READ = 1
 HIT_DOT_OFFSET = 1              # the hit flag for pixel x is set at dot x + 1 of its line
 NO_HIT_X = SCREEN_WIDTH - 1     # x = 255 never hits (the pixel pipeline, per "PPU OAM")
 LEFT_COLUMN_WIDTH = 8           # x = 0-7: hidden when either left-column bit of $2001 is clear
@@ -98,6 +109,10 @@ OAM_SIZE = 256
 OAM_ENTRY_SIZE = 4              # Y, tile, attributes, X
 SPRITE_Y_OFFSET = 1             # a sprite at OAM Y is drawn from line Y + 1
 SPRITE_WIDTH = 8
+SPRITE_HEIGHT_8X8 = 8
+SPRITE_HEIGHT_8X16 = 16
+SPRITES_PER_LINE = 8            # sprite evaluation copies at most 8 sprites per line, then looks for overflow
+SPRITE_EVALUATION_DOT = 65      # evaluation reads sprite 0's Y on this dot of each visible line
 TILE_SIZE = 8
 TILE_BYTES = 16                 # plane 0 rows, then plane 1 rows
 PLANE_OFFSET = 8

@@ -2,7 +2,7 @@
 
 What a program sees (nesdev wiki "PPU registers", "PPU scrolling", "PPU frame timing"):
 - $2000-$2007 repeat every 8 bytes up to $3FFF.
-- $2002 returns vblank (bit 7), sprite-zero hit (bit 6), overflow (bit 5, not modelled: 0) and the
+- $2002 returns vblank (bit 7), sprite-zero hit (bit 6), sprite overflow (bit 5) and the
   I/O latch in bits 0-4. Reading it clears bit 7 and the $2005/$2006 write toggle, never bit 6.
   The vblank flag is set at line 241 dot 1; vblank and hit are cleared at dot 1 of the pre-render
   line. The hit flag is set at the dot the hit model (`retro.chips.ppu.hit`) gives.
@@ -16,8 +16,10 @@ What a program sees (nesdev wiki "PPU registers", "PPU scrolling", "PPU frame ti
 The PPU clock follows `retro.chips.ppu.clock`. The frame's scroll is taken from t and x, which the
 real PPU copies into v during the pre-render line (vertical) and at dot 257 of each line
 (horizontal); writes during lines 0-239 take effect for the pixels after the write, as if the new
-state held for the whole frame (the real PPU's mid-frame v/t details are not modelled), nor are
-NMI, sprite overflow, the $2002 read/vblank race, or the power-up write lock-out.
+state held for the whole frame (the real PPU's mid-frame v/t details are not modelled, nor is the
+power-up write lock-out). The NMI output, the $2002 read racing the vblank flag and the odd-frame
+skip follow the rules of docs/nes.md, "The vblank and NMI timeline"; sprite overflow follows
+`retro.chips.ppu.overflow`, recomputed like the hit whenever OAM, $2000 or $2001 change.
 """
 
 from __future__ import annotations
@@ -33,12 +35,14 @@ from retro.chips.ppu.constants import (
     CTRL_INCREMENT_32,
     CTRL_NAMETABLE,
     CTRL_NMI,
+    CTRL_SPRITE_8X16,
     DOTS_PER_LINE,
     FINE_SCROLL,
     FLAG_CLEAR_DOT,
     MASK_RENDERING,
     MIRRORING,
     NAMETABLE_SIZE,
+    NMI_SAMPLE_DOT_OFFSET,
     NAMETABLE_SPACE_MASK,
     OAM_DMA_CYCLES,
     OAM_DMA_ODD_EXTRA,
@@ -46,7 +50,7 @@ from retro.chips.ppu.constants import (
     OAMADDR,
     OAMDATA,
     OAMDMA,
-    ODD_FRAME_SKIP_DOT,
+    ODD_FRAME_DECISION_DOT,
     PALETTE_BASE,
     PALETTE_SHADOW_OFFSET,
     PALETTE_SIZE,
@@ -61,6 +65,7 @@ from retro.chips.ppu.constants import (
     PPUSTATUS,
     SCREEN_HEIGHT,
     STATUS_OPEN_BUS,
+    STATUS_OVERFLOW,
     STATUS_SPRITE0_HIT,
     STATUS_VBLANK,
     V_BITS,
@@ -72,10 +77,12 @@ from retro.chips.ppu.constants import (
     V_NAMETABLE,
     V_NAMETABLE_SHIFT,
     VBLANK_DOT,
+    VBLANK_SUPPRESSING_READ,
     VBLANK_LINE,
     VRAM_ADDRESS_MASK,
     VideoStandard,
 )
+from retro.chips.ppu.overflow import overflow_dots
 from retro.chips.ppu.hit import hit_dot, hit_pixels, rendering_enabled_for_hits
 from retro.chips.ppu.state import PpuState
 from retro.cpu.bus import NEVER
@@ -97,8 +104,9 @@ class PpuDevice:
 
     def __init__(self, state: PpuState | None = None, *, origin: int = 0,
                  read_memory: Callable[[int], int] | None = None,
-                 stall: Callable[[int], None] | None = None) -> None:
+                 stall: Callable[[int], None] | None = None, chr_writable: bool = True) -> None:
         state = state or PpuState()
+        self.chr_writable = chr_writable  # False for a cartridge's CHR ROM: $2007 writes there do nothing
         self.video: VideoStandard = state.video
         self.mirroring = state.mirroring
         self.ctrl = state.ctrl
@@ -116,6 +124,7 @@ class PpuDevice:
         self.latch = 0
         self.vblank = False
         self.sprite0_hit = False
+        self.sprite_overflow = False
         self.read_memory = read_memory or (lambda address: 0)
         self.stall = stall or (lambda cycles: None)
         # clock
@@ -127,15 +136,23 @@ class PpuDevice:
         self._event = 0                 # index into _fixed_events of the next one
         self._state_from = -1           # absolute dot of the last change that can move the hit
         self._candidates: np.ndarray | None = None
+        # ((frame_start, _state_from), the next overflow dot): valid until OAM, $2000/$2001 or the frame change
+        self._overflow_next: tuple[tuple[int, int], int | None] | None = None
         self.hits: list[tuple[int, int, int]] = []   # (frame, line, dot) of each hit, for inspection
-        self.nmi_pending = False        # an NMI edge the CPU has not taken yet
-        self.nmi_edge_cycle = -NEVER    # the CPU cycle of that edge: a poll before it does not see it
+        self.overflows: list[tuple[int, int, int]] = []  # (frame, line, dot) of each overflow flag
+        # The NMI output is low while the vblank flag and $2000 bit 7 are both set. The CPU samples it
+        # once a cycle (NMI_SAMPLE_DOT_OFFSET dots after the dot its reads see); an edge counts once a
+        # sample sees the output low, so output that goes high again at or before that sample is lost.
+        self.nmi_pending = False        # an edge the CPU has sampled (or will, unless the output goes high first)
+        self.nmi_edge_cycle = -NEVER    # the CPU cycle whose sample sees it: a poll before it does not
+        self._nmi_sample_dot = -NEVER   # the absolute dot of that sample
+        self._vblank_suppressed = False  # a $2002 read just before the vblank dot keeps the flag from being set
         self.nmi_next = NEVER
         pre = self.video.pre_render_line
         self._fixed_events = [
             (VBLANK_LINE * DOTS_PER_LINE + VBLANK_DOT, self._set_vblank),
             (pre * DOTS_PER_LINE + FLAG_CLEAR_DOT, self._clear_flags),
-            (pre * DOTS_PER_LINE + ODD_FRAME_SKIP_DOT, self._decide_frame_length),
+            (pre * DOTS_PER_LINE + ODD_FRAME_DECISION_DOT, self._decide_frame_length),
             (None, self._next_frame),   # at frame_length
         ]
 
@@ -158,6 +175,7 @@ class PpuDevice:
     def _changed(self, dot: int) -> None:
         self._state_from = dot
         self._candidates = None
+        self._overflow_next = None
 
     # ---- clock -------------------------------------------------------------------------------
 
@@ -182,17 +200,30 @@ class PpuDevice:
         later = self._candidates[self._candidates > self._state_from - self.frame_start]
         return int(later[0]) + self.frame_start if later.size else None
 
+    def _next_overflow(self) -> int | None:
+        if self.sprite_overflow or self._event > 0 or not self.mask & MASK_RENDERING:
+            return None
+        key = (self.frame_start, self._state_from)
+        if self._overflow_next is None or self._overflow_next[0] != key:
+            dots = overflow_dots(bytes(self.oam), bool(self.ctrl & CTRL_SPRITE_8X16))
+            later = dots[dots > self._state_from - self.frame_start]
+            self._overflow_next = (key, int(later[0]) + self.frame_start if later.size else None)
+        return self._overflow_next[1]
+
     def advance(self, target: int) -> None:
         """Apply every PPU event at absolute dots <= target."""
         while True:
             offset, action = self._fixed_events[self._event]
             fixed_at = self.frame_start + (self.frame_length if offset is None else offset)
-            hit_at = self._next_hit()
-            if hit_at is not None and hit_at <= fixed_at:
-                if hit_at > target:
+            flag_at, flag = min(((at, flag) for at, flag in ((self._next_hit(), "sprite0_hit"),
+                                                             (self._next_overflow(), "sprite_overflow"))
+                                 if at is not None), default=(None, None))
+            if flag_at is not None and flag_at <= fixed_at:
+                if flag_at > target:
                     break
-                self.sprite0_hit = True
-                self.hits.append((self.frame, *line_and_dot(hit_at - self.frame_start)))
+                setattr(self, flag, True)   # a sprite flag raised mid-frame: (frame, line, dot) kept for inspection
+                (self.hits if flag == "sprite0_hit" else self.overflows).append(
+                    (self.frame, *line_and_dot(flag_at - self.frame_start)))
                 continue
             if fixed_at > target:
                 break
@@ -201,11 +232,30 @@ class PpuDevice:
         self.position = max(self.position, target)
 
     def _set_vblank(self, dot: int) -> None:
+        if self._vblank_suppressed:
+            self._vblank_suppressed = False
+            return
         self.vblank = True
         if self.ctrl & CTRL_NMI:
-            self.nmi_pending = True
-            self.nmi_edge_cycle = -NEVER  # reached by catching up to a poll: that poll sees it
+            self._nmi_output_low(dot)
+
+    def _nmi_output_low(self, dot: int) -> None:
+        """The NMI output fell at absolute dot `dot`: the first CPU sample at or after it sees the edge."""
+        cycle = first_cycle_seeing(dot - NMI_SAMPLE_DOT_OFFSET, self.origin, self.video)
+        self.nmi_pending = True
+        self.nmi_edge_cycle = cycle
+        self._nmi_sample_dot = self.dot_of(cycle) + NMI_SAMPLE_DOT_OFFSET
         self._refresh_nmi_next()
+
+    def _nmi_output_high(self, dot: int) -> None:
+        """The NMI output rose at `dot` (flag cleared or NMI disabled): an edge not sampled by then is lost."""
+        if self.nmi_pending and dot <= self._nmi_sample_dot:
+            self.nmi_pending = False
+            self._refresh_nmi_next()
+
+    def _vblank_dot(self) -> int:
+        """The absolute dot of this frame's vblank flag."""
+        return self.frame_start + VBLANK_LINE * DOTS_PER_LINE + VBLANK_DOT
 
     # ---- the CPU's lines ---------------------------------------------------------------------
 
@@ -222,17 +272,18 @@ class PpuDevice:
         elif not self.ctrl & CTRL_NMI:
             self.nmi_next = NEVER
         else:
-            vblank = VBLANK_LINE * DOTS_PER_LINE + VBLANK_DOT
-            # this frame's, or (past it) the next frame's, at most one dot early (the odd-frame skip)
-            dot = self.frame_start + vblank if self._event == 0 else self.frame_start + self.frame_length - 1 + vblank
-            self.nmi_next = first_cycle_seeing(dot, self.origin, self.video)
+            # this frame's vblank, or (past it) the next frame's, at most one dot early (the odd-frame skip)
+            dot = self._vblank_dot() + (0 if self._event == 0 else self.frame_length - 1)
+            self.nmi_next = first_cycle_seeing(dot - NMI_SAMPLE_DOT_OFFSET, self.origin, self.video)
 
     def nmi_edge(self, cycle: int) -> bool:
         """Whether the CPU's poll at `cycle` (never before `nmi_next`) sees an NMI edge; it is taken."""
-        self.advance(self.dot_of(cycle))
-        taken, self.nmi_pending = self.nmi_pending, False
+        self.advance(self.dot_of(cycle) + NMI_SAMPLE_DOT_OFFSET)
+        if not self.nmi_pending or self.nmi_edge_cycle > cycle:
+            return False
+        self.nmi_pending = False
         self._refresh_nmi_next()
-        return taken
+        return True
 
     def irq_low(self, cycle: int) -> bool:
         return False
@@ -246,6 +297,9 @@ class PpuDevice:
     def _clear_flags(self, dot: int) -> None:
         self.vblank = False
         self.sprite0_hit = False
+        self.sprite_overflow = False
+        self._vblank_suppressed = False
+        self._nmi_output_high(dot)
 
     def _decide_frame_length(self, dot: int) -> None:
         self.frame_length = frame_dots(self.frame, bool(self.mask & MASK_RENDERING), self.video)
@@ -261,11 +315,16 @@ class PpuDevice:
     def read(self, address: int, cycle: int) -> int:
         if address == OAMDMA:
             return self.latch
-        self.advance(self.dot_of(cycle))
+        dot = self.dot_of(cycle)
+        self.advance(dot)
         register = PPU_REGISTER_BASE | (address & PPU_REGISTER_MASK)
         if register == PPUSTATUS:
             value = self._status()
-            self.vblank = False
+            if self.vblank:
+                self.vblank = False
+                self._nmi_output_high(dot)
+            elif self._event == 0 and dot == self._vblank_dot() - VBLANK_SUPPRESSING_READ:
+                self._vblank_suppressed = True
             self.w = 0
         elif register == OAMDATA:
             value = self.oam[self.oam_addr]
@@ -298,13 +357,14 @@ class PpuDevice:
             return
         register = PPU_REGISTER_BASE | (address & PPU_REGISTER_MASK)
         if register == PPUCTRL:
-            if self.vblank and value & CTRL_NMI and not self.ctrl & CTRL_NMI:
+            enabled, self.ctrl = self.ctrl & CTRL_NMI, value
+            if self.vblank and value & CTRL_NMI and not enabled:
                 # the NMI output falls in the write's cycle: after the poll of the writing instruction
                 # (its penultimate cycle), so the NMI follows the next instruction [blargg ppu_vbl_nmi
                 # 04-nmi_control, test 11: "immediate occurrence should be after NEXT instruction"]
-                self.nmi_pending = True
-                self.nmi_edge_cycle = cycle
-            self.ctrl = value
+                self._nmi_output_low(dot)
+            elif enabled and not value & CTRL_NMI:
+                self._nmi_output_high(dot)
             self._refresh_nmi_next()
             self.t = (self.t & ~V_NAMETABLE) | ((value & CTRL_NAMETABLE) << V_NAMETABLE_SHIFT)
         elif register == PPUMASK:
@@ -330,6 +390,7 @@ class PpuDevice:
 
     def _status(self) -> int:
         return ((STATUS_VBLANK if self.vblank else 0) | (STATUS_SPRITE0_HIT if self.sprite0_hit else 0)
+                | (STATUS_OVERFLOW if self.sprite_overflow else 0)
                 | (self.latch & STATUS_OPEN_BUS))
 
     def _write_scroll(self, value: int) -> None:
@@ -387,7 +448,8 @@ class PpuDevice:
     def _vram_write(self, address: int, value: int) -> None:
         address &= VRAM_ADDRESS_MASK
         if address < CHR_SIZE:
-            self.chr[address] = value
+            if self.chr_writable:
+                self.chr[address] = value
         elif address < PALETTE_BASE:
             self.ciram[self._ciram_index(address)] = value
         else:
