@@ -76,6 +76,7 @@ class LaneError(IntEnum):
     JAM = 2
     UNSTABLE = 3
     BUDGET = 4
+    HALT = 5  # the 65C02's STP, or WAI with no interrupt source
 
 
 class LaneMemoryFull(Exception):
@@ -275,6 +276,10 @@ class BatchCpu:
             raise InputError(f"unknown CPU variant {variant!r} (known: {', '.join(VARIANTS)})")
         self.variant = variant
         self.decimal = VARIANTS[variant].has_decimal
+        self.handlers = HANDLERS
+        if VARIANTS[variant].opcode_table is not OPCODE_TABLE:  # the 65C02: its own table of handlers
+            from retro.cpu.batch65c02 import HANDLERS_65C02
+            self.handlers = HANDLERS_65C02
         self.lanes = lanes
         self.stop_on_brk = stop_on_brk
         self.memory = LaneMemory(image, lanes, memory_limit)
@@ -356,7 +361,7 @@ class BatchCpu:
 
     def _dispatch(self, opcode: int, group: Lanes, pc, lo, hi):
         self.instructions += 1
-        handler = HANDLERS.get(opcode)
+        handler = self.handlers.get(opcode)
         if handler is None:
             group.stop(pc, LaneError.JAM if opcode in JAM_OPCODES else LaneError.UNSTABLE)
             return
@@ -624,10 +629,12 @@ def _operation(mnemonic: str):
     raise AssertionError(mnemonic)  # pragma: no cover - READS lists only the mnemonics handled here
 
 
-def _make_read(mnemonic: str, mode: str, cycles: int, penalised: bool, length: int) -> Handler:
-    """Instructions that read an operand (immediate or memory) and change registers and flags."""
-    address_of = ADDRESSING.get(mode)
-    operate = _operation(mnemonic)
+def _make_read(mnemonic: str, mode: str, cycles: int, penalised: bool, length: int, *,
+               operate: Callable | None = None, address_of: Callable | None = None) -> Handler:
+    """Instructions that read an operand (immediate or memory) and change registers and flags
+    (`operate`, `address_of`: another CPU's operation or addressing mode, by default the NMOS ones)."""
+    address_of = address_of or ADDRESSING.get(mode)
+    operate = operate or _operation(mnemonic)
     if mode == "imm":
         def handler(g, pc, lo, hi):
             operate(g, lo)

@@ -32,7 +32,7 @@ from retro.cpu.machine import (
     push_return_trap,
 )
 from retro.cpu.mpu import FLAG_B, FLAG_U
-from retro.cpu.timing import OPCODES
+from retro.cpu.timing import timing_table
 from retro.errors import InputError
 from retro.fileio import read_text
 from retro.machines import build_machine
@@ -187,9 +187,10 @@ class RoutineRunner:
         if routine.init is not None:
             self.machine.call_fast(self.machine.resolve(routine.init, "program.init"), budget=self.limit)
         self.call_image = bytearray(self.machine.memory)  # what every call starts from (the batch's image)
-        # (indirect),Y instructions: the timing model needs their pointer. Every byte of the program
-        # that could be such an opcode is listed; a data byte in the set only costs a lookup.
-        indirect_y = {opcode for opcode, op in OPCODES.items() if op.mode == "iny"}
+        # (indirect),Y instructions: the timing model needs their pointer (and the 65C02's BBR/BBS the
+        # zero-page byte they test). Every byte of the program that could be such an opcode is listed;
+        # a data byte in the set only costs a lookup.
+        indirect_y = {opcode for opcode, op in timing_table(routine.cpu).items() if op.mode in ("iny", "zpr")}
         self.pointer_pcs = frozenset(self.program.origin + i for i, b in enumerate(self.program.code) if b in indirect_y)
         self._plan()
 
