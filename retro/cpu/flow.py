@@ -27,6 +27,7 @@ from retro.cpu.timing import (
     CMOS_DECIMAL_CYCLES,
     PAGE_CROSS_CYCLES,
     WDC_65C02,
+    TimingError,
     branch_target,
     crosses_page,
     timing_of,
@@ -73,7 +74,11 @@ def decode(read: Callable[[int], int], entry: int,
         if opcode in unsupported or (opcode == OPCODE_JSR and call_cost is None):
             name = unsupported.get(opcode, "JSR")
             raise InputError(f"${pc:04X}: {name} is not supported by the static analysis")
-        op = timing_of(opcode, cpu)
+        try:
+            op = timing_of(opcode, cpu)
+        except TimingError:
+            raise InputError(f"${pc:04X}: opcode ${opcode:02X} is not an instruction the {cpu.upper()} runs "
+                             f"(a JAM or unstable opcode; is the CPU right? program.cpu)") from None
         operand = read((pc + 1) & 0xFFFF) | read((pc + 2) & 0xFFFF) << 8
         extra = 0
         if op.page_penalty and (op.mode == "iny" or (op.mode in ("abx", "aby") and operand & 0xFF)):
