@@ -785,7 +785,7 @@ def check_record(check: RoutineCheck) -> dict:
     """One routine's check as plain data (what `retro check --json` prints)."""
     t = check.totals
     record = {"routine": check.routine.name, "spec": str(check.routine.spec_path), "cpu": check.routine.cpu,
-              "cases": t.cases, "mismatches": check.mismatches,
+              "machine": check.routine.machine, "cases": t.cases, "mismatches": check.mismatches,
               "result_mismatches": t.result_mismatches,
               "cycle_mismatches": t.cycle_mismatches + (check.agreement.cycle_mismatches if check.agreement else 0),
               "run_errors": t.run_errors, "bounds_violations": check.bounds_violations,
