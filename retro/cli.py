@@ -98,7 +98,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     flags = {flag: getattr(args, flag) for flag in run.SETTABLE_FLAGS if getattr(args, flag) is not None}
     report = run.run(args.program, args.entry, labels=args.labels, load=args.load, a=args.a, x=args.x, y=args.y,
                      flags=flags, sets=args.sets, peeks=args.peeks, budget=args.budget, scene=args.scene,
-                     trace=args.trace)
+                     trace=args.trace, cpu=args.cpu)
     _print(run, report, args.json)
     return 0
 
@@ -219,6 +219,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--budget", default=str(DEFAULT_BUDGET), metavar="CYCLES",
                    help=f"stop the routine after this many cycles (default {DEFAULT_BUDGET:,}, at most {MAX_BUDGET:,})")
     p.add_argument("--scene", metavar="SCENE.toml", help="attach a VIC-II or NES PPU scene to the machine")
+    p.add_argument("--cpu", metavar="CPU", help="the CPU: 6510 (default), 2a03 (an iNES image's) or 65c02 (WDC)")
     output = p.add_mutually_exclusive_group()  # the JSON object's keys are fixed: no room for a trace
     output.add_argument("--trace", action="store_true", help="print every instruction executed")
     output.add_argument("--json", action="store_true", help="print one JSON object")

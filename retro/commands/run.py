@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from retro.cpu.machine import DEFAULT_BUDGET, DEFAULT_FLAGS, JSR_CYCLES, MAX_BUDGET, CallResult, Machine
-from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z
+from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z, VARIANTS
 from retro.errors import InputError
 from retro.loaders import load_program
 from retro.numbers import parse_int
@@ -78,12 +78,25 @@ def _peek_counts(peeks: list[str]) -> dict[str, int]:
     return counts
 
 
+def _cpu(cpu: str | None, program, path) -> str | None:
+    """--cpu, checked against the CPU the file implies (an iNES image: the 2A03)."""
+    if cpu is None:
+        return program.cpu
+    chosen = str(cpu).lower()
+    if chosen not in VARIANTS:
+        raise InputError(f"--cpu: expected one of {', '.join(VARIANTS)}, got {cpu!r}")
+    if program.cpu and chosen != program.cpu:
+        raise InputError(f"--cpu {cpu}: {path} is a program for the {program.cpu.upper()}")
+    return chosen
+
+
 def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None, load: int | str | None = None,
         a: int | str = 0, x: int | str = 0, y: int | str = 0, flags: dict[str, int | str] | None = None,
         sets: list[str] = (), peeks: list[str] = (), budget: int | str = DEFAULT_BUDGET,
-        scene: str | Path | None = None, trace: bool = False) -> RunReport:
+        scene: str | Path | None = None, trace: bool = False, cpu: str | None = None) -> RunReport:
     """Call `entry` of the program at `path` (as by JSR, through its RTS). `sets` are TARGET=V[,V...]
-    stores before the call, `peeks` TARGET[:N] reads after it; `scene` attaches a VIC-II or NES scene."""
+    stores before the call, `peeks` TARGET[:N] reads after it; `scene` attaches a VIC-II or NES scene;
+    `cpu` ("6510", "2a03", "65c02") is the CPU to run on (default: the file's own, else the 6510)."""
     registers = {name: parse_int(value, field=f"--{name}", lo=0, hi=0xFF) for name, value in (("a", a), ("x", x), ("y", y))}
     budget = parse_int(budget, field="--budget", lo=1, hi=MAX_BUDGET)
     status = status_with_flags(flags)
@@ -96,7 +109,7 @@ def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None,
     if loaded_scene is not None and program.cpu and loaded_scene.cpu_variant != program.cpu:
         raise InputError(f"--scene {scene}: a scene for the {loaded_scene.cpu_variant.upper()}, "
                          f"but {path} is a program for the {program.cpu.upper()}")
-    machine = build_machine(loaded_scene, cpu=program.cpu)
+    machine = build_machine(loaded_scene, cpu=_cpu(cpu, program, path))
     machine.load(program)
     memory = dict(parse_assignment(s) for s in sets)
     for target in memory:

@@ -5,18 +5,23 @@ table against the independent timing model; and named facts of the data sheet wr
 
 from __future__ import annotations
 
+import json
 import random
+from pathlib import Path
 
 import numpy as np
 import pytest
 from ref65c02 import Ref65C02
 
+from retro.analysis.raster import format_raster, raster_figures
+from retro.cli import main
 from retro.cpu.batch import BatchCpu, LaneError
 from retro.cpu.machine import Machine
 from retro.cpu.mpu import FLAG_D, MPU65C02, CpuHalt
 from retro.cpu.opcodes import DOCUMENTED, OPCODE_TABLE_65C02, RESERVED, opcodes_of
 from retro.cpu.timing import OPCODES_65C02
 from retro.errors import RunError
+from retro.machines import machine_for
 
 REAL_FLAGS = 0xCF  # B and bit 5 exist only in pushed copies
 VECTORS_PER_OPCODE = 24
@@ -247,3 +252,54 @@ def test_store_zero_trb_tsb_and_the_zero_page_indirect_mode():
     result = machine.call(0xC000)
     assert machine.peek(0x4000) == [0b1010_1111 & ~0x0A]
     assert machine.peek(0x30) == [0] and result.flags["Z"] == 0
+
+
+# ---- choosing the CPU: retro run --cpu, scenes ---------------------------------------------------------
+
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "65c02_boxhit"
+DATA = Path(__file__).resolve().parents[1] / "data"
+
+
+def _run_cli(capsys, *args) -> tuple[int, str, str]:
+    code = main(["run", str(EXAMPLE / "hit65.prg"), "--labels", str(EXAMPLE / "hit65.sym"), *args])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_retro_run_with_cpu_65c02_runs_the_65c02_routine(capsys):
+    code, out, _ = _run_cli(capsys, "--entry", "hit65", "--cpu", "65C02", "--set", "bptr=$42,$10",
+                            "--set", "box_ax=10", "--set", "box_aw=10", "--set", "box_ay=10", "--set", "box_ah=5",
+                            "--set", "boxb_x=15,12,3,3", "--peek", "hit", "--json")
+    assert code == 0
+    record = json.loads(out)
+    # the longest path: STZ 3, (zp) loads and compares 5 each, ADC (zp),Y 5, RTS 6 ...
+    assert record["peek"] == {"hit": [1]} and record["cycles"] == 94
+
+
+def test_retro_run_on_the_default_6510_stops_at_the_first_65c02_opcode(capsys):
+    code, _, err = _run_cli(capsys, "--entry", "hit65", "--set", "bptr=$42,$10")
+    assert code == 1 and "JAM (opcode $B2) at $100B" in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("args, message", [
+    (("--cpu", "z80"), "--cpu: expected one of 6510, 2a03, 65c02, got 'z80'"),
+    (("--cpu", "65c02", "--scene", "VIC"), "a scene for the 6510, not the 65C02"),
+])
+def test_retro_run_refuses_a_bad_cpu_in_one_line(capsys, args, message):
+    args = tuple(str(EXAMPLE.parent / "vic_two_balls.toml") if a == "VIC" else a for a in args)
+    code, _, err = _run_cli(capsys, "--entry", "hit65", *args)
+    assert code == 2 and message in err and err.count("\n") == 1, err
+
+
+def test_an_ines_image_is_for_the_2a03_only(capsys):
+    code = main(["run", str(DATA / "foreign" / "nes_boxhit.nes"), "--entry", "$C000", "--cpu", "65c02"])
+    err = capsys.readouterr().err
+    assert code == 2 and "nes_boxhit.nes is a program for the 2A03" in err and err.count("\n") == 1
+
+
+def test_a_bare_machine_has_no_raster_timelines_and_named_machines_keep_theirs():
+    assert raster_figures("none", 10, 20, 30) == {} and format_raster("none", {}) == ""
+    assert set(raster_figures("c64", 10, 20, 63)) == {"c64_pal", "c64_ntsc"}
+    assert raster_figures("c64", 10, 20, 63)["c64_pal"]["max_lines"] == 1.0
+    assert set(raster_figures("nes", 10, 20, 30)) == {"nes_ntsc", "nes_pal"}
+    assert [machine_for(cpu) for cpu in ("6510", "2a03", "65c02")] == ["c64", "nes", "none"]
