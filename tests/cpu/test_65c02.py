@@ -19,8 +19,9 @@ from retro.cpu.batch import BatchCpu, LaneError
 from retro.cpu.machine import Machine
 from retro.cpu.mpu import FLAG_D, MPU65C02, CpuHalt
 from retro.cpu.opcodes import DOCUMENTED, OPCODE_TABLE_65C02, RESERVED, opcodes_of
-from retro.cpu.timing import OPCODES_65C02
-from retro.errors import RunError
+from retro.cpu.flow import analyse
+from retro.cpu.timing import OPCODES_65C02, instruction_cycles
+from retro.errors import InputError, RunError
 from retro.machines import machine_for
 
 REAL_FLAGS = 0xCF  # B and bit 5 exist only in pushed copies
@@ -303,3 +304,53 @@ def test_a_bare_machine_has_no_raster_timelines_and_named_machines_keep_theirs()
     assert raster_figures("c64", 10, 20, 63)["c64_pal"]["max_lines"] == 1.0
     assert set(raster_figures("nes", 10, 20, 30)) == {"nes_ntsc", "nes_pal"}
     assert [machine_for(cpu) for cpu in ("6510", "2a03", "65c02")] == ["c64", "nes", "none"]
+
+
+# ---- the static analysis and the timing model on 65C02 code ----------------------------------------------
+
+BIT_BRANCH_CODE = [0x0F, 0x10, 0x05,  # $C000 BBR0 $10, $C008
+                   0xA9, 0x01,        # $C003 LDA #1
+                   0x80, 0x01,        # $C005 BRA $C008 (always: the BRK after it is never decoded)
+                   0x00,              # $C007 BRK
+                   0x60]              # $C008 RTS
+
+
+def _memory(code: list[int], at: int = 0xC000) -> list[int]:
+    memory = [0] * 0x10000
+    memory[at:at + len(code)] = code
+    return memory
+
+
+def test_static_analysis_follows_bbr_both_ways_and_bra_one_way():
+    bounds = analyse(_memory(BIT_BRANCH_CODE).__getitem__, 0xC000, cpu="65c02")
+    assert (bounds.best, bounds.worst) == (5 + 1 + 6, 5 + 2 + 3 + 6)
+    for value, cycles in ((0, 12), (1, 16)):  # bit 0 clear: BBR0 branches
+        machine = Machine("65c02")
+        machine.poke(0xC000, BIT_BRANCH_CODE)
+        machine.poke(0x10, [value])
+        assert machine.call(0xC000).cycles == cycles
+
+
+def test_static_analysis_counts_the_decimal_cycle_as_possible():
+    bounds = analyse(_memory([0xA9, 0x01, 0x69, 0x01, 0x60]).__getitem__, 0xC000, cpu="65c02")
+    assert (bounds.best, bounds.worst) == (10, 11)
+    assert analyse(_memory([0xA9, 0x01, 0x69, 0x01, 0x60]).__getitem__, 0xC000).worst == 10  # the 6510: no
+
+
+@pytest.mark.parametrize("code, name", [([0x7C, 0x00, 0x20], "JMP \\(abs,X\\)"), ([0xDB], "STP"), ([0xCB], "WAI")])
+def test_static_analysis_refuses_what_it_cannot_follow(code, name):
+    with pytest.raises(InputError, match=f"\\$C000: {name} is not supported by the static analysis"):
+        analyse(_memory(code).__getitem__, 0xC000, cpu="65c02")
+
+
+def test_the_timing_model_prices_bit_branches_and_decimal_mode():
+    memory = _memory([0x8F, 0x10, 0x7F], at=0xC0F0)  # BBS0 $10 to $C0F3 + $7F = $C172: another page
+    read = memory.__getitem__
+    assert instruction_cycles(read, 0xC0F0, 0, 0, 0x20, pointer=0x01, cpu="65c02") == 5 + 1 + 1
+    assert instruction_cycles(read, 0xC0F0, 0, 0, 0x20, pointer=0x00, cpu="65c02") == 5
+    memory[0xC000:0xC002] = [0x69, 0x01]  # ADC #1
+    assert instruction_cycles(read, 0xC000, 0, 0, 0x28, 0, cpu="65c02") == 3
+    assert instruction_cycles(read, 0xC000, 0, 0, 0x28, 0, cpu="6510") == 2
+    memory[0xC000:0xC003] = [0x1E, 0x80, 0x40]  # ASL $4080,X
+    assert [instruction_cycles(read, 0xC000, x, 0, 0x20, 0, cpu="65c02") for x in (0x7F, 0x80)] == [6, 7]
+    assert [instruction_cycles(read, 0xC000, x, 0, 0x20, 0, cpu="6510") for x in (0x7F, 0x80)] == [7, 7]
