@@ -122,6 +122,7 @@ class MPU6510(_Py65MPU):
     has_decimal = True
     opcode_table = OPCODE_TABLE
     interrupt_clears = 0  # P bits the interrupt sequence clears besides setting I (the 65C02 clears D)
+    decimal_extra_cycles = 0  # cycles ADC/SBC add with D set (the 65C02's one)
 
     # Opcodes whose memory operand is read, modified and written back (read at n-3, the unmodified
     # value written at n-2, the result at n-1, where n is the instruction's cycle count).
@@ -697,6 +698,7 @@ class MPU65C02(MPU6510):
     instruction = make_instruction_decorator(instruct, disassemble, cycletime, extracycles)
     opcode_table = OPCODE_TABLE_65C02
     interrupt_clears = FLAG_D
+    decimal_extra_cycles = DECIMAL_EXTRA_CYCLES
 
     def ZeroPageIndirectAddr(self):
         pointer = self.memory[self.pc]
@@ -713,7 +715,7 @@ class MPU65C02(MPU6510):
         if not self.p & FLAG_D:
             MPU6510._adc(self, v)
             return
-        self.excycles += DECIMAL_EXTRA_CYCLES
+        self.excycles += self.decimal_extra_cycles
         a = self.a
         carry = self.p & FLAG_C
         low = (a & 0x0F) + (v & 0x0F) + carry  # Clark, sequence 1
@@ -732,7 +734,7 @@ class MPU65C02(MPU6510):
         if not self.p & FLAG_D:
             MPU6510._sbc(self, v)
             return
-        self.excycles += DECIMAL_EXTRA_CYCLES
+        self.excycles += self.decimal_extra_cycles
         a = self.a
         borrow = 1 - (self.p & FLAG_C)
         MPU6510._sbc(self, v)  # C and V from the binary difference (A is set below)

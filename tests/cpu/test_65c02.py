@@ -354,3 +354,25 @@ def test_the_timing_model_prices_bit_branches_and_decimal_mode():
     memory[0xC000:0xC003] = [0x1E, 0x80, 0x40]  # ASL $4080,X
     assert [instruction_cycles(read, 0xC000, x, 0, 0x20, 0, cpu="65c02") for x in (0x7F, 0x80)] == [6, 7]
     assert [instruction_cycles(read, 0xC000, x, 0, 0x20, 0, cpu="6510") for x in (0x7F, 0x80)] == [7, 7]
+
+
+def test_the_trace_and_errors_show_the_65c02_modes():
+    machine = Machine("65c02")
+    machine.poke(0xC000, [0xB2, 0x20, 0x7C, 0x00, 0x30, 0x8F, 0x10, 0xFD, 0xDB])
+    assert [machine.disassemble_at(a) for a in (0xC000, 0xC002, 0xC005)] == [
+        "LDA ($20)", "JMP ($3000,X)", "BBS0 $10,$C005"]
+    machine.poke(0x3000, [0x05, 0xC0])
+    with pytest.raises(RunError, match=r"STP \(opcode \$DB\) at \$C008; last instructions: "
+                                       r"\$C000 LDA \(\$20\), \$C002 JMP \(\$3000,X\), \$C005 BBS0 \$10,\$C005, \$C008 STP"):
+        machine.call(0xC000)
+
+
+def test_the_trace_marks_bit_branches_taken_and_no_page_crossing_for_the_decimal_cycle():
+    machine = Machine("65c02")
+    machine.poke(0xC000, [0xF8, 0x69, 0x01, 0x0F, 0x10, 0x00, 0x64, 0x20, 0x60])  # SED; ADC #1; BBR0 $10,+0; STZ $20
+    machine.poke(0x20, [0x77])
+    trace = machine.call(0xC000, trace=True).trace
+    adc, bbr, stz = trace[1], trace[2], trace[3]
+    assert (adc.cycles, adc.page_crossed) == (3, False)
+    assert (bbr.cycles, bbr.branch_taken, bbr.page_crossed) == (6, True, False)
+    assert stz.read is None and machine.peek(0x20) == [0]
