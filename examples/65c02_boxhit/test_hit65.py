@@ -18,6 +18,7 @@ def test_hit65_matches_its_reference_on_the_65c02_with_no_raster_figures():
     assert report.routine.cpu == "65c02" and report.routine.machine == "none"
     assert report.totals.cases > 65_536
     assert report.static.worst <= 120
+    assert report.size.code_bytes == 0x1042 - 0x1000  # init and hit65, decoded as 65C02 code
     assert cycle_figures(report)["raster"] == {}  # a bare CPU: no C64 or NES lines
 
 
