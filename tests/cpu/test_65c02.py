@@ -17,7 +17,7 @@ from retro.analysis.raster import format_raster, raster_figures
 from retro.cli import main
 from retro.cpu.batch import BatchCpu, LaneError
 from retro.cpu.machine import Machine
-from retro.cpu.mpu import FLAG_D, MPU65C02, CpuHalt
+from retro.cpu.mpu import FLAG_D, MPU65C02, MPU6510, CpuHalt
 from retro.cpu.opcodes import DOCUMENTED, OPCODE_TABLE_65C02, RESERVED, opcodes_of
 from retro.cpu.flow import analyse
 from retro.cpu.timing import OPCODES_65C02, instruction_cycles
@@ -376,3 +376,33 @@ def test_the_trace_marks_bit_branches_taken_and_no_page_crossing_for_the_decimal
     assert (adc.cycles, adc.page_crossed) == (3, False)
     assert (bbr.cycles, bbr.branch_taken, bbr.page_crossed) == (6, True, False)
     assert stz.read is None and machine.peek(0x20) == [0]
+
+
+class _IrqLow:
+    """Control lines with IRQ held low and the bus always free (the interface step_timed reads)."""
+    nmi_next = 1 << 62
+    irq_next = 0
+
+    def ba_free(self, cycle):
+        return 1 << 30
+
+    def ba_wait(self, cycle):
+        return 0
+
+    def nmi_edge(self, cycle):
+        return False
+
+    def irq_low(self, cycle):
+        return True
+
+
+@pytest.mark.parametrize("cpu_class, d_after", [(MPU65C02, 0), (MPU6510, FLAG_D)])
+def test_an_interrupt_clears_decimal_mode_on_the_65c02_only(cpu_class, d_after):
+    memory = [0xEA] * 0x10000
+    memory[0xFFFE:0x10000] = [0x00, 0xD0]
+    mpu = cpu_class(memory=memory, pc=0xC000)
+    mpu.p = 0x20 | FLAG_D  # I clear
+    mpu.lines = _IrqLow()
+    assert mpu.step_timed() and mpu.pending_interrupt == "IRQ"
+    assert not mpu.step_timed()  # the interrupt sequence
+    assert mpu.pc == 0xD000 and mpu.p & FLAG_D == d_after and mpu.memory[0x100 + mpu.sp + 1] & FLAG_D
