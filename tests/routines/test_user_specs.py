@@ -263,3 +263,14 @@ def test_a_reference_may_import_its_neighbours(tmp_path, capsys):
         "def boxhit(ax, ay, aw, ah, bx, by, bw, bh):\n    return overlap(ax, aw, bx, bw) and overlap(ay, ah, by, bh)\n")
     code, (record,) = _check_json(capsys, str(spec), "--random", "50")
     assert code == 0 and record["mismatches"] == 0
+
+
+@pytest.mark.parametrize("machine, timelines", [("none", set()), ("c64", {"c64_pal", "c64_ntsc"}),
+                                                 ("C64", {"c64_pal", "c64_ntsc"})])
+def test_the_raster_figures_follow_the_named_machine(tmp_path, capsys, machine, timelines):
+    """6510 code from another computer (a VIC-20, an Atari 2600) names no machine: no C64 raster lines."""
+    spec = _variant(tmp_path, {'entry = "boxhit"': f'entry = "boxhit"\nmachine = "{machine}"'})
+    code, (record,) = _check_json(capsys, str(spec), "--random", "50")
+    assert code == 0 and record["machine"] == machine.lower() and set(record["raster"]) == timelines
+    assert main(["check", str(spec), "--random", "50", "--jobs", "1"]) == 0
+    assert ("raster (CPU never stalled): C64 PAL" in capsys.readouterr().out) == bool(timelines)
