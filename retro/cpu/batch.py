@@ -674,9 +674,11 @@ def _arr(g, value, p):
     return np.where(decimal, dec, result), np.where(decimal, dec_flags, flags)
 
 
-def _make_store(mnemonic: str, mode: str, cycles: int, length: int) -> Handler:
-    address_of = ADDRESSING[mode]
-    source = {"STA": lambda g: g.a, "STX": lambda g: g.x, "STY": lambda g: g.y, "SAX": lambda g: g.a & g.x}[mnemonic]
+def _make_store(mnemonic: str, mode: str, cycles: int, length: int, *, address_of: Callable | None = None) -> Handler:
+    """Instructions that write a register (or zero: the 65C02's STZ) to memory."""
+    address_of = address_of or ADDRESSING[mode]
+    source = {"STA": lambda g: g.a, "STX": lambda g: g.x, "STY": lambda g: g.y, "SAX": lambda g: g.a & g.x,
+              "STZ": lambda g: 0}[mnemonic]
 
     def handler(g, pc, lo, hi):
         address, _ = address_of(g, lo, hi)
@@ -726,22 +728,27 @@ def _make_branch(opcode: int, cycles: int) -> Handler:
         target = (following + _signed(lo)) & WORD
         crossed = (following & PAGE_MASK) != (target & PAGE_MASK)
         g.cycles += cycles
-        if isinstance(target, int) and isinstance(following, int):
-            jump = np.flatnonzero(taken)
-            extra = extra_taken + crossed * BRANCH_PAGE_CYCLES
-            if len(jump) == len(taken):
-                g.cycles += extra
-                return target
-            if not len(jump):
-                return following
-            stay = np.ones(len(taken), dtype=bool)
-            stay[jump] = False
-            jumped = g.take(jump)
-            jumped.cycles += extra
-            return [(target, jumped), (following, g.take(np.flatnonzero(stay)))]
-        g.cycles += taken * (extra_taken + crossed * BRANCH_PAGE_CYCLES)
-        return np.where(taken, target, following)
+        return _branch_split(g, taken, target, following, extra_taken + crossed * BRANCH_PAGE_CYCLES)
     return handler
+
+
+def _branch_split(g, taken: np.ndarray, target, following, extra):
+    """Where a group goes at a branch (taken: per lane): one next PC, a list of (next pc, lanes) when
+    the lanes part, or per-lane PCs when the addresses are per lane; the taken lanes pay `extra`."""
+    if isinstance(target, int) and isinstance(following, int):
+        jump = np.flatnonzero(taken)
+        if len(jump) == len(taken):
+            g.cycles += extra
+            return target
+        if not len(jump):
+            return following
+        stay = np.ones(len(taken), dtype=bool)
+        stay[jump] = False
+        jumped = g.take(jump)
+        jumped.cycles += extra
+        return [(target, jumped), (following, g.take(np.flatnonzero(stay)))]
+    g.cycles += taken * extra
+    return np.where(taken, target, following)
 
 
 FLAG_BITS = {"C": FLAG_C, "I": FLAG_I, "V": FLAG_V, "D": FLAG_D}

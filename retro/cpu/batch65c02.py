@@ -26,10 +26,12 @@ from retro.cpu.batch import (
     LaneError,
     _add_cycles,
     _binary_adc,
+    _branch_split,
     _brk,
     _full,
     _make_read,
     _make_rmw,
+    _make_store,
     _next,
     _nz,
     _signed,
@@ -97,18 +99,6 @@ def _bit_immediate(g, value):  # BIT #imm sets only Z
 
 # ---- handlers ---------------------------------------------------------------------------------------------
 
-def _store(mode: str, cycles: int, source) -> Handler:
-    address_of = ADDRESSING_65C02[mode]
-    length = MODE_LENGTH[mode]
-
-    def handler(g, pc, lo, hi):
-        address, _ = address_of(g, lo, hi)
-        g.write(_uniform(address), source(g))
-        g.cycles += cycles
-        return _next(pc, length)
-    return handler
-
-
 def _modify(mode: str, cycles: int, penalised: bool, change) -> Handler:
     """A read-modify-write: change(group, value) -> the value written (and sets flags)."""
     address_of = ADDRESSING_65C02[mode]
@@ -141,26 +131,6 @@ def _memory_bit(mask: int, setting: bool):
     return lambda g, value: (value | mask) if setting else (value & ~mask & BYTE)
 
 
-def _split(g, taken, target, following, extra):
-    """Next PCs of a group at a branch; `extra` is the taken branch's cycles (per lane or one)."""
-    if not isinstance(taken, np.ndarray):
-        taken = np.full(len(g), bool(taken))
-    if isinstance(target, int) and isinstance(following, int):
-        jump = np.flatnonzero(taken)
-        if len(jump) == len(taken):
-            g.cycles += extra
-            return target
-        if not len(jump):
-            return following
-        stay = np.ones(len(taken), dtype=bool)
-        stay[jump] = False
-        jumped = g.take(jump)
-        jumped.cycles += extra
-        return [(target, jumped), (following, g.take(np.flatnonzero(stay)))]
-    g.cycles += taken * extra
-    return np.where(taken, target, following)
-
-
 def _branch_always(cycles: int) -> Handler:
     def handler(g, pc, lo, hi):  # BRA
         following = (pc + 2) & WORD
@@ -179,7 +149,9 @@ def _bit_branch(mask: int, when_set: bool, cycles: int) -> Handler:
         target = (following + _signed(hi)) & WORD
         crossed = (following & PAGE_MASK) != (target & PAGE_MASK)
         g.cycles += cycles
-        return _split(g, taken, target, following, BRANCH_TAKEN_CYCLES + crossed * BRANCH_PAGE_CYCLES)
+        if not isinstance(taken, np.ndarray):  # the byte is the same in every lane
+            taken = np.full(len(g), bool(taken))
+        return _branch_split(g, taken, target, following, BRANCH_TAKEN_CYCLES + crossed * BRANCH_PAGE_CYCLES)
     return handler
 
 
@@ -248,13 +220,11 @@ def _handler(opcode: int, row) -> Handler:
                           address_of=ADDRESSING_65C02.get(mode))
     if nmos == row and name not in ("BRK", "JMP"):
         return HANDLERS[opcode]  # the NMOS 6502 runs it the same way
-    if mode == "zpi" and name == "STA":
-        return _store(mode, cycles, lambda g: g.a)
+    if name in ("STA", "STZ"):  # STA (zp), STZ
+        return _make_store(name, mode, cycles, length, address_of=ADDRESSING_65C02[mode])
     if mode == "zpi" or name == "BIT":
         return _make_read(name, mode, cycles, row.page_penalty, length, address_of=ADDRESSING_65C02.get(mode),
                           operate=_bit_immediate if mode == "imm" else None)
-    if name == "STZ":
-        return _store(mode, cycles, lambda g: 0)
     if name in SHIFTS_ABX and mode == "abx":
         return _modify(mode, cycles, row.page_penalty, _shift(SHIFTS[name]))
     if name in ("INC", "DEC"):  # INC A, DEC A
