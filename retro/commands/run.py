@@ -100,7 +100,7 @@ def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None,
     registers = {name: parse_int(value, field=f"--{name}", lo=0, hi=0xFF) for name, value in (("a", a), ("x", x), ("y", y))}
     budget = parse_int(budget, field="--budget", lo=1, hi=MAX_BUDGET)
     status = status_with_flags(flags)
-    program = load_program(path, symbols=labels, load=load)
+    program = load_program(path, symbols=labels, load=load, cpu=str(cpu).lower() if cpu else None)
     from_binary_without_symbols = labels is None and not program.listing
     if from_binary_without_symbols and _is_label(str(entry)) and str(entry).strip() not in program.symbols:
         raise InputError(f"{path} has no symbols: pass --labels with the symbol file your assembler wrote, "

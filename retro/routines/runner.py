@@ -163,7 +163,8 @@ class RoutineRunner:
         self.routine = routine
         self.seed = seed
         self.start = start
-        self.program = load_program(routine.program_file, symbols=routine.symbols_file, load=routine.load)
+        self.program = load_program(routine.program_file, symbols=routine.symbols_file, load=routine.load,
+                                    cpu=routine.cpu)
         self.vic = None
         if start is None:
             self.machine = build_machine(cpu=routine.cpu)

@@ -244,7 +244,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     cpu = _text(r, program_doc, "cpu", "program.cpu")
     if cpu is not None:
         cpu = r.choice(cpu, "program.cpu", CPUS, fold_case=True)
-    program = load_program(program_file, symbols=symbols_file, load=load)
+    program = load_program(program_file, symbols=symbols_file, load=load, cpu=cpu)
     cpu = cpu or program.cpu or "6510"
     machine = _machine(r, program_doc, cpu)
     entry = _entry_text(r, program_doc, "entry", required=True)

@@ -23,6 +23,7 @@ from retro.cpu.flow import analyse
 from retro.cpu.timing import OPCODES_65C02, instruction_cycles
 from retro.errors import InputError, RunError
 from retro.machines import machine_for
+from retro.testing import check, spec_from_dict
 
 REAL_FLAGS = 0xCF  # B and bit 5 exist only in pushed copies
 VECTORS_PER_OPCODE = 24
@@ -406,3 +407,42 @@ def test_an_interrupt_clears_decimal_mode_on_the_65c02_only(cpu_class, d_after):
     assert mpu.step_timed() and mpu.pending_interrupt == "IRQ"
     assert not mpu.step_timed()  # the interrupt sequence
     assert mpu.pc == 0xD000 and mpu.p & FLAG_D == d_after and mpu.memory[0x100 + mpu.sp + 1] & FLAG_D
+
+
+OPHIS_65C02 = """; sum of the bytes a pointer in zero page points at (count in X), in Ophis syntax with 65C02 opcodes
+.org $1000
+sum:
+    stz total
+    ldy #0
+loop:
+    lda (ptr),y
+    clc
+    adc total
+    sta total
+    iny
+    dex
+    bne loop
+    bra done
+    brk
+done:
+    rts
+.alias ptr $20
+.alias total $22
+"""
+
+
+def test_an_ophis_source_for_the_65c02_is_assembled_with_its_opcodes(tmp_path, capsys):
+    (tmp_path / "sum.s").write_text(OPHIS_65C02)
+    (tmp_path / "ref.py").write_text("def total(a, b, c, count, pointer):\n    return (a + b + c) & 0xFF\n")
+    spec = {"program": {"file": "sum.s", "entry": "sum", "cpu": "65c02", "init": None},
+            "inputs": {"a": "$3000", "b": "$3001", "c": "$3002", "count": {"at": "X", "values": "3..3"},
+                       "pointer": {"at": "$20", "size": 2, "values": [0x3000]}},
+            "outputs": {"total": "$22"}, "reference": {"function": "ref.py:total"},
+            "cases": {"random": 300, "seed": 1}, "cycles": {"loops": {"loop": 3}}}
+    del spec["program"]["init"]
+    report = check(spec_from_dict(spec, base=tmp_path))
+    assert report.mismatches == 0 and report.totals.cases == 300
+    # STZ 3, LDY 2, three rounds of (5 + 2 + 3 + 3 + 2 + 2 + 3) - 1 for the last BNE, BRA 3, RTS 6
+    assert report.totals.cycles_min == report.totals.cycles_max == 3 + 2 + 3 * 20 - 1 + 3 + 6
+    code = main(["run", str(tmp_path / "sum.s"), "--entry", "sum"])
+    assert code == 2 and "sum.s:" in capsys.readouterr().err  # on the 6510 Ophis refuses STZ
