@@ -1,9 +1,10 @@
 """The 6502 cores: py65's MPU made cycle-exact, bus-aware, and complete for C64 code.
 
-Two variants:
+Three variants:
 - `MPU6510` (Commodore 64): NMOS 6502 with decimal mode.
 - `MPU2A03` (NES): the same core with decimal mode removed: ADC, SBC and the undocumented
   opcodes built on them (RRA, ISC, ARR) ignore the D flag.
+- `MPU65C02`: the WDC 65C02, built from its opcode table (see the class; docs/cpu.md).
 
 What this adds to py65 1.2.0:
 - DEC abs ($CE) costs 6 cycles (py65 charges 3).
@@ -689,7 +690,8 @@ class MPU65C02(MPU6510):
     V by sequence 2, N and Z from the result; SBC gives A by sequence 4, C and V from the binary
     difference, N and Z from the result; both take one cycle more with D set. BRK and interrupts clear D.
     STP stops the clock until a reset, WAI until an interrupt: no chip drives a 65C02's interrupt lines
-    here, so both stop the run with CpuHalt naming them.
+    here, so both stop the run with CpuHalt naming them. (For the same reason `step_timed`'s stall
+    model, which knows the NMOS write cycles, is not adapted to the 65C02's.)
     Read-modify-writes (ASL ... INC DEC, TSB TRB, RMB SMB) write the result once, in their last cycle
     (the 65C02 reads the operand twice where the NMOS writes it twice).
     """
