@@ -446,3 +446,10 @@ def test_an_ophis_source_for_the_65c02_is_assembled_with_its_opcodes(tmp_path, c
     assert report.totals.cycles_min == report.totals.cycles_max == 3 + 2 + 3 * 20 - 1 + 3 + 6
     code = main(["run", str(tmp_path / "sum.s"), "--entry", "sum"])
     assert code == 2 and "sum.s:" in capsys.readouterr().err  # on the 6510 Ophis refuses STZ
+
+
+def test_retro_check_refuses_a_scene_for_a_65c02_routine(capsys):
+    code = main(["check", str(EXAMPLE / "hit65.toml"), "--scene", str(EXAMPLE.parent / "vic_two_balls.toml"),
+                 "--random", "10", "--jobs", "1"])
+    err = capsys.readouterr().err
+    assert code == 2 and "a 6510 scene cannot run the 65c02 routine hit65" in err and err.count("\n") == 1
