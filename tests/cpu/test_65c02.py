@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from ref65c02 import Ref65C02
 
+from retro.analysis.check import check_routine
 from retro.analysis.raster import format_raster, raster_figures
 from retro.cli import main
 from retro.cpu.batch import BatchCpu, LaneError
@@ -453,3 +454,23 @@ def test_retro_check_refuses_a_scene_for_a_65c02_routine(capsys):
                  "--random", "10", "--jobs", "1"])
     err = capsys.readouterr().err
     assert code == 2 and "a 6510 scene cannot run the 65c02 routine hit65" in err and err.count("\n") == 1
+
+
+def test_a_bit_branch_routine_checks_exhaustively_on_both_engines(tmp_path):
+    """BBS7 splits the lanes of the batched core; Machine and the timing model agree on every case."""
+    code = [0xFF, 0x10, 0x05,        # $1000 BBS7 $10, $1008
+            0x64, 0x11,              # $1003 STZ $11
+            0x80, 0x05,              # $1005 BRA $100C
+            0x00,                    # $1007 BRK (never reached)
+            0xA9, 0x01, 0x85, 0x11,  # $1008 LDA #1; STA $11
+            0x60]                    # $100C RTS
+    (tmp_path / "sign.bin").write_bytes(bytes(code))
+    (tmp_path / "ref.py").write_text("def negative(v):\n    return int(v >= 128)\n")
+    spec = {"program": {"file": "sign.bin", "load": "$1000", "entry": "$1000", "cpu": "65c02"},
+            "inputs": {"v": "$10"}, "outputs": {"negative": "$11"}, "reference": {"function": "ref.py:negative"},
+            "cases": {"exhaustive": ["v"]}}
+    report = check_routine(spec_from_dict(spec, base=tmp_path), exhaustive=True, random_count=0, engine="batch")
+    assert report.engine == "batch" and report.mismatches == 0 and report.totals.cases == 256
+    assert report.agreement.engine_cases == 256 and report.agreement.engine_mismatches == 0
+    assert report.totals.cycles_min == report.totals.cycles_max == 5 + 3 + 3 + 6 == 5 + 1 + 2 + 3 + 6
+    assert (report.static.best, report.static.worst) == (17, 17)
