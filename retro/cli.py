@@ -90,7 +90,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _cmd_asm(args: argparse.Namespace) -> int:
-    _print(asm, asm.asm(args.source, output=args.output, labels=args.labels, listing=args.listing))
+    _print(asm, asm.asm(args.source, output=args.output, labels=args.labels, listing=args.listing, cpu=args.cpu))
     return 0
 
 
@@ -200,6 +200,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="OUT.prg", help="PRG to write (default: FILE.prg)")
     p.add_argument("--labels", metavar="OUT.lbl", help="VICE label file to write")
     p.add_argument("--list", dest="listing", metavar="OUT.lst", help="listing to write")
+    p.add_argument("--cpu", metavar="CPU", help="65c02: assemble the WDC 65C02's opcodes (default: the NMOS "
+                                                "6502's, undocumented ones included)")
 
     p = _add(sub, "run", _cmd_run, help="call a 6502 routine in the emulator and report registers, cycles and memory")
     p.add_argument("program", metavar="FILE.s|FILE.prg|FILE.bin|FILE.nes",

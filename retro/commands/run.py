@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from retro.cpu.machine import DEFAULT_BUDGET, DEFAULT_FLAGS, JSR_CYCLES, MAX_BUDGET, CallResult, Machine
-from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z, VARIANTS
+from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z, variant_named
 from retro.errors import InputError
 from retro.loaders import load_program
 from retro.numbers import parse_int
@@ -82,9 +82,7 @@ def _cpu(cpu: str | None, program, path) -> str | None:
     """--cpu, checked against the CPU the file implies (an iNES image: the 2A03)."""
     if cpu is None:
         return program.cpu
-    chosen = str(cpu).lower()
-    if chosen not in VARIANTS:
-        raise InputError(f"--cpu: expected one of {', '.join(VARIANTS)}, got {cpu!r}")
+    chosen = variant_named(cpu, "--cpu")
     if program.cpu and chosen != program.cpu:
         raise InputError(f"--cpu {cpu}: {path} is a program for the {program.cpu.upper()}")
     return chosen
@@ -100,7 +98,7 @@ def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None,
     registers = {name: parse_int(value, field=f"--{name}", lo=0, hi=0xFF) for name, value in (("a", a), ("x", x), ("y", y))}
     budget = parse_int(budget, field="--budget", lo=1, hi=MAX_BUDGET)
     status = status_with_flags(flags)
-    program = load_program(path, symbols=labels, load=load, cpu=str(cpu).lower() if cpu else None)
+    program = load_program(path, symbols=labels, load=load, cpu=variant_named(cpu, "--cpu") if cpu else None)
     from_binary_without_symbols = labels is None and not program.listing
     if from_binary_without_symbols and _is_label(str(entry)) and str(entry).strip() not in program.symbols:
         raise InputError(f"{path} has no symbols: pass --labels with the symbol file your assembler wrote, "

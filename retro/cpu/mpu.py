@@ -58,6 +58,7 @@ from retro.cpu.opcodes import (
     UNSTABLE,
     opcodes_of,
 )
+from retro.errors import InputError
 
 ADDRESS_MASK = 0xFFFF
 PAGE_SHIFT = 8
@@ -872,3 +873,11 @@ def _brk_65c02(self):
 _register_65c02(MPU65C02)
 
 VARIANTS = {"6510": MPU6510, "2a03": MPU2A03, "65c02": MPU65C02}
+
+
+def variant_named(text: str, field: str) -> str:
+    """A CPU variant as a user names it (any case: "65C02"), or a one-line error naming the field."""
+    name = str(text).lower()
+    if name not in VARIANTS:
+        raise InputError(f"{field}: expected one of {', '.join(VARIANTS)}, got {text!r}")
+    return name

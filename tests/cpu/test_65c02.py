@@ -474,3 +474,17 @@ def test_a_bit_branch_routine_checks_exhaustively_on_both_engines(tmp_path):
     assert report.agreement.engine_cases == 256 and report.agreement.engine_mismatches == 0
     assert report.totals.cycles_min == report.totals.cycles_max == 5 + 3 + 3 + 6 == 5 + 1 + 2 + 3 + 6
     assert (report.static.best, report.static.worst) == (17, 17)
+
+
+def test_retro_asm_with_cpu_65c02_writes_the_65c02_opcodes(tmp_path, capsys):
+    source = tmp_path / "clear.s"
+    source.write_text(".org $1000\nclear:\n    stz $10\n    lda ($12)\n    inc\n    bra +\n    nop\n*   rts\n")
+    assert main(["asm", str(source), "-o", str(tmp_path / "clear.prg"), "--cpu", "65C02"]) == 0
+    assert (tmp_path / "clear.prg").read_bytes() == bytes([0x00, 0x10, 0x64, 0x10, 0xB2, 0x12, 0x1A, 0x80, 0x01,
+                                                           0xEA, 0x60])
+    capsys.readouterr()
+    assert main(["asm", str(source), "-o", str(tmp_path / "other.prg"), "--cpu", "z80"]) == 2
+    err = capsys.readouterr().err
+    assert "--cpu: expected one of 6510, 2a03, 65c02, got 'z80'" in err and err.count("\n") == 1
+    assert main(["asm", str(source), "-o", str(tmp_path / "other.prg")]) == 2  # STZ is no NMOS opcode
+    assert not (tmp_path / "other.prg").exists()
