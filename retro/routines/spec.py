@@ -245,6 +245,9 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     if cpu is not None:
         cpu = r.choice(cpu, "program.cpu", CPUS, fold_case=True)
     program = load_program(program_file, symbols=symbols_file, load=load, cpu=cpu)
+    if cpu is not None and program.cpu is not None and cpu != program.cpu:
+        raise r.error("program.cpu", f"{program_file.name} is a program for the {program.cpu.upper()}, "
+                                     f"not the {cpu.upper()}")
     cpu = cpu or program.cpu or "6510"
     machine = _machine(r, program_doc, cpu)
     entry = _entry_text(r, program_doc, "entry", required=True)

@@ -274,3 +274,11 @@ def test_the_raster_figures_follow_the_named_machine(tmp_path, capsys, machine, 
     assert code == 0 and record["machine"] == machine.lower() and set(record["raster"]) == timelines
     assert main(["check", str(spec), "--random", "50", "--jobs", "1"]) == 0
     assert ("raster (CPU never stalled): C64 PAL" in capsys.readouterr().out) == bool(timelines)
+
+
+@pytest.mark.parametrize("cpu", ["6510", "65c02"])
+def test_an_ines_image_is_checked_on_the_2a03_only(tmp_path, capsys, cpu):
+    spec = _variant(tmp_path, {'entry = "boxhit"': f'entry = "boxhit"\ncpu = "{cpu}"'}, name="boxhit_nes.toml")
+    assert main(["check", str(spec), "--random", "10", "--jobs", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"program.cpu: nes_boxhit.nes is a program for the 2A03, not the {cpu.upper()}" in err
