@@ -90,7 +90,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _cmd_asm(args: argparse.Namespace) -> int:
-    _print(asm, asm.asm(args.source, output=args.output, labels=args.labels, listing=args.listing))
+    _print(asm, asm.asm(args.source, output=args.output, labels=args.labels, listing=args.listing, cpu=args.cpu))
     return 0
 
 
@@ -98,7 +98,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     console = {"frames": args.frames, "until": args.until, "until_value": args.until_value, "result": args.result}
     if args.entry is None:
         report = run.run_console_or_refuse(args.program, labels=args.labels, peeks=args.peeks, load=args.load,
-                                           scene=args.scene, trace=args.trace,
+                                           scene=args.scene, trace=args.trace, cpu=args.cpu,
                                            **{k: v for k, v in console.items() if v is not None})
         _print(run, report, args.json)
         return 1 if report.verdict is not None and report.verdict.passed is False else 0
@@ -106,7 +106,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     flags = {flag: getattr(args, flag) for flag in run.SETTABLE_FLAGS if getattr(args, flag) is not None}
     report = run.run(args.program, args.entry, labels=args.labels, load=args.load, a=args.a, x=args.x, y=args.y,
                      flags=flags, sets=args.sets, peeks=args.peeks, budget=args.budget, scene=args.scene,
-                     trace=args.trace)
+                     trace=args.trace, cpu=args.cpu)
     _print(run, report, args.json)
     return 0
 
@@ -210,6 +210,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="OUT.prg", help="PRG to write (default: FILE.prg)")
     p.add_argument("--labels", metavar="OUT.lbl", help="VICE label file to write")
     p.add_argument("--list", dest="listing", metavar="OUT.lst", help="listing to write")
+    p.add_argument("--cpu", metavar="CPU", help="65c02: assemble the WDC 65C02's opcodes (default: the NMOS "
+                                                "6502's, undocumented ones included)")
 
     p = _add(sub, "run", _cmd_run, help="call a 6502 routine in the emulator and report registers, cycles and memory")
     p.add_argument("program", metavar="FILE.s|FILE.prg|FILE.bin|FILE.nes",
@@ -236,6 +238,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--budget", default=str(DEFAULT_BUDGET), metavar="CYCLES",
                    help=f"stop the routine after this many cycles (default {DEFAULT_BUDGET:,}, at most {MAX_BUDGET:,})")
     p.add_argument("--scene", metavar="SCENE.toml", help="attach a VIC-II or NES PPU scene to the machine")
+    p.add_argument("--cpu", metavar="CPU", help="the CPU: 6510 (default), 2a03 (an iNES image's) or 65c02 (WDC)")
     output = p.add_mutually_exclusive_group()  # the JSON object's keys are fixed: no room for a trace
     output.add_argument("--trace", action="store_true", help="print every instruction executed")
     output.add_argument("--json", action="store_true", help="print one JSON object")

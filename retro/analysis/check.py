@@ -345,7 +345,7 @@ def check_chunk(spec: str, seed: int, chunk: list[tuple], start: SceneStart | No
             expected = None  # a reference may refuse inputs outside the domain: no answer to compare
         out.cases += 1
         cpu_cycles = cycles - runner.last_stolen  # the timing model and the static bounds know no stalls
-        modelled = model_cycles(read, steps)
+        modelled = model_cycles(read, steps, routine.cpu)
         if modelled != cpu_cycles:
             out.cycle_mismatches += 1
             out.failure = out.failure or Failure(case, "cycles", answer, expected,
@@ -578,7 +578,7 @@ def static_bounds(routine: Routine, runner: RoutineRunner | None = None) -> Boun
         return f"${address:04X}" + (f" ({names[address]})" if address in names else "")
     try:
         return analyse(memory.__getitem__, runner.entry, bounds, name=routine.name,
-                       within=(program.origin, program.end), describe=describe)
+                       within=(program.origin, program.end), describe=describe, cpu=routine.cpu)
     except InputError as exc:
         raise InputError(f"{routine.spec_path}: static analysis: {exc} ([cycles] static = false skips it)") from None
 
@@ -791,7 +791,7 @@ def cycle_figures(check: RoutineCheck) -> dict:
             "min_inputs": inputs_by_name(routine, t.min_case) if t.min_case is not None else None,
             "max_inputs": inputs_by_name(routine, t.max_case) if t.max_case is not None else None,
             "budget": routine.budget,
-            "raster": {**raster_figures(routine.cpu, t.cycles_min, check.mean if t.cycles_count else None,
+            "raster": {**raster_figures(routine.machine, t.cycles_min, check.mean if t.cycles_count else None,
                                         t.cycles_max), **scene_raster(check)}}
 
 
@@ -817,7 +817,7 @@ def check_record(check: RoutineCheck) -> dict:
     """One routine's check as plain data (what `retro check --json` prints)."""
     t = check.totals
     record = {"routine": check.routine.name, "spec": str(check.routine.spec_path), "cpu": check.routine.cpu,
-              "cases": t.cases, "mismatches": check.mismatches,
+              "machine": check.routine.machine, "cases": t.cases, "mismatches": check.mismatches,
               "result_mismatches": t.result_mismatches,
               "cycle_mismatches": t.cycle_mismatches + (check.agreement.cycle_mismatches if check.agreement else 0),
               "run_errors": t.run_errors, "bounds_violations": check.bounds_violations,
@@ -895,7 +895,7 @@ def format_check(check: RoutineCheck) -> list[str]:
     if t.cycles_count:
         lines.append(f"  fastest: {describe_case(routine, t.min_case)}")
         lines.append(f"  slowest: {describe_case(routine, t.max_case)}")
-        raster = format_raster(routine.cpu, raster_figures(routine.cpu, t.cycles_min, check.mean, t.cycles_max))
+        raster = format_raster(routine.machine, raster_figures(routine.machine, t.cycles_min, check.mean, t.cycles_max))
         if raster:
             lines.append(f"  raster (CPU never stalled): {raster}")
         scene = scene_raster(check).get("scene")

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from retro.assembler import assemble_file
+from retro.cpu.mpu import variant_named
 from retro.fileio import read_bytes, write_all_atomic
 from retro.loaders import refuse_foreign_source
 from retro.program import Program, format_vice_labels, prg_bytes
@@ -18,12 +19,14 @@ class Assembled:
 
 
 def asm(source: str | Path, *, output: str | Path | None = None, labels: str | Path | None = None,
-        listing: str | Path | None = None) -> Assembled:
+        listing: str | Path | None = None, cpu: str | None = None) -> Assembled:
     """Assemble `source`; write the PRG to `output` (default: the source's name with .prg), the VICE
-    labels and the listing where asked. All files are written or none, never over the source."""
+    labels and the listing where asked. All files are written or none, never over the source.
+    `cpu="65c02"` assembles the 65C02's opcodes (Ophis's -c) instead of the NMOS undocumented ones."""
+    cpu = variant_named(cpu, "--cpu") if cpu else None
     data = read_bytes(source, "source file")  # read once: the source may be a FIFO
     refuse_foreign_source(source, data)
-    program = assemble_file(source, data=data)
+    program = assemble_file(source, data=data, cpu=cpu)
     outputs = {Path(output) if output else Path(source).with_suffix(".prg"): prg_bytes(program)}
     if labels:
         outputs[Path(labels)] = format_vice_labels(program.symbols)

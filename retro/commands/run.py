@@ -13,7 +13,7 @@ from retro.analysis.console_run import MAX_FRAMES, ConsoleRun, ppu_registers, ru
 from retro.chips.cartridge import read_nrom
 from retro.chips.ines import INES_MAGIC
 from retro.cpu.machine import DEFAULT_BUDGET, DEFAULT_FLAGS, JSR_CYCLES, MAX_BUDGET, CallResult, Machine
-from retro.cpu.mpu import FLAG_B, FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_U, FLAG_V, FLAG_Z
+from retro.cpu.mpu import FLAG_B, FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_U, FLAG_V, FLAG_Z, variant_named
 from retro.errors import InputError
 from retro.fileio import read_bytes
 from retro.loaders import load_program
@@ -134,26 +134,40 @@ def refuse_console_options(given: dict) -> None:
         raise InputError(f"{', '.join(used)}: only for an iNES image run from its reset vector (without --entry)")
 
 
-def run_console_or_refuse(path: str | Path, *, load=None, scene=None, trace: bool = False, **options) -> ConsoleRun:
+def run_console_or_refuse(path: str | Path, *, load=None, scene=None, trace: bool = False, cpu: str | None = None,
+                          **options) -> ConsoleRun:
     """`retro run FILE` without --entry: a cartridge from reset, or a one-line error saying what is missing."""
     if not is_cartridge(path):
         raise InputError(f"--entry: required for {path} (only an iNES image runs from its reset vector)")
     for name, value in (("--load", load), ("--scene", scene), ("--trace", trace or None)):
         if value is not None:
             raise InputError(f"{name}: not for a cartridge run from reset ({path} is an iNES image run without --entry)")
+    if cpu is not None and variant_named(cpu, "--cpu") != "2a03":
+        raise InputError(f"--cpu {cpu}: {path} is an iNES image: a console runs it on the 2A03")
     return run_console(path, **options)
+
+
+def _cpu(cpu: str | None, program, path) -> str | None:
+    """--cpu, checked against the CPU the file implies (an iNES image: the 2A03)."""
+    if cpu is None:
+        return program.cpu
+    chosen = variant_named(cpu, "--cpu")
+    if program.cpu and chosen != program.cpu:
+        raise InputError(f"--cpu {cpu}: {path} is a program for the {program.cpu.upper()}")
+    return chosen
 
 
 def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None, load: int | str | None = None,
         a: int | str = 0, x: int | str = 0, y: int | str = 0, flags: dict[str, int | str] | None = None,
         sets: list[str] = (), peeks: list[str] = (), budget: int | str = DEFAULT_BUDGET,
-        scene: str | Path | None = None, trace: bool = False) -> RunReport:
+        scene: str | Path | None = None, trace: bool = False, cpu: str | None = None) -> RunReport:
     """Call `entry` of the program at `path` (as by JSR, through its RTS). `sets` are TARGET=V[,V...]
-    stores before the call, `peeks` TARGET[:N] reads after it; `scene` attaches a VIC-II or NES scene."""
+    stores before the call, `peeks` TARGET[:N] reads after it; `scene` attaches a VIC-II or NES scene;
+    `cpu` ("6510", "2a03", "65c02") is the CPU to run on (default: the file's own, else the 6510)."""
     registers = {name: parse_int(value, field=f"--{name}", lo=0, hi=0xFF) for name, value in (("a", a), ("x", x), ("y", y))}
     budget = parse_int(budget, field="--budget", lo=1, hi=MAX_BUDGET)
     status = status_with_flags(flags)
-    program = load_program(path, symbols=labels, load=load)
+    program = load_program(path, symbols=labels, load=load, cpu=variant_named(cpu, "--cpu") if cpu else None)
     from_binary_without_symbols = labels is None and not program.listing
     if from_binary_without_symbols and _is_label(str(entry)) and str(entry).strip() not in program.symbols:
         raise InputError(f"{path} has no symbols: pass --labels with the symbol file your assembler wrote, "
@@ -162,7 +176,7 @@ def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None,
     if loaded_scene is not None and program.cpu and loaded_scene.cpu_variant != program.cpu:
         raise InputError(f"--scene {scene}: a scene for the {loaded_scene.cpu_variant.upper()}, "
                          f"but {path} is a program for the {program.cpu.upper()}")
-    machine = build_machine(loaded_scene, cpu=program.cpu)
+    machine = build_machine(loaded_scene, cpu=_cpu(cpu, program, path))
     machine.load(program)
     memory = dict(parse_assignment(s) for s in sets)
     for target in memory:

@@ -76,6 +76,7 @@ class LaneError(IntEnum):
     JAM = 2
     UNSTABLE = 3
     BUDGET = 4
+    HALT = 5  # the 65C02's STP, or WAI with no interrupt source
 
 
 class LaneMemoryFull(Exception):
@@ -275,6 +276,10 @@ class BatchCpu:
             raise InputError(f"unknown CPU variant {variant!r} (known: {', '.join(VARIANTS)})")
         self.variant = variant
         self.decimal = VARIANTS[variant].has_decimal
+        self.handlers = HANDLERS
+        if VARIANTS[variant].opcode_table is not OPCODE_TABLE:  # the 65C02: its own table of handlers
+            from retro.cpu.batch65c02 import HANDLERS_65C02
+            self.handlers = HANDLERS_65C02
         self.lanes = lanes
         self.stop_on_brk = stop_on_brk
         self.memory = LaneMemory(image, lanes, memory_limit)
@@ -356,7 +361,7 @@ class BatchCpu:
 
     def _dispatch(self, opcode: int, group: Lanes, pc, lo, hi):
         self.instructions += 1
-        handler = HANDLERS.get(opcode)
+        handler = self.handlers.get(opcode)
         if handler is None:
             group.stop(pc, LaneError.JAM if opcode in JAM_OPCODES else LaneError.UNSTABLE)
             return
@@ -624,10 +629,12 @@ def _operation(mnemonic: str):
     raise AssertionError(mnemonic)  # pragma: no cover - READS lists only the mnemonics handled here
 
 
-def _make_read(mnemonic: str, mode: str, cycles: int, penalised: bool, length: int) -> Handler:
-    """Instructions that read an operand (immediate or memory) and change registers and flags."""
-    address_of = ADDRESSING.get(mode)
-    operate = _operation(mnemonic)
+def _make_read(mnemonic: str, mode: str, cycles: int, penalised: bool, length: int, *,
+               operate: Callable | None = None, address_of: Callable | None = None) -> Handler:
+    """Instructions that read an operand (immediate or memory) and change registers and flags
+    (`operate`, `address_of`: another CPU's operation or addressing mode, by default the NMOS ones)."""
+    address_of = address_of or ADDRESSING.get(mode)
+    operate = operate or _operation(mnemonic)
     if mode == "imm":
         def handler(g, pc, lo, hi):
             operate(g, lo)
@@ -667,9 +674,11 @@ def _arr(g, value, p):
     return np.where(decimal, dec, result), np.where(decimal, dec_flags, flags)
 
 
-def _make_store(mnemonic: str, mode: str, cycles: int, length: int) -> Handler:
-    address_of = ADDRESSING[mode]
-    source = {"STA": lambda g: g.a, "STX": lambda g: g.x, "STY": lambda g: g.y, "SAX": lambda g: g.a & g.x}[mnemonic]
+def _make_store(mnemonic: str, mode: str, cycles: int, length: int, *, address_of: Callable | None = None) -> Handler:
+    """Instructions that write a register (or zero: the 65C02's STZ) to memory."""
+    address_of = address_of or ADDRESSING[mode]
+    source = {"STA": lambda g: g.a, "STX": lambda g: g.x, "STY": lambda g: g.y, "SAX": lambda g: g.a & g.x,
+              "STZ": lambda g: 0}[mnemonic]
 
     def handler(g, pc, lo, hi):
         address, _ = address_of(g, lo, hi)
@@ -719,22 +728,27 @@ def _make_branch(opcode: int, cycles: int) -> Handler:
         target = (following + _signed(lo)) & WORD
         crossed = (following & PAGE_MASK) != (target & PAGE_MASK)
         g.cycles += cycles
-        if isinstance(target, int) and isinstance(following, int):
-            jump = np.flatnonzero(taken)
-            extra = extra_taken + crossed * BRANCH_PAGE_CYCLES
-            if len(jump) == len(taken):
-                g.cycles += extra
-                return target
-            if not len(jump):
-                return following
-            stay = np.ones(len(taken), dtype=bool)
-            stay[jump] = False
-            jumped = g.take(jump)
-            jumped.cycles += extra
-            return [(target, jumped), (following, g.take(np.flatnonzero(stay)))]
-        g.cycles += taken * (extra_taken + crossed * BRANCH_PAGE_CYCLES)
-        return np.where(taken, target, following)
+        return _branch_split(g, taken, target, following, extra_taken + crossed * BRANCH_PAGE_CYCLES)
     return handler
+
+
+def _branch_split(g, taken: np.ndarray, target, following, extra):
+    """Where a group goes at a branch (taken: per lane): one next PC, a list of (next pc, lanes) when
+    the lanes part, or per-lane PCs when the addresses are per lane; the taken lanes pay `extra`."""
+    if isinstance(target, int) and isinstance(following, int):
+        jump = np.flatnonzero(taken)
+        if len(jump) == len(taken):
+            g.cycles += extra
+            return target
+        if not len(jump):
+            return following
+        stay = np.ones(len(taken), dtype=bool)
+        stay[jump] = False
+        jumped = g.take(jump)
+        jumped.cycles += extra
+        return [(target, jumped), (following, g.take(np.flatnonzero(stay)))]
+    g.cycles += taken * extra
+    return np.where(taken, target, following)
 
 
 FLAG_BITS = {"C": FLAG_C, "I": FLAG_I, "V": FLAG_V, "D": FLAG_D}

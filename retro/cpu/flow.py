@@ -1,10 +1,12 @@
 """Static best/worst-case cycles of a routine from its bytes, by control-flow analysis.
 
 The routine is decoded from its entry, following both ways of every branch and JMP absolute, up to
-each RTS. Each instruction costs its datasheet cycles (retro.cpu.timing) plus the penalties the
+each RTS (on the 65C02 also BRA, always taken, and BBR/BBS, both ways). Each instruction costs its
+datasheet cycles (retro.cpu.timing) plus the penalties the
 bytes cannot rule out: an indexed read whose base address has a non-zero low byte may cross a page
 (+0 or +1); an (indirect),Y read may always cross (its pointer is data); a taken branch costs +1,
-and +1 more when its target lies in another page (known from the addresses).
+and +1 more when its target lies in another page (known from the addresses); on the 65C02 an ADC
+or SBC may run in decimal mode (+0 or +1: D is data).
 
 Loops: every back edge of the decoded graph closes a loop whose header needs a bound, the most
 times the header runs per entry into the loop (`loop_bounds`: header address -> count; the asm
@@ -22,7 +24,10 @@ from dataclasses import dataclass, field
 from retro.cpu.timing import (
     BRANCH_PAGE_CYCLES,
     BRANCH_TAKEN_CYCLES,
+    CMOS_DECIMAL_CYCLES,
     PAGE_CROSS_CYCLES,
+    WDC_65C02,
+    TimingError,
     branch_target,
     crosses_page,
     timing_of,
@@ -33,6 +38,8 @@ OPCODE_JMP_ABS = 0x4C
 OPCODE_JSR = 0x20
 OPCODE_RTS = 0x60
 UNSUPPORTED = {0x6C: "JMP (indirect)", 0x40: "RTI", 0x00: "BRK"}
+# The 65C02's: a jump through a table indexed by X (its target is data), and the two that stop the clock.
+UNSUPPORTED_65C02 = {**UNSUPPORTED, 0x7C: "JMP (abs,X)", 0xCB: "WAI", 0xDB: "STP"}
 JSR_LENGTH = 3
 
 
@@ -52,9 +59,11 @@ class Bounds:
 
 
 def decode(read: Callable[[int], int], entry: int,
-           call_cost: Callable[[int, int], tuple[int, int]] | None = None) -> dict[int, Node]:
+           call_cost: Callable[[int, int], tuple[int, int]] | None = None, cpu: str = "6510") -> dict[int, Node]:
     """The instructions reachable from entry. A JSR costs its own cycles plus the callee's best and
     worst (`call_cost(pc, target)`), then continues after it, as the callee's RTS returns there."""
+    cmos = cpu == WDC_65C02
+    unsupported = UNSUPPORTED_65C02 if cmos else UNSUPPORTED
     nodes: dict[int, Node] = {}
     pending = [entry]
     while pending:
@@ -62,14 +71,20 @@ def decode(read: Callable[[int], int], entry: int,
         if pc in nodes:
             continue
         opcode = read(pc)
-        if opcode in UNSUPPORTED or (opcode == OPCODE_JSR and call_cost is None):
-            name = UNSUPPORTED.get(opcode, "JSR")
+        if opcode in unsupported or (opcode == OPCODE_JSR and call_cost is None):
+            name = unsupported.get(opcode, "JSR")
             raise InputError(f"${pc:04X}: {name} is not supported by the static analysis")
-        op = timing_of(opcode)
+        try:
+            op = timing_of(opcode, cpu)
+        except TimingError:
+            raise InputError(f"${pc:04X}: opcode ${opcode:02X} is not an instruction the {cpu.upper()} runs "
+                             f"(a JAM or unstable opcode; is the CPU right? program.cpu)") from None
         operand = read((pc + 1) & 0xFFFF) | read((pc + 2) & 0xFFFF) << 8
         extra = 0
         if op.page_penalty and (op.mode == "iny" or (op.mode in ("abx", "aby") and operand & 0xFF)):
             extra = PAGE_CROSS_CYCLES
+        if cmos and op.mnemonic in ("ADC", "SBC"):
+            extra += CMOS_DECIMAL_CYCLES
         node = Node(pc, (op.cycles, op.cycles + extra))
         following = (pc + op.length) & 0xFFFF
         if opcode == OPCODE_JSR:
@@ -80,10 +95,14 @@ def decode(read: Callable[[int], int], entry: int,
             node.returns = True
         elif opcode == OPCODE_JMP_ABS:
             node.successors.append((operand, 0))
-        elif op.mode == "rel":
-            target = branch_target(pc, operand & 0xFF)
+        elif op.mode in ("rel", "zpr"):  # zpr: BBR/BBS, the offset in their third byte
+            offset = operand & 0xFF if op.mode == "rel" else operand >> 8
+            target = branch_target(pc, offset, op.length)
             taken = BRANCH_TAKEN_CYCLES + (BRANCH_PAGE_CYCLES if crosses_page(following, target) else 0)
-            node.successors += [(following, 0), (target, taken)]
+            if op.mnemonic == "BRA":
+                node.successors.append((target, taken))
+            else:
+                node.successors += [(following, 0), (target, taken)]
         else:
             node.successors.append((following, 0))
         nodes[pc] = node
@@ -127,16 +146,18 @@ def _loops(nodes: dict[int, Node], entry: int) -> dict[int, frozenset[int]]:
 
 def analyse(read: Callable[[int], int], entry: int, loop_bounds: dict[int, int] | None = None,
             name: str = "routine", within: tuple[int, int] | None = None,
-            describe: Callable[[int], str] | None = None) -> Bounds:
+            describe: Callable[[int], str] | None = None, cpu: str = "6510") -> Bounds:
     """Best and worst cycles from the entry through an RTS over every path the bytes allow.
 
     Subroutines called with JSR are analysed the same way (their loops bounded by the same
     `loop_bounds`) and their cost is included, as long as they lie in `within` (start, end) when
     given; recursion is an error. `describe(address)` names an address in errors (a label)."""
-    return _analyse(read, entry, dict(loop_bounds or {}), name, within, describe or (lambda a: f"${a:04X}"), {}, ())
+    return _analyse(read, entry, dict(loop_bounds or {}), name, within, describe or (lambda a: f"${a:04X}"), {}, (),
+                    cpu)
 
 
-def _analyse(read, entry: int, bounds: dict[int, int], name: str, within, describe, done: dict, calling: tuple) -> Bounds:
+def _analyse(read, entry: int, bounds: dict[int, int], name: str, within, describe, done: dict, calling: tuple,
+             cpu: str) -> Bounds:
     def call_cost(pc: int, target: int) -> tuple[int, int]:
         if within is not None and not within[0] <= target < within[1]:
             raise InputError(f"{name}: JSR {describe(target)} at ${pc:04X} calls outside the program "
@@ -144,11 +165,11 @@ def _analyse(read, entry: int, bounds: dict[int, int], name: str, within, descri
         if target in calling or target == entry:
             raise InputError(f"{name}: JSR {describe(target)} at ${pc:04X} is recursive")
         if target not in done:
-            done[target] = _analyse(read, target, bounds, name, within, describe, done, (*calling, entry))
+            done[target] = _analyse(read, target, bounds, name, within, describe, done, (*calling, entry), cpu)
         callee = done[target]
         return callee.best, callee.worst
 
-    nodes = decode(read, entry, call_cost)
+    nodes = decode(read, entry, call_cost, cpu)
     loops = _loops(nodes, entry)
     for header in loops:
         if header not in bounds:

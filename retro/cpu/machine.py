@@ -39,7 +39,7 @@ NO_ADDRESS = -1  # a stop address the PC never equals
 ANY_STACK = -1  # stop at the address whatever the stack pointer
 JSR_CYCLES = 6  # the caller's JSR, excluded from every reported count
 LOADS = frozenset({"LDA", "LDX", "LDY", "LAX"})
-STORES = frozenset({"STA", "STX", "STY", "SAX", "SHA", "SHX", "SHY", "TAS"})
+STORES = frozenset({"STA", "STX", "STY", "SAX", "SHA", "SHX", "SHY", "TAS", "STZ"})
 
 
 @dataclass(frozen=True)
@@ -276,6 +276,8 @@ class Machine:
             return memory[pointer] | memory[(pointer + 1) & 0xFF] << 8
         if mode == "iny":
             return ((memory[lo] | memory[(lo + 1) & 0xFF] << 8) + mpu.y) & 0xFFFF
+        if mode in ("zpi", "zpr"):  # 65C02: (zp), and the zero-page byte BBR/BBS test
+            return memory[lo] | memory[(lo + 1) & 0xFF] << 8 if mode == "zpi" else lo
         return None
 
     def _over_budget(self, budget: int, count: int) -> None:
@@ -299,6 +301,8 @@ class Machine:
             "abs": f"${word:04X}", "abx": f"${word:04X},X", "aby": f"${word:04X},Y",
             "ind": f"(${word:04X})", "inx": f"(${lo:02X},X)", "iny": f"(${lo:02X}),Y",
             "rel": f"${(address + 2 + (lo - 256 if lo & 0x80 else lo)) & 0xFFFF:04X}",
+            "zpi": f"(${lo:02X})", "iax": f"(${word:04X},X)",  # the 65C02's
+            "zpr": f"${lo:02X},${(address + 3 + (hi - 256 if hi & 0x80 else hi)) & 0xFFFF:04X}",
         }.get(mode, "")
         return f"{mnemonic} {operand}".strip()
 
@@ -359,7 +363,9 @@ class _Tracer:
             return
         mnemonic, mode = self.mnemonic, self.mode
         extra = cycles - stolen - mpu.cycletime[self.opcode]
-        is_branch = mode == "rel"
+        if mnemonic in ("ADC", "SBC") and mpu.p & FLAG_D:
+            extra -= mpu.decimal_extra_cycles  # the 65C02's decimal cycle is no page crossing
+        is_branch = mode in ("rel", "zpr")  # zpr: the 65C02's BBR/BBS
         value = self.before_value
         if self.reads and mnemonic in LOADS:  # what the load put in its register is what it read
             value = {"LDA": mpu.a, "LDX": mpu.x, "LDY": mpu.y, "LAX": mpu.a}[mnemonic]

@@ -1,4 +1,4 @@
-"""NMOS 6502 cycle timing kept in the project, independent of py65's tables.
+"""6502 cycle timing kept in the project, independent of py65's tables and of retro.cpu.opcodes.
 
 Sources: the MOS MCS6500 Microcomputer Family Programming Manual (1976), appendix "Instruction
 timing", for the documented opcodes, and 64doc (J. Ahola, M. Korpi et al., "6502 instructions and
@@ -9,6 +9,12 @@ their cycle counts") for the stable undocumented NMOS opcodes. Rules:
   the longer count, so they have no penalty);
 - a relative branch takes one more cycle when taken, and one more again when the target lies in
   another page than the instruction that follows the branch.
+
+The WDC 65C02 has its own table (`OPCODES_65C02`, from WDC's "W65C02S 8-bit Microprocessor" data sheet,
+table 5-7, by families of the NMOS documented table and the changes the data sheet lists) and rules:
+ADC and SBC take one cycle more with D set; BRA is always taken; BBR/BBS take 5 cycles, +1 when
+taken and +1 more when the target lies in another page than the next instruction; shifts and
+rotates abs,X have the page penalty (6 or 7 cycles). `timing_table(cpu)` gives a CPU's table.
 
 `model_cycles(trace)` sums these over an executed path, deriving every penalty from addresses
 (the operand bytes, the index registers before the instruction, the next PC), never from the
@@ -27,7 +33,9 @@ PAGE_CROSS_CYCLES = 1
 
 # Operand bytes per addressing mode.
 MODE_LENGTH = {"imp": 1, "acc": 1, "imm": 2, "zpg": 2, "zpx": 2, "zpy": 2, "inx": 2, "iny": 2, "rel": 2,
-               "abs": 3, "abx": 3, "aby": 3, "ind": 3}
+               "abs": 3, "abx": 3, "aby": 3, "ind": 3, "zpi": 2, "iax": 3, "zpr": 3}
+CMOS_DECIMAL_CYCLES = 1  # 65C02: ADC/SBC with D set
+WDC_65C02 = "65c02"
 
 
 @dataclass(frozen=True)
@@ -42,16 +50,23 @@ class OpTiming:
         return MODE_LENGTH[self.mode]
 
 
-def _build() -> dict[int, OpTiming]:
-    table: dict[int, OpTiming] = {}
-
+def _putter(table: dict[int, OpTiming]):
     def put(mnemonic: str, rows: Iterable[tuple[int, str, int]], penalised: tuple[str, ...] = ()) -> None:
         for opcode, mode, cycles in rows:
             if opcode in table:
                 raise AssertionError(f"opcode ${opcode:02X} listed twice")
             table[opcode] = OpTiming(mnemonic, mode, cycles, mode in penalised)
+    return put
 
-    read_modes = ("abx", "aby", "iny")
+
+READ_MODES = ("abx", "aby", "iny")
+
+
+def _documented() -> dict[int, OpTiming]:
+    """The 151 opcodes of the MOS programming manual."""
+    table: dict[int, OpTiming] = {}
+    put = _putter(table)
+    read_modes = READ_MODES
     # The eight-mode ALU/load group: imm, zp, zp,X, abs, abs,X, abs,Y, (zp,X), (zp),Y.
     group = (("imm", 2), ("zpg", 3), ("zpx", 4), ("abs", 4), ("abx", 4), ("aby", 4), ("inx", 6), ("iny", 5))
     low = {"imm": 0x09, "zpg": 0x05, "zpx": 0x15, "abs": 0x0D, "abx": 0x1D, "aby": 0x19, "inx": 0x01, "iny": 0x11}
@@ -89,7 +104,14 @@ def _build() -> dict[int, OpTiming]:
     put("PHP", [(0x08, "imp", 3)])
     put("PLA", [(0x68, "imp", 4)])
     put("PLP", [(0x28, "imp", 4)])
-    # ---- stable undocumented NMOS opcodes (64doc) ----
+    return table
+
+
+def _build() -> dict[int, OpTiming]:
+    """The NMOS table: documented and stable undocumented opcodes (64doc)."""
+    table = _documented()
+    put = _putter(table)
+    read_modes = READ_MODES
     rmw = (("zpg", 0x07, 5), ("zpx", 0x17, 6), ("inx", 0x03, 8), ("iny", 0x13, 8),
            ("abs", 0x0F, 6), ("abx", 0x1F, 7), ("aby", 0x1B, 7))
     for mnemonic, base in (("SLO", 0x00), ("RLA", 0x20), ("SRE", 0x40), ("RRA", 0x60), ("DCP", 0xC0), ("ISC", 0xE0)):
@@ -111,22 +133,71 @@ def _build() -> dict[int, OpTiming]:
     return table
 
 
+def _build_65c02() -> dict[int, OpTiming]:
+    """The W65C02S data sheet (table 5-7): the NMOS documented opcodes with their changes, the new
+    ones, and every other opcode a NOP of the size and cycles the data sheet gives."""
+    table = _documented()
+    table[0x6C] = OpTiming("JMP", "ind", 6, False)  # the page-wrap bug fixed, one cycle more
+    for opcode in (0x1E, 0x3E, 0x5E, 0x7E):  # ASL ROL LSR ROR abs,X: 6, +1 across a page
+        table[opcode] = OpTiming(table[opcode].mnemonic, "abx", 6, True)
+    put = _putter(table)
+    for mnemonic, opcode in (("ORA", 0x12), ("AND", 0x32), ("EOR", 0x52), ("ADC", 0x72), ("STA", 0x92),
+                             ("LDA", 0xB2), ("CMP", 0xD2), ("SBC", 0xF2)):
+        put(mnemonic, [(opcode, "zpi", 5)])  # the (zp) mode
+    put("BIT", [(0x89, "imm", 2), (0x34, "zpx", 4), (0x3C, "abx", 4)], READ_MODES)
+    put("BRA", [(0x80, "rel", 2)])  # always taken: 3, 4 across a page
+    put("STZ", [(0x64, "zpg", 3), (0x74, "zpx", 4), (0x9C, "abs", 4), (0x9E, "abx", 5)])
+    put("TSB", [(0x04, "zpg", 5), (0x0C, "abs", 6)])
+    put("TRB", [(0x14, "zpg", 5), (0x1C, "abs", 6)])
+    put("INC", [(0x1A, "acc", 2)])
+    put("DEC", [(0x3A, "acc", 2)])
+    put("PHX", [(0xDA, "imp", 3)])
+    put("PHY", [(0x5A, "imp", 3)])
+    put("PLX", [(0xFA, "imp", 4)])
+    put("PLY", [(0x7A, "imp", 4)])
+    put("JMP", [(0x7C, "iax", 6)])
+    put("WAI", [(0xCB, "imp", 3)])
+    put("STP", [(0xDB, "imp", 3)])
+    for bit in range(8):
+        put(f"RMB{bit}", [(bit << 4 | 0x07, "zpg", 5)])
+        put(f"SMB{bit}", [((8 + bit) << 4 | 0x07, "zpg", 5)])
+        put(f"BBR{bit}", [(bit << 4 | 0x0F, "zpr", 5)])
+        put(f"BBS{bit}", [((8 + bit) << 4 | 0x0F, "zpr", 5)])
+    # The reserved opcodes, by the data sheet's columns: x2 two bytes and two cycles, x3 and xB one
+    # byte and one cycle; $44 (3 cycles), $54 $D4 $F4 (4) two bytes; $DC $FC (4) and $5C (8) three.
+    nops = {0x44: ("zpg", 3), 0x54: ("zpx", 4), 0xD4: ("zpx", 4), 0xF4: ("zpx", 4), 0xDC: ("abs", 4),
+            0xFC: ("abs", 4), 0x5C: ("abs", 8)}
+    for opcode in range(256):
+        if opcode in table:
+            continue
+        mode, cycles = nops.get(opcode) or (("imm", 2) if opcode & 0x0F == 0x02 else ("imp", 1))
+        put("NOP", [(opcode, mode, cycles)])
+    return table
+
+
 OPCODES: dict[int, OpTiming] = _build()
+OPCODES_65C02: dict[int, OpTiming] = _build_65c02()
+
+
+def timing_table(cpu: str) -> dict[int, OpTiming]:
+    """The timing table of a CPU variant ("6510", "2a03": NMOS; "65c02": WDC)."""
+    return OPCODES_65C02 if cpu == WDC_65C02 else OPCODES
 
 
 class TimingError(ValueError):
     """An opcode the table does not know (an unstable or JAM opcode)."""
 
 
-def timing_of(opcode: int) -> OpTiming:
+def timing_of(opcode: int, cpu: str = "6510") -> OpTiming:
     try:
-        return OPCODES[opcode]
+        return timing_table(cpu)[opcode]
     except KeyError:
         raise TimingError(f"opcode ${opcode:02X} has no entry in the timing table") from None
 
 
-def branch_target(pc: int, offset: int) -> int:
-    next_pc = (pc + 2) & 0xFFFF
+def branch_target(pc: int, offset: int, length: int = 2) -> int:
+    """Where a relative branch at pc goes (length: 2, or 3 for BBR/BBS, whose offset is the last byte)."""
+    next_pc = (pc + length) & 0xFFFF
     return (next_pc + (offset - 256 if offset & 0x80 else offset)) & 0xFFFF
 
 
@@ -144,19 +215,27 @@ def branch_taken(opcode: int, p: int) -> bool:
     return bool(p & flag) == bool(wanted)
 
 
-def instruction_cycles(read: Callable[[int], int], pc: int, x: int, y: int, p: int, pointer: int) -> int:
+def instruction_cycles(read: Callable[[int], int], pc: int, x: int, y: int, p: int, pointer: int,
+                       cpu: str = "6510") -> int:
     """Cycles of the instruction at pc, given the registers before it.
 
-    `pointer` is the 16-bit pointer an (indirect),Y instruction reads from zero page (else unused).
+    `pointer` is the 16-bit pointer an (indirect),Y instruction reads from zero page (else unused); for
+    the 65C02's BBR/BBS its low byte is the zero-page byte they test.
     """
     opcode = read(pc)
-    op = timing_of(opcode)
+    op = timing_of(opcode, cpu)
     cycles = op.cycles
     mode = op.mode
     if mode == "rel":
-        if branch_taken(opcode, p):
+        if op.mnemonic == "BRA" or branch_taken(opcode, p):
             cycles += BRANCH_TAKEN_CYCLES
             if crosses_page((pc + 2) & 0xFFFF, branch_target(pc, read((pc + 1) & 0xFFFF))):
+                cycles += BRANCH_PAGE_CYCLES
+    elif mode == "zpr":
+        bit_set = bool(pointer >> int(op.mnemonic[3]) & 1)
+        if bit_set == (op.mnemonic[2] == "S"):
+            cycles += BRANCH_TAKEN_CYCLES
+            if crosses_page((pc + 3) & 0xFFFF, branch_target(pc, read((pc + 2) & 0xFFFF), 3)):
                 cycles += BRANCH_PAGE_CYCLES
     elif op.page_penalty:
         if mode == "iny":
@@ -166,9 +245,12 @@ def instruction_cycles(read: Callable[[int], int], pc: int, x: int, y: int, p: i
             index = x if mode == "abx" else y
         if crosses_page(base, base + index):
             cycles += PAGE_CROSS_CYCLES
+    if cpu == WDC_65C02 and p & 0x08 and op.mnemonic in ("ADC", "SBC"):
+        cycles += CMOS_DECIMAL_CYCLES
     return cycles
 
 
-def model_cycles(read: Callable[[int], int], steps: Iterable[tuple[int, int, int, int, int]]) -> int:
+def model_cycles(read: Callable[[int], int], steps: Iterable[tuple[int, int, int, int, int]],
+                 cpu: str = "6510") -> int:
     """Total cycles of an executed path; steps are (pc, x, y, p, pointer) before each instruction."""
-    return sum(instruction_cycles(read, pc, x, y, p, pointer) for pc, x, y, p, pointer in steps)
+    return sum(instruction_cycles(read, pc, x, y, p, pointer, cpu) for pc, x, y, p, pointer in steps)

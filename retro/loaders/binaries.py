@@ -140,9 +140,10 @@ def _with_symbols(program: Program, symbols: str | Path | None, vectors: dict[st
                    notes=(symbol_file.note,) if symbol_file and symbol_file.note else ())
 
 
-def load_program(path: str | Path, *, symbols: str | Path | None = None, load: int | str | None = None) -> Program:
+def load_program(path: str | Path, *, symbols: str | Path | None = None, load: int | str | None = None,
+                 cpu: str | None = None) -> Program:
     """Any program file -> Program; `symbols` is a symbol file in any known format, `load` the
-    address of a raw binary."""
+    address of a raw binary, `cpu` the CPU a source is assembled for ("65c02": its opcodes)."""
     from retro.assembler import assemble_file  # Ophis runs only for a source
 
     source = str(path)
@@ -163,6 +164,6 @@ def load_program(path: str | Path, *, symbols: str | Path | None = None, load: i
         if symbols:
             raise InputError(f"{symbols}: --labels goes with a .prg, a raw binary or a .nes image; "
                              f"a source's labels come from the assembler")
-        return assemble_file(path, data=data)
+        return assemble_file(path, data=data, cpu=cpu)
     raise InputError(f"{source}: a binary file without a load address: pass --load ADDR for a raw binary, "
                      f"or name a C64 program .prg (2-byte load address first)")

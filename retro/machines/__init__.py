@@ -14,6 +14,17 @@ from retro.scenes.nes import NesScene
 from retro.scenes.vic import VicScene
 
 DEFAULT_CPU = "6510"
+# The machines a routine can be shown on, by name, with their CPU; "none" is a bare CPU (code from
+# another 6502 computer: an Atari 2600, a VIC-20, a Commander X16): no C64 or NES raster figures.
+MACHINE_CPUS = {"c64": "6510", "nes": "2a03"}
+BARE = "none"
+MACHINES = (*MACHINE_CPUS, BARE)
+
+
+def machine_for(cpu: str) -> str:
+    """The machine a CPU implies when none is named: the C64 for the 6510, the NES for the 2A03,
+    no machine for any other (the 65C02)."""
+    return next((name for name, its_cpu in MACHINE_CPUS.items() if its_cpu == cpu), BARE)
 
 
 def build_machine(scene: VicScene | NesScene | None = None, *, cpu: str | None = None) -> Machine:

@@ -32,7 +32,7 @@ from retro.cpu.machine import (
     push_return_trap,
 )
 from retro.cpu.mpu import FLAG_B, FLAG_U
-from retro.cpu.timing import OPCODES
+from retro.cpu.timing import timing_table
 from retro.errors import InputError
 from retro.fileio import read_text
 from retro.machines import build_machine
@@ -53,7 +53,7 @@ class Size:
     storage_bytes: int
 
 
-def routine_code(read, entries: list[int], within: tuple[int, int]) -> dict[int, int]:
+def routine_code(read, entries: list[int], within: tuple[int, int], cpu: str = "6510") -> dict[int, int]:
     """{address: length} of every instruction reachable from the entries (following branches, JMP and
     JSR into the program), as the static analysis decodes them."""
     from retro.cpu.flow import decode
@@ -72,20 +72,20 @@ def routine_code(read, entries: list[int], within: tuple[int, int]) -> dict[int,
                 callees.append(target)
             return (0, 0)
         try:
-            nodes = decode(read, entry, note_call)
+            nodes = decode(read, entry, note_call, cpu)
         except (InputError, KeyError, ValueError):  # code the decoder does not follow: count none of it
             continue
         for pc in nodes:
-            found[pc] = timing_of(read(pc)).length
+            found[pc] = timing_of(read(pc), cpu).length
         pending.extend(callees)
     return found
 
 
-def program_size(program: Program, source_text: str | None, entries: list[int], read) -> Size:
+def program_size(program: Program, source_text: str | None, entries: list[int], read, cpu: str = "6510") -> Size:
     """The routine's bytes: its reachable instructions (the entry's and init's, with their subroutines)
     and the generated tables they name (by address, or by `#>table` for pointers set up at init)."""
     within = (program.origin, program.end)
-    code = routine_code(read, entries, within)
+    code = routine_code(read, entries, within, cpu)
     names = requested_tables(source_text) if source_text else []
     spans = {n: (program.symbols[n], program.symbols[n] + len(GENERATORS[n]())) for n in names if n in program.symbols}
     used = set()
@@ -163,7 +163,8 @@ class RoutineRunner:
         self.routine = routine
         self.seed = seed
         self.start = start
-        self.program = load_program(routine.program_file, symbols=routine.symbols_file, load=routine.load)
+        self.program = load_program(routine.program_file, symbols=routine.symbols_file, load=routine.load,
+                                    cpu=routine.cpu)
         self.vic = None
         if start is None:
             self.machine = build_machine(cpu=routine.cpu)
@@ -187,9 +188,10 @@ class RoutineRunner:
         if routine.init is not None:
             self.machine.call_fast(self.machine.resolve(routine.init, "program.init"), budget=self.limit)
         self.call_image = bytearray(self.machine.memory)  # what every call starts from (the batch's image)
-        # (indirect),Y instructions: the timing model needs their pointer. Every byte of the program
-        # that could be such an opcode is listed; a data byte in the set only costs a lookup.
-        indirect_y = {opcode for opcode, op in OPCODES.items() if op.mode == "iny"}
+        # (indirect),Y instructions: the timing model needs their pointer (and the 65C02's BBR/BBS the
+        # zero-page byte they test). Every byte of the program that could be such an opcode is listed;
+        # a data byte in the set only costs a lookup.
+        indirect_y = {opcode for opcode, op in timing_table(routine.cpu).items() if op.mode in ("iny", "zpr")}
         self.pointer_pcs = frozenset(self.program.origin + i for i, b in enumerate(self.program.code) if b in indirect_y)
         self._plan()
 
@@ -326,7 +328,7 @@ class RoutineRunner:
         source = self.routine.program_file
         text = read_text(source, "source file") if source.suffix.lower() in (".s", ".asm", ".oph") else None
         entries = [self.entry] + ([self.machine.resolve(self.routine.init)] if self.routine.init else [])
-        return program_size(self.program, text, entries, self.code_image.__getitem__)
+        return program_size(self.program, text, entries, self.code_image.__getitem__, self.routine.cpu)
 
 
 def port_values(ports: Sequence[Port], registers: dict, p, read: Callable, widen: Callable, table: Callable) -> list:

@@ -25,6 +25,7 @@ from pathlib import Path
 
 
 from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z, VARIANTS
+from retro.machines import BARE, MACHINE_CPUS, MACHINES, machine_for
 from retro.errors import InputError
 from retro.fields import Fields, describe
 from retro.fileio import is_dir, parse_toml, read_bytes
@@ -46,7 +47,7 @@ FLAGS = {"C": FLAG_C, "Z": FLAG_Z, "I": FLAG_I, "D": FLAG_D, "V": FLAG_V, "N": F
 CPUS = tuple(VARIANTS)
 
 TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows"}
-PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "init", "load"}
+PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load"}
 PORT_KEYS = {"at", "size", "values", "table"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays"}
@@ -144,6 +145,7 @@ class Routine:
     load: int | None
     entry: str
     cpu: str
+    machine: str  # "c64", "nes" or "none" (a bare CPU): what the raster figures are for
     init: str | None
     inputs: tuple[Port, ...]
     outputs: tuple[Port, ...]
@@ -222,6 +224,18 @@ def load_spec(path: str | Path) -> Routine:
     return _load_cached(str(spec_path.resolve()), str(path), mtime)
 
 
+def _machine(r: Fields, program_doc: dict, cpu: str) -> str:
+    """`program.machine`: the machine the routine runs in (default: the CPU's, retro.machines.machine_for)."""
+    name = _text(r, program_doc, "machine", "program.machine")
+    if name is None:
+        return machine_for(cpu)
+    name = r.choice(name, "program.machine", MACHINES, fold_case=True)
+    if name != BARE and MACHINE_CPUS[name] != cpu:
+        raise r.error("program.machine", f"the {name.upper()} has a {MACHINE_CPUS[name].upper()}, not the "
+                                         f"{cpu.upper()} the program runs on (program.cpu, or the file's own CPU)")
+    return name
+
+
 def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     r = Fields(shown or str(path), folder=path.parent, number_characters=NUMBER_CHARACTERS)
     r.table(doc, "", TOP_KEYS)
@@ -234,8 +248,12 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     cpu = _text(r, program_doc, "cpu", "program.cpu")
     if cpu is not None:
         cpu = r.choice(cpu, "program.cpu", CPUS, fold_case=True)
-    program = load_program(program_file, symbols=symbols_file, load=load)
+    program = load_program(program_file, symbols=symbols_file, load=load, cpu=cpu)
+    if cpu is not None and program.cpu is not None and cpu != program.cpu:
+        raise r.error("program.cpu", f"{program_file.name} is a program for the {program.cpu.upper()}, "
+                                     f"not the {cpu.upper()}")
     cpu = cpu or program.cpu or "6510"
+    machine = _machine(r, program_doc, cpu)
     entry = _entry_text(r, program_doc, "entry", required=True)
     _resolve(r, program, entry, "program.entry")
     init = _entry_text(r, program_doc, "init")
@@ -305,7 +323,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
         raise r.error("summary", f"expected a string, got {describe(summary)}")
     routine = Routine(
         name=name, spec_path=path, program_file=program_file, symbols_file=symbols_file, load=load, entry=entry,
-        cpu=cpu, init=init, inputs=inputs, outputs=outputs, memory=memory, reference=reference,
+        cpu=cpu, machine=machine, init=init, inputs=inputs, outputs=outputs, memory=memory, reference=reference,
         reference_name=reference_name, reference_memory=reference_memory, reference_arrays=reference_arrays, exhaustive=tuple(exhaustive),
         random=random_count, seed=seed, domain=domain, boundary=generators.get("boundary"),
         sweep=generators.get("sweep"), random_generator=generators.get("random_generator"), budget=budget,

@@ -38,6 +38,7 @@ def test_each_assemblers_build_is_checked(assembler, capsys):
     assert record["budget"] == 80
     # an iNES image runs on the 2A03 and is shown in NES raster lines (341 dots / 3 per CPU cycle)
     assert record["cpu"] == ("2a03" if assembler == "nes" else "6510")
+    assert record["machine"] == ("nes" if assembler == "nes" else "c64")
     timeline = record["raster"]["nes_ntsc" if assembler == "nes" else "c64_pal"]
     assert timeline["max_lines"] == round(SLOWEST / (341 / 3 if assembler == "nes" else 63), 3)
     assert set(record["min_inputs"]) == {"ax", "ay", "aw", "ah", "bx", "by", "bw", "bh"}
@@ -133,6 +134,9 @@ BAD_SPECS = [
     ({'where = "aw': 'where = "zz >= 1 and aw'}, "cases.where: unknown name 'zz'"),
     ({'"../foreign/acme_boxhit.prg"': '"../foreign/nothing.prg"'}, "program.file: "),
     ({'entry = "boxhit"': 'entry = "boxhit"\ncpu = "z80"'}, "program.cpu: expected one of"),
+    ({'entry = "boxhit"': 'entry = "boxhit"\ncpu = "65c03"'}, "program.cpu: expected one of '6510', '2a03', '65c02'"),
+    ({'entry = "boxhit"': 'entry = "boxhit"\nmachine = "atari"'}, "program.machine: expected one of 'c64', 'nes', 'none'"),
+    ({'entry = "boxhit"': 'entry = "boxhit"\nmachine = "nes"'}, "program.machine: the NES has a 2A03, not the 6510"),
     ({'[cycles]': '[cycles]\nloops = { boxhit = 0 }'}, "cycles.loops.boxhit: 0 is out of range 1.."),
     ({'boxhit_refs.py:boxhit': 'boxhit_refs.py:nothing'}, "reference.function: boxhit_refs.py has no function"),
     ({'max = 80': 'max = 80\n[cycles.extra]'}, "cycles.extra: unknown key"),
@@ -222,7 +226,7 @@ def test_a_spec_on_a_scene_counts_bad_line_stalls_from_the_start_line(tmp_path, 
 def test_cycle_model_disagreements_are_counted_and_fail(monkeypatch, capsys):
     import retro.analysis.check as check
 
-    monkeypatch.setattr(check, "model_cycles", lambda read, steps: 1)  # a timing model that disagrees
+    monkeypatch.setattr(check, "model_cycles", lambda read, steps, cpu: 1)  # a timing model that disagrees
     code, (record,) = _check_json(capsys, str(SPECS / "boxhit_xa.toml"), "--random", "10")
     assert code == 1 and record["cycle_mismatches"] == record["cases"] > 0
     assert record["first_failure"]["kind"] == "cycles" and "the timing model says 1" in record["first_failure"]["message"]
@@ -259,3 +263,22 @@ def test_a_reference_may_import_its_neighbours(tmp_path, capsys):
         "def boxhit(ax, ay, aw, ah, bx, by, bw, bh):\n    return overlap(ax, aw, bx, bw) and overlap(ay, ah, by, bh)\n")
     code, (record,) = _check_json(capsys, str(spec), "--random", "50")
     assert code == 0 and record["mismatches"] == 0
+
+
+@pytest.mark.parametrize("machine, timelines", [("none", set()), ("c64", {"c64_pal", "c64_ntsc"}),
+                                                 ("C64", {"c64_pal", "c64_ntsc"})])
+def test_the_raster_figures_follow_the_named_machine(tmp_path, capsys, machine, timelines):
+    """6510 code from another computer (a VIC-20, an Atari 2600) names no machine: no C64 raster lines."""
+    spec = _variant(tmp_path, {'entry = "boxhit"': f'entry = "boxhit"\nmachine = "{machine}"'})
+    code, (record,) = _check_json(capsys, str(spec), "--random", "50")
+    assert code == 0 and record["machine"] == machine.lower() and set(record["raster"]) == timelines
+    assert main(["check", str(spec), "--random", "50", "--jobs", "1"]) == 0
+    assert ("raster (CPU never stalled): C64 PAL" in capsys.readouterr().out) == bool(timelines)
+
+
+@pytest.mark.parametrize("cpu", ["6510", "65c02"])
+def test_an_ines_image_is_checked_on_the_2a03_only(tmp_path, capsys, cpu):
+    spec = _variant(tmp_path, {'entry = "boxhit"': f'entry = "boxhit"\ncpu = "{cpu}"'}, name="boxhit_nes.toml")
+    assert main(["check", str(spec), "--random", "10", "--jobs", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"program.cpu: nes_boxhit.nes is a program for the 2A03, not the {cpu.upper()}" in err
