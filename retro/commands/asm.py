@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from retro.assembler import assemble_file
-from retro.fileio import read_bytes, write_all_atomic
+from retro.fileio import all_or_nothing, read_bytes, write_atomic
 from retro.loaders import refuse_foreign_source
 from retro.program import Program, format_vice_labels, prg_bytes
 
@@ -17,6 +17,7 @@ class Assembled:
     written: tuple[Path, ...]  # the PRG first, then the labels and the listing if asked for
 
 
+@all_or_nothing
 def asm(source: str | Path, *, output: str | Path | None = None, labels: str | Path | None = None,
         listing: str | Path | None = None) -> Assembled:
     """Assemble `source`; write the PRG to `output` (default: the source's name with .prg), the VICE
@@ -24,13 +25,15 @@ def asm(source: str | Path, *, output: str | Path | None = None, labels: str | P
     data = read_bytes(source, "source file")  # read once: the source may be a FIFO
     refuse_foreign_source(source, data)
     program = assemble_file(source, data=data)
-    outputs = {Path(output) if output else Path(source).with_suffix(".prg"): prg_bytes(program)}
+    outputs = [(Path(output) if output else Path(source).with_suffix(".prg"), prg_bytes(program),
+                "PRG (-o)" if output else "PRG")]
     if labels:
-        outputs[Path(labels)] = format_vice_labels(program.symbols)
+        outputs.append((Path(labels), format_vice_labels(program.symbols), "labels (--labels)"))
     if listing:
-        outputs[Path(listing)] = program.listing
-    write_all_atomic(outputs, inputs=[source])
-    return Assembled(program, tuple(outputs))
+        outputs.append((Path(listing), program.listing, "listing (--list)"))
+    for path, data, what in outputs:  # staged; all put in place when asm returns (all_or_nothing)
+        write_atomic(path, data, what=what)
+    return Assembled(program, tuple(path for path, _, _ in outputs))
 
 
 def lines(result: Assembled) -> list[str]:
