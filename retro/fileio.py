@@ -409,11 +409,15 @@ def _staged_or(path: str | os.PathLike) -> Path:
     return Path(path)
 
 
-def output_folder(path: str | os.PathLike) -> Path:
+def output_folder(path: str | os.PathLike, names: Iterable[str] = ()) -> Path:
     """Check an output folder up front, so a long run fails before it starts, not after: it is a
-    folder or can be made one (the nearest existing folder above it is writable). Nothing is created
-    here: the folder appears when the command's outputs are committed (`command_files`)."""
+    folder or can be made one (the nearest existing folder above it is writable), and none of the
+    files `names` it will hold is a link or an input read so far. Nothing is created here: the
+    folder appears when the command's outputs are committed (`command_files`)."""
     folder = Path(path)
+    if _session is not None:
+        for name in names:
+            _check_target(_target(folder / name), str(folder / name), "output", _session)
     if exists(folder) and not is_dir(folder):
         raise InputError(f"{folder}: is a file, not a folder")
     existing = _resolved(folder)
