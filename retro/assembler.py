@@ -168,8 +168,9 @@ def _note_included(opened: Path, scratch: Path) -> None:
         names = opened.read_text(encoding="utf-8", errors="surrogateescape").split("\0")
     except OSError:
         return
+    python = {Path(p) for p in (sys.prefix, sys.base_prefix, sys.exec_prefix)}  # Ophis's own lazy imports
     for name in dict.fromkeys(filter(None, names)):
-        if not Path(name).is_relative_to(scratch):
+        if not any(Path(name).is_relative_to(folder) for folder in (scratch, *python)):
             note_input(name, "included file")
 
 
