@@ -251,7 +251,10 @@ def _make_folder(folder: Path, session: _Session) -> None:
         missing.append(folder)
         folder = folder.parent
     for made in reversed(missing):
-        made.mkdir()
+        try:
+            made.mkdir()
+        except FileExistsError:  # another command made it meanwhile: it is not ours to remove
+            continue
         session.created.append(made)
 
 
@@ -415,9 +418,6 @@ def output_folder(path: str | os.PathLike, names: Iterable[str] = ()) -> Path:
     files `names` it will hold is a link or an input read so far. Nothing is created here: the
     folder appears when the command's outputs are committed (`command_files`)."""
     folder = Path(path)
-    if _session is not None:
-        for name in names:
-            _check_target(_target(folder / name), str(folder / name), "output", _session)
     if exists(folder) and not is_dir(folder):
         raise InputError(f"{folder}: is a file, not a folder")
     existing = _resolved(folder)
@@ -428,4 +428,7 @@ def output_folder(path: str | os.PathLike, names: Iterable[str] = ()) -> Path:
     if not os.access(existing, os.W_OK | os.X_OK):
         raise InputError(f"{folder}: output folder is not writable" if existing == _resolved(folder)
                          else f"{folder}: cannot create output folder: {existing} is not writable")
+    if _session is not None:
+        for name in names:
+            _check_target(_target(folder / name), str(folder / name), "output", _session)
     return folder
