@@ -1,7 +1,7 @@
 """Outputs never over inputs (docs/files.md): every writing command, its outputs pointed at each file
 it reads (the files named on its command line and the files those name: a scene's sprites, charset,
-screen, CHR and nametable; a source's .include and .incbin; a method's spec, the spec's program and
-Python file; a --sprites file, a --script file), directly, through `./`, through `../`, through a
+screen, CHR and nametable; a source's .include and .incbin; a method's spec, the spec's program,
+Python and memory files; a --sprites file, a --script file), directly, through `./`, through `../`, through a
 linked folder, as a symbolic link to it and as a hard link to it. Each run must end with exit 2 and
 one line, and leave the whole tree byte for byte as it was: no input touched, no output, no temp."""
 
@@ -57,7 +57,10 @@ def make_workspace(w: Path) -> dict[str, Path]:
     files["method"].write_text(f'name = "mine"\nroutine = "spec.toml"\n[hitbox]\nshape = "box"\n[inputs]\n{AABB8_INPUTS}')
     spec = (ASM_DIR / "aabb8.toml").read_text().replace('file = "aabb8.s"', 'file = "prog.s"')
     files["spec"] = w / "m" / "spec.toml"
-    files["spec"].write_text(spec.replace('"retro.routines.reference:aabb8"', '"ref.py:aabb8"'))
+    files["spec"].write_text(spec.replace('"retro.routines.reference:aabb8"', '"ref.py:aabb8"')
+                             + '\n[memory]\ntable = { at = "$0400", file = "table.bin" }\n')
+    files["memory"] = w / "m" / "table.bin"
+    files["memory"].write_bytes(bytes(range(16)))
     files["program"] = w / "m" / "prog.s"
     shutil.copy(ASM_DIR / "aabb8.s", files["program"])
     files["python"] = w / "m" / "ref.py"
@@ -175,7 +178,7 @@ def test_a_folder_output_never_replaces_an_input(tmp_path, capsys, case):
     moved = out / output_name  # the input, living where the command writes that output
     files[name].rename(moved)
     if name == "method":  # the method's spec is relative to it
-        for other in ("spec", "program", "python"):
+        for other in ("spec", "program", "python", "memory"):
             files[other].rename(out / files[other].name)
     value = ("@" if option == "--script" else "") + str(moved)
     (tmp_path / "Lout").symlink_to(out, target_is_directory=True)
@@ -190,10 +193,10 @@ def test_a_folder_output_never_replaces_an_input(tmp_path, capsys, case):
 @pytest.mark.parametrize("link", ["symlink", "hard link"])
 def test_a_folder_output_that_is_a_link_to_an_input(tmp_path, capsys, case, link):
     """The output file is a link to one of the files the command reads (for a method: its spec, the
-    spec's program and Python file too)."""
+    spec's program, Python file and memory file too)."""
     files = make_workspace(tmp_path)
     argv, option, name, output_name = FOLDER_CASES[case]
-    reads = [name] + (["spec", "program", "python"] if name == "method" else [])
+    reads = [name] + (["spec", "program", "python", "memory"] if name == "method" else [])
     value = ("@" if option == "--script" else "") + str(files[name])
     for read in reads:
         out = tmp_path / "out" / read.replace(" ", "_")
