@@ -4,6 +4,7 @@ SIGHUP one line and 128 + the signal's number, with no traceback and no temp fil
 
 from __future__ import annotations
 
+import os
 import sys
 
 from retro import interrupts
@@ -18,9 +19,20 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt as exc:  # before or after the command's own handling (imports, exit)
         print(f"retro: {interrupts.describe(exc)}", file=sys.stderr)
         code = interrupts.exit_code(exc)
-    try:
-        sys.stdout.flush()
-    except (BrokenPipeError, KeyboardInterrupt):
-        pass
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError, KeyboardInterrupt):
+            pass
+    if interrupts.stopping() and not _resource_tracker_running():
+        # Cleanup has run (temp files, workers): skip the interpreter's teardown of numpy and
+        # matplotlib, most of a second of the stop. Not with a multiprocessing resource tracker
+        # (spawn/forkserver pools), which would report the skipped semaphores as leaked.
+        os._exit(code)
     interrupts.exit_now_on_signal()
     return code
+
+
+def _resource_tracker_running() -> bool:
+    tracker = sys.modules.get("multiprocessing.resource_tracker")
+    return tracker is not None and getattr(getattr(tracker, "_resource_tracker", None), "_pid", None) is not None
