@@ -16,6 +16,8 @@ def main(argv: list[str] | None = None) -> int:
         from retro.cli import main as run_command  # numpy, Pillow, ...: a second or so
 
         code = run_command(argv)
+        if code != interrupts.stop_exit_code():  # a stop whose exception Python dropped: still a stop
+            interrupts.raise_if_stopping()
     except KeyboardInterrupt as exc:  # before or after the command's own handling (imports, exit)
         print(f"retro: {interrupts.describe(exc)}", file=sys.stderr)
         code = interrupts.exit_code(exc)

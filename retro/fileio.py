@@ -54,6 +54,7 @@ class _Session:
         outputs = list(self.outputs.values())
         if not outputs:
             return
+        interrupts.raise_if_stopping()  # never commit a command that was told to stop
         with _folders_locked({o.target.parent for o in outputs}), interrupts.deferred():
             for output in outputs:  # a file may have become an input or a link since it was staged
                 _check_target(output.target, output.given, output.what, self)
@@ -190,6 +191,7 @@ def write_all_atomic(outputs: dict, inputs: Iterable[str | os.PathLike] = (), wh
 
 
 def _stage(session: _Session, path: str | os.PathLike, data: bytes | str, what: str) -> Path:
+    interrupts.raise_if_stopping()
     given = str(path)
     target = _target(Path(path))
     _check_target(target, given, what, session)

@@ -39,10 +39,28 @@ def stopping() -> bool:
     return _stopping
 
 
+_signum = 0
+
+
 def _raise(signum: int, frame) -> None:
-    global _stopping
-    _stopping = True
+    global _stopping, _signum
+    _stopping, _signum = True, signum
     raise Interrupted(signum)
+
+
+def stop_exit_code() -> int | None:
+    """128 + the stop signal's number once one arrived, else None."""
+    return 128 + _signum if _stopping else None
+
+
+def raise_if_stopping() -> None:
+    """Raise `Interrupted` again if a stop signal arrived. The handler's exception can be lost: when
+    the signal lands in Python code that C code runs with its errors cleared (an attribute lookup
+    through `PyObject_HasAttr`, a key's `__eq__` under `PyDict_GetItem`), Python drops it. So places
+    the work passes often (a task handed to a worker, an output about to be written or committed)
+    ask again."""
+    if _stopping:
+        raise Interrupted(_signum)
 
 
 def install() -> None:

@@ -37,6 +37,10 @@ class _Pool(ProcessPoolExecutor):
     `with` block on KeyboardInterrupt) cancels what is queued and ends the workers at once, instead
     of waiting for their tasks (up to 30 s for a chart's)."""
 
+    def submit(self, *args, **kwargs):
+        interrupts.raise_if_stopping()  # a stop the handler's exception did not carry out
+        return super().submit(*args, **kwargs)
+
     def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
         if interrupts.stopping():
             self.stop_workers()

@@ -118,6 +118,36 @@ def test_every_signal_in_every_write_window_leaves_nothing(tmp_path):
                 interrupt_in_window(case, command, window, signum)
 
 
+def test_a_stop_whose_exception_python_dropped_still_stops_before_the_commit(tmp_path):
+    """Python loses a signal handler's exception raised inside code whose errors C clears (a
+    `__getattr__` under PyObject_HasAttr); the stop must still win before anything is committed."""
+    dropping = CHILD.replace("import retro.fileio as fileio", textwrap.dedent("""
+        import retro.fileio as fileio
+        import retro.interrupts as interrupts
+        real_raise = interrupts._raise
+        def dropped(signum, frame):
+            try:
+                real_raise(signum, frame)
+            except KeyboardInterrupt:
+                pass  # as C code that clears errors would
+        interrupts._raise = dropped"""))
+    source = tmp_path / "a.s"
+    source.write_text(SOURCE.format(value=1))
+    out = tmp_path / "out"
+    child = subprocess.Popen([sys.executable, "-c", dropping, "asm", str(source), "-o", str(out / "a.prg"),
+                              "--labels", str(out / "a.lbl")], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                             text=True, env={**os.environ, "RETRO_TEST_WINDOW": "1", "PYTHONPATH": str(ROOT)})
+    try:
+        assert child.stderr.readline() == "IN-WINDOW\n"
+        child.send_signal(signal.SIGTERM)
+        err = child.stderr.read()
+        child.wait(timeout=30)
+    finally:
+        child.kill()
+    assert (child.returncode, err) == (143, "retro asm: stopped by SIGTERM\n")
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["a.s"]
+
+
 def test_ctrl_c_during_the_imports_is_one_line_and_130(tmp_path):
     """SIGINT arrives while retro.cli imports numpy (the child sends it to itself at that import)."""
     child = textwrap.dedent("""
