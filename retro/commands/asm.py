@@ -21,7 +21,7 @@ class Assembled:
 def asm(source: str | Path, *, output: str | Path | None = None, labels: str | Path | None = None,
         listing: str | Path | None = None) -> Assembled:
     """Assemble `source`; write the PRG to `output` (default: the source's name with .prg), the VICE
-    labels and the listing where asked. All files are written or none, never over the source."""
+    labels and the listing where asked: all or none, never over a file the assembly read (docs/files.md)."""
     data = read_bytes(source, "source file")  # read once: the source may be a FIFO
     refuse_foreign_source(source, data)
     program = assemble_file(source, data=data)
