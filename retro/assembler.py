@@ -16,18 +16,24 @@ Results are cached by the content of everything assembled, so tests can assemble
 from __future__ import annotations
 
 import hashlib
+import os
 import re
 import subprocess
 import sys
 import tempfile
-from functools import lru_cache
 from pathlib import Path
 
 from retro.errors import InputError
-from retro.fileio import exists, is_dir, is_file, read_text
+from retro.fileio import cached_reads, exists, is_dir, is_file, note_input, read_text
 from retro.program import ADDRESS_LIMIT, Program
 
-_OPHIS_DRIVER = "import sys; from Ophis.Main import run_ophis; sys.exit(run_ophis(sys.argv[1:]))"
+# The driver also lists, NUL-separated, every file Ophis opens for reading (its .include, .require
+# and .incbin files) in the file named by RETRO_OPENED: they are inputs no output may replace.
+_OPHIS_DRIVER = ("import os, sys; from Ophis.Main import run_ophis; "
+                 "opened = open(os.environ['RETRO_OPENED'], 'w', encoding='utf-8', errors='surrogateescape'); "
+                 "sys.addaudithook(lambda event, a: event == 'open' and isinstance(a[0], str) and "
+                 "(a[1] is None or 'r' in a[1]) and opened.write(os.path.abspath(a[0]) + chr(0))); "
+                 "code = run_ophis(sys.argv[1:]); opened.close(); sys.exit(code)")
 _ERROR_LINE = re.compile(r"^(?P<file>.+?):(?P<line>\d+): (?P<message>.+)$")
 _MAP_LINE = re.compile(r"^\$(?P<address>[0-9A-Fa-f]+)\s*\|\s*(?P<name>\S+)\s*\|")
 _LISTING_ADDRESS = re.compile(r"^\s*(?P<address>[0-9A-Fa-f]{4,})\s")
@@ -116,7 +122,7 @@ def _fingerprint(path: Path, text: str) -> str:
     return digest.hexdigest()
 
 
-@lru_cache(maxsize=256)
+@cached_reads(maxsize=256)  # a cached program still names the files it read as inputs
 def _assemble_cached(resolved: str, shown: str, fingerprint: str, opcodes: str = "-u") -> Program:
     return _assemble(resolved, shown, Path(resolved).read_text(), opcodes=opcodes)
 
@@ -142,13 +148,16 @@ def _assemble(resolved: str, shown: str, text: str, cwd: Path | None = None, opc
             infiles.append(str(generated))
         command = [sys.executable, "-c", _OPHIS_DRIVER, "--no-branch-extend", opcodes, "-q",
                    "-o", str(out / "out.bin"), "-l", str(out / "out.lst"), "-m", str(out / "out.map"), *infiles]
+        opened = out / "opened"
         try:
             done = subprocess.run(command, capture_output=True, text=True, timeout=ASSEMBLER_TIMEOUT_SECONDS,
-                                  input=text if resolved == _STDIN else None, cwd=cwd, preexec_fn=_limit_memory)
+                                  input=text if resolved == _STDIN else None, cwd=cwd, preexec_fn=_limit_memory,
+                                  env={**os.environ, "RETRO_OPENED": str(opened)})
         except subprocess.TimeoutExpired:
             raise InputError(f"{shown}: the assembler did not finish in {ASSEMBLER_TIMEOUT_SECONDS} s") from None
         if done.returncode != 0:
             raise InputError(_first_error(done.stderr + done.stdout, resolved, shown))
+        _note_included(opened, out)
         code = (out / "out.bin").read_bytes()
         listing = (out / "out.lst").read_text()
         symbols = _parse_map((out / "out.map").read_text())
@@ -158,6 +167,18 @@ def _assemble(resolved: str, shown: str, text: str, cwd: Path | None = None, opc
     if origin + len(code) > ADDRESS_LIMIT + 1:  # the PRG could not be loaded, nor the code run
         raise InputError(f"{shown}: {len(code)} bytes at ${origin:04X} run past ${ADDRESS_LIMIT:04X}")
     return Program(code=code, origin=origin, symbols=symbols, listing=listing, source=shown)
+
+
+def _note_included(opened: Path, scratch: Path) -> None:
+    """Record the files Ophis read (the source, its includes and binaries) as the command's inputs."""
+    try:
+        names = opened.read_text(encoding="utf-8", errors="surrogateescape").split("\0")
+    except OSError:
+        return
+    python = {Path(p) for p in (sys.prefix, sys.base_prefix, sys.exec_prefix)}  # Ophis's own lazy imports
+    for name in dict.fromkeys(filter(None, names)):
+        if not any(Path(name).is_relative_to(folder) for folder in (scratch, *python)):
+            note_input(name, "included file")
 
 
 def _first_error(output: str, resolved: str, shown: str) -> str:

@@ -13,7 +13,7 @@ import json
 import sys
 from collections.abc import Callable
 
-from retro import __version__
+from retro import __version__, interrupts
 from retro.analysis.check import AGREEMENT_PER_PART, AUTO_BATCH_CASES, ENGINES
 from retro.analysis.cost import COST_FIELDS
 from retro.analysis.study.chart_run import REDUCED_COST_SAMPLES
@@ -337,8 +337,8 @@ def main(argv: list[str] | None = None) -> int:
     except RetroError as exc:
         print(one_line(f"retro {args.command}: {exc}"), file=sys.stderr)
         return exc.exit_code
-    except KeyboardInterrupt:
-        print(f"retro {args.command}: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM/SIGHUP once retro.entry installed its handlers
+        print(f"retro {args.command}: {interrupts.describe(exc)}", file=sys.stderr)
+        return interrupts.exit_code(exc)
     except BrokenPipeError:
         return 1

@@ -1,14 +1,26 @@
-"""Atomic file writes: a reader never sees half a file."""
+"""Files in and out of a command: reads with one-line errors and a size limit, recorded as the
+command's inputs; writes staged and committed all at once, never over an input, never through a
+link (docs/files.md)."""
 
 from __future__ import annotations
 
+import functools
 import os
+import stat
 import sys
 import tempfile
-from collections.abc import Iterable
+import time
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
+from retro import interrupts
 from retro.errors import InputError
+
+try:
+    import fcntl
+except ImportError:  # pragma: no cover - not POSIX: commits are not serialised between processes
+    fcntl = None
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -16,58 +28,299 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 MAX_INPUT_BYTES = 64 << 20  # no file a user gives retro (program, symbols, sprites, scenes) is near this
+TEMP_SUFFIX = ".retro-tmp"  # every temp file retro makes beside an output ends so
+LOCK_SECONDS = 60  # how long a commit waits for another command committing into the same folder
 
 
-def write_atomic(path: str | os.PathLike, data: bytes | str, inputs: Iterable[str | os.PathLike] = ()) -> Path:
-    """Write data to a temp file beside path, then rename it over path: all or nothing."""
-    return next(iter(write_all_atomic({path: data}, inputs=inputs)))
+class _Output:
+    """An output staged in a session: its temp file beside the target, until the commit."""
+
+    def __init__(self, target: Path, given: str, what: str, temp: Path) -> None:
+        self.target, self.given, self.what, self.temp = target, given, what, temp
 
 
-def write_all_atomic(outputs: dict, inputs: Iterable[str | os.PathLike] = ()) -> list[Path]:
-    """Write every output or none: each to a temp file beside it first, then all renamed into place.
+class _Session:
+    """The files of one command: every input it read (by device and inode, so that a link, `./`,
+    `../` or a hard link names the same file) and every output it staged."""
 
-    Refused before anything is written: an output that is one of the `inputs`, one that is not a
-    regular file (a device, a FIFO, a folder: `--png /dev/stdout` is not replaced by a file), and the
-    same output twice. A symlink to a regular file is written through (the link stays a link). Temp
-    files are removed whatever stops the write, Ctrl-C included.
-    """
-    targets = [_checked_target(Path(path)) for path in outputs]
-    if len(set(targets)) != len(targets):
-        raise InputError("the same output file is named twice")
-    protected = {_resolved(Path(p)) for p in inputs}
-    for given, target in zip(outputs, targets):
-        if target in protected:
-            raise InputError(f"{given}: is an input of this command: refusing to write over it")
-    temps: list[str] = []
+    def __init__(self) -> None:
+        self.inputs: dict[tuple[int, int], str] = {}
+        self.outputs: dict[Path, _Output] = {}
+        self.created: list[Path] = []  # folders made for outputs, removed again if nothing is written
+
+    def commit(self) -> None:
+        """Every staged output renamed into place, or (on any failure) none: signals wait meanwhile,
+        and a rename that fails puts back the files already replaced."""
+        outputs = list(self.outputs.values())
+        if not outputs:
+            return
+        interrupts.raise_if_stopping()  # never commit a command that was told to stop
+        with _folders_locked({o.target.parent for o in outputs}), interrupts.deferred():
+            for output in outputs:  # a file may have become an input or a link since it was staged
+                _check_target(output.target, output.given, output.what, self)
+            replaced: list[tuple[_Output, Path | None]] = []
+            try:
+                for output in outputs:
+                    previous = _keep_previous(output.target)
+                    try:
+                        os.replace(output.temp, output.target)
+                    except OSError:
+                        if previous is not None:
+                            _remove(previous)
+                        raise
+                    replaced.append((output, previous))
+            except OSError as exc:
+                _put_back(replaced)
+                raise InputError(f"{output.given}: cannot write: {exc.strerror or exc}") from None
+            for _, previous in replaced:
+                if previous is not None:
+                    _remove(previous)
+            self.outputs.clear()
+            self.created.clear()
+
+    def abort(self) -> None:
+        with interrupts.deferred():
+            for output in self.outputs.values():
+                _remove(output.temp)
+            self.outputs.clear()
+            for folder in reversed(self.created):
+                try:
+                    folder.rmdir()  # only if empty: a file someone else put there stays
+                except OSError:
+                    pass
+            self.created.clear()
+
+
+_session: _Session | None = None
+_recorders: list[set] = []  # reads collected for `cached_reads`
+
+
+@contextmanager
+def command_files() -> Iterator[_Session]:
+    """The files of one command, all or nothing: inside, every file read through this module is an
+    input no output may replace, and every write is staged beside its target; at the end all the
+    outputs are renamed into place together, or, if anything stops the command (an error, Ctrl-C,
+    SIGTERM), the staged files are removed and no output is touched. A nested use joins the outer
+    command (the demo's steps write as one command)."""
+    global _session
+    if _session is not None:
+        yield _session
+        return
+    session = _session = _Session()
     try:
-        for target, data in zip(targets, outputs.values()):
-            payload = data.encode() if isinstance(data, str) else bytes(data)
-            directory = target.parent
-            try:
-                directory.mkdir(parents=True, exist_ok=True)
-                fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
-            except OSError as exc:
-                raise InputError(f"{target}: cannot write: {exc.strerror or exc}") from None
-            temps.append(tmp)
-            try:
-                with os.fdopen(fd, "wb") as fh:
-                    fh.write(payload)
-                os.chmod(tmp, _mode_for(target))  # mkstemp makes the file private (0600); a plain write would not
-            except OSError as exc:
-                raise InputError(f"{target}: cannot write: {exc.strerror or exc}") from None
-        for target, tmp in zip(targets, temps):
-            try:
-                os.replace(tmp, target)
-            except OSError as exc:
-                raise InputError(f"{target}: cannot write: {exc.strerror or exc}") from None
-        temps.clear()
+        yield session
+        session.commit()
+    except BaseException:
+        session.abort()
+        raise
     finally:
-        for tmp in temps:
+        _session = None
+
+
+def all_or_nothing(function: Callable) -> Callable:
+    """A command function whose files are one `command_files()` session."""
+    @functools.wraps(function)
+    def command(*args, **kwargs):
+        with command_files():
+            return function(*args, **kwargs)
+    return command
+
+
+def note_input(path: str | os.PathLike, what: str = "file") -> None:
+    """Record a file read other than through `read_bytes` (by the assembler, by Python's import) as
+    an input of the current command. A name that is no file is ignored."""
+    try:
+        status = os.stat(path)
+    except (OSError, ValueError):
+        return
+    _record((status.st_dev, status.st_ino), f"{what} {path}")
+
+
+def _record(key: tuple[int, int], shown: str) -> None:
+    if _session is not None:
+        _session.inputs.setdefault(key, shown)
+    for recorder in _recorders:
+        recorder.add((key, shown))
+
+
+def cached_reads(maxsize: int | None = 128) -> Callable:
+    """functools.lru_cache for a function that reads files: a cached answer records the files the
+    first call read as inputs of the current command again, so a cache never hides an input."""
+    def decorate(function: Callable) -> Callable:
+        @functools.lru_cache(maxsize=maxsize)
+        def remembered(*args):
+            reads: set = set()
+            _recorders.append(reads)
             try:
-                os.unlink(tmp)
+                result = function(*args)
+            finally:
+                _recorders.remove(reads)
+            return result, tuple(reads)
+
+        @functools.wraps(function)
+        def cached(*args):
+            result, reads = remembered(*args)
+            for key, shown in reads:
+                _record(key, shown)
+            return result
+
+        cached.cache_clear = remembered.cache_clear
+        cached.cache_info = remembered.cache_info
+        return cached
+    return decorate
+
+
+def write_atomic(path: str | os.PathLike, data: bytes | str, inputs: Iterable[str | os.PathLike] = (),
+                 what: str = "output") -> Path:
+    """Write data to `path` as part of the current command (see `command_files`), or alone: a temp
+    file beside the target, renamed over it at the end. Returns the target (its folder resolved)."""
+    with command_files() as session:
+        for extra in inputs:
+            note_input(extra, "input")
+        return _stage(session, path, data, what)
+
+
+def write_all_atomic(outputs: dict, inputs: Iterable[str | os.PathLike] = (), what: dict | None = None) -> list[Path]:
+    """Write every output or none (see `command_files`); `what` names each output in errors
+    (`{path: "--labels"}`)."""
+    what = what or {}
+    with command_files() as session:
+        for extra in inputs:
+            note_input(extra, "input")
+        return [_stage(session, path, data, what.get(path, "output")) for path, data in outputs.items()]
+
+
+def _stage(session: _Session, path: str | os.PathLike, data: bytes | str, what: str) -> Path:
+    interrupts.raise_if_stopping()
+    given = str(path)
+    target = _target(Path(path))
+    _check_target(target, given, what, session)
+    if target in session.outputs:
+        first = session.outputs[target]
+        raise InputError(f"{given}: the {what} and the {first.what} ({first.given}) are the same file")
+    payload = data.encode() if isinstance(data, str) else bytes(data)
+    with interrupts.deferred():  # the folder and the temp file are recorded the moment they exist
+        try:
+            _make_folder(target.parent, session)
+            fd, temp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=TEMP_SUFFIX, dir=target.parent)
+        except OSError as exc:
+            raise InputError(f"{given}: cannot write: {exc.strerror or exc}") from None
+        session.outputs[target] = _Output(target, given, what, Path(temp))
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            _write_hook(target)
+            fh.write(payload)
+        os.chmod(temp, _mode_for(target))  # mkstemp makes the file private (0600); a plain write would not
+    except OSError as exc:
+        raise InputError(f"{given}: cannot write: {exc.strerror or exc}") from None
+    return target
+
+
+def _write_hook(target: Path) -> None:
+    """Called inside the write window (a temp file exists, nothing is in place): the fault tests
+    replace it to send a signal or fill the disk at exactly this moment."""
+
+
+def _target(path: Path) -> Path:
+    """Where an output goes: its folder resolved (links, `.`, `..`), its own name kept, so that a
+    link in the last place is seen (and refused), not followed."""
+    if path.name in ("", ".", ".."):
+        return _resolved(path)
+    return _resolved(path.parent) / path.name
+
+
+def _check_target(target: Path, given: str, what: str, session: _Session) -> None:
+    """Refuse an output that is a link, not a regular file, or one of the command's inputs."""
+    try:
+        status = os.lstat(target)
+    except FileNotFoundError:
+        return
+    except (OSError, ValueError) as exc:  # a name too long, a component that is not a folder, ...
+        raise InputError(f"{given[:80]}: cannot write there: {getattr(exc, 'strerror', None) or exc}") from None
+    if stat.S_ISLNK(status.st_mode):
+        raise InputError(f"{given}: is a symbolic link: refusing to write through it (name the file itself)")
+    if not stat.S_ISREG(status.st_mode):
+        kind = "a folder" if stat.S_ISDIR(status.st_mode) else "not a regular file"
+        raise InputError(f"{given}: is {kind}: give a file name to write")
+    source = session.inputs.get((status.st_dev, status.st_ino))
+    if source is not None:
+        raise InputError(f"{given}: is an input of this command ({source}): refusing to write over it")
+
+
+def _make_folder(folder: Path, session: _Session) -> None:
+    missing = []
+    while not folder.exists():
+        missing.append(folder)
+        folder = folder.parent
+    for made in reversed(missing):
+        try:
+            made.mkdir()
+        except FileExistsError:  # another command made it meanwhile: it is not ours to remove
+            continue
+        session.created.append(made)
+
+
+def _keep_previous(target: Path) -> Path | None:
+    """A hard link to the file about to be replaced, so a failed commit can put it back."""
+    if not target.exists():
+        return None
+    keep = target.with_name(f".{target.name}.{os.getpid()}.previous{TEMP_SUFFIX}")
+    try:
+        _remove(keep)
+        os.link(target, keep)
+    except OSError:  # a file system without hard links: this one cannot be put back
+        return None
+    return keep
+
+
+def _put_back(replaced: list[tuple[_Output, Path | None]]) -> None:
+    for output, previous in reversed(replaced):
+        try:
+            if previous is not None:
+                os.replace(previous, output.target)
+            else:  # there was no file before
+                _remove(output.target)
+        except OSError:
+            pass
+
+
+def _remove(path: Path) -> None:
+    try:
+        os.unlink(path)
+    except OSError:
+        pass
+
+
+@contextmanager
+def _folders_locked(folders: set[Path]) -> Iterator[None]:
+    """Two commands committing into one folder at once take turns (flock on the folder), so each
+    leaves a whole set: the later one's, never a mix."""
+    if fcntl is None:
+        yield
+        return
+    held = []
+    try:
+        for folder in sorted(folders):
+            try:
+                fd = os.open(folder, os.O_RDONLY)
             except OSError:
-                pass
-    return targets
+                continue
+            held.append(fd)
+            deadline = time.monotonic() + LOCK_SECONDS
+            while True:
+                try:
+                    fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                    break
+                except BlockingIOError:
+                    if time.monotonic() > deadline:
+                        raise InputError(f"{folder}: another command is writing there (waited {LOCK_SECONDS} s)") from None
+                    time.sleep(0.01)
+                except OSError:  # a file system without locks
+                    break
+        yield
+    finally:
+        for fd in held:
+            os.close(fd)
 
 
 def _resolved(path: Path) -> Path:
@@ -75,18 +328,6 @@ def _resolved(path: Path) -> Path:
         return path.resolve()
     except (OSError, RuntimeError):  # a symlink loop
         return path.absolute()
-
-
-def _checked_target(path: Path) -> Path:
-    target = _resolved(path)
-    try:
-        exists = target.exists()
-    except OSError as exc:  # a name too long, a component that is not a folder, ...
-        raise InputError(f"{str(path)[:80]}: cannot write there: {exc.strerror}") from None
-    if exists and not target.is_file():
-        kind = "a folder" if target.is_dir() else "not a regular file"
-        raise InputError(f"{path}: is {kind}: give a file name to write")
-    return target
 
 
 def _mode_for(target: Path) -> int:
@@ -101,7 +342,7 @@ def _mode_for(target: Path) -> int:
 
 def _asks(test, path) -> bool:
     try:
-        return test(Path(path))
+        return test(_staged_or(path))
     except (OSError, ValueError):  # a name too long, a NUL byte in it, ...: there is no such file
         return False
 
@@ -124,7 +365,9 @@ def read_bytes(path: str | os.PathLike, what: str = "file", limit: int = MAX_INP
     if is_dir(path):
         raise InputError(f"{path}: {what} is a folder, not a file")
     try:
-        with open(path, "rb") as stream:
+        with open(_staged_or(path), "rb") as stream:
+            status = os.fstat(stream.fileno())
+            _record((status.st_dev, status.st_ino), f"{what} {path}")
             data = stream.read(limit + 1)
         if len(data) > limit:
             raise InputError(f"{path}: {what} is larger than {limit >> 20} MiB")
@@ -158,15 +401,36 @@ def parse_toml(data: bytes, shown: str) -> dict:
         raise InputError(f"{shown}: not valid TOML: {str(exc).split(':')[0]}") from None
 
 
-def output_folder(path: str | os.PathLike) -> Path:
-    """Create an output folder (and parents) up front, so a long run fails before it starts, not after."""
+def _staged_or(path: str | os.PathLike) -> Path:
+    """The temp file of an output the current command has staged but not yet put in place (the demo
+    runs the PRG it has just assembled), else the path itself."""
+    if _session is not None and _session.outputs:
+        try:
+            staged = _session.outputs.get(_target(Path(path)))
+        except (OSError, ValueError):
+            staged = None
+        if staged is not None:
+            return staged.temp
+    return Path(path)
+
+
+def output_folder(path: str | os.PathLike, names: Iterable[str] = ()) -> Path:
+    """Check an output folder up front, so a long run fails before it starts, not after: it is a
+    folder or can be made one (the nearest existing folder above it is writable), and none of the
+    files `names` it will hold is a link or an input read so far. Nothing is created here: the
+    folder appears when the command's outputs are committed (`command_files`)."""
     folder = Path(path)
-    if folder.exists() and not folder.is_dir():
+    if exists(folder) and not is_dir(folder):
         raise InputError(f"{folder}: is a file, not a folder")
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"{folder}: cannot create output folder: {exc.strerror or exc}") from None
-    if not os.access(folder, os.W_OK):
-        raise InputError(f"{folder}: output folder is not writable")
+    existing = _resolved(folder)
+    while not existing.exists():
+        existing = existing.parent
+    if not existing.is_dir():
+        raise InputError(f"{folder}: cannot create output folder: {existing} is a file")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise InputError(f"{folder}: output folder is not writable" if existing == _resolved(folder)
+                         else f"{folder}: cannot create output folder: {existing} is not writable")
+    if _session is not None:
+        for name in names:
+            _check_target(_target(folder / name), str(folder / name), "output", _session)
     return folder

@@ -99,15 +99,17 @@ def test_an_interrupted_write_leaves_no_temp_file(tmp_path, monkeypatch):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_a_symlink_to_a_file_is_written_through(tmp_path):
+def test_a_symlink_is_refused_not_written_through(tmp_path):
     real = tmp_path / "real.bin"
     real.write_bytes(b"old")
     link = tmp_path / "link.bin"
     link.symlink_to(real)
-    fileio.write_atomic(link, b"new")
-    assert link.is_symlink() and real.read_bytes() == b"new"
-    with pytest.raises(InputError, match="twice"):
-        fileio.write_all_atomic({link: b"1", real: b"2"})
+    with pytest.raises(InputError, match="symbolic link"):
+        fileio.write_atomic(link, b"new")
+    assert link.is_symlink() and real.read_bytes() == b"old"
+    with pytest.raises(InputError, match="same file"):
+        fileio.write_all_atomic({tmp_path / "a.bin": b"1", tmp_path / "x" / ".." / "a.bin": b"2"})
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.bin", "real.bin"]
 
 
 def test_ctrl_c_in_a_check_exits_130_without_a_traceback(tmp_path):

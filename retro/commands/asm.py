@@ -7,7 +7,7 @@ from pathlib import Path
 
 from retro.assembler import assemble_file
 from retro.cpu.mpu import variant_named
-from retro.fileio import read_bytes, write_all_atomic
+from retro.fileio import all_or_nothing, read_bytes, write_atomic
 from retro.loaders import refuse_foreign_source
 from retro.program import Program, format_vice_labels, prg_bytes
 
@@ -18,22 +18,25 @@ class Assembled:
     written: tuple[Path, ...]  # the PRG first, then the labels and the listing if asked for
 
 
+@all_or_nothing
 def asm(source: str | Path, *, output: str | Path | None = None, labels: str | Path | None = None,
         listing: str | Path | None = None, cpu: str | None = None) -> Assembled:
     """Assemble `source`; write the PRG to `output` (default: the source's name with .prg), the VICE
-    labels and the listing where asked. All files are written or none, never over the source.
+    labels and the listing where asked: all or none, never over a file the assembly read (docs/files.md).
     `cpu="65c02"` assembles the 65C02's opcodes (Ophis's -c) instead of the NMOS undocumented ones."""
     cpu = variant_named(cpu, "--cpu") if cpu else None
     data = read_bytes(source, "source file")  # read once: the source may be a FIFO
     refuse_foreign_source(source, data)
     program = assemble_file(source, data=data, cpu=cpu)
-    outputs = {Path(output) if output else Path(source).with_suffix(".prg"): prg_bytes(program)}
+    outputs = [(Path(output) if output else Path(source).with_suffix(".prg"), prg_bytes(program),
+                "PRG (-o)" if output else "PRG")]
     if labels:
-        outputs[Path(labels)] = format_vice_labels(program.symbols)
+        outputs.append((Path(labels), format_vice_labels(program.symbols), "labels (--labels)"))
     if listing:
-        outputs[Path(listing)] = program.listing
-    write_all_atomic(outputs, inputs=[source])
-    return Assembled(program, tuple(outputs))
+        outputs.append((Path(listing), program.listing, "listing (--list)"))
+    for path, data, what in outputs:  # staged; all put in place when asm returns (all_or_nothing)
+        write_atomic(path, data, what=what)
+    return Assembled(program, tuple(path for path, _, _ in outputs))
 
 
 def lines(result: Assembled) -> list[str]:

@@ -8,6 +8,7 @@ from pathlib import Path
 from retro.analysis.check import engine_default
 from retro.analysis.study.chart_run import AUTO, ChartOutput, run_chart, summary_lines
 from retro.analysis.study.methods import with_user_methods
+from retro.fileio import all_or_nothing
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
 
@@ -26,6 +27,7 @@ def samples_count(samples: int | str | None) -> int | str | None:
     return parse_int(samples, field="--samples", lo=1, hi=MAX_SAMPLES)
 
 
+@all_or_nothing
 def chart(out: str | Path = DEFAULT_OUT, *, reduced: bool = False, methods: list[str] = (), sprites: list[str] = (),
           samples: int | str | None = "auto", per_frame: bool = False, jobs: int | str = DEFAULT_JOBS,
           engine: str = "auto", progress: Progress = quiet, shapes: tuple[str, ...] | None = None) -> ChartOutput:

@@ -10,7 +10,7 @@ from pathlib import Path
 from retro.chips.ppu.clock import first_cycle_seeing
 from retro.chips.ppu.constants import DOTS_PER_LINE
 from retro.commands import asm, chart, cycles, nes, parry, run, vic
-from retro.fileio import output_folder, write_atomic
+from retro.fileio import all_or_nothing, output_folder, write_atomic
 from retro.machines.c64 import interrupt_budgets
 from retro.paths import ASM_DIR, EXAMPLES_DIR
 from retro.progress import quiet
@@ -96,6 +96,7 @@ STEPS: tuple[tuple[str, Callable[[Path], list[str]]], ...] = (
 )
 
 
+@all_or_nothing
 def demo(out: str | Path = "retro-out", emit: Callable[[str], None] = print) -> Path:
     """Run every step, printing through `emit` as it goes; returns the output folder."""
     out = output_folder(Path(out))

@@ -9,6 +9,7 @@ from retro.chips.ppu.constants import VBLANK_LINE, VBLANK_DOT
 from retro.chips.ppu.hit import SpriteZeroHit, sprite_zero_hit
 from retro.chips.ppu.overflow import SpriteOverflow, sprite_overflow
 from retro.errors import InputError
+from retro.fileio import all_or_nothing
 from retro.numbers import parse_int
 from retro.scenes import load_scene
 from retro.scenes.nes import NesScene
@@ -24,6 +25,7 @@ class NesRun:
     png: Path | None  # the picture written, if one was asked for
 
 
+@all_or_nothing
 def nes(path: str | Path, *, png: str | Path | None = None, scale: int | str = 2) -> NesRun:
     """The sprite-zero hit of the scene at path; with png, also write its picture there."""
     scale = parse_int(scale, field="--scale", lo=1, hi=MAX_SCALE)

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from retro.errors import InputError
-from retro.fileio import read_text
+from retro.fileio import all_or_nothing, read_text
 from retro.geometry.parry import ACTIONS, DEFAULT_FRAMES, MAX_FRAMES, Event, FrameState, events_of, simulate
 from retro.numbers import parse_int
 from retro.render.parry import write_parry
@@ -64,6 +64,7 @@ def load_script(spec: str | None, frames: int = DEFAULT_FRAMES) -> tuple[str, st
     return spec, "--script"
 
 
+@all_or_nothing
 def parry(script: str | None = None, *, out: str | Path = DEFAULT_OUT, frames: int | str = DEFAULT_FRAMES) -> ParryRun:
     """Simulate `frames` frames under the script (text, '@FILE', or None for the built-in one) and
     write parry.gif, one PNG per event frame and parry_events.txt into `out`."""

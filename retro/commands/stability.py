@@ -8,11 +8,13 @@ from pathlib import Path
 from retro.analysis.check import engine_default
 from retro.analysis.study.methods import with_user_methods
 from retro.analysis.study.stability.run import StabilityOutput, run_stability
+from retro.fileio import all_or_nothing
 from retro.progress import Progress, quiet
 
 DEFAULT_OUT = "retro-out/stability"
 
 
+@all_or_nothing
 def stability(out: str | Path = DEFAULT_OUT, *, reduced: bool = False, methods: list[str] = (),
               engine: str = "auto", progress: Progress = quiet) -> StabilityOutput:
     """The stability study of the built-in methods and the user's method files `methods`;

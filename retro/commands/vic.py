@@ -22,6 +22,7 @@ from retro.chips.vic.constants import (
 from retro.chips.vic.model import LatchReport, frame_collisions, run_frames
 from retro.chips.palettes import C64_DEFAULT_PALETTE, PALETTES
 from retro.errors import InputError
+from retro.fileio import all_or_nothing
 from retro.numbers import parse_int
 from retro.scenes.vic import VicScene, load
 
@@ -39,6 +40,7 @@ class VicRun:
     per_frame: list[dict] | None = None  # with moving sprites and --frames N: what each frame showed
 
 
+@all_or_nothing
 def vic(path: str | Path, *, frames: int | str = 1, png: str | Path | None = None, scale: int | str = 2,
         palette: str = C64_DEFAULT_PALETTE, pixels: bool = False) -> VicRun:
     """Load a scene, compute the latches after `frames` frames, optionally write the overlap PNG."""

@@ -20,7 +20,6 @@ import re
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import lru_cache
 from pathlib import Path
 
 
@@ -28,7 +27,7 @@ from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z, VARIAN
 from retro.machines import BARE, MACHINE_CPUS, MACHINES, machine_for
 from retro.errors import InputError
 from retro.fields import Fields, describe
-from retro.fileio import is_dir, parse_toml, read_bytes
+from retro.fileio import cached_reads, is_dir, note_input, parse_toml, read_bytes
 from retro.loaders import load_program
 from retro.program import Program
 from retro.routines.rows import Row, misplaced_rows, parse_rows
@@ -206,7 +205,7 @@ def read_spec_document(path: str | Path) -> dict:
     return parse_toml(data, shown)
 
 
-@lru_cache(maxsize=64)
+@cached_reads(maxsize=64)  # a cached spec still names its files (program, memory, Python) as inputs
 def _load_cached(resolved: str, shown: str, mtime: float) -> Routine:
     return parse_spec(read_spec_document(resolved), Path(resolved), shown)
 
@@ -567,10 +566,11 @@ def load_function(text: str | None, r: Fields, key: str) -> Callable:
     return function
 
 
-@lru_cache(maxsize=64)
+@cached_reads(maxsize=64)
 def import_user_module(path: str, mtime: float):
     """A user's Python file as a module, imported once per (path, modification time); its folder is
     put on sys.path so that it may import its neighbours. Routine specs and method files use it."""
+    note_input(path, "Python file")
     name = f"retro_user_{abs(hash(path)):x}"
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)

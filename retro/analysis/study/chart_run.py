@@ -54,7 +54,8 @@ def run_chart(out_dir: Path, reduced: bool = False, workers: int | None = None, 
     names = shape_names or (REDUCED_SHAPES if reduced else DEFAULT_SHAPES)
     shapes = load_shapes(names)
     shapes += load_sprite_files(sprite_files, taken={s.name for s in shapes})  # checked before any output
-    output_folder(out_dir)
+    output_folder(out_dir, (CSV_NAME, MARKDOWN_NAME, OVERALL_PNG, PAIRS_PNG)
+                  + ((PER_FRAME_CSV, PER_FRAME_MARKDOWN, PER_FRAME_PNG) if per_frame else ()))
     start = time.perf_counter()
     table = evaluate(shapes, methods, workers=workers, progress=progress)
     samples = (REDUCED_COST_SAMPLES if reduced else FULL_COST_SAMPLES) if cost_samples == AUTO else cost_samples

@@ -30,12 +30,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from functools import lru_cache
 
 import numpy as np
 
 from retro.analysis import check
 from retro.analysis.study.corpus import Pair
+from retro.fileio import cached_reads
 
 OBJECT = "object"  # Method.prepare_per: the preparation runs once per object and frame
 KIND_PAIR = "kind_pair"  # ... or once per pair of object kinds (a radius sum); charged every frame here
@@ -52,7 +52,7 @@ def sub_pair(pair: Pair, indices) -> Pair:
     return replace(pair, dx=pair.dx[idx], dy=pair.dy[idx], overlap=pair.overlap[idx])
 
 
-@lru_cache(maxsize=None)
+@cached_reads(maxsize=None)  # a cached spec still names its files as the command's inputs
 def routine_spec(name_or_path: str):
     """The Routine of a spec (built-in name or path), read once per process."""
     from retro.routines.registry import get

@@ -13,6 +13,8 @@ from retro.fileio import output_folder, write_atomic
 
 REDUCED_SPEEDS = tuple(range(1, 25))
 FULL_SPEEDS = tuple(range(1, 65))
+OUTPUT_NAMES = ("tunnelling.csv", "tunnelling.png", "wrap.csv", "wrap.png", "ranges.csv", "edges.csv",
+                "latch_pitfalls.csv", "stability.md")  # checked against the inputs before the run
 
 
 @dataclass(frozen=True)
@@ -69,7 +71,7 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
     from retro.analysis.study.methods import METHODS
 
     methods = METHODS if methods is None else tuple(methods)
-    output_folder(out_dir)
+    output_folder(out_dir, OUTPUT_NAMES)
     start = time.perf_counter()
     files: list[Path] = []
     md = ["# Stability: where each method breaks\n"]
