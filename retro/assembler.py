@@ -23,17 +23,22 @@ from functools import lru_cache
 from pathlib import Path
 
 from retro.errors import InputError
-from retro.fileio import exists, is_dir, is_file, read_text
+from retro.fileio import is_file, read_text
 from retro.program import ADDRESS_LIMIT, Program
 
-_OPHIS_DRIVER = "import sys; from Ophis.Main import run_ophis; sys.exit(run_ophis(sys.argv[1:]))"
+# Ophis runs inside retro.ophis_guard (bounded reads, nothing past $FFFF), started as a file
+_OPHIS_GUARD = Path(__file__).with_name("ophis_guard.py")
+_RUN_GUARD = "import runpy, sys; sys.argv.pop(0); runpy.run_path(sys.argv[0], run_name='__main__')"
 _ERROR_LINE = re.compile(r"^(?P<file>.+?):(?P<line>\d+): (?P<message>.+)$")
 _MAP_LINE = re.compile(r"^\$(?P<address>[0-9A-Fa-f]+)\s*\|\s*(?P<name>\S+)\s*\|")
 _LISTING_ADDRESS = re.compile(r"^\s*(?P<address>[0-9A-Fa-f]{4,})\s")
 _TABLES_REQUEST = re.compile(r"^[ \t]*;[ \t]*retro-tables:(?P<names>.*)$", re.MULTILINE)
 ASSEMBLER_TIMEOUT_SECONDS = 60
-ASSEMBLER_MEMORY_BYTES = 2 << 30  # an `.incbin "/dev/zero"` stops here, not when the machine's memory runs out
-MAX_SOURCE_BYTES = 16 << 20
+ASSEMBLER_MEMORY_BYTES = 1 << 30  # a last bound on the assembler's process, beyond the guard's
+# Ophis holds about 100 bytes per byte of source: 4 MiB of sources (the top file and its includes
+# together; a 64 KiB program's source is far smaller) stays under the memory bound
+MAX_SOURCE_BYTES = 4 << 20
+MAX_INCBIN_BYTES = ADDRESS_LIMIT + 1  # one .incbin brings in at most what the 6502 can address
 _STDIN = "-"  # Ophis's name for standard input
 ANONYMOUS_LABEL = "*"  # Ophis's `*` labels, reached by +/- references only
 
@@ -62,26 +67,12 @@ def _check_tables(source_text: str, shown: str, known: dict) -> list[str]:
 
 
 def assemble_file(path: str | Path, data: bytes | None = None) -> Program:
-    """Assemble a source file (and the tables it requests). A file that is not a regular file (a
-    FIFO, a device) is read once (or its bytes are given as `data`, already read) and handed to
-    Ophis as text, its includes relative to its folder."""
+    """Assemble a source file (and the tables it requests); `data` is its bytes if the caller has
+    read them already. Only a regular file of at most MAX_SOURCE_BYTES is read (a FIFO or a device
+    is refused by its kind, a larger file by its size, before it is read)."""
     source_path = Path(path)
-    if exists(source_path) and not is_file(source_path) and not is_dir(source_path):
-        text = _decode(source_path, data) if data is not None else _read_once(source_path)
-        return _assemble(_STDIN, str(source_path), text, cwd=source_path.parent)
-    text = read_text(source_path, "source file")
+    text = _decode(source_path, data) if data is not None else read_text(source_path, "source file", MAX_SOURCE_BYTES)
     return _assemble_cached(str(source_path.resolve()), str(source_path), _fingerprint(source_path, text))
-
-
-def _read_once(path: Path) -> str:
-    try:
-        with open(path, "rb") as stream:
-            data = stream.read(MAX_SOURCE_BYTES + 1)
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read source file: {exc.strerror or exc}") from None
-    if len(data) > MAX_SOURCE_BYTES:
-        raise InputError(f"{path}: a source of more than {MAX_SOURCE_BYTES >> 20} MiB")
-    return _decode(path, data)
 
 
 def _decode(path: Path, data: bytes) -> str:
@@ -104,14 +95,16 @@ def _fingerprint(path: Path, text: str) -> str:
     digest = hashlib.sha256(text.encode())
     for included in sorted(re.findall(r'\.(?:include|incbin|require)\s+"([^"]+)"', text)):
         candidate = path.parent / included
-        if is_file(candidate):
-            digest.update(candidate.read_bytes())
+        if is_file(candidate):  # one the guard will refuse for its size is known by size and time
+            info = candidate.stat()
+            digest.update(candidate.read_bytes() if info.st_size <= MAX_SOURCE_BYTES
+                          else f"{info.st_size}:{info.st_mtime_ns}".encode())
     return digest.hexdigest()
 
 
 @lru_cache(maxsize=256)
 def _assemble_cached(resolved: str, shown: str, fingerprint: str) -> Program:
-    return _assemble(resolved, shown, Path(resolved).read_text())
+    return _assemble(resolved, shown, read_text(resolved, "source file", MAX_SOURCE_BYTES))
 
 
 def _limit_memory() -> None:  # runs in the assembler's process, before Ophis starts
@@ -133,7 +126,8 @@ def _assemble(resolved: str, shown: str, text: str, cwd: Path | None = None) -> 
             generated = out / "retro-tables.s"
             generated.write_text(tables.ophis_source(table_names, source=shown))
             infiles.append(str(generated))
-        command = [sys.executable, "-c", _OPHIS_DRIVER, "--no-branch-extend", "-u", "-q",
+        command = [sys.executable, "-c", _RUN_GUARD, str(_OPHIS_GUARD), str(MAX_SOURCE_BYTES), str(MAX_INCBIN_BYTES),
+                   "--no-branch-extend", "-u", "-q",
                    "-o", str(out / "out.bin"), "-l", str(out / "out.lst"), "-m", str(out / "out.map"), *infiles]
         try:
             done = subprocess.run(command, capture_output=True, text=True, timeout=ASSEMBLER_TIMEOUT_SECONDS,
@@ -145,6 +139,8 @@ def _assemble(resolved: str, shown: str, text: str, cwd: Path | None = None) -> 
         code = (out / "out.bin").read_bytes()
         listing = (out / "out.lst").read_text()
         symbols = _parse_map((out / "out.map").read_text())
+    if not code:  # a PRG of a load address and nothing else is no program
+        raise InputError(f"{shown}: no code or data: the source assembles to nothing")
     origin = _origin(listing)
     if origin > ADDRESS_LIMIT:
         raise InputError(f"{shown}: the code starts at ${origin:X}, above ${ADDRESS_LIMIT:04X}")

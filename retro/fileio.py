@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import stat
 import sys
 import tempfile
 from collections.abc import Iterable
@@ -15,7 +16,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-MAX_INPUT_BYTES = 64 << 20  # no file a user gives retro (program, symbols, sprites, scenes) is near this
+MAX_INPUT_BYTES = 16 << 20  # the default limit of a read; formats that hold less pass their own
 
 
 def write_atomic(path: str | os.PathLike, data: bytes | str, inputs: Iterable[str | os.PathLike] = ()) -> Path:
@@ -120,23 +121,55 @@ def exists(path: str | os.PathLike) -> bool:
 
 
 def read_bytes(path: str | os.PathLike, what: str = "file", limit: int = MAX_INPUT_BYTES) -> bytes:
-    """The file's bytes, read once (a FIFO works); more than `limit` bytes is an error, not a hang."""
-    if is_dir(path):
-        raise InputError(f"{path}: {what} is a folder, not a file")
+    """The bytes of a regular file no larger than `limit` (each format passes the most it can
+    hold). A folder, a device, a FIFO or a socket is refused by its kind and a larger file by its
+    size, both before anything is read: `/dev/zero` or a 2 GB file costs nothing."""
     try:
-        with open(path, "rb") as stream:
-            data = stream.read(limit + 1)
-        if len(data) > limit:
-            raise InputError(f"{path}: {what} is larger than {limit >> 20} MiB")
-        return data
+        info = os.stat(path)
     except FileNotFoundError:
-        raise InputError(f"{path}: {what} not found") from None
+        raise InputError(f"{str(path)[:200]}: {what} not found") from None
     except (OSError, ValueError) as exc:
         raise InputError(f"{str(path)[:200]}: cannot read {what}: {getattr(exc, 'strerror', None) or exc}") from None
+    kind = file_kind(info.st_mode)
+    if kind == "a folder":
+        raise InputError(f"{path}: {what} is a folder, not a file")
+    if kind:
+        raise InputError(f"{path}: {what} is {kind}, not a regular file")
+    if info.st_size > limit:
+        raise InputError(f"{path}: {what} is {info.st_size} bytes; the most read is {size_text(limit)}")
+    try:
+        with open(path, "rb") as stream:
+            data = stream.read(limit + 1)  # the file may have grown since it was measured
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{str(path)[:200]}: cannot read {what}: {getattr(exc, 'strerror', None) or exc}") from None
+    if len(data) > limit:
+        raise InputError(f"{path}: {what} is larger than {size_text(limit)}, the most read")
+    return data
 
 
-def read_text(path: str | os.PathLike, what: str = "file") -> str:
-    data = read_bytes(path, what)
+def file_kind(mode: int) -> str | None:
+    """None for a regular file, else what it is, for an error: "a folder", "a device", ..."""
+    if stat.S_ISREG(mode):
+        return None
+    if stat.S_ISDIR(mode):
+        return "a folder"
+    if stat.S_ISFIFO(mode):
+        return "a FIFO (a named pipe)"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    return "a device"
+
+
+def size_text(size: int) -> str:
+    """1048576 -> "1 MiB", 65538 -> "65538 bytes"."""
+    for unit, shift in (("GiB", 30), ("MiB", 20), ("KiB", 10)):
+        if size >= 1 << shift and size % (1 << shift) == 0:
+            return f"{size >> shift} {unit}"
+    return f"{size} bytes"
+
+
+def read_text(path: str | os.PathLike, what: str = "file", limit: int = MAX_INPUT_BYTES) -> str:
+    data = read_bytes(path, what, limit)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:

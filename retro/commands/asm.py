@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from retro.assembler import assemble_file
+from retro.assembler import MAX_SOURCE_BYTES, assemble_file
 from retro.fileio import read_bytes, write_all_atomic
 from retro.loaders import refuse_foreign_source
 from retro.program import Program, format_vice_labels, prg_bytes
@@ -21,7 +21,7 @@ def asm(source: str | Path, *, output: str | Path | None = None, labels: str | P
         listing: str | Path | None = None) -> Assembled:
     """Assemble `source`; write the PRG to `output` (default: the source's name with .prg), the VICE
     labels and the listing where asked. All files are written or none, never over the source."""
-    data = read_bytes(source, "source file")  # read once: the source may be a FIFO
+    data = read_bytes(source, "source file", MAX_SOURCE_BYTES)
     refuse_foreign_source(source, data)
     program = assemble_file(source, data=data)
     outputs = {Path(output) if output else Path(source).with_suffix(".prg"): prg_bytes(program)}

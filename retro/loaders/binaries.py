@@ -24,6 +24,7 @@ from retro.chips.ines import (
     parse_header,
     unmodelled,
 )
+from retro.assembler import MAX_SOURCE_BYTES, assemble_file
 from retro.errors import InputError
 from retro.fileio import read_bytes
 from retro.loaders.symbols import load_symbol_tables
@@ -36,6 +37,8 @@ NROM_PRG_START = 0x8000  # where the cartridge's PRG ROM appears in the CPU's ad
 CPU_VECTORS = {"nmi": 0xFFFA, "reset": 0xFFFC, "irq": 0xFFFE}
 VECTOR_PREFIX = "vector:"  # not a label character in any supported assembler: never clashes
 PRG_SUFFIX = ".prg"
+# the largest program file is an Ophis source (a PRG, a raw binary or an NROM image is under 64 KiB)
+MAX_PROGRAM_BYTES = MAX_SOURCE_BYTES
 
 _BINARY_CONTROL = re.compile(rb"[\x00-\x08\x0e-\x1a\x1c-\x1f]")  # not in any text file (ESC aside)
 
@@ -144,10 +147,8 @@ def _with_symbols(program: Program, symbols: str | Path | None, vectors: dict[st
 def load_program(path: str | Path, *, symbols: str | Path | None = None, load: int | str | None = None) -> Program:
     """Any program file -> Program; `symbols` is a symbol file in any known format, `load` the
     address of a raw binary."""
-    from retro.assembler import assemble_file  # Ophis runs only for a source
-
     source = str(path)
-    data = read_bytes(path, "program file")
+    data = read_bytes(path, "program file", MAX_PROGRAM_BYTES)
     if data[:len(INES_MAGIC)] == INES_MAGIC:
         if load is not None:
             raise InputError(f"--load: {source} is an iNES image, which says where its ROM goes")
