@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import stat
 import sys
 import tempfile
@@ -188,7 +189,21 @@ def parse_toml(data: bytes, shown: str) -> dict:
     except RecursionError:
         raise InputError(f"{shown}: not valid TOML: nested too deeply") from None
     except ValueError as exc:  # int() of a huge literal inside the reader
-        raise InputError(f"{shown}: not valid TOML: {str(exc).split(':')[0]}") from None
+        raise InputError(_huge_integer(data.decode("utf-8"), shown) or f"{shown}: not valid TOML: {exc}") from None
+
+
+_LONG_INTEGER = re.compile(r"(?:(?P<key>[\w\"'.-]+)[ \t]*=[ \t]*)?[-+]?\d[\d_]{4299,}")
+
+
+def _huge_integer(text: str, shown: str) -> str | None:
+    """The error for an integer literal longer than Python converts, with its line and key."""
+    match = _LONG_INTEGER.search(text)
+    if not match:
+        return None
+    line = text.count("\n", 0, match.start()) + 1
+    key = f" {match.group('key').strip(chr(34) + chr(39))}:" if match.group("key") else ""
+    digits = sum(c.isdigit() for c in match.group().split("=")[-1])
+    return f"{shown}:{line}:{key} an integer of {digits} digits (Python reads at most 4300)"
 
 
 def output_folder(path: str | os.PathLike) -> Path:

@@ -17,6 +17,7 @@ from retro.render.parry import write_parry
 
 DEFAULT_OUT = "retro-out/parry"
 DEFAULT_SCRIPT = "40:parry 106:parry 150:left 170:stop 192:parry"
+MAX_SCRIPT_BYTES = 1 << 20  # a FRAME:ACTION for every frame of the longest run is about 120 KB
 
 
 @dataclass(frozen=True)
@@ -60,7 +61,7 @@ def load_script(spec: str | None, frames: int = DEFAULT_FRAMES) -> tuple[str, st
         return " ".join(kept), "built-in script"
     if spec.startswith("@"):
         path = spec[1:]
-        return read_text(path, "parry script"), path
+        return read_text(path, "parry script", MAX_SCRIPT_BYTES), path
     return spec, "--script"
 
 
