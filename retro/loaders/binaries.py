@@ -163,8 +163,8 @@ def load_program(path: str | Path, *, symbols: str | Path | None = None, load: i
     if is_text(data):
         refuse_foreign_source(path, data)
         if symbols:
-            raise InputError(f"{symbols}: --labels goes with a .prg, a raw binary or a .nes image; "
-                             f"a source's labels come from the assembler")
+            raise InputError(f"{symbols}: a symbol file (--labels) goes with a .prg, a raw binary or a .nes "
+                             f"image; a source's labels come from the assembler")
         return assemble_file(path, data=data)
     raise InputError(f"{source}: a binary file without a load address: pass --load ADDR for a raw binary, "
                      f"or name a C64 program .prg (2-byte load address first)")

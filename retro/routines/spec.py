@@ -230,7 +230,11 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     cpu = _text(r, program_doc, "cpu", "program.cpu")
     if cpu is not None:
         cpu = r.choice(cpu, "program.cpu", CPUS, fold_case=True)
-    program = load_program(program_file, symbols=symbols_file, load=load)
+    try:
+        program = load_program(program_file, symbols=symbols_file, load=load)
+    except InputError as exc:  # named by the key that named the file
+        field = "program.symbols" if symbols_file and str(exc).startswith(str(symbols_file)) else "program.file"
+        raise r.error(field, str(exc)) from None
     cpu = cpu or program.cpu or "6510"
     entry = _entry_text(r, program_doc, "entry", required=True)
     _resolve(r, program, entry, "program.entry")
