@@ -108,6 +108,14 @@ def _asks(test, path) -> bool:
         return False
 
 
+def file_option(value, option: str):
+    """The file name given to a command-line option; an empty one (a shell variable left unset) is
+    an error naming the option, never taken for the option's absence. None stays None."""
+    if value is not None and not str(value).strip():
+        raise InputError(f"{option}: an empty file name")
+    return value
+
+
 def is_file(path: str | os.PathLike) -> bool:
     """Path.is_file for names users give: False, not an exception, for names no file can have."""
     return _asks(Path.is_file, path)
@@ -192,7 +200,7 @@ def parse_toml(data: bytes, shown: str) -> dict:
         raise InputError(_huge_integer(data.decode("utf-8"), shown) or f"{shown}: not valid TOML: {exc}") from None
 
 
-_LONG_INTEGER = re.compile(r"(?:(?P<key>[\w\"'.-]+)[ \t]*=[ \t]*)?[-+]?\d[\d_]{4299,}")
+_LONG_INTEGER = re.compile(r"(?:(?P<key>[\w\"'.$-]+)[ \t]*=[ \t]*)?[-+]?\d[\d_]{4299,}")
 
 
 def _huge_integer(text: str, shown: str) -> str | None:

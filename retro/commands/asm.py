@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from retro.assembler import MAX_SOURCE_BYTES, assemble_file
-from retro.fileio import read_bytes, write_all_atomic
+from retro.fileio import file_option, read_bytes, write_all_atomic
 from retro.loaders import refuse_foreign_source
 from retro.program import Program, format_vice_labels, prg_bytes
 
@@ -21,13 +21,15 @@ def asm(source: str | Path, *, output: str | Path | None = None, labels: str | P
         listing: str | Path | None = None) -> Assembled:
     """Assemble `source`; write the PRG to `output` (default: the source's name with .prg), the VICE
     labels and the listing where asked. All files are written or none, never over the source."""
+    for option, name in (("-o", output), ("--labels", labels), ("--list", listing)):
+        file_option(name, option)
     data = read_bytes(source, "source file", MAX_SOURCE_BYTES)
     refuse_foreign_source(source, data)
     program = assemble_file(source, data=data)
-    outputs = {Path(output) if output else Path(source).with_suffix(".prg"): prg_bytes(program)}
-    if labels:
+    outputs = {Path(output) if output is not None else Path(source).with_suffix(".prg"): prg_bytes(program)}
+    if labels is not None:
         outputs[Path(labels)] = format_vice_labels(program.symbols)
-    if listing:
+    if listing is not None:
         outputs[Path(listing)] = program.listing
     write_all_atomic(outputs, inputs=[source])
     return Assembled(program, tuple(outputs))

@@ -59,6 +59,9 @@ def load_script(spec: str | None, frames: int = DEFAULT_FRAMES) -> tuple[str, st
         kept = [token for frame, token in zip(parse_script(DEFAULT_SCRIPT), DEFAULT_SCRIPT.split())
                 if frame[0] < frames]
         return " ".join(kept), "built-in script"
+    if not spec.strip():  # not the built-in script: a shell variable left empty
+        raise InputError("--script: empty: give FRAME:ACTION inputs or @FILE, or leave --script out for the "
+                         "built-in script")
     if spec.startswith("@"):
         path = spec[1:]
         return read_text(path, "parry script", MAX_SCRIPT_BYTES), path
