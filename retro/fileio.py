@@ -200,7 +200,7 @@ def parse_toml(data: bytes, shown: str) -> dict:
         raise InputError(_huge_integer(data.decode("utf-8"), shown) or f"{shown}: not valid TOML: {exc}") from None
 
 
-_LONG_INTEGER = re.compile(r"(?:(?P<key>[\w\"'.$-]+)[ \t]*=[ \t]*)?[-+]?\d[\d_]{4299,}")
+_LONG_INTEGER = re.compile(r"""(?:(?P<key>"[^"\n]*"|'[^'\n]*'|[\w.$-]+)[ \t]*=[ \t]*)?[-+]?\d[\d_]{4299,}""")
 
 
 def _huge_integer(text: str, shown: str) -> str | None:

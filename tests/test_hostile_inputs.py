@@ -162,3 +162,17 @@ def test_incbin_and_include_are_bounded_at_the_line_that_asks(tmp_path, capsys):
     (tmp_path / "s.s").write_text('.org $1000\n.incbin "big.bin", 10, 100\n')
     assert main(["asm", str(tmp_path / "s.s"), "-o", str(tmp_path / "s.prg")]) == 0
     assert (tmp_path / "s.prg").read_bytes() == b"\x00\x10" + bytes(range(10, 110))
+
+
+@pytest.mark.parametrize("text, message", [
+    ('[chr]\ntiles = { "1:4" = ' + "9" * 5000 + " }\n", "s.toml:2: 1:4: an integer of 5000 digits"),
+    ('"$d011" = ' + "9" * 5000 + "\n", "s.toml:1: $d011: an integer of 5000 digits"),
+    ("a = 1\nb.c = -" + "7" * 4400 + "\n", "s.toml:2: b.c: an integer of 4400 digits"),
+])
+def test_a_toml_integer_too_long_for_python_names_its_line_and_key(text, message):
+    from retro.errors import InputError
+    from retro.fileio import parse_toml
+
+    with pytest.raises(InputError) as error:
+        parse_toml(text.encode(), "s.toml")
+    assert str(error.value).startswith(message)
