@@ -36,6 +36,7 @@ LEGACY_COLOUR_KEYS = {"t": "0", "m1": "2", "m2": "3"}
 PEN_PAIR = (0b00, 0b10, 0b01, 0b11)  # pen -> multicolour bit pair
 MAX_SPRITES = 4096  # Spritemate files hold a few hundred at most; this bounds the work on a hostile file
 _NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
+_KEY_BEFORE = re.compile(r'"([^"\\]{1,40})"\s*:\s*$')  # the key whose value starts where the search ends
 
 
 class _NotANumber(Exception):
@@ -65,9 +66,11 @@ def _number_error(text: str, number: str, name: str) -> InputError:
         at = text.find(number)
     line = text.count("\n", 0, at) + 1
     column = at - (text.rfind("\n", 0, at) + 1) + 1
+    key = _KEY_BEFORE.search(text, max(0, at - 200), at)
     what = (f"a number of {len(number)} characters (at most {MAX_DIGITS} are read)" if len(number) > MAX_DIGITS
             else f"{number} is not a JSON number")
-    return InputError(f"{name}: not a Spritemate file: line {line} column {column}: {what}")
+    return InputError(f"{name}: not a Spritemate file: line {line} column {column}: "
+                      f"{key.group(1) + ': ' if key else ''}{what}")
 
 
 @dataclass(frozen=True)
