@@ -106,3 +106,28 @@ def test_the_hostile_corpus(tmp_path, monkeypatch):
             failures.append(f"{case.name}: {problem}")
     assert len(chosen) >= 200
     assert not failures, f"{len(failures)} of {len(chosen)} cases misbehaved, e.g. " + "; ".join(failures[:8])
+
+
+def _report() -> None:
+    """Every case; the numbers for docs/hostile.md (`python tests/hostile/test_corpus.py`)."""
+    import resource
+    import sys
+    import tempfile
+    import time
+
+    all_cases = list(cases())
+    started, failures = time.time(), 0
+    with tempfile.TemporaryDirectory() as tmp:
+        os.chdir(tmp)
+        for i, case in enumerate(all_cases):
+            problem = run_case(case, Path(tmp) / f"case{i}")
+            if problem:
+                failures += 1
+                print(f"{case.name}: {problem}", flush=True)
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss >> 10
+    print(f"{len(all_cases)} cases, {len(all_cases) - failures} clean, {time.time() - started:.0f} s, peak {peak} MiB",
+          file=sys.stderr)
+
+
+if __name__ == "__main__":
+    _report()
