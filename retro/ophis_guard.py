@@ -1,4 +1,4 @@
-"""Ophis with bounds: what retro.assembler runs in the assembler's own process, never imported by retro.
+"""Ophis with bounds: what retro.assembler runs in the assembler's own process (retro never imports it).
 
     python -c RUNNER ophis_guard.py SOURCE_LIMIT BINARY_LIMIT OPHIS-ARGUMENTS...
 
@@ -12,16 +12,17 @@ the bounds retro puts on every file it reads are put here, around Ophis's file r
   be cut with the directive's offset and length);
 - no byte is emitted past $FFFF: code or data that an `.org` puts beyond the address space.
 Each refusal is an Ophis error at the line that caused it (`file:line: message`), so retro reports
-it like any other assembly error. It runs as a file, not as `retro.*`, so that it imports nothing
-of retro into the assembler's process.
+it like any other assembly error. It runs as a file in the assembler's own interpreter, which
+imports of retro only the file checks it shares with retro.fileio.
 """
 
 from __future__ import annotations
 
 import builtins
 import os
-import stat
 import sys
+
+from retro.fileio import file_kind
 
 ADDRESS_LIMIT = 0xFFFF
 _real_open = builtins.open
@@ -29,16 +30,6 @@ _real_open = builtins.open
 
 class Refused(OSError):
     """A read refused here; Ophis catches OSError and adds its own 'Could not read' after ours."""
-
-
-def _kind(mode: int) -> str | None:
-    if stat.S_ISREG(mode):
-        return None
-    if stat.S_ISDIR(mode):
-        return "a folder"
-    if stat.S_ISFIFO(mode):
-        return "a FIFO (a named pipe)"
-    return "a socket" if stat.S_ISSOCK(mode) else "a device"
 
 
 class _Guard:
@@ -62,7 +53,7 @@ class _Guard:
             info = os.stat(file)
         except OSError:
             return _real_open(file, mode, *args, **kwargs)  # Ophis's own "Could not read" follows
-        kind = _kind(info.st_mode)
+        kind = file_kind(info.st_mode)
         if kind:
             raise self.refuse(f"{name}: is {kind}, not a regular file")
         if "b" in mode:
