@@ -177,6 +177,9 @@ def seeds() -> list[Seed]:
         Seed("iNES", "p.nes", _ines(),
              Target("run", {}, ("run", "{dir}/{file}", "--entry", "$8000", "--budget", "20000"), exit_1_allowed=True),
              header=tuple(range(4, 16)), words=(4, 8)),
+        Seed("NES 2.0", "p.nes", _ines()[:7] + bytes([_ines()[7] & 0xF3 | 0x08]) + _ines()[8:],
+             Target("run", {}, ("run", "{dir}/{file}", "--entry", "$8000", "--budget", "20000"), exit_1_allowed=True),
+             header=tuple(range(4, 16)), words=(4, 8, 10, 12, 14)),
         Seed("Ophis source", "p.s", (ROOT / "asm" / "mul8.s").read_bytes(),
              Target("asm", {}, ("asm", "{dir}/{file}", "-o", "{dir}/out.prg")), kind="text"),
         # scenes
