@@ -176,3 +176,35 @@ def test_a_toml_integer_too_long_for_python_names_its_line_and_key(text, message
     with pytest.raises(InputError) as error:
         parse_toml(text.encode(), "s.toml")
     assert str(error.value).startswith(message)
+
+
+def test_read_bytes_refuses_by_kind_and_size_without_opening(tmp_path, monkeypatch):
+    import builtins
+    import socket
+
+    from retro.errors import InputError
+    from retro.fileio import read_bytes
+
+    big = tmp_path / "big.bin"
+    with open(big, "wb") as stream:
+        stream.truncate(100)
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    listener = socket.socket(socket.AF_UNIX)
+    listener.bind(str(tmp_path / "sock"))
+
+    def no_open(*args, **kwargs):
+        raise AssertionError("opened")
+
+    monkeypatch.setattr(builtins, "open", no_open)
+    for path, message in ((big, "big.bin: sprite file is 100 bytes; the most read is 99 bytes"),
+                          (fifo, "pipe: sprite file is a FIFO (a named pipe), not a regular file"),
+                          (tmp_path / "sock", "sock: sprite file is a socket, not a regular file"),
+                          (tmp_path, "sprite file is a folder, not a file"),
+                          ("/dev/null", "/dev/null: sprite file is a device, not a regular file")):
+        with pytest.raises(InputError) as error:
+            read_bytes(path, "sprite file", limit=99)
+        assert message in str(error.value)
+    listener.close()
+    monkeypatch.undo()
+    assert read_bytes(big, limit=100) == bytes(100)
