@@ -91,7 +91,8 @@ def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None,
     program = load_program(path, symbols=file_option(labels, "--labels"), load=load)
     from_binary_without_symbols = labels is None and not program.listing
     if from_binary_without_symbols and _is_label(str(entry)) and str(entry).strip() not in program.symbols:
-        raise InputError(f"{path} has no symbols: pass --labels with the symbol file your assembler wrote, "
+        how = " (read as a raw binary: --load)" if load is not None else ""
+        raise InputError(f"{path}{how} has no symbols: pass --labels with the symbol file your assembler wrote, "
                          f"or give --entry as an address")
     loaded_scene = None if scene is None else load_scene(scene)
     if loaded_scene is not None and program.cpu and loaded_scene.cpu_variant != program.cpu:
