@@ -176,8 +176,9 @@ def _report() -> None:
             if problem:
                 failures.append(f"{case.name}: {problem}")
                 print(failures[-1], flush=True)
+        elapsed = time.time() - started  # before the case folders are removed
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss >> 10
-    print(f"{len(all_cases)} cases, {len(all_cases) - len(failures)} clean, {time.time() - started:.0f} s, "
+    print(f"{len(all_cases)} cases, {len(all_cases) - len(failures)} clean, {elapsed:.0f} s, "
           f"peak {peak} MiB")
 
 
