@@ -1,6 +1,7 @@
 """The mutational fuzzer (fuzz.py) through the commands that read each format. Clean means: success,
 or exit 2 with one line on stderr that names the mutated file (and the key, for a value of the wrong
-type), or exit 1 with one line where the file is a program whose routine may fail; never a
+type), or exit 1 where the file is a program or spec whose routine may fail (one line, or a failed
+check's report on stdout); never a
 traceback, never more than SECONDS_PER_CASE, and (in the subprocess sample) peak memory under
 1 GiB. CI runs a deterministic sample (a few cases of every format, seconds); RETRO_EXHAUSTIVE=1
 runs every case of both seeds. Each case runs in-process through `retro.cli.main` (the command
@@ -94,10 +95,10 @@ def judge(case: Case, code, stderr: str) -> str | None:
         return None
     if code == 1 and not case.seed.target.exit_1_allowed:
         return f"exit 1 for a bad input: {lines[:1]}"
+    if code == 1:  # the routine failed: a line on where it stopped, or a failed check's report on stdout
+        return None if len(lines) <= 1 else f"{len(lines)} lines on stderr: {lines[:3]}"
     if len(lines) != 1:
         return f"{len(lines)} lines on stderr: {lines[:3]}"
-    if code == 1:  # the routine failed: the line says where it stopped, not which file
-        return None
     if Path(case.seed.name).name not in lines[0]:
         return f"the error does not name {case.seed.name}: {lines[0][:200]}"
     if case.field and case.field not in lines[0]:
