@@ -35,9 +35,10 @@ _LISTING_ADDRESS = re.compile(r"^\s*(?P<address>[0-9A-Fa-f]{4,})\s")
 _TABLES_REQUEST = re.compile(r"^[ \t]*;[ \t]*retro-tables:(?P<names>.*)$", re.MULTILINE)
 ASSEMBLER_TIMEOUT_SECONDS = 60
 ASSEMBLER_MEMORY_BYTES = 1 << 30  # a last bound on the assembler's process, beyond the guard's
-# Ophis holds about 100 bytes per byte of source: 4 MiB of sources (the top file and its includes
-# together; a 64 KiB program's source is far smaller) stays under the memory bound
-MAX_SOURCE_BYTES = 4 << 20
+# Ophis holds 150-220 bytes per byte of source (measured: 4 MiB of `.byte` lists peak at 870 MB and
+# take a minute): 2 MiB of sources (the top file and its includes together; a commented source of
+# a full 64 KiB program is about 1 MiB) stays well under the memory bound and the time limit
+MAX_SOURCE_BYTES = 2 << 20
 MAX_INCBIN_BYTES = ADDRESS_LIMIT + 1  # one .incbin brings in at most what the 6502 can address
 _STDIN = "-"  # Ophis's name for standard input
 ANONYMOUS_LABEL = "*"  # Ophis's `*` labels, reached by +/- references only

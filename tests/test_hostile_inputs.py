@@ -142,16 +142,16 @@ def test_sizes_are_checked_before_reading(tmp_path, capsys):
     with open(huge, "wb") as stream:
         stream.truncate(18_000_000)  # sparse: costs no disk, and would cost 2 GB inside Ophis
     assert main(["asm", str(huge)]) == 2
-    assert "huge.s: source file is 18000000 bytes; the most read is 4 MiB" in _one_line(capsys)
+    assert "huge.s: source file is 18000000 bytes; the most read is 2 MiB" in _one_line(capsys)
 
 
 def test_incbin_and_include_are_bounded_at_the_line_that_asks(tmp_path, capsys):
     (tmp_path / "big.bin").write_bytes(bytes(range(256)) * 400)  # 102,400 bytes: more than 64 KiB
     with open(tmp_path / "big.inc", "wb") as stream:
-        stream.truncate(5 << 20)
+        stream.truncate(3 << 20)
     cases = {
         '.org $1000\n.incbin "big.bin"\n': "s.s:2: " + str(tmp_path / "big.bin") + ": 102400 bytes to include, more than the 65536",
-        '.org $1000\nnop\n.include "big.inc"\n': "s.s:3: " + str(tmp_path / "big.inc") + ": the sources of this program total more than 4 MiB",
+        '.org $1000\nnop\n.include "big.inc"\n': "s.s:3: " + str(tmp_path / "big.inc") + ": the sources of this program total more than 2 MiB",
         '.org $1000\n.incbin "' + str(tmp_path) + '"\n': "s.s:2: " + str(tmp_path) + ": is a folder, not a regular file",
     }
     for text, message in cases.items():
