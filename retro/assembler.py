@@ -24,23 +24,25 @@ import tempfile
 from pathlib import Path
 
 from retro.errors import InputError
-from retro.fileio import cached_reads, exists, is_dir, is_file, note_input, read_text
+from retro.fileio import cached_reads, is_file, note_input, read_text
 from retro.program import ADDRESS_LIMIT, Program
 
-# The driver also lists, NUL-separated, every file Ophis opens for reading (its .include, .require
-# and .incbin files) in the file named by RETRO_OPENED: they are inputs no output may replace.
-_OPHIS_DRIVER = ("import os, sys; from Ophis.Main import run_ophis; "
-                 "opened = open(os.environ['RETRO_OPENED'], 'w', encoding='utf-8', errors='surrogateescape'); "
-                 "sys.addaudithook(lambda event, a: event == 'open' and isinstance(a[0], str) and "
-                 "(a[1] is None or 'r' in a[1]) and opened.write(os.path.abspath(a[0]) + chr(0))); "
-                 "code = run_ophis(sys.argv[1:]); opened.close(); sys.exit(code)")
+# Ophis runs inside retro.ophis_guard (bounded reads, nothing past $FFFF), started as a file; the
+# guard also lists, NUL-separated, every file Ophis opens for reading (its .include, .require and
+# .incbin files) in the file named by RETRO_OPENED: they are inputs no output may replace.
+_OPHIS_GUARD = Path(__file__).with_name("ophis_guard.py")
+_RUN_GUARD = "import runpy, sys; sys.argv.pop(0); runpy.run_path(sys.argv[0], run_name='__main__')"
 _ERROR_LINE = re.compile(r"^(?P<file>.+?):(?P<line>\d+): (?P<message>.+)$")
 _MAP_LINE = re.compile(r"^\$(?P<address>[0-9A-Fa-f]+)\s*\|\s*(?P<name>\S+)\s*\|")
 _LISTING_ADDRESS = re.compile(r"^\s*(?P<address>[0-9A-Fa-f]{4,})\s")
 _TABLES_REQUEST = re.compile(r"^[ \t]*;[ \t]*retro-tables:(?P<names>.*)$", re.MULTILINE)
 ASSEMBLER_TIMEOUT_SECONDS = 60
-ASSEMBLER_MEMORY_BYTES = 2 << 30  # an `.incbin "/dev/zero"` stops here, not when the machine's memory runs out
-MAX_SOURCE_BYTES = 16 << 20
+ASSEMBLER_MEMORY_BYTES = 1 << 30  # a last bound on the assembler's process, beyond the guard's
+# Ophis holds 150-220 bytes per byte of source (measured: 4 MiB of `.byte` lists peak at 870 MB and
+# take a minute): 2 MiB of sources (the top file and its includes together; a commented source of
+# a full 64 KiB program is about 1 MiB) stays well under the memory bound and the time limit
+MAX_SOURCE_BYTES = 2 << 20
+MAX_INCBIN_BYTES = ADDRESS_LIMIT + 1  # one .incbin brings in at most what the 6502 can address
 _STDIN = "-"  # Ophis's name for standard input
 ANONYMOUS_LABEL = "*"  # Ophis's `*` labels, reached by +/- references only
 
@@ -69,15 +71,13 @@ def _check_tables(source_text: str, shown: str, known: dict) -> list[str]:
 
 
 def assemble_file(path: str | Path, data: bytes | None = None, cpu: str | None = None) -> Program:
-    """Assemble a source file (and the tables it requests). A file that is not a regular file (a
-    FIFO, a device) is read once (or its bytes are given as `data`, already read) and handed to
-    Ophis as text, its includes relative to its folder. `cpu="65c02"` assembles the 65C02's opcodes."""
+    """Assemble a source file (and the tables it requests); `data` is its bytes if the caller has
+    read them already. Only a regular file of at most MAX_SOURCE_BYTES is read (a FIFO or a device
+    is refused by its kind, a larger file by its size, before it is read). `cpu="65c02"` assembles
+    the 65C02's opcodes."""
     source_path = Path(path)
     opcodes = _opcode_switch(cpu)
-    if exists(source_path) and not is_file(source_path) and not is_dir(source_path):
-        text = _decode(source_path, data) if data is not None else _read_once(source_path)
-        return _assemble(_STDIN, str(source_path), text, cwd=source_path.parent, opcodes=opcodes)
-    text = read_text(source_path, "source file")
+    text = _decode(source_path, data) if data is not None else read_text(source_path, "source file", MAX_SOURCE_BYTES)
     return _assemble_cached(str(source_path.resolve()), str(source_path), _fingerprint(source_path, text), opcodes)
 
 
@@ -85,16 +85,6 @@ def _opcode_switch(cpu: str | None) -> str:
     """Ophis's instruction-set switch: the 65C02's extensions, or the NMOS undocumented opcodes."""
     return "-c" if cpu == "65c02" else "-u"
 
-
-def _read_once(path: Path) -> str:
-    try:
-        with open(path, "rb") as stream:
-            data = stream.read(MAX_SOURCE_BYTES + 1)
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read source file: {exc.strerror or exc}") from None
-    if len(data) > MAX_SOURCE_BYTES:
-        raise InputError(f"{path}: a source of more than {MAX_SOURCE_BYTES >> 20} MiB")
-    return _decode(path, data)
 
 
 def _decode(path: Path, data: bytes) -> str:
@@ -117,14 +107,16 @@ def _fingerprint(path: Path, text: str) -> str:
     digest = hashlib.sha256(text.encode())
     for included in sorted(re.findall(r'\.(?:include|incbin|require)\s+"([^"]+)"', text)):
         candidate = path.parent / included
-        if is_file(candidate):
-            digest.update(candidate.read_bytes())
+        if is_file(candidate):  # one the guard will refuse for its size is known by size and time
+            info = candidate.stat()
+            digest.update(candidate.read_bytes() if info.st_size <= MAX_SOURCE_BYTES
+                          else f"{info.st_size}:{info.st_mtime_ns}".encode())
     return digest.hexdigest()
 
 
 @cached_reads(maxsize=256)  # a cached program still names the files it read as inputs
 def _assemble_cached(resolved: str, shown: str, fingerprint: str, opcodes: str = "-u") -> Program:
-    return _assemble(resolved, shown, Path(resolved).read_text(), opcodes=opcodes)
+    return _assemble(resolved, shown, read_text(resolved, "source file", MAX_SOURCE_BYTES), opcodes=opcodes)
 
 
 def _limit_memory() -> None:  # runs in the assembler's process, before Ophis starts
@@ -146,7 +138,8 @@ def _assemble(resolved: str, shown: str, text: str, cwd: Path | None = None, opc
             generated = out / "retro-tables.s"
             generated.write_text(tables.ophis_source(table_names, source=shown))
             infiles.append(str(generated))
-        command = [sys.executable, "-c", _OPHIS_DRIVER, "--no-branch-extend", opcodes, "-q",
+        command = [sys.executable, "-c", _RUN_GUARD, str(_OPHIS_GUARD), str(MAX_SOURCE_BYTES), str(MAX_INCBIN_BYTES),
+                   "--no-branch-extend", opcodes, "-q",
                    "-o", str(out / "out.bin"), "-l", str(out / "out.lst"), "-m", str(out / "out.map"), *infiles]
         opened = out / "opened"
         try:
@@ -161,6 +154,8 @@ def _assemble(resolved: str, shown: str, text: str, cwd: Path | None = None, opc
         code = (out / "out.bin").read_bytes()
         listing = (out / "out.lst").read_text()
         symbols = _parse_map((out / "out.map").read_text())
+    if not code:  # a PRG of a load address and nothing else is no program
+        raise InputError(f"{shown}: no code or data: the source assembles to nothing")
     origin = _origin(listing)
     if origin > ADDRESS_LIMIT:
         raise InputError(f"{shown}: the code starts at ${origin:X}, above ${ADDRESS_LIMIT:04X}")

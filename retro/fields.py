@@ -26,6 +26,7 @@ from retro.fileio import exists, is_dir, is_file, read_bytes
 from retro.numbers import MAX_DIGITS, parse_int
 
 SHOWN_CHARACTERS = 40  # of a string quoted in an error: enough to recognise it, short enough for one line
+SHOWN_PATH = 200  # of a path in an error
 
 
 def describe(value) -> str:
@@ -173,11 +174,12 @@ class Fields:
         path = Path(value)
         if not path.is_absolute():
             path = self.folder / path
+        shown, looked = describe(value), str(path) if len(str(path)) <= SHOWN_PATH else f"{str(path)[:SHOWN_PATH]}..."
         if is_dir(path):
-            raise self.error(field, f"{what} {value!r} is a folder, not a file ({path})")
+            raise self.error(field, f"{what} {shown} is a folder, not a file ({looked})")
         if not is_file(path):
             problem = "is not a regular file" if exists(path) else "not found"
-            raise self.error(field, f"{what} {value!r} {problem} (looked for {path})")
+            raise self.error(field, f"{what} {shown} {problem} (looked for {looked})")
         return path.resolve() if resolve and not Path(value).is_absolute() else path
 
     def read_file(self, value, field: str, what: str = "file") -> bytes:

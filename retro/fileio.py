@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import functools
 import os
+import re
 import stat
 import sys
 import tempfile
@@ -27,7 +28,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-MAX_INPUT_BYTES = 64 << 20  # no file a user gives retro (program, symbols, sprites, scenes) is near this
+MAX_INPUT_BYTES = 16 << 20  # the default limit of a read; formats that hold less pass their own
 TEMP_SUFFIX = ".retro-tmp"  # every temp file retro makes beside an output ends so
 LOCK_SECONDS = 60  # how long a commit waits for another command committing into the same folder
 
@@ -347,6 +348,14 @@ def _asks(test, path) -> bool:
         return False
 
 
+def file_option(value, option: str):
+    """The file name given to a command-line option; an empty one (a shell variable left unset) is
+    an error naming the option, never taken for the option's absence. None stays None."""
+    if value is not None and not str(value).strip():
+        raise InputError(f"{option}: an empty file name")
+    return value
+
+
 def is_file(path: str | os.PathLike) -> bool:
     """Path.is_file for names users give: False, not an exception, for names no file can have."""
     return _asks(Path.is_file, path)
@@ -361,25 +370,57 @@ def exists(path: str | os.PathLike) -> bool:
 
 
 def read_bytes(path: str | os.PathLike, what: str = "file", limit: int = MAX_INPUT_BYTES) -> bytes:
-    """The file's bytes, read once (a FIFO works); more than `limit` bytes is an error, not a hang."""
-    if is_dir(path):
-        raise InputError(f"{path}: {what} is a folder, not a file")
+    """The bytes of a regular file no larger than `limit` (each format passes the most it can
+    hold), recorded as an input of the current command. A folder, a device, a FIFO or a socket is
+    refused by its kind and a larger file by its size, both before anything is read: `/dev/zero` or
+    a 2 GB file costs nothing."""
+    source = _staged_or(path)
     try:
-        with open(_staged_or(path), "rb") as stream:
-            status = os.fstat(stream.fileno())
-            _record((status.st_dev, status.st_ino), f"{what} {path}")
-            data = stream.read(limit + 1)
-        if len(data) > limit:
-            raise InputError(f"{path}: {what} is larger than {limit >> 20} MiB")
-        return data
+        info = os.stat(source)
     except FileNotFoundError:
-        raise InputError(f"{path}: {what} not found") from None
+        raise InputError(f"{str(path)[:200]}: {what} not found") from None
     except (OSError, ValueError) as exc:
         raise InputError(f"{str(path)[:200]}: cannot read {what}: {getattr(exc, 'strerror', None) or exc}") from None
+    kind = file_kind(info.st_mode)
+    if kind == "a folder":
+        raise InputError(f"{path}: {what} is a folder, not a file")
+    if kind:
+        raise InputError(f"{path}: {what} is {kind}, not a regular file")
+    if info.st_size > limit:
+        raise InputError(f"{path}: {what} is {info.st_size} bytes; the most read is {size_text(limit)}")
+    try:
+        with open(source, "rb") as stream:
+            status = os.fstat(stream.fileno())
+            _record((status.st_dev, status.st_ino), f"{what} {path}")
+            data = stream.read(limit + 1)  # the file may have grown since it was measured
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{str(path)[:200]}: cannot read {what}: {getattr(exc, 'strerror', None) or exc}") from None
+    if len(data) > limit:
+        raise InputError(f"{path}: {what} is larger than {size_text(limit)}, the most read")
+    return data
+
+def file_kind(mode: int) -> str | None:
+    """None for a regular file, else what it is, for an error: "a folder", "a device", ..."""
+    if stat.S_ISREG(mode):
+        return None
+    if stat.S_ISDIR(mode):
+        return "a folder"
+    if stat.S_ISFIFO(mode):
+        return "a FIFO (a named pipe)"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    return "a device"
 
 
-def read_text(path: str | os.PathLike, what: str = "file") -> str:
-    data = read_bytes(path, what)
+def size_text(size: int) -> str:
+    """1048576 -> "1 MiB", 65538 -> "65538 bytes"."""
+    for unit, shift in (("GiB", 30), ("MiB", 20), ("KiB", 10)):
+        if size >= 1 << shift and size % (1 << shift) == 0:
+            return f"{size >> shift} {unit}"
+    return f"{size} bytes"
+
+def read_text(path: str | os.PathLike, what: str = "file", limit: int = MAX_INPUT_BYTES) -> str:
+    data = read_bytes(path, what, limit)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -398,7 +439,21 @@ def parse_toml(data: bytes, shown: str) -> dict:
     except RecursionError:
         raise InputError(f"{shown}: not valid TOML: nested too deeply") from None
     except ValueError as exc:  # int() of a huge literal inside the reader
-        raise InputError(f"{shown}: not valid TOML: {str(exc).split(':')[0]}") from None
+        raise InputError(_huge_integer(data.decode("utf-8"), shown) or f"{shown}: not valid TOML: {exc}") from None
+
+
+_LONG_INTEGER = re.compile(r"""(?:(?P<key>"[^"\n]*"|'[^'\n]*'|[\w.$-]+)[ \t]*=[ \t]*)?[-+]?\d[\d_]{4299,}""")
+
+
+def _huge_integer(text: str, shown: str) -> str | None:
+    """The error for an integer literal longer than Python converts, with its line and key."""
+    match = _LONG_INTEGER.search(text)
+    if not match:
+        return None
+    line = text.count("\n", 0, match.start()) + 1
+    key = f" {match.group('key').strip(chr(34) + chr(39))}:" if match.group("key") else ""
+    digits = sum(c.isdigit() for c in match.group().split("=")[-1])
+    return f"{shown}:{line}:{key} an integer of {digits} digits (Python reads at most 4300)"
 
 
 def _staged_or(path: str | os.PathLike) -> Path:

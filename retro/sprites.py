@@ -157,7 +157,7 @@ def read_sprite_frames(path: str | Path, multicolor: bool = False, colours: Spri
 
 def _read_frames(path: str | Path, multicolor: bool, colours: SpriteColours | None, palette: str | None,
                  field: str) -> tuple[list[SpriteFrame], str]:
-    raw = read_bytes(path, "sprite file")  # read once: a FIFO works
+    raw = read_bytes(path, "sprite file")  # read once, then told apart by content
     kind = sprite_format(raw, path)
     if palette is not None and kind != "png":
         raise InputError(f"{path}: palette: only a PNG's colours go through a palette (this is a "

@@ -149,7 +149,7 @@ def test_code_running_past_ffff_is_an_error_naming_the_source(tmp_path):
     # 20 bytes from $FFF0 would end at $10003: no 6502 can hold them, and the PRG would not load.
     source = tmp_path / "wrap.s"
     source.write_text(".org $fff0\n.byte " + ", ".join(["1"] * 20) + "\n")
-    with pytest.raises(InputError, match=r"wrap\.s: 20 bytes at \$FFF0 run past \$FFFF"):
+    with pytest.raises(InputError, match=r"wrap\.s:2: code or data at \$10000, past \$FFFF"):
         assemble_file(source)
     # exactly up to $FFFF is fine
     source.write_text(".org $fff0\n.byte " + ", ".join(["1"] * 16) + "\n")

@@ -78,7 +78,7 @@ def test_run_text_output_says_the_jsr_is_not_counted(capsys, source):
     (["--entry", "double", "--set", "nolabel=1"], 2, "unknown label 'nolabel'"),
     (["--entry", "double", "--peek", "result:0"], 2, "out of range"),
     (["--entry", "double", "--budget", "0"], 2, "--budget"),
-    (["--entry", "double", "--labels", "x.lbl"], 2, "--labels goes with a .prg"),
+    (["--entry", "double", "--labels", "x.lbl"], 2, "a symbol file (--labels) goes with a .prg"),
 ])
 def test_run_failures_exit_1_or_2_with_one_line(capsys, source, args, code, needle):
     got, out, err = run_cli(capsys, "run", source, *args)

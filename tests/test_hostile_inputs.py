@@ -51,7 +51,10 @@ def test_an_output_that_is_a_device_is_refused(source, capsys):
 
 @pytest.mark.parametrize("text, message", [
     ("        lda #1/0\n", "the assembler failed on this source: ZeroDivisionError"),
-    ("        .org $10000\n        lda #1\n", "the code starts at $10000, above $FFFF"),
+    ("        .org $10000\n        lda #1\n", "self.s:2: code or data at $10000, past $FFFF"),
+    ("        .org $c000\n        nop\n        .org $fffe\n        lda $1234\n", "self.s:4: code or data at $10000"),
+    ("; nothing but a comment\n", "self.s: no code or data: the source assembles to nothing"),
+    ('        .org $c000\n        .incbin "/dev/zero"\n', "self.s:2: /dev/zero: is a device, not a regular file"),
     ('        .include "self.s"\n', "the assembler recursed too deeply"),
 ])
 def test_ophis_crashes_are_one_line(tmp_path, capsys, text, message):
@@ -61,19 +64,17 @@ def test_ophis_crashes_are_one_line(tmp_path, capsys, text, message):
     assert message in _one_line(capsys)
 
 
-def test_a_fifo_source_is_read_once(tmp_path, capsys):
+def test_a_fifo_is_refused_by_its_kind_without_waiting_for_a_writer(tmp_path, capsys):
     fifo = tmp_path / "pipe.s"
-    os.mkfifo(fifo)
-    writer = threading.Thread(target=lambda: fifo.write_text(OK_SOURCE))
-    writer.start()
-    assert main(["asm", str(fifo), "-o", str(tmp_path / "pipe.prg")]) == 0
-    writer.join(timeout=10)
-    assert (tmp_path / "pipe.prg").read_bytes() == bytes([0x00, 0xC0, 0xA9, 0x01, 0x60])
+    os.mkfifo(fifo)  # no writer: opening it would block for ever
+    assert main(["asm", str(fifo), "-o", str(tmp_path / "pipe.prg")]) == 2
+    assert _one_line(capsys).rstrip().endswith("pipe.s: source file is a FIFO (a named pipe), not a regular file")
+    assert not (tmp_path / "pipe.prg").exists()
 
 
 def test_an_endless_file_is_refused_not_read(capsys):
     assert main(["run", "/dev/zero", "--entry", "0"]) == 2
-    assert "larger than" in _one_line(capsys)
+    assert _one_line(capsys).rstrip().endswith("/dev/zero: program file is a device, not a regular file")
 
 
 def test_numbers_of_thousands_of_digits(source, capsys):
@@ -136,3 +137,76 @@ def test_a_folder_given_as_a_sprite_file_says_so(tmp_path, capsys):
                                          '[[sprite]]\nindex = 0\nx = 100\ny = 100\nfile = "ball.spr"\n')
     assert main(["vic", str(tmp_path / "scene.toml")]) == 2
     assert "is a folder, not a file" in _one_line(capsys)
+
+
+def test_sizes_are_checked_before_reading(tmp_path, capsys):
+    huge = tmp_path / "huge.s"
+    with open(huge, "wb") as stream:
+        stream.truncate(18_000_000)  # sparse: costs no disk, and would cost 2 GB inside Ophis
+    assert main(["asm", str(huge)]) == 2
+    assert "huge.s: source file is 18000000 bytes; the most read is 2 MiB" in _one_line(capsys)
+
+
+def test_incbin_and_include_are_bounded_at_the_line_that_asks(tmp_path, capsys):
+    (tmp_path / "big.bin").write_bytes(bytes(range(256)) * 400)  # 102,400 bytes: more than 64 KiB
+    with open(tmp_path / "big.inc", "wb") as stream:
+        stream.truncate(3 << 20)
+    cases = {
+        '.org $1000\n.incbin "big.bin"\n': "s.s:2: " + str(tmp_path / "big.bin") + ": 102400 bytes to include, more than the 65536",
+        '.org $1000\nnop\n.include "big.inc"\n': "s.s:3: " + str(tmp_path / "big.inc") + ": the sources of this program total more than 2 MiB",
+        '.org $1000\n.incbin "' + str(tmp_path) + '"\n': "s.s:2: " + str(tmp_path) + ": is a folder, not a regular file",
+    }
+    for text, message in cases.items():
+        (tmp_path / "s.s").write_text(text)
+        assert main(["asm", str(tmp_path / "s.s")]) == 2
+        assert message in _one_line(capsys)
+    # a slice of a large file is fine: offset 10, 100 bytes
+    (tmp_path / "s.s").write_text('.org $1000\n.incbin "big.bin", 10, 100\n')
+    assert main(["asm", str(tmp_path / "s.s"), "-o", str(tmp_path / "s.prg")]) == 0
+    assert (tmp_path / "s.prg").read_bytes() == b"\x00\x10" + bytes(range(10, 110))
+
+
+@pytest.mark.parametrize("text, message", [
+    ('[chr]\ntiles = { "1:4" = ' + "9" * 5000 + " }\n", "s.toml:2: 1:4: an integer of 5000 digits"),
+    ('"$d011" = ' + "9" * 5000 + "\n", "s.toml:1: $d011: an integer of 5000 digits"),
+    ("a = 1\nb.c = -" + "7" * 4400 + "\n", "s.toml:2: b.c: an integer of 4400 digits"),
+])
+def test_a_toml_integer_too_long_for_python_names_its_line_and_key(text, message):
+    from retro.errors import InputError
+    from retro.fileio import parse_toml
+
+    with pytest.raises(InputError) as error:
+        parse_toml(text.encode(), "s.toml")
+    assert str(error.value).startswith(message)
+
+
+def test_read_bytes_refuses_by_kind_and_size_without_opening(tmp_path, monkeypatch):
+    import builtins
+    import socket
+
+    from retro.errors import InputError
+    from retro.fileio import read_bytes
+
+    big = tmp_path / "big.bin"
+    with open(big, "wb") as stream:
+        stream.truncate(100)
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    listener = socket.socket(socket.AF_UNIX)
+    listener.bind(str(tmp_path / "sock"))
+
+    def no_open(*args, **kwargs):
+        raise AssertionError("opened")
+
+    monkeypatch.setattr(builtins, "open", no_open)
+    for path, message in ((big, "big.bin: sprite file is 100 bytes; the most read is 99 bytes"),
+                          (fifo, "pipe: sprite file is a FIFO (a named pipe), not a regular file"),
+                          (tmp_path / "sock", "sock: sprite file is a socket, not a regular file"),
+                          (tmp_path, "sprite file is a folder, not a file"),
+                          ("/dev/null", "/dev/null: sprite file is a device, not a regular file")):
+        with pytest.raises(InputError) as error:
+            read_bytes(path, "sprite file", limit=99)
+        assert message in str(error.value)
+    listener.close()
+    monkeypatch.undo()
+    assert read_bytes(big, limit=100) == bytes(100)

@@ -12,6 +12,7 @@ from retro.analysis.study.broad_phase import MAX_OBJECTS
 from retro.analysis.study.methods import with_user_methods
 from retro.commands.chart import DEFAULT_JOBS, MAX_JOBS
 from retro.errors import InputError
+from retro.fileio import file_option
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
 
@@ -37,6 +38,8 @@ def advise(scene: str | Path, *, accuracy: float | str = DEFAULT_ACCURACY, metho
     `software`) measured on the scene's sprites; the cheapest one that decides at least `accuracy` of
     the cases correctly, per test or, for `objects` objects, per frame."""
     target = accuracy_target(accuracy)
+    for method in methods:
+        file_option(method, "--method")
     workers = parse_int(jobs, field="--jobs", lo=1, hi=MAX_JOBS)
     count = None if objects is None else parse_int(objects, field="--objects", lo=1, hi=MAX_OBJECTS)
     with engine_default(engine):

@@ -5,9 +5,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from retro.assembler import assemble_file
+from retro.assembler import MAX_SOURCE_BYTES, assemble_file
 from retro.cpu.mpu import variant_named
-from retro.fileio import all_or_nothing, read_bytes, write_atomic
+from retro.fileio import all_or_nothing, file_option, read_bytes, write_atomic
 from retro.loaders import refuse_foreign_source
 from retro.program import Program, format_vice_labels, prg_bytes
 
@@ -24,15 +24,17 @@ def asm(source: str | Path, *, output: str | Path | None = None, labels: str | P
     """Assemble `source`; write the PRG to `output` (default: the source's name with .prg), the VICE
     labels and the listing where asked: all or none, never over a file the assembly read (docs/files.md).
     `cpu="65c02"` assembles the 65C02's opcodes (Ophis's -c) instead of the NMOS undocumented ones."""
+    for option, name in (("-o", output), ("--labels", labels), ("--list", listing)):
+        file_option(name, option)
     cpu = variant_named(cpu, "--cpu") if cpu else None
-    data = read_bytes(source, "source file")  # read once: the source may be a FIFO
+    data = read_bytes(source, "source file", MAX_SOURCE_BYTES)
     refuse_foreign_source(source, data)
     program = assemble_file(source, data=data, cpu=cpu)
-    outputs = [(Path(output) if output else Path(source).with_suffix(".prg"), prg_bytes(program),
-                "PRG (-o)" if output else "PRG")]
-    if labels:
+    outputs = [(Path(output) if output is not None else Path(source).with_suffix(".prg"), prg_bytes(program),
+                "PRG (-o)" if output is not None else "PRG")]
+    if labels is not None:
         outputs.append((Path(labels), format_vice_labels(program.symbols), "labels (--labels)"))
-    if listing:
+    if listing is not None:
         outputs.append((Path(listing), program.listing, "listing (--list)"))
     for path, data, what in outputs:  # staged; all put in place when asm returns (all_or_nothing)
         write_atomic(path, data, what=what)

@@ -9,7 +9,7 @@ from pathlib import Path
 from retro.analysis.check import RoutineCheck, SceneStart, check_record, format_check, run_checks
 from retro.analysis.junit import junit_xml
 from retro.errors import InputError
-from retro.fileio import write_atomic
+from retro.fileio import file_option, write_atomic
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
 from retro.routines import cases as case_sets
@@ -36,7 +36,7 @@ def check(routines: list[str] | None = None, *, exhaustive: bool = False, seed: 
 
 
 def scene_start(scene: str | Path | None, at_line: int | str | None, at_cycle: int | str | None) -> SceneStart | None:
-    if scene is None:
+    if file_option(scene, "--scene") is None:
         if at_line is not None or at_cycle is not None:
             raise InputError("--at-line and --at-cycle go with --scene")
         return None

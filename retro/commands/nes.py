@@ -9,7 +9,7 @@ from retro.chips.ppu.constants import VBLANK_LINE, VBLANK_DOT
 from retro.chips.ppu.hit import SpriteZeroHit, sprite_zero_hit
 from retro.chips.ppu.overflow import SpriteOverflow, sprite_overflow
 from retro.errors import InputError
-from retro.fileio import all_or_nothing
+from retro.fileio import all_or_nothing, file_option
 from retro.numbers import parse_int
 from retro.scenes import load_scene
 from retro.scenes.nes import NesScene
@@ -29,6 +29,7 @@ class NesRun:
 def nes(path: str | Path, *, png: str | Path | None = None, scale: int | str = 2) -> NesRun:
     """The sprite-zero hit of the scene at path; with png, also write its picture there."""
     scale = parse_int(scale, field="--scale", lo=1, hi=MAX_SCALE)
+    file_option(png, "--png")
     scene = load_scene(path)
     if not isinstance(scene, NesScene):
         raise InputError(f"{path}: chip: expected 'nes' for `retro nes`")

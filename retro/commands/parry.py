@@ -17,6 +17,7 @@ from retro.render.parry import write_parry
 
 DEFAULT_OUT = "retro-out/parry"
 DEFAULT_SCRIPT = "40:parry 106:parry 150:left 170:stop 192:parry"
+MAX_SCRIPT_BYTES = 1 << 20  # a FRAME:ACTION for every frame of the longest run is about 120 KB
 
 
 @dataclass(frozen=True)
@@ -58,9 +59,12 @@ def load_script(spec: str | None, frames: int = DEFAULT_FRAMES) -> tuple[str, st
         kept = [token for frame, token in zip(parse_script(DEFAULT_SCRIPT), DEFAULT_SCRIPT.split())
                 if frame[0] < frames]
         return " ".join(kept), "built-in script"
+    if not spec.strip():  # not the built-in script: a shell variable left empty
+        raise InputError("--script: empty: give FRAME:ACTION inputs or @FILE, or leave --script out for the "
+                         "built-in script")
     if spec.startswith("@"):
         path = spec[1:]
-        return read_text(path, "parry script"), path
+        return read_text(path, "parry script", MAX_SCRIPT_BYTES), path
     return spec, "--script"
 
 

@@ -15,7 +15,7 @@ from retro.chips.ines import INES_MAGIC
 from retro.cpu.machine import DEFAULT_BUDGET, DEFAULT_FLAGS, JSR_CYCLES, MAX_BUDGET, CallResult, Machine
 from retro.cpu.mpu import FLAG_B, FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_U, FLAG_V, FLAG_Z, variant_named
 from retro.errors import InputError
-from retro.fileio import read_bytes
+from retro.fileio import file_option, read_bytes
 from retro.loaders import load_program
 from retro.numbers import parse_int
 from retro.machines import build_machine
@@ -167,10 +167,12 @@ def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None,
     registers = {name: parse_int(value, field=f"--{name}", lo=0, hi=0xFF) for name, value in (("a", a), ("x", x), ("y", y))}
     budget = parse_int(budget, field="--budget", lo=1, hi=MAX_BUDGET)
     status = status_with_flags(flags)
-    program = load_program(path, symbols=labels, load=load, cpu=variant_named(cpu, "--cpu") if cpu else None)
+    program = load_program(path, symbols=file_option(labels, "--labels"), load=load,
+                           cpu=variant_named(cpu, "--cpu") if cpu else None)
     from_binary_without_symbols = labels is None and not program.listing
     if from_binary_without_symbols and _is_label(str(entry)) and str(entry).strip() not in program.symbols:
-        raise InputError(f"{path} has no symbols: pass --labels with the symbol file your assembler wrote, "
+        how = " (read as a raw binary: --load)" if load is not None else ""
+        raise InputError(f"{path}{how} has no symbols: pass --labels with the symbol file your assembler wrote, "
                          f"or give --entry as an address")
     loaded_scene = None if scene is None else load_scene(scene)
     if loaded_scene is not None and program.cpu and loaded_scene.cpu_variant != program.cpu:

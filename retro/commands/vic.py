@@ -22,7 +22,7 @@ from retro.chips.vic.constants import (
 from retro.chips.vic.model import LatchReport, frame_collisions, run_frames
 from retro.chips.palettes import C64_DEFAULT_PALETTE, PALETTES
 from retro.errors import InputError
-from retro.fileio import all_or_nothing
+from retro.fileio import all_or_nothing, file_option
 from retro.numbers import parse_int
 from retro.scenes.vic import VicScene, load
 
@@ -48,6 +48,7 @@ def vic(path: str | Path, *, frames: int | str = 1, png: str | Path | None = Non
     scale = parse_int(scale, field="--scale", lo=1, hi=MAX_SCALE)
     if palette not in C64_PALETTES:
         raise InputError(f"--palette: {palette!r} is not a C64 palette (known: {', '.join(C64_PALETTES)})")
+    file_option(png, "--png")
     scene = load(path)
     per_frame = None
     if frames > 1 and any(spec.velocity != (0, 0) for spec in scene.sprites):

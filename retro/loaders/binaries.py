@@ -1,7 +1,8 @@
 """A program file of any kind the user brings -> `Program`, recognised from its content.
 
-- iNES image (`NES\\x1a` header, nesdev wiki "INES"): mapper 0 (NROM) only; 16 KiB of PRG ROM is
-  seen at $8000 and mirrored at $C000, 32 KiB fills $8000-$FFFF; the CPU is the 2A03. The vectors
+- iNES or NES 2.0 image (`NES\\x1a` header, nesdev wiki "INES", "NES 2.0"): mapper 0 (NROM) only; a
+  header that asks for hardware retro does not model is refused, naming the field
+  (retro.chips.ines.unmodelled); 16 KiB of PRG ROM is seen at $8000 and mirrored at $C000, 32 KiB fills $8000-$FFFF; the CPU is the 2A03. The vectors
   at $FFFA/$FFFC/$FFFE are named `vector:nmi`, `vector:reset`, `vector:irq`, and `nmi`, `reset`,
   `irq` too where the symbol file does not use those names (a user's label always wins).
 - Text: Ophis source, assembled; source in another assembler's syntax is refused, naming it.
@@ -16,13 +17,14 @@ import re
 from pathlib import Path
 
 from retro.chips.ines import (
-    HEADER_SIZE,
     INES_MAGIC,
     NROM,
     NROM_PRG_SIZES,
     PRG_BANK_SIZE,
     parse_header,
+    unmodelled,
 )
+from retro.assembler import MAX_SOURCE_BYTES, assemble_file
 from retro.errors import InputError
 from retro.fileio import read_bytes
 from retro.loaders.symbols import read_symbol_file, symbol_tables
@@ -31,12 +33,12 @@ from retro.program import ADDRESS_LIMIT, Program, parse_prg
 
 NES_CPU = "2a03"
 NROM_PRG_START = 0x8000  # where the cartridge's PRG ROM appears in the CPU's address space
-INES_TRAINER_SIZE = 512  # byte 6 bit 2: a 512-byte trainer sits between the header and PRG ROM
-INES_FLAG6_TRAINER = 0x04
 # 6502 hardware vectors (MOS datasheet): the CPU reads the handler's address from these words
 CPU_VECTORS = {"nmi": 0xFFFA, "reset": 0xFFFC, "irq": 0xFFFE}
 VECTOR_PREFIX = "vector:"  # not a label character in any supported assembler: never clashes
 PRG_SUFFIX = ".prg"
+# the largest program file is an Ophis source (a PRG, a raw binary or an NROM image is under 64 KiB)
+MAX_PROGRAM_BYTES = MAX_SOURCE_BYTES
 
 _BINARY_CONTROL = re.compile(rb"[\x00-\x08\x0e-\x1a\x1c-\x1f]")  # not in any text file (ESC aside)
 
@@ -105,9 +107,13 @@ def _nes_program(data: bytes, source: str) -> tuple[Program, dict[str, int]]:
     header = parse_header(data, source)
     if header.mapper != NROM:
         raise InputError(f"{source}: iNES mapper {header.mapper} is not supported; only mapper 0 (NROM) is")
+    problems = unmodelled(header)
+    if problems:
+        field, promise = problems[0]
+        raise InputError(f"{source}: {'NES 2.0' if header.nes2 else 'iNES'} header {field}: {promise}")
     if header.prg_size not in NROM_PRG_SIZES:
         raise InputError(f"{source}: NROM needs 16 or 32 KiB of PRG ROM, the header says {header.prg_size} bytes")
-    start = HEADER_SIZE + (INES_TRAINER_SIZE if data[6] & INES_FLAG6_TRAINER else 0)
+    start = header.prg_start
     if len(data) < start + header.prg_size + header.chr_size:
         raise InputError(f"{source}: truncated: the header promises {header.prg_size} bytes of PRG ROM and "
                          f"{header.chr_size} of CHR ROM, the file has {max(0, len(data) - start)} after the header")
@@ -144,10 +150,8 @@ def load_program(path: str | Path, *, symbols: str | Path | None = None, load: i
                  cpu: str | None = None) -> Program:
     """Any program file -> Program; `symbols` is a symbol file in any known format, `load` the
     address of a raw binary, `cpu` the CPU a source is assembled for ("65c02": its opcodes)."""
-    from retro.assembler import assemble_file  # Ophis runs only for a source
-
     source = str(path)
-    data = read_bytes(path, "program file")
+    data = read_bytes(path, "program file", MAX_PROGRAM_BYTES)
     if data[:len(INES_MAGIC)] == INES_MAGIC:
         if load is not None:
             raise InputError(f"--load: {source} is an iNES image, which says where its ROM goes")
@@ -162,8 +166,8 @@ def load_program(path: str | Path, *, symbols: str | Path | None = None, load: i
     if is_text(data):
         refuse_foreign_source(path, data)
         if symbols:
-            raise InputError(f"{symbols}: --labels goes with a .prg, a raw binary or a .nes image; "
-                             f"a source's labels come from the assembler")
+            raise InputError(f"{symbols}: a symbol file (--labels) goes with a .prg, a raw binary or a .nes "
+                             f"image; a source's labels come from the assembler")
         return assemble_file(path, data=data, cpu=cpu)
     raise InputError(f"{source}: a binary file without a load address: pass --load ADDR for a raw binary, "
                      f"or name a C64 program .prg (2-byte load address first)")

@@ -1,7 +1,8 @@
 """NES pattern data (CHR) from a file, detected by content -> the PPU's 8 KiB pattern space.
 
-- an iNES image (`NES` $1A): the first 8 KiB CHR ROM bank, found after the 16-byte header, the
-  512-byte trainer when flag 6 bit 2 is set, and the PRG ROM (nesdev wiki "INES"); a board with
+- an iNES or NES 2.0 image (`NES` $1A; sizes as retro.chips.ines reads them): the first 8 KiB CHR
+  ROM bank, found after the 16-byte header, the 512-byte trainer when flag 6 bit 2 is set, and the
+  PRG ROM (nesdev wiki "INES", "NES 2.0"); a board with
   CHR RAM (CHR size 0) has no pattern data in the file, which is an error;
 - 8 KiB: both pattern tables ($0000 and $1000);
 - 4 KiB: one pattern table, placed at the table the caller names (the other stays zero).
@@ -9,12 +10,9 @@
 
 from __future__ import annotations
 
-from retro.chips.ines import HEADER_SIZE, INES_MAGIC, parse_header
+from retro.chips.ines import INES_MAGIC, parse_header
 from retro.chips.ppu.constants import CHR_SIZE, PATTERN_TABLE_SIZE
 from retro.errors import InputError
-
-FLAG6_TRAINER = 0x04   # nesdev wiki "INES", flags 6 bit 2
-TRAINER_SIZE = 512
 
 
 def chr_from_bytes(content: bytes, name: str, table: int = 0) -> bytes:
@@ -23,7 +21,7 @@ def chr_from_bytes(content: bytes, name: str, table: int = 0) -> bytes:
         header = parse_header(content, name)
         if header.chr_size == 0:
             raise InputError(f"{name}: the cartridge has CHR RAM (CHR ROM size 0): no pattern data in the file")
-        start = HEADER_SIZE + (TRAINER_SIZE if content[6] & FLAG6_TRAINER else 0) + header.prg_size
+        start = header.prg_start + header.prg_size
         if len(content) < start + CHR_SIZE:
             raise InputError(f"{name}: the header says CHR ROM starts at byte {start}, "
                              f"the file ends at {len(content)}")

@@ -20,6 +20,7 @@ src/js/Save.ts, src/js/SpriteTypes.ts, src/js/Export-Base.ts); nothing here is c
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -28,11 +29,48 @@ import numpy as np
 from retro.chips.vic.constants import SPRITE_HEIGHT, SPRITE_WIDTH
 from retro.errors import InputError
 from retro.fileio import read_bytes
+from retro.numbers import MAX_DIGITS
 
 LEGACY_PENS = {"t": 0, "i": 1, "m1": 2, "m2": 3}  # before 2018-05-26
 LEGACY_COLOUR_KEYS = {"t": "0", "m1": "2", "m2": "3"}
 PEN_PAIR = (0b00, 0b10, 0b01, 0b11)  # pen -> multicolour bit pair
 MAX_SPRITES = 4096  # Spritemate files hold a few hundred at most; this bounds the work on a hostile file
+_NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
+_KEY_BEFORE = re.compile(r'"([^"\\]{1,40})"\s*:\s*$')  # the key whose value starts where the search ends
+
+
+class _NotANumber(Exception):
+    """A JSON number retro does not read (too long, or NaN / Infinity, which JSON does not have)."""
+
+
+def _strict_int(text: str) -> int:
+    if len(text.lstrip("-")) > MAX_DIGITS:
+        raise _NotANumber(text)
+    return int(text)
+
+
+def _strict_float(text: str) -> float:
+    if len(text) > MAX_DIGITS:
+        raise _NotANumber(text)
+    return float(text)
+
+
+def _no_constant(text: str):
+    raise _NotANumber(text)
+
+
+def _number_error(text: str, number: str, name: str) -> InputError:
+    """Where in the file the refused number is, for the error."""
+    at = next((m.start() for m in _NUMBER.finditer(text) if m.group() == number), None)
+    if at is None:
+        at = text.find(number)
+    line = text.count("\n", 0, at) + 1
+    column = at - (text.rfind("\n", 0, at) + 1) + 1
+    key = _KEY_BEFORE.search(text, max(0, at - 200), at)
+    what = (f"a number of {len(number)} characters (at most {MAX_DIGITS} are read)" if len(number) > MAX_DIGITS
+            else f"{number} is not a JSON number")
+    return InputError(f"{name}: not a Spritemate file: line {line} column {column}: "
+                      f"{key.group(1) + ': ' if key else ''}{what}")
 
 
 @dataclass(frozen=True)
@@ -108,7 +146,9 @@ def parse_spm(raw: bytes, name: str = "sprite file") -> SpritemateFile:
     except UnicodeDecodeError as exc:
         raise InputError(f"{name}: not a Spritemate file: not UTF-8 text (byte {exc.start})") from None
     try:
-        doc = json.loads(text)
+        doc = json.loads(text, parse_int=_strict_int, parse_float=_strict_float, parse_constant=_no_constant)
+    except _NotANumber as exc:
+        raise _number_error(text, exc.args[0], name) from None
     except json.JSONDecodeError as exc:
         raise InputError(f"{name}: not a Spritemate file: JSON error at line {exc.lineno} column {exc.colno}: "
                          f"{exc.msg}") from None

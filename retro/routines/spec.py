@@ -247,17 +247,21 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     cpu = _text(r, program_doc, "cpu", "program.cpu")
     if cpu is not None:
         cpu = r.choice(cpu, "program.cpu", CPUS, fold_case=True)
-    program = load_program(program_file, symbols=symbols_file, load=load, cpu=cpu)
+    try:
+        program = load_program(program_file, symbols=symbols_file, load=load, cpu=cpu)
+    except InputError as exc:  # named by the key that named the file
+        field = "program.symbols" if symbols_file and str(exc).startswith(str(symbols_file)) else "program.file"
+        raise r.error(field, str(exc)) from None
     if cpu is not None and program.cpu is not None and cpu != program.cpu:
         raise r.error("program.cpu", f"{program_file.name} is a program for the {program.cpu.upper()}, "
                                      f"not the {cpu.upper()}")
     cpu = cpu or program.cpu or "6510"
     machine = _machine(r, program_doc, cpu)
     entry = _entry_text(r, program_doc, "entry", required=True)
-    _resolve(r, program, entry, "program.entry")
     init = _entry_text(r, program_doc, "init")
-    if init is not None:
-        _resolve(r, program, init, "program.init")
+    for field_name, text in (("program.entry", entry), ("program.init", init)):
+        if text is not None:
+            _in_program(r, program, _resolve(r, program, text, field_name), field_name)
 
     inputs = tuple(_port(r, program, name, value, "inputs", is_input=True)
                    for name, value in r.table(r.required(doc, "inputs", hint="the [inputs] table"), "inputs").items())
@@ -352,6 +356,12 @@ def _entry_text(r: Fields, doc: dict, key: str, required: bool = False) -> str |
     if isinstance(value, int) and not isinstance(value, bool):
         return str(r.integer(value, f"program.{key}", 0, 0xFFFF))
     return _text(r, doc, key, f"program.{key}")
+
+
+def _in_program(r: Fields, program: Program, address: int, field_name: str) -> None:
+    """A routine starts in the program's bytes: elsewhere the 6502 would run zeroed RAM."""
+    if not program.origin <= address < program.end:
+        raise r.error(field_name, f"${address:04X} is outside the program (${program.origin:04X}-${program.end - 1:04X})")
 
 
 def _resolve(r: Fields, program: Program, text: str, field_name: str) -> int:
@@ -614,8 +624,8 @@ def _reference_signature(r: Fields, function: Callable, text: str, inputs: tuple
     known = {port.name for port in inputs} | {m.name for m in memory}
     for name in required:
         if name not in known:
-            raise r.error("reference.function", f"{text} needs argument {name!r}, which is neither an input nor a "
-                                               "memory block")
+            raise r.error("reference.function", f"{text} needs argument {name!r}, which is neither in [inputs] nor "
+                                               "a [memory] block")
     return tuple(m.name for m in memory if m.name in names or takes_any)
 
 

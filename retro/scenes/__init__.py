@@ -11,20 +11,23 @@ from __future__ import annotations
 from pathlib import Path
 
 from retro.errors import InputError
+from retro.fields import describe
 from retro.fileio import parse_toml, read_bytes
 
 CHIPS = ("vic-ii", "nes")  # the `chip` key of a scene file
+# a scene that spells out every cell of four nametables and 512 tiles is about 200 KB
+MAX_SCENE_BYTES = 1 << 20
 
 
 def read_toml(path: str | Path) -> dict:
-    return parse_toml(read_bytes(path, "scene file"), str(path))
+    return parse_toml(read_bytes(path, "scene file", MAX_SCENE_BYTES), str(path))
 
 
 def load_scene(path: str | Path):
     doc = read_toml(path)
     chip = doc.get("chip")
     if not isinstance(chip, str) or chip not in CHIPS:
-        raise InputError(f"{path}: chip: expected one of {', '.join(repr(c) for c in CHIPS)}, got {chip!r}")
+        raise InputError(f"{path}: chip: expected one of {', '.join(repr(c) for c in CHIPS)}, got {describe(chip)}")
     from retro.scenes import nes, vic  # here, not at the top: both use this package's helpers
 
     parse = {"vic-ii": vic.parse, "nes": nes.parse}[chip]

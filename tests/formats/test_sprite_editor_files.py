@@ -252,6 +252,14 @@ def test_spritemate_read_by_content_whatever_the_name(tmp_path):
     (json.dumps({"colors": {"0": 0, "2": 1, "3": 2}, "sprites": [{"pixels": grid()}]}), "sprites[0].color: missing"),
     (json.dumps({"colors": {"0": 0, "2": 1, "3": 2}, "sprites": []}), "sprites: expected a list of at least one"),
     (json.dumps({"colors": {"0": 0, "2": 1, "3": 2}, "sprites": [{}] * 4097}), "4097 sprites, at most 4096"),
+    # numbers Python would choke on (int() of 4,300+ digits) or JSON does not have: one line, with where
+    ('{"colors": {"0": 0, "2": 1, "3": ' + "9" * 5000 + '}, "sprites": []}',
+     "not a Spritemate file: line 1 column 34: 3: a number of 5000 characters (at most 80 are read)"),
+    ('{"colors": {"0": 0, "2": 1, "3": 2},\n "sprites": [{"color": -' + "7" * 5000 + '}]}',
+     "line 2 column 24: color: a number of 5001 characters"),
+    ('{"colors": {"0": 0, "2": 1, "3": 1.' + "5" * 5000 + '}, "sprites": []}', "line 1 column 34: 3: a number of 5002"),
+    ('{"colors": {"0": NaN, "2": 1, "3": 2}, "sprites": []}', "line 1 column 18: 0: NaN is not a JSON number"),
+    ('{"colors": {"0": 0, "2": -Infinity, "3": 2}, "sprites": []}', "line 1 column 26: 2: -Infinity is not a JSON number"),
 ])
 def test_bad_spritemate_files_one_line(tmp_path, text, message):
     path = tmp_path / "bad.spm"

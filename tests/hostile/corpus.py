@@ -38,6 +38,9 @@ class Case:
     name: str
     files: dict  # file name -> text, written into a fresh folder
     argv: tuple  # "{dir}" is replaced by that folder
+    # what an error must name: the file and key of a TOML value, or the option (its value for a file name)
+    names: tuple = ()
+    refused: bool = False  # exit 2 is the only right answer (an empty file name is no file name)
 
 
 def _paths(doc, prefix=()) -> Iterator[tuple]:
@@ -90,13 +93,14 @@ def _replace(doc, path: tuple, marker: str):
 MARKER = "@@HOSTILE@@"
 
 
-def _mutations(text: str) -> Iterator[tuple[str, str]]:
-    """(description, TOML text) for every key path of a document and every hostile value."""
+def _mutations(text: str) -> Iterator[tuple[str, str, str]]:
+    """(description, TOML text, the key) for every key path of a document and every hostile value."""
     doc = tomllib.loads(text)
     for path in _paths(doc):
         template = dump_toml(_replace(doc, path, MARKER))
+        key = next(str(step) for step in reversed(path) if not isinstance(step, int))
         for value in HOSTILE_TOML:
-            yield ".".join(map(str, path)) + " = " + value[:20], template.replace(_dump(MARKER), value)
+            yield ".".join(map(str, path)) + " = " + value[:20], template.replace(_dump(MARKER), value), key
 
 
 def _files_of(folder: Path, names: list[str]) -> dict:
@@ -108,23 +112,23 @@ def cases() -> Iterator[Case]:
     for scene, command in (("vic_two_balls.toml", "vic"), ("vic_text_collision.toml", "vic"),
                            ("nes_sprite0.toml", "nes")):
         sprites = {p.name: p.read_bytes() for p in (ROOT / "sprites").glob("*.spr")}
-        for what, text in _mutations((EXAMPLES / scene).read_text()):
+        for what, text, key in _mutations((EXAMPLES / scene).read_text()):
             yield Case(f"{command} {scene}: {what}", {"examples/scene.toml": text,
                                                       **{f"sprites/{k}": v for k, v in sprites.items()}},
-                       (command, "{dir}/examples/scene.toml", "--json"))
+                       (command, "{dir}/examples/scene.toml", "--json"), ("scene.toml", key))
     # routine specs: every key of the example spec
     boxhit = EXAMPLES / "boxhit"
     extra = _files_of(boxhit, ["boxhit.asm", "boxhit.prg", "boxhit.sym", "boxhit_ref.py"])
-    for what, text in _mutations((boxhit / "boxhit.toml").read_text()):
+    for what, text, key in _mutations((boxhit / "boxhit.toml").read_text()):
         yield Case(f"check boxhit.toml: {what}", {"boxhit.toml": text, **extra},
-                   ("check", "{dir}/boxhit.toml", "--random", "20", "--jobs", "1", "--json"))
+                   ("check", "{dir}/boxhit.toml", "--random", "20", "--jobs", "1", "--json"), ("boxhit.toml", key))
     # method files: every key of the example methods
     for method in ("shrunk_box.toml", "cross.toml"):
         extra = _files_of(EXAMPLES / "methods", ["cross.py"])
-        for what, text in _mutations((EXAMPLES / "methods" / method).read_text()):
+        for what, text, key in _mutations((EXAMPLES / "methods" / method).read_text()):
             yield Case(f"advise --method {method}: {what}", {"m.toml": text, **extra},
                        ("advise", str(EXAMPLES / "vic_two_balls.toml"), "--method", "{dir}/m.toml", "--jobs", "1",
-                        "--quiet"))
+                        "--quiet"), ("m.toml", key))
     # command-line options: every option value of the commands
     scene = str(EXAMPLES / "vic_two_balls.toml")
     nes = str(EXAMPLES / "nes_sprite0.toml")
@@ -143,7 +147,14 @@ def cases() -> Iterator[Case]:
     for command, (base, options) in commands.items():
         for option in options:
             for value in HOSTILE_ARGS:
-                yield Case(f"{command} {option} {value[:20]!r}", source, tuple(base) + (option, value))
+                names_a_file = option in FILE_OPTIONS
+                yield Case(f"{command} {option} {value[:20]!r}", source, tuple(base) + (option, value),
+                           names=(value[:20],) if names_a_file and value and value != "--" else (option,),
+                           refused=names_a_file and not value)
+
+
+# options whose value is a file name (read or written): an error names the file, an empty name is refused
+FILE_OPTIONS = {"-o", "--labels", "--list", "--png", "--script", "--scene", "--method"}
 
 
 if __name__ == "__main__":
