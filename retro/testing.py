@@ -19,7 +19,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from retro.analysis.check import RoutineCheck, check_routine, format_check
+from retro.analysis.check import RoutineCheck, check_routine
+from retro.commands.check import format_check
 from retro.routines.spec import Routine, parse_spec
 
 __all__ = ["RoutineCheck", "RoutineFailed", "assert_routine", "check", "report_text", "spec_from_dict"]

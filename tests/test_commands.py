@@ -13,7 +13,7 @@ import pytest
 
 import retro.commands
 from retro import cli
-from retro.analysis import check as check_module
+from retro.analysis.check import engines as check_module
 from retro.commands import advise, asm, chart, demo, nes, parry, run, stability, vic
 from retro.errors import InputError
 from retro.paths import ASM_DIR, EXAMPLES_DIR

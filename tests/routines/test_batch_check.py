@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from retro.analysis import check as check_module
+from retro.analysis.check import check_routine
+from retro.analysis.check import engines as check_module
 from retro.cli import main
 from retro.cpu import batch
 from retro.errors import InputError
@@ -176,7 +177,7 @@ def test_auto_takes_the_batched_core_for_large_case_sets(capsys):
     code, (large,) = check_json(capsys, "mul8", "--random", str(check_module.AUTO_BATCH_CASES))
     assert (small["engine"], large["engine"]) == ("scalar", "batch")
     with pytest.raises(InputError):
-        check_module.check_routine("mul8", engine="gpu")
+        check_routine("mul8", engine="gpu")
 
 
 @pytest.mark.exhaustive

@@ -34,7 +34,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from retro.analysis import check
+from retro.analysis.check import engines as check_engines
 from retro.analysis.study.corpus import Pair
 
 OBJECT = "object"  # Method.prepare_per: the preparation runs once per object and frame
@@ -67,7 +67,7 @@ def routine_runner(name_or_path: str):
     return RoutineRunner(routine_spec(name_or_path))
 
 
-# A pair's calls run on retro.analysis.check.DEFAULT_ENGINE (set by the commands' --engine through
+# A pair's calls run on retro.analysis.check.engines.DEFAULT_ENGINE (set by the commands' --engine through
 # engine_default): "auto" takes the batched core (retro.cpu.batch) from BATCH_FROM calls on, "scalar" is
 # Machine only, "batch" the batched core whatever the count.
 BATCH_FROM = 256
@@ -115,7 +115,7 @@ class RoutineSession(Session):
     def run_many(self, indices: list[int]) -> tuple[list[bool], list[int]]:
         """On the batched core when there are enough calls (the default engine); a call that does not
         return is run again on Machine, whose error names it."""
-        engine = check.DEFAULT_ENGINE
+        engine = check_engines.DEFAULT_ENGINE
         batched = self.runner.batchable and (engine == "batch" or (engine == "auto" and len(indices) >= BATCH_FROM))
         if not batched or not indices:
             return super().run_many(indices)

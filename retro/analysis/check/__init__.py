@@ -1,0 +1,40 @@
+"""Cross-check a routine (a spec: built-in or the user's) against its reference, results and cycles.
+
+For every case: the routine's outputs must equal the reference's (inside the spec's `where`
+domain), and the measured cycle count must equal the independent timing model summed over the
+executed path (retro.cpu.timing). Cases outside the domain are run too: their failures are what
+shows each condition of the domain is needed, and a failure inside it is a mismatch. Measured
+extremes must lie within the static best/worst case (retro.cpu.flow), and both within the spec's
+cycle budget (`[cycles] max`) when it has one.
+
+Cases are made lazily (retro.routines.cases) and run in chunks over worker processes (`jobs`);
+the first run failure (BRK, JAM, a runaway past `[cycles] limit`) stops the check and is reported
+with its inputs.
+
+Two engines run the calls: `Machine` (scalar, the reference, with the timing model on every call)
+and the batched core (retro.cpu.batch: 65,536 cases at a time with numpy). `engine="auto"` takes the
+batched core from AUTO_BATCH_CASES planned cases on; then the first AGREEMENT_PER_PART cases of every
+part also run on `Machine` with the timing model, and the two engines must agree call for call
+(outputs and cycles): a disagreement is a mismatch of kind "engine".
+
+The check by job: `results` (the per-chunk tallies and a routine's check), `reference` (the
+reference's answers), `engines` (running cases on either engine, the runners cached per worker),
+`verdicts` (static bounds), `run` (a whole check: plans, pools, progress). The reports (text and
+JSON) live beside the commands that print them: retro/commands/check.py and cycles.py.
+"""
+
+from retro.analysis.check.engines import (
+    AGREEMENT_PER_PART,
+    AUTO_BATCH_CASES,
+    ENGINES,
+    SceneStart,
+    engine_default,
+)
+from retro.analysis.check.reference import expected_columns, expected_outputs
+from retro.analysis.check.results import ChunkResult, Failure, PartRun, RoutineCheck, describe_case, inputs_by_name
+from retro.analysis.check.run import check_routine, run_checks
+from retro.analysis.check.verdicts import static_bounds
+
+__all__ = ["AGREEMENT_PER_PART", "AUTO_BATCH_CASES", "ENGINES", "ChunkResult", "Failure", "PartRun", "RoutineCheck",
+           "SceneStart", "check_routine", "describe_case", "engine_default", "expected_columns", "expected_outputs",
+           "inputs_by_name", "run_checks", "static_bounds"]
