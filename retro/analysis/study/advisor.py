@@ -129,7 +129,7 @@ def _shape_key(shape: Shape) -> tuple:
 
 def advise(path: str, target: float, workers: int | None = None, progress: Progress = quiet,
            samples: int = ADVICE_COST_SAMPLES, methods: tuple[Method, ...] = METHODS, software: bool = False,
-           objects: int | None = None) -> Advice:
+           objects: int | None = None, engine: str = "auto") -> Advice:
     """`target` in (0, 1] and `objects` in 1..MAX_OBJECTS are checked by retro.commands.advise."""
     from retro.analysis.study.cost_runs import measure_costs
 
@@ -157,14 +157,14 @@ def advise(path: str, target: float, workers: int | None = None, progress: Progr
     keys = list(jobs)
     table = evaluate([], methods, workers=workers, progress=progress, pair_list=[jobs[k] for k in keys])
     costs = measure_costs([], samples=samples, workers=workers, progress=progress, pair_list=[jobs[k] for k in keys],
-                          methods=methods)
+                          methods=methods, engine=engine)
     sprite_count = len(indexed) if objects is None else objects
     frames = {}
     if objects is not None:
         from retro.analysis.study.per_frame import best_phase, per_frame
 
         model = per_frame(methods, {k: c.overall for k, c in costs.items()}, [s for _, s in indexed], counts=(objects,),
-                          budget=scene.budget, workers=workers, progress=progress)
+                          budget=scene.budget, workers=workers, progress=progress, engine=engine)
         frames = {m.key: best_phase(model.rows, m.key, objects) for m in methods}
     figures = []
     for m in methods:

@@ -39,7 +39,8 @@ def method_samples(method: Method, samples: int | None) -> int | None:
     return cap if samples is None else min(samples, cap)
 
 
-def _measure_pair(method: Method, a: Shape, b: Shape, samples: int | None) -> tuple[str, list[int]]:
+def _measure_pair(method: Method, a: Shape, b: Shape, samples: int | None,
+                  engine: str = "auto") -> tuple[str, list[int]]:
     pair = make_pair(a, b)
     if method.unmeasurable(pair):
         return pair.name, []
@@ -47,7 +48,7 @@ def _measure_pair(method: Method, a: Shape, b: Shape, samples: int | None) -> tu
     session = method.session(pair)
     verdict = None if method.averaged else method.verdict(sub_pair(pair, indices)) > 0
     cycles = []
-    answers, spent_cycles = session.run_many(indices)
+    answers, spent_cycles = session.run_many(indices, engine)
     for k, (index, answer, spent) in enumerate(zip(indices, answers, spent_cycles)):
         expected = session.expected(index) if verdict is None else bool(verdict[k])
         if answer != expected:
@@ -59,7 +60,7 @@ def _measure_pair(method: Method, a: Shape, b: Shape, samples: int | None) -> tu
 
 def measure_costs(shapes: list[Shape], samples: int | None, workers: int | None = None, progress: Progress = quiet,
                   pair_list: list[tuple[Shape, Shape]] | None = None,
-                  methods: tuple[Method, ...] = METHODS) -> dict[str, MethodCost]:
+                  methods: tuple[Method, ...] = METHODS, engine: str = "auto") -> dict[str, MethodCost]:
     """MethodCost for every method; a host-only method gets no cycles and says so. `samples`: cases
     measured per pair (None: every case)."""
     jobs = pair_list if pair_list is not None else list(combinations_with_replacement(shapes, 2))
@@ -69,7 +70,7 @@ def measure_costs(shapes: list[Shape], samples: int | None, workers: int | None 
     tasks = [(m, a, b) for m in measured for a, b in jobs]
     if workers > 1 and len(tasks) > 1:
         with worker_pool(workers) as pool:
-            futures = [pool.submit(_measure_pair, m, a, b, samples) for m, a, b in tasks]
+            futures = [pool.submit(_measure_pair, m, a, b, samples, engine) for m, a, b in tasks]
             results = []
             for (m, _, _), future in zip(tasks, futures):
                 results.append(future.result())
@@ -78,7 +79,7 @@ def measure_costs(shapes: list[Shape], samples: int | None, workers: int | None 
     else:
         results = []
         for m, a, b in tasks:
-            results.append(_measure_pair(m, a, b, samples))
+            results.append(_measure_pair(m, a, b, samples, engine))
             if len(results) % len(jobs) == 0:
                 progress(f"cost: {m.key} ({m.routine}) measured on {len(jobs)} pairs")
     by_method = {m.key: results[i * len(jobs):(i + 1) * len(jobs)] for i, m in enumerate(measured)}

@@ -56,7 +56,7 @@ def edges_markdown(rows: list) -> str:
 
 
 def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = quiet,
-                  methods: tuple | None = None) -> StabilityOutput:
+                  methods: tuple | None = None, engine: str = "auto") -> StabilityOutput:
     from retro.analysis.study.stability import (
         charts,
         edges,
@@ -118,7 +118,7 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
 
     # Arithmetic range
     progress("stability: arithmetic range")
-    range_rows = ranges.range_rows(reduced=reduced, progress=progress)
+    range_rows = ranges.range_rows(reduced=reduced, progress=progress, engine=engine)
     files.append(write_atomic(out_dir / "ranges.csv", _csv(range_rows)))
     md.append("## Arithmetic range\n\n")
     md.append("Found by running the assembly (`retro check`'s domain search: structured and random cases, "
