@@ -103,7 +103,7 @@ MUTANTS = [
            "node.cycles = (op.cycles + best, op.cycles + worst)", "node.cycles = (op.cycles, op.cycles)",
            CHECK_TESTS),
     Mutant("flag-input-ignored", "retro/routines/runner.py",
-           "            if case[index]:\n                p |= bit", "            if False:\n                p |= bit",
+           "p |= (values[index] != 0) * bit", "p |= 0 * bit",
            ("tests/routines",)),
     Mutant("high-byte-of-output-dropped", "retro/routines/runner.py",
            "value = value | widen(byte) << (8 * shift)", "value = value | (widen(byte) if shift == 0 else widen(0))",

@@ -146,6 +146,62 @@ def row_of(arrays: list, i: int) -> tuple:
     return tuple(tuple(a[i].tolist()) if a.ndim == 2 else int(a[i]) for a in arrays)
 
 
+def _case_byte(value: Sequence[int], k: int) -> int:
+    return value[k]
+
+
+def _column_byte(value: np.ndarray, k: int) -> np.ndarray:
+    return value[:, k]
+
+
+@dataclass(frozen=True)
+class InputPlan:
+    """Where each input goes, worked out once per routine so a call does no lookups by name; the
+    same plan puts one case (numbers) or a column block (arrays, one element per lane) in place."""
+
+    registers: tuple[tuple[int, str, int], ...]  # (input index, register, byte shift)
+    flags: tuple[tuple[int, int], ...]  # (input index, P bit)
+    bytes: tuple[tuple[int, int, int], ...]  # (input index, address, byte shift)
+    tables: tuple[tuple[int, tuple[int, ...]], ...]  # (input index, addresses)
+    base_flags: int  # P before the flag inputs: the default flags without those the inputs set
+    output_addresses: tuple[int, ...]  # output places in memory (restored before each Machine call)
+
+    @classmethod
+    def of(cls, routine: Routine) -> "InputPlan":
+        registers, flags, places, tables = [], [], [], []
+        for index, port in enumerate(routine.inputs):
+            if port.flag:
+                flags.append((index, port.places[0].bit))
+            elif port.table:
+                tables.append((index, tuple(p.address for p in port.places)))
+            else:
+                for byte, place in enumerate(port.places):
+                    if place.kind == "register":
+                        registers.append((index, place.register, 8 * byte))
+                    else:
+                        places.append((index, place.address, 8 * byte))
+        forced = 0
+        for _, bit in flags:
+            forced |= bit
+        outputs = sorted({place.address for port in routine.outputs for place in port.places if place.kind == "memory"})
+        return cls(tuple(registers), tuple(flags), tuple(places), tuple(tables), DEFAULT_FLAGS & ~forced,
+                   tuple(outputs))
+
+    def place(self, values: Sequence, table_byte: Callable) -> tuple[list[tuple[int, object]], dict[str, object], object]:
+        """(memory writes, register values, P) for `values` (one per input: numbers, or arrays of
+        lanes); `table_byte(value, k)` is byte k of a table input's value."""
+        writes = [(address, (values[index] >> shift) & 0xFF) for index, address, shift in self.bytes]
+        for index, addresses in self.tables:
+            writes.extend((address, table_byte(values[index], k)) for k, address in enumerate(addresses))
+        registers = {"a": 0, "x": 0, "y": 0}
+        for index, register, shift in self.registers:
+            registers[register] |= (values[index] >> shift) & 0xFF
+        p = self.base_flags
+        for index, bit in self.flags:
+            p |= (values[index] != 0) * bit
+        return writes, registers, p
+
+
 @dataclass(frozen=True)
 class RasterStart:
     """Run every call with a VIC-II scene on the bus and the beam at this line and cycle (the CPU
@@ -191,51 +247,18 @@ class RoutineRunner:
         # that could be such an opcode is listed; a data byte in the set only costs a lookup.
         indirect_y = {opcode for opcode, op in OPCODES.items() if op.mode == "iny"}
         self.pointer_pcs = frozenset(self.program.origin + i for i, b in enumerate(self.program.code) if b in indirect_y)
-        self._plan()
+        self.plan = InputPlan.of(routine)
 
     @property
     def limit(self) -> int:
         return self.routine.limit or DEFAULT_BUDGET
 
-    def _plan(self) -> None:
-        """Precompute how each input is stored, so a call does no lookups by name."""
-        self.register_inputs: list[tuple[int, str, int]] = []  # (case index, register, byte shift)
-        self.flag_inputs: list[tuple[int, int]] = []  # (case index, P bit)
-        self.byte_inputs: list[tuple[int, int, int]] = []  # (case index, address, byte shift)
-        self.table_inputs: list[tuple[int, tuple[int, ...]]] = []  # (case index, addresses)
-        for index, port in enumerate(self.routine.inputs):
-            if port.flag:
-                self.flag_inputs.append((index, port.places[0].bit))
-            elif port.table:
-                self.table_inputs.append((index, tuple(p.address for p in port.places)))
-            else:
-                for byte, place in enumerate(port.places):
-                    if place.kind == "register":
-                        self.register_inputs.append((index, place.register, 8 * byte))
-                    else:
-                        self.byte_inputs.append((index, place.address, 8 * byte))
-        forced = 0
-        for _, bit in self.flag_inputs:
-            forced |= bit
-        self.base_flags = DEFAULT_FLAGS & ~forced
-        self.output_addresses = tuple(sorted({place.address for port in self.routine.outputs for place in port.places
-                                              if place.kind == "memory"}))
-
     def inputs_for_call(self, case: Sequence) -> tuple[list[tuple[int, int]], dict[str, int], int]:
-        """(memory writes, register values, P) that put the case where the spec says."""
+        """(memory writes, register values, P) that put the case where the spec says; the output
+        places in memory are restored first (see the module's docstring)."""
         image = self.call_image
-        writes = [(address, image[address]) for address in self.output_addresses]
-        writes += [(address, (case[index] >> shift) & 0xFF) for index, address, shift in self.byte_inputs]
-        for index, addresses in self.table_inputs:
-            writes.extend(zip(addresses, case[index]))
-        registers = {"a": 0, "x": 0, "y": 0}
-        for index, register, shift in self.register_inputs:
-            registers[register] |= (case[index] >> shift) & 0xFF
-        p = self.base_flags
-        for index, bit in self.flag_inputs:
-            if case[index]:
-                p |= bit
-        return writes, registers, p
+        writes, registers, p = self.plan.place(case, _case_byte)
+        return [(address, image[address]) for address in self.plan.output_addresses] + writes, registers, p
 
     def run(self, case: Sequence, record: list | None = None) -> tuple[tuple, int]:
         """(outputs in the spec's order, cycles) of one call."""
@@ -291,17 +314,13 @@ class RoutineRunner:
         image = bytearray(self.call_image)
         stack_pointer = push_return_trap(image)
         cpu = BatchCpu(self.routine.cpu, image, n)
-        registers = {"a": cpu.a, "x": cpu.x, "y": cpu.y}
-        for index, register, shift in self.register_inputs:
-            registers[register] |= ((columns[index] >> shift) & 0xFF).astype(np.int32)
-        cpu.p[:] = (self.base_flags | FLAG_U) & ~FLAG_B  # as Machine sets P
-        for index, bit in self.flag_inputs:
-            cpu.p |= np.where(columns[index] != 0, bit, 0).astype(np.int32)
-        for index, address, shift in self.byte_inputs:
-            cpu.memory.fill(address, (columns[index] >> shift) & 0xFF)
-        for index, addresses in self.table_inputs:
-            for byte, address in enumerate(addresses):
-                cpu.memory.fill(address, columns[index][:, byte])
+        writes, registers, p = self.plan.place(columns, _column_byte)
+        for name, value in registers.items():
+            lanes = getattr(cpu, name)
+            lanes |= np.asarray(value).astype(lanes.dtype)
+        cpu.p[:] = (p | FLAG_U) & ~FLAG_B  # as Machine sets P
+        for address, value in writes:
+            cpu.memory.fill(address, value)
         cpu.sp[:] = stack_pointer
         cpu.call(self.entry, self.limit, RETURN_TRAP, CALL_STACK_TOP)
         outputs = port_values(self.routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,
