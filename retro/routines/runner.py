@@ -214,12 +214,10 @@ class RasterStart:
 
 class RoutineRunner:
     def __init__(self, routine: Routine, seed: int = 0, start: RasterStart | None = None) -> None:
-        from retro.loaders import load_program
-
         self.routine = routine
         self.seed = seed
         self.start = start
-        self.program = load_program(routine.program_file, symbols=routine.symbols_file, load=routine.load)
+        self.program = routine.program  # read once, by the spec
         self.vic = None
         if start is None:
             self.machine = build_machine(cpu=routine.cpu)
@@ -233,7 +231,7 @@ class RoutineRunner:
             self.vic = vic_of(self.machine)
         self.machine.load(self.program)
         self.last_stolen = 0  # cycles of the last call in which the VIC-II held the CPU
-        self.entry = self.machine.resolve(routine.entry, "program.entry")
+        self.entry = routine.entry_address
         self.memory_values = memory_values(routine, seed)
         memory = self.machine.memory
         for block in routine.memory:
@@ -241,7 +239,7 @@ class RoutineRunner:
             memory[block.address:block.address + len(data)] = list(data)
         self.code_image = bytes(self.machine.memory)  # before init and the cases patch anything
         if routine.init is not None:
-            self.machine.call_fast(self.machine.resolve(routine.init, "program.init"), budget=self.limit)
+            self.machine.call_fast(routine.init_address, budget=self.limit)
         self.call_image = bytearray(self.machine.memory)  # what every call starts from (the batch's image)
         # (indirect),Y instructions: the timing model needs their pointer. Every byte of the program
         # that could be such an opcode is listed; a data byte in the set only costs a lookup.
@@ -344,7 +342,7 @@ class RoutineRunner:
         """Bytes of code, lookup tables and caller-filled storage of the routine's program."""
         source = self.routine.program_file
         text = read_text(source, "source file") if source.suffix.lower() in (".s", ".asm", ".oph") else None
-        entries = [self.entry] + ([self.machine.resolve(self.routine.init)] if self.routine.init else [])
+        entries = [self.entry] + ([self.routine.init_address] if self.routine.init is not None else [])
         return program_size(self.program, text, entries, self.code_image.__getitem__)
 
 

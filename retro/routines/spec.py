@@ -151,6 +151,10 @@ class Routine:
     reference_name: str
     reference_memory: tuple[str, ...]  # memory blocks the reference takes by name
     reference_arrays: bool = False  # the reference takes numpy arrays (one element per case) and answers so
+    program: Program | None = None  # the program, read once when the spec is loaded
+    entry_address: int = 0  # entry, init and the loop labels resolved against its symbols
+    init_address: int | None = None
+    loop_addresses: dict[int, int] = field(default_factory=dict)  # loop header address -> bound
     exhaustive: tuple[str, ...] = ()
     random: int = 0
     seed: int = 0
@@ -220,8 +224,44 @@ def load_spec(path: str | Path) -> Routine:
 
 
 def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
+    """A spec document -> a loaded `Routine`: the program read once and every label resolved here,
+    each section read by its own function below (every error names the file and the key)."""
     r = Fields(shown or str(path), folder=path.parent, number_characters=NUMBER_CHARACTERS)
     r.table(doc, "", TOP_KEYS)
+    program = _program_section(r, doc)
+    inputs, outputs, memory = _places_sections(r, doc, program.program)
+    reference = _reference_section(r, doc, inputs, memory)
+    cases = _cases_section(r, doc, inputs)
+    cycles = _cycles_section(r, doc, program.program)
+    routine = Routine(name=_text(r, doc, "name", "name") or path.stem, spec_path=path, **program.fields(),
+                      inputs=inputs, outputs=outputs, memory=memory, **reference, **cases, **cycles,
+                      summary=_summary(r, doc))
+    if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep):
+        raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary or sweep")
+    if routine.exhaustive_count() > MAX_EXHAUSTIVE:
+        raise r.error("cases.exhaustive", f"{routine.exhaustive_count():,} cases is more than 2^32: "
+                                         "narrow the inputs' values or sweep fewer inputs")
+    return routine
+
+
+@dataclass(frozen=True)
+class _ProgramSection:
+    program_file: Path
+    symbols_file: Path | None
+    load: int | None
+    cpu: str
+    entry: str
+    init: str | None
+    program: Program
+    entry_address: int
+    init_address: int | None
+
+    def fields(self) -> dict:
+        return dict(self.__dict__)
+
+
+def _program_section(r: Fields, doc: dict) -> _ProgramSection:
+    """[program]: the file read once, its CPU, entry and init resolved to addresses."""
     program_doc = r.table(r.required(doc, "program", hint="the [program] table"), "program", PROGRAM_KEYS)
     program_file = r.file(_text(r, program_doc, "file", "program.file", required=True), "program.file", resolve=True)
     symbols_name = _text(r, program_doc, "symbols", "program.symbols")
@@ -231,13 +271,17 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     if cpu is not None:
         cpu = r.choice(cpu, "program.cpu", CPUS, fold_case=True)
     program = load_program(program_file, symbols=symbols_file, load=load)
-    cpu = cpu or program.cpu or "6510"
     entry = _entry_text(r, program_doc, "entry", required=True)
-    _resolve(r, program, entry, "program.entry")
+    entry_address = _resolve(r, program, entry, "program.entry")
     init = _entry_text(r, program_doc, "init")
-    if init is not None:
-        _resolve(r, program, init, "program.init")
+    init_address = _resolve(r, program, init, "program.init") if init is not None else None
+    return _ProgramSection(program_file, symbols_file, load, cpu or program.cpu or "6510", entry, init, program,
+                           entry_address, init_address)
 
+
+def _places_sections(r: Fields, doc: dict, program: Program) -> tuple[tuple[Port, ...], tuple[Port, ...],
+                                                                     tuple[MemoryBlock, ...]]:
+    """[inputs], [outputs] and [memory]: where every value lives, none overlapping."""
     inputs = tuple(_port(r, program, name, value, "inputs", is_input=True)
                    for name, value in r.table(r.required(doc, "inputs", hint="the [inputs] table"), "inputs").items())
     outputs = tuple(_port(r, program, name, value, "outputs", is_input=False)
@@ -249,14 +293,22 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     memory = tuple(_memory_block(r, program, name, value)
                    for name, value in r.table(doc.get("memory", {}), "memory").items())
     _no_overlap_memory(r, memory, inputs)
+    return inputs, outputs, memory
 
+
+def _reference_section(r: Fields, doc: dict, inputs: tuple[Port, ...], memory: tuple[MemoryBlock, ...]) -> dict:
+    """[reference]: the function, the memory blocks it takes, whether it works on arrays."""
     reference_doc = r.table(r.required(doc, "reference", hint="the [reference] table"), "reference", REFERENCE_KEYS)
     reference_name = _text(r, reference_doc, "function", "reference.function", required=True)
     reference = load_function(reference_name, r, "reference.function")
-    reference_memory = _reference_signature(r, reference, reference_name, inputs, memory)
-    # true: the function takes numpy arrays, one element per case
-    reference_arrays = r.flag(reference_doc.get("arrays", False), "reference.arrays")
+    return {"reference": reference, "reference_name": reference_name,
+            "reference_memory": _reference_signature(r, reference, reference_name, inputs, memory),
+            # true: the function takes numpy arrays, one element per case
+            "reference_arrays": r.flag(reference_doc.get("arrays", False), "reference.arrays")}
 
+
+def _cases_section(r: Fields, doc: dict, inputs: tuple[Port, ...]) -> dict:
+    """[cases]: exhaustive inputs, random count and seed, the `where` domain, generators."""
     cases_doc = r.table(doc.get("cases", {}), "cases", CASES_KEYS)
     names = tuple(p.name for p in inputs)
     exhaustive = cases_doc.get("exhaustive", [])
@@ -267,42 +319,39 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
             raise r.error("cases.exhaustive", f"unknown input {n!r} (inputs: {', '.join(names)})")
     if len(set(exhaustive)) != len(exhaustive):
         raise r.error("cases.exhaustive", "an input is named twice")
-    random_count = r.integer(cases_doc.get("random", DEFAULT_RANDOM), "cases.random", 0, MAX_RANDOM)
-    seed = r.integer(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1)
     where = cases_doc.get("where")
-    coverage = _text(r, cases_doc, "coverage", "cases.coverage") or ""
     tables = frozenset(p.name for p in inputs if p.table)
-    domain = parse_where(where, names, f"{r.source}: cases.where", tables) if where is not None else ()
     generators = {key: load_function(_text(r, cases_doc, key, f"cases.{key}"), r, f"cases.{key}")
                   for key in ("boundary", "sweep", "random_generator") if key in cases_doc}
+    return {"exhaustive": tuple(exhaustive),
+            "random": r.integer(cases_doc.get("random", DEFAULT_RANDOM), "cases.random", 0, MAX_RANDOM),
+            "seed": r.integer(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1),
+            "coverage": _text(r, cases_doc, "coverage", "cases.coverage") or "",
+            "domain": parse_where(where, names, f"{r.source}: cases.where", tables) if where is not None else (),
+            "boundary": generators.get("boundary"), "sweep": generators.get("sweep"),
+            "random_generator": generators.get("random_generator")}
 
+
+def _cycles_section(r: Fields, doc: dict, program: Program) -> dict:
+    """[cycles]: budget, runaway limit, loop bounds (labels resolved to addresses), static on/off."""
     cycles_doc = r.table(doc.get("cycles", {}), "cycles", CYCLES_KEYS)
-    budget = r.integer(cycles_doc["max"], "cycles.max", 1, 1 << 40) if "max" in cycles_doc else None
-    limit = r.integer(cycles_doc["limit"], "cycles.limit", 1, 1 << 40) if "limit" in cycles_doc else None
     loops_doc = r.table(cycles_doc.get("loops", {}), "cycles.loops")  # label = bound, e.g. { loop = 8 }
-    loop_bounds = {}
+    loop_bounds, loop_addresses = {}, {}
     for label, bound in loops_doc.items():
-        _resolve(r, program, label, f"cycles.loops.{label}")
+        address = _resolve(r, program, label, f"cycles.loops.{label}")
         loop_bounds[label] = r.integer(bound, f"cycles.loops.{label}", 1, MAX_LOOP_BOUND)
-    static = r.flag(cycles_doc.get("static", True), "cycles.static")
+        loop_addresses[address] = loop_bounds[label]
+    return {"budget": r.integer(cycles_doc["max"], "cycles.max", 1, 1 << 40) if "max" in cycles_doc else None,
+            "limit": r.integer(cycles_doc["limit"], "cycles.limit", 1, 1 << 40) if "limit" in cycles_doc else None,
+            "loop_bounds": loop_bounds, "loop_addresses": loop_addresses,
+            "static": r.flag(cycles_doc.get("static", True), "cycles.static")}
 
-    name = _text(r, doc, "name", "name") or path.stem
+
+def _summary(r: Fields, doc: dict) -> str:
     summary = doc.get("summary", "")
     if not isinstance(summary, str):
         raise r.error("summary", f"expected a string, got {describe(summary)}")
-    routine = Routine(
-        name=name, spec_path=path, program_file=program_file, symbols_file=symbols_file, load=load, entry=entry,
-        cpu=cpu, init=init, inputs=inputs, outputs=outputs, memory=memory, reference=reference,
-        reference_name=reference_name, reference_memory=reference_memory, reference_arrays=reference_arrays, exhaustive=tuple(exhaustive),
-        random=random_count, seed=seed, domain=domain, boundary=generators.get("boundary"),
-        sweep=generators.get("sweep"), random_generator=generators.get("random_generator"), budget=budget,
-        loop_bounds=loop_bounds, limit=limit, static=static, summary=summary, coverage=coverage)
-    if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep):
-        raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary or sweep")
-    if routine.exhaustive_count() > MAX_EXHAUSTIVE:
-        raise r.error("cases.exhaustive", f"{routine.exhaustive_count():,} cases is more than 2^32: "
-                                         "narrow the inputs' values or sweep fewer inputs")
-    return routine
+    return summary
 
 
 def _text(r: Fields, doc: dict, key: str, field: str, required: bool = False) -> str | None:

@@ -20,7 +20,7 @@ def static_bounds(routine: Routine, runner: RoutineRunner | None = None) -> Boun
     machine = runner.machine
     program = runner.program
     memory = list(machine.memory)
-    bounds = {machine.resolve(label, f"cycles.loops.{label}"): count for label, count in routine.loop_bounds.items()}
+    bounds = dict(routine.loop_addresses)
     names = {address: label for label, address in sorted(program.symbols.items(), key=lambda kv: len(kv[0]))[::-1]}
 
     def describe(address: int) -> str:
