@@ -16,7 +16,6 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import inspect
-import re
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -24,104 +23,42 @@ from functools import lru_cache
 from pathlib import Path
 
 
-from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z, VARIANTS
+from retro.cpu.mpu import VARIANTS
 from retro.errors import InputError
 from retro.fields import Fields, describe
 from retro.fileio import is_dir, parse_toml, read_bytes
 from retro.loaders import load_program
 from retro.program import Program
+from retro.routines.places import (
+    BYTE_VALUES,
+    MAX_TABLE,
+    Port,
+    no_overlap,
+    parse_values,
+    places_of,
+    port_of,
+    resolve,
+)
 from retro.routines.where import Condition, parse_where
 
-BYTE_VALUES = 256
 MAX_EXHAUSTIVE = 1 << 32  # cases in an exhaustive set
 MAX_RANDOM = 10 ** 9
 DEFAULT_RANDOM = 10_000  # random cases when a spec does not say (2,000 of them without --exhaustive)
-MAX_TABLE = 0x10000
 MAX_SPEC_BYTES = 1 << 20  # a spec file is a page of TOML, never megabytes
 MAX_LOOP_BOUND = 1 << 20
 NUMBER_CHARACTERS = 40  # the longest number a spec may write as text
-REGISTERS = ("A", "X", "Y")
-FLAGS = {"C": FLAG_C, "Z": FLAG_Z, "I": FLAG_I, "D": FLAG_D, "V": FLAG_V, "N": FLAG_N}
 CPUS = tuple(VARIANTS)
 
 TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles"}
 PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "init", "load"}
-PORT_KEYS = {"at", "size", "values", "table"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays"}
 CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage"}
 CYCLES_KEYS = {"max", "loops", "limit", "static"}
 
-_LABEL = re.compile(r"^(?P<name>[A-Za-z_@.][\w.:@]*)\s*(?:(?P<sign>[+-])\s*(?P<offset>\S+))?$")
 
 
 # ---- plain data ----------------------------------------------------------------------------------
-
-@dataclass(frozen=True)
-class Place:
-    """Where one byte (or one flag bit) of a value lives."""
-
-    kind: str  # "register" (A/X/Y), "flag" (a P bit) or "memory"
-    register: str = ""  # "a", "x", "y" for registers
-    bit: int = 0  # the P bit for flags
-    address: int = 0  # for memory
-
-    def describe(self) -> str:
-        if self.kind == "register":
-            return self.register.upper()
-        if self.kind == "flag":
-            return next(name for name, bit in FLAGS.items() if bit == self.bit)
-        return f"${self.address:04X}"
-
-
-@dataclass(frozen=True)
-class Values:
-    """The values an input (or each byte of a table input) takes: lo..hi, or a list."""
-
-    lo: int
-    hi: int
-    listed: tuple[int, ...] | None = None
-
-    @property
-    def count(self) -> int:
-        return len(self.listed) if self.listed is not None else self.hi - self.lo + 1
-
-    def at(self, index: int) -> int:
-        return self.listed[index] if self.listed is not None else self.lo + index
-
-    def describe(self) -> str:
-        if self.listed is not None:
-            return "[" + ", ".join(str(v) for v in self.listed[:8]) + (", ..." if len(self.listed) > 8 else "") + "]"
-        return f"{self.lo}..{self.hi}"
-
-
-@dataclass(frozen=True)
-class Port:
-    """An input or an output: a number over one or more byte places (low byte first), or a table."""
-
-    name: str
-    places: tuple[Place, ...]
-    table: bool = False  # a list of bytes at consecutive addresses, not one number
-    values: Values | None = None  # inputs only: per value (per byte for a table)
-
-    @property
-    def flag(self) -> bool:
-        return self.places[0].kind == "flag"
-
-    @property
-    def bits(self) -> int:
-        return 1 if self.flag else 8 * (1 if self.table else len(self.places))
-
-    @property
-    def count(self) -> int:
-        """How many distinct values the input takes (a table: per byte, to the power of its size)."""
-        return self.values.count ** len(self.places) if self.table else self.values.count
-
-    def describe(self) -> str:
-        if self.table:
-            return f"{len(self.places)} bytes at {self.places[0].describe()}"
-        return "+".join(p.describe() for p in self.places)
-
 
 @dataclass(frozen=True)
 class MemoryBlock:
@@ -272,9 +209,9 @@ def _program_section(r: Fields, doc: dict) -> _ProgramSection:
         cpu = r.choice(cpu, "program.cpu", CPUS, fold_case=True)
     program = load_program(program_file, symbols=symbols_file, load=load)
     entry = _entry_text(r, program_doc, "entry", required=True)
-    entry_address = _resolve(r, program, entry, "program.entry")
+    entry_address = resolve(r, program, entry, "program.entry")
     init = _entry_text(r, program_doc, "init")
-    init_address = _resolve(r, program, init, "program.init") if init is not None else None
+    init_address = resolve(r, program, init, "program.init") if init is not None else None
     return _ProgramSection(program_file, symbols_file, load, cpu or program.cpu or "6510", entry, init, program,
                            entry_address, init_address)
 
@@ -282,14 +219,14 @@ def _program_section(r: Fields, doc: dict) -> _ProgramSection:
 def _places_sections(r: Fields, doc: dict, program: Program) -> tuple[tuple[Port, ...], tuple[Port, ...],
                                                                      tuple[MemoryBlock, ...]]:
     """[inputs], [outputs] and [memory]: where every value lives, none overlapping."""
-    inputs = tuple(_port(r, program, name, value, "inputs", is_input=True)
+    inputs = tuple(port_of(r, program, name, value, "inputs", is_input=True)
                    for name, value in r.table(r.required(doc, "inputs", hint="the [inputs] table"), "inputs").items())
-    outputs = tuple(_port(r, program, name, value, "outputs", is_input=False)
+    outputs = tuple(port_of(r, program, name, value, "outputs", is_input=False)
                     for name, value in r.table(r.required(doc, "outputs", hint="the [outputs] table"),
                                                "outputs").items())
     if not outputs:
         raise r.error("outputs", "names no output")
-    _no_overlap(r, inputs, "inputs")
+    no_overlap(r, inputs, "inputs")
     memory = tuple(_memory_block(r, program, name, value)
                    for name, value in r.table(doc.get("memory", {}), "memory").items())
     _no_overlap_memory(r, memory, inputs)
@@ -338,7 +275,7 @@ def _cycles_section(r: Fields, doc: dict, program: Program) -> dict:
     loops_doc = r.table(cycles_doc.get("loops", {}), "cycles.loops")  # label = bound, e.g. { loop = 8 }
     loop_bounds, loop_addresses = {}, {}
     for label, bound in loops_doc.items():
-        address = _resolve(r, program, label, f"cycles.loops.{label}")
+        address = resolve(r, program, label, f"cycles.loops.{label}")
         loop_bounds[label] = r.integer(bound, f"cycles.loops.{label}", 1, MAX_LOOP_BOUND)
         loop_addresses[address] = loop_bounds[label]
     return {"budget": r.integer(cycles_doc["max"], "cycles.max", 1, 1 << 40) if "max" in cycles_doc else None,
@@ -372,120 +309,6 @@ def _entry_text(r: Fields, doc: dict, key: str, required: bool = False) -> str |
     return _text(r, doc, key, f"program.{key}")
 
 
-def _resolve(r: Fields, program: Program, text: str, field_name: str) -> int:
-    """A label (optionally `label+N`) of the program, or an address."""
-    text = str(text).strip()
-    if text in program.symbols:
-        return program.symbols[text]
-    if text in program.ambiguous:
-        from retro.program import ambiguity_message
-
-        raise r.error(field_name, ambiguity_message(text, program.ambiguous[text]))
-    if text[:1] in "$%" or text[:1].isdigit():
-        return r.integer(text, field_name, 0, 0xFFFF)
-    match = _LABEL.match(text)
-    if match and match.group("sign"):
-        base = _resolve(r, program, match.group("name"), field_name)
-        offset = r.integer(match.group("offset"), field_name, 0, 0xFFFF)
-        address = base + offset if match.group("sign") == "+" else base - offset
-        if not 0 <= address <= 0xFFFF:
-            raise r.error(field_name, f"{text} is outside $0000-$FFFF")
-        return address
-    hint = " (registers are written A, X, Y and flags C, Z, I, D, V, N)" if text.upper() in (*REGISTERS, *FLAGS) else ""
-    if not program.symbols:
-        hint = f" ({program.source or 'the program'} has no symbols: give [program] symbols, or an address)"
-    raise r.error(field_name, f"unknown label {text!r}{hint}")
-
-
-def _places(r: Fields, program: Program, at, size: int | None, key: str) -> tuple[Place, ...]:
-    items = at if isinstance(at, list) else [at]
-    if not items:
-        raise r.error(key, "expected a register, flag, label or address")
-    places: list[Place] = []
-    for item in items:
-        if isinstance(item, int) and not isinstance(item, bool):
-            item = str(item)
-        if not isinstance(item, str) or not item.strip():
-            raise r.error(key, f"expected a register, flag, label or address, got {item!r:.40}")
-        text = item.strip()
-        if text in REGISTERS:
-            places.append(Place("register", register=text.lower()))
-        elif text in FLAGS:
-            places.append(Place("flag", bit=FLAGS[text]))
-        else:
-            places.append(Place("memory", address=_resolve(r, program, text, key)))
-    if size is not None:
-        if len(places) != 1 or places[0].kind != "memory":
-            raise r.error(key, "size goes with one memory location (a label or an address)")
-        start = places[0].address
-        if start + size > 0x10000:
-            raise r.error(key, f"{size} bytes from ${start:04X} run past $FFFF")
-        places = [Place("memory", address=start + i) for i in range(size)]
-    if any(p.kind == "flag" for p in places) and len(places) > 1:
-        raise r.error(key, "a flag is one bit: it cannot be combined with other places")
-    return tuple(places)
-
-
-def parse_values(r: Fields, value, key: str) -> Values:
-    if isinstance(value, str):
-        lo_text, sep, hi_text = value.partition("..")
-        if not sep:
-            raise r.error(key, f"expected a range LO..HI or a list, got {value!r:.40}")
-        lo = r.integer(lo_text.strip(), key, 0, (1 << 32) - 1)
-        hi = r.integer(hi_text.strip(), key, 0, (1 << 32) - 1)
-        if hi < lo:
-            raise r.error(key, f"empty range {value!r}")
-        return Values(lo, hi)
-    if isinstance(value, list):
-        if not value:
-            raise r.error(key, "the list of values is empty")
-        if len(value) > MAX_TABLE:
-            raise r.error(key, f"more than {MAX_TABLE} listed values")
-        listed = tuple(dict.fromkeys(r.integer(v, key, 0, (1 << 32) - 1) for v in value))
-        return Values(min(listed), max(listed), listed)
-    raise r.error(key, f"expected a range \"LO..HI\" or a list of numbers, got {describe(value)}")
-
-
-def _port(r: Fields, program: Program, name: str, value, section: str, is_input: bool) -> Port:
-    key = f"{section}.{name}"
-    if not name.isidentifier() or name.startswith("__"):
-        raise r.error(key, "a name must be a Python identifier (it names the reference's argument)")
-    doc = {"at": value} if isinstance(value, (str, list)) else value
-    if not isinstance(doc, dict):
-        raise r.error(key, "expected a location (\"A\", \"C\", \"label\", \"$fb\") or a table { at = ... }")
-    r.known(doc, key, PORT_KEYS if is_input else PORT_KEYS - {"values"})
-    r.required(doc, "at", key)
-    size = r.integer(doc["size"], f"{key}.size", 1, MAX_TABLE) if "size" in doc else None
-    places = _places(r, program, doc["at"], size, f"{key}.at")
-    values = parse_values(r, doc["values"], f"{key}.values") if "values" in doc else None
-    table_flag = r.flag(doc["table"], f"{key}.table") if "table" in doc else None
-    # `size` N with byte values is a table of N bytes; otherwise an N-byte little-endian number
-    table = table_flag if table_flag is not None else (
-        size is not None and size > 1 and values is not None and values.hi < BYTE_VALUES)
-    if table and (size is None or places[0].kind != "memory"):
-        raise r.error(f"{key}.table", "a table needs a memory location and a size")
-    port = Port(name, places, table, None)
-    width = 1 << port.bits
-    if values is None and is_input:
-        values = Values(0, (BYTE_VALUES if table else width) - 1)
-    if values is not None:
-        limit = BYTE_VALUES if table else width
-        if values.hi >= limit:
-            raise r.error(f"{key}.values", f"{values.describe()} does not fit in {port.describe()} "
-                                          f"({'each byte ' if table else ''}0..{limit - 1})")
-    return Port(name, places, table, values)
-
-
-def _no_overlap(r: Fields, ports: tuple[Port, ...], section: str) -> None:
-    owner: dict[Place, str] = {}
-    for port in ports:
-        for place in port.places:
-            if place in owner:
-                raise r.error(f"{section}.{port.name}.at",
-                              f"{place.describe()} is also where {section}.{owner[place]} goes")
-            owner[place] = port.name
-
-
 def _memory_block(r: Fields, program: Program, name: str, doc) -> MemoryBlock:
     key = f"memory.{name}"
     if not name.isidentifier():
@@ -494,7 +317,7 @@ def _memory_block(r: Fields, program: Program, name: str, doc) -> MemoryBlock:
         raise r.error(key, "expected a table { at = ..., bytes = [...] | file = ... | generator = ... | values + size }")
     r.known(doc, key, MEMORY_KEYS)
     r.required(doc, "at", key)
-    (place,) = _places(r, program, doc["at"], None, f"{key}.at")[:1] or (None,)
+    (place,) = places_of(r, program, doc["at"], None, f"{key}.at")[:1] or (None,)
     if place is None or place.kind != "memory" or isinstance(doc["at"], list):
         raise r.error(f"{key}.at", "expected one label or address")
     source = r.exactly_one(doc, ("bytes", "file", "generator", "values", "fill"), key)
