@@ -155,8 +155,32 @@ def format_coverage(check: RoutineCheck) -> str:
 
 
 def format_check(check: RoutineCheck) -> list[str]:
+    """One routine's check as the lines `retro check` prints."""
     t = check.totals
     routine = check.routine
+    lines = [_headline(check)]
+    if check.parts:
+        lines.append(f"  cases: {format_coverage(check)}; input space {format_space(check.routine.input_space())}")
+    if routine.coverage:
+        lines.append(f"  coverage: {routine.coverage}")
+    if t.cycles_count:
+        lines += _cycle_lines(check)
+    if routine.budget is not None:
+        lines.append(f"  budget: {routine.budget} cycles: {'broken' if check.budget_violations else 'kept'}")
+    lines += [f"  {line}" for line in check.domain_report()[1:]] if routine.domain else []
+    if t.outside:
+        lines.append(f"  outside the stated domain: {t.outside} cases, {t.outside_wrong} wrong"
+                     + (f", e.g. {t.outside_examples[0]}" if t.outside_examples else ""))
+    lines += [f"  MISMATCH {example}" for example in t.examples]
+    lines += [f"  MISMATCH {violation}" for violation in check.bounds_violations]
+    lines += [f"  BUDGET {violation}" for violation in check.budget_violations]
+    if t.failure is not None:
+        lines += _failure_lines(check)
+    return lines
+
+
+def _headline(check: RoutineCheck) -> str:
+    t = check.totals
     verdict = "OK" if not check.mismatches else f"{check.mismatches} MISMATCH(ES)"
     static = (f"static {check.static.best}-{check.static.worst}, worst case "
               f"{'reached' if check.worst_reached else 'not reached'}" if check.static else "static analysis off")
@@ -169,41 +193,35 @@ def format_check(check: RoutineCheck) -> list[str]:
         checked = (f"batched core; on {a.engine_cases} of the calls Machine agrees on "
                    f"{a.engine_cases - a.engine_mismatches} and the timing model on "
                    f"{a.cases - a.cycle_mismatches - a.run_errors}")
-    lines = [f"{routine.name}: {t.cases} cases, {verdict}; {cost}, {static}; {checked}"]
-    if check.parts:
-        lines.append(f"  cases: {format_coverage(check)}; input space {format_space(check.routine.input_space())}")
-    if routine.coverage:
-        lines.append(f"  coverage: {routine.coverage}")
-    if t.cycles_count:
-        lines.append(f"  fastest: {describe_case(routine, t.min_case)}")
-        lines.append(f"  slowest: {describe_case(routine, t.max_case)}")
-        raster = format_raster(routine.cpu, raster_figures(routine.cpu, t.cycles_min, check.mean, t.cycles_max))
-        if raster:
-            lines.append(f"  raster (CPU never stalled): {raster}")
-        scene = scene_raster(check).get("scene")
-        if scene:
-            lines.append(f"  on the scene from line {scene['start_line']} cycle {scene['start_cycle']} ({scene['chip']}): "
-                         f"{scene['min_lines']:.2f}-{scene['max_lines']:.2f} lines, up to {scene['stolen_max']} cycles "
-                         f"stolen; the slowest ends at line {scene['slowest_end_line']} cycle {scene['slowest_end_cycle']}"
-                         + (f" {scene['frames_crossed']} frame(s) later" if scene["frames_crossed"] else ""))
-    if routine.budget is not None:
-        lines.append(f"  budget: {routine.budget} cycles: {'broken' if check.budget_violations else 'kept'}")
-    lines += [f"  {line}" for line in check.domain_report()[1:]] if routine.domain else []
-    if t.outside:
-        lines.append(f"  outside the stated domain: {t.outside} cases, {t.outside_wrong} wrong"
-                     + (f", e.g. {t.outside_examples[0]}" if t.outside_examples else ""))
-    lines += [f"  MISMATCH {example}" for example in t.examples]
-    lines += [f"  MISMATCH {violation}" for violation in check.bounds_violations]
-    lines += [f"  BUDGET {violation}" for violation in check.budget_violations]
-    if t.failure is not None:
-        lines.append(f"  first failing case: {describe_case(routine, t.failure.case)}")
-        if t.failure.outputs is not None:
-            lines.append(f"    routine:   {describe_outputs(routine, t.failure.outputs)}")
-        if t.failure.expected is not None:
-            lines.append(f"    reference: {describe_outputs(routine, t.failure.expected)}")
-        if t.failure.message:
-            lines.append(f"    {t.failure.message}")
-        lines.append("    trace (address, instruction, cycles, running total):")
-        lines += [f"    {line}" for line in check.trace]
+    return f"{check.routine.name}: {t.cases} cases, {verdict}; {cost}, {static}; {checked}"
+
+
+def _cycle_lines(check: RoutineCheck) -> list[str]:
+    """Fastest and slowest inputs, raster lines, and with --scene where the calls fall on the beam."""
+    t = check.totals
+    routine = check.routine
+    lines = [f"  fastest: {describe_case(routine, t.min_case)}", f"  slowest: {describe_case(routine, t.max_case)}"]
+    raster = format_raster(routine.cpu, raster_figures(routine.cpu, t.cycles_min, check.mean, t.cycles_max))
+    if raster:
+        lines.append(f"  raster (CPU never stalled): {raster}")
+    scene = scene_raster(check).get("scene")
+    if scene:
+        lines.append(f"  on the scene from line {scene['start_line']} cycle {scene['start_cycle']} ({scene['chip']}): "
+                     f"{scene['min_lines']:.2f}-{scene['max_lines']:.2f} lines, up to {scene['stolen_max']} cycles "
+                     f"stolen; the slowest ends at line {scene['slowest_end_line']} cycle {scene['slowest_end_cycle']}"
+                     + (f" {scene['frames_crossed']} frame(s) later" if scene["frames_crossed"] else ""))
     return lines
 
+
+def _failure_lines(check: RoutineCheck) -> list[str]:
+    failure = check.totals.failure
+    routine = check.routine
+    lines = [f"  first failing case: {describe_case(routine, failure.case)}"]
+    if failure.outputs is not None:
+        lines.append(f"    routine:   {describe_outputs(routine, failure.outputs)}")
+    if failure.expected is not None:
+        lines.append(f"    reference: {describe_outputs(routine, failure.expected)}")
+    if failure.message:
+        lines.append(f"    {failure.message}")
+    lines.append("    trace (address, instruction, cycles, running total):")
+    return lines + [f"    {line}" for line in check.trace]

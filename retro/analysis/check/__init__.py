@@ -31,12 +31,12 @@ from retro.analysis.check.engines import (
     batched,
     check_engine,
 )
-from retro.analysis.check.reference import expected_columns, expected_outputs
+from retro.analysis.check.reference import reference_answers, expected_outputs
 from retro.analysis.check.results import Failure, PartRun, RoutineCheck, describe_case, inputs_by_name
 from retro.analysis.check.tally import Tally
 from retro.analysis.check.run import check_routine, run_checks
 from retro.analysis.check.verdicts import static_bounds
 
 __all__ = ["AGREEMENT_PER_PART", "AUTO_BATCH_CASES", "ENGINES", "Failure", "PartRun", "RoutineCheck",
-           "SceneStart", "check_routine", "describe_case", "batched", "check_engine", "expected_columns", "expected_outputs",
+           "SceneStart", "check_routine", "describe_case", "batched", "check_engine", "reference_answers", "expected_outputs",
            "inputs_by_name", "run_checks", "static_bounds", "Tally"]

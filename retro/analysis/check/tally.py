@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from retro.analysis.check.engines import CallBlock, disagreement
-from retro.analysis.check.reference import expected_columns
+from retro.analysis.check.reference import reference_answers
 from retro.analysis.check.results import Failure, describe_case, describe_outputs
 from retro.routines import cases as case_sets
 from retro.routines.runner import row_of
@@ -160,7 +160,7 @@ def _calls(routine: Routine, block: CallBlock, columns: list, cases: list[tuple]
     for broken in broken_by:
         inside &= ~broken
     if n:
-        expected, answerable = expected_columns(routine, columns, cases, memory, inside)
+        expected, answerable = reference_answers(routine, columns, cases, memory, inside)
     else:
         expected, answerable = [np.zeros((0, *o.shape[1:]), dtype=np.int64) for o in block.outputs], inside
     equal = np.ones(n, dtype=bool)
