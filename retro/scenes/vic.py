@@ -23,8 +23,6 @@ from retro.chips.vic.constants import (
     REG_SPRITE_EXPAND_Y,
     REG_SPRITE_MULTICOLOR,
     REG_SPRITE_PRIORITY,
-    REG_SPRITE_X0,
-    REG_SPRITE_X_MSB,
     REG_SPRITE_Y0,
     REGISTER_COUNT,
     SCREEN_CELLS,
@@ -39,6 +37,7 @@ from retro.chips.vic.constants import (
 )
 from retro.chips.vic.graphics import VicMemory
 from retro.chips.vic.model import VicState
+from retro.chips.vic.sprite_registers import set_sprite_x
 from retro.errors import InputError
 from retro.fields import Fields
 from retro.fileio import read_bytes
@@ -119,8 +118,7 @@ def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: Fields) 
     bit = 1 << n
     if "x" in entry:
         x = where.integer(entry["x"], f"{name}.x", 0, X_BITS_MASK)
-        registers[REG_SPRITE_X0 + 2 * n] = x & 0xFF
-        registers[REG_SPRITE_X_MSB] = (registers[REG_SPRITE_X_MSB] & ~bit) | (bit if x >> 8 else 0)
+        set_sprite_x(registers, n, x)
     if "y" in entry:
         registers[REG_SPRITE_Y0 + 2 * n] = where.integer(entry["y"], f"{name}.y", 0, Y_COMPARE_MASK)
     flags = {"enabled": True, **{k: entry[k] for k in SPRITE_FLAGS if k in entry}}
