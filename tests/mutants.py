@@ -119,7 +119,7 @@ MUTANTS = [
     Mutant("batch-rts-without-plus-one", "retro/cpu/batch.py",
            "return _uniform(((g.pull() << 8 | low) + 1) & WORD)", "return _uniform((g.pull() << 8 | low) & WORD)",
            BATCH_TESTS),
-    Mutant("batch-lane-rows-ignored-on-read", "retro/cpu/batch.py",
+    Mutant("batch-lane-rows-ignored-on-read", "retro/cpu/lane_memory.py",
            "            row = self.rows.get(int(address))\n            if row is None:",
            "            row = None\n            if row is None:", BATCH_TESTS),
     Mutant("batch-result-mismatches-not-counted", "retro/analysis/check/tally.py",

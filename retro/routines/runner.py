@@ -22,7 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from retro.assembler import requested_tables
-from retro.cpu.batch import BatchCpu, LaneMemoryFull
+from retro.cpu.batch import BatchCpu
+from retro.cpu.lane_memory import LaneMemoryFull
 from retro.cpu.machine import (
     CALL_STACK_TOP,
     DEFAULT_BUDGET,

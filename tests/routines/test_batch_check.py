@@ -13,7 +13,7 @@ import pytest
 from retro.analysis.check import check_routine
 from retro.analysis.check import engines as check_module
 from retro.cli import main
-from retro.cpu import batch
+from retro.cpu import batch, lane_memory
 from retro.errors import InputError
 from retro.routines import cases as case_sets
 from retro.routines import runner as runner_module
@@ -165,10 +165,10 @@ def test_a_batch_too_big_for_lane_memory_is_split(monkeypatch):
 
 
 def test_lane_memory_refuses_past_its_limit():
-    memory = batch.LaneMemory(bytes(0x10000), lanes=100, limit=100 * 4 * 3)
+    memory = lane_memory.LaneMemory(bytes(0x10000), lanes=100, limit=100 * 4 * 3)
     for address in (0x10, 0x11, 0x12):
         memory.row(address)
-    with pytest.raises(batch.LaneMemoryFull):
+    with pytest.raises(lane_memory.LaneMemoryFull):
         memory.row(0x13)
 
 
