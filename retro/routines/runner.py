@@ -138,9 +138,6 @@ class BatchOutcome:
     cycles: np.ndarray
     error: np.ndarray
 
-    def case_outputs(self, i: int) -> tuple:
-        return row_of(self.outputs, i)
-
 
 def row_of(arrays: list, i: int) -> tuple:
     """Case i of per-output arrays ((n,) numbers or (n, bytes) tables) as the tuple a scalar run gives."""
