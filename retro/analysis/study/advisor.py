@@ -134,26 +134,9 @@ def advise(path: str, target: float, workers: int | None = None, progress: Progr
     from retro.analysis.study.cost_runs import measure_costs
 
     scene = scene_objects(path)
-    notes = []
-    absent = [m for m in methods if scene.machine not in m.machines]
-    if absent:
-        notes.append(f"not on the {scene.machine.upper()}: " + ", ".join(m.label for m in absent))
-    methods = tuple(m for m in methods if scene.machine in m.machines)
-    if software:
-        left_out = [m for m in methods if m.hardware]
-        if left_out:
-            notes.append("--software: left out " + ", ".join(m.label for m in left_out))
-        methods = tuple(m for m in methods if not m.hardware)
-    if scene.hardware:
-        notes.append(scene.hardware)
+    methods, notes = _usable_methods(scene, methods, software)
     indexed = scene.shapes
-    # Identical shape pairs (same data and flags, either order) are one job with a weight.
-    weights: dict[tuple, int] = {}
-    jobs: dict[tuple, tuple[Shape, Shape]] = {}
-    for (_, a), (_, b) in combinations(indexed, 2):
-        key = tuple(sorted((_shape_key(a), _shape_key(b)), key=repr))
-        weights[key] = weights.get(key, 0) + 1
-        jobs.setdefault(key, (a, b))
+    weights, jobs = _pair_jobs(indexed)
     keys = list(jobs)
     table = evaluate([], methods, workers=workers, progress=progress, pair_list=[jobs[k] for k in keys])
     costs = measure_costs([], samples=samples, workers=workers, progress=progress, pair_list=[jobs[k] for k in keys],
@@ -170,19 +153,7 @@ def advise(path: str, target: float, workers: int | None = None, progress: Progr
     for m in methods:
         counts = pooled([_scaled(p.counts[m.key], weights[k]) for p, k in zip(table.pairs, keys)])
         cycles = costs[m.key].overall if m.key in costs else CycleStats.of([])
-        note = ""
-        qualifies = counts.accuracy >= target
-        unusable = m.advice_note(sprite_count)
-        if m.host_only or cycles.samples == 0:
-            qualifies, note = False, costs[m.key].counted if m.key in costs else "no 6502 cost"
-        elif unusable:
-            qualifies, note = False, unusable
-        elif objects is not None and frames.get(m.key) is None:
-            qualifies, note = False, f"cannot serve {objects} objects"
-        elif not qualifies:
-            note = "below the target"
-        elif m.prepare and objects is None:
-            note = f"per test; {m.prepare} once per {m.prepare_per.replace('_', ' ')} besides"
+        qualifies, note = _verdict(m, counts.accuracy >= target, cycles, costs, sprite_count, objects, frames)
         figures.append(MethodFigures(m.key, m.label, counts, cycles, qualifies, note, frames.get(m.key)))
     figures.sort(key=_cost_order)
     eligible = [f for f in figures if f.qualifies]
@@ -190,6 +161,53 @@ def advise(path: str, target: float, workers: int | None = None, progress: Progr
                   cases=figures[0].counts.cases, target=target, figures=figures,
                   chosen=eligible[0] if eligible else None, runner_up=eligible[1] if len(eligible) > 1 else None,
                   machine=scene.machine, budget=scene.budget, objects=objects, software=software, notes=tuple(notes))
+
+
+def _usable_methods(scene: SceneObjects, methods: tuple[Method, ...],
+                    software: bool) -> tuple[tuple[Method, ...], list[str]]:
+    """The methods that exist on the scene's machine (without the hardware ones with `software`),
+    and notes saying which were left out and why."""
+    notes = []
+    absent = [m for m in methods if scene.machine not in m.machines]
+    if absent:
+        notes.append(f"not on the {scene.machine.upper()}: " + ", ".join(m.label for m in absent))
+    methods = tuple(m for m in methods if scene.machine in m.machines)
+    if software:
+        left_out = [m for m in methods if m.hardware]
+        if left_out:
+            notes.append("--software: left out " + ", ".join(m.label for m in left_out))
+        methods = tuple(m for m in methods if not m.hardware)
+    if scene.hardware:
+        notes.append(scene.hardware)
+    return methods, notes
+
+
+def _pair_jobs(indexed: list[tuple[int, Shape]]) -> tuple[dict[tuple, int], dict[tuple, tuple[Shape, Shape]]]:
+    """Identical shape pairs (same data and flags, either order) are one job with a weight."""
+    weights: dict[tuple, int] = {}
+    jobs: dict[tuple, tuple[Shape, Shape]] = {}
+    for (_, a), (_, b) in combinations(indexed, 2):
+        key = tuple(sorted((_shape_key(a), _shape_key(b)), key=repr))
+        weights[key] = weights.get(key, 0) + 1
+        jobs.setdefault(key, (a, b))
+    return weights, jobs
+
+
+def _verdict(m: Method, accurate: bool, cycles: CycleStats, costs: dict, sprite_count: int, objects: int | None,
+             frames: dict) -> tuple[bool, str]:
+    """Whether a method qualifies, and the note saying why not (or what its cost leaves out)."""
+    unusable = m.advice_note(sprite_count)
+    if m.host_only or cycles.samples == 0:
+        return False, costs[m.key].counted if m.key in costs else "no 6502 cost"
+    if unusable:
+        return False, unusable
+    if objects is not None and frames.get(m.key) is None:
+        return False, f"cannot serve {objects} objects"
+    if not accurate:
+        return False, "below the target"
+    if m.prepare and objects is None:
+        return True, f"per test; {m.prepare} once per {m.prepare_per.replace('_', ' ')} besides"
+    return True, ""
 
 
 def _cost_order(f: MethodFigures) -> tuple:
