@@ -169,21 +169,33 @@ def lines(run: VicRun) -> list[str]:
              f"overlapping sprite pairs (not visible to a program): {pairs}",
              f"sprites over foreground graphics: {background}"]
     if run.pixels:
-        for p in overlap_pairs(run):
-            lines.append(f"pixels of {p['sprites'][0]}+{p['sprites'][1]} (line, X): "
-                         + " ".join(f"{line},{x}" for line, x in p["at"]))
-        for b in background_overlaps(run):
-            lines.append(f"pixels of {b['sprite']} over graphics (line, X): "
-                         + " ".join(f"{line},{x}" for line, x in b["at"]))
+        lines += _pixel_lines(run)
     if run.per_frame is not None:
-        hits = [f for f in run.per_frame if f["d01e"] or f["d01f"]]
-        lines.append(f"moving sprites, {len(run.per_frame)} frames read once each (clear on read): "
-                     f"{len(hits)} frame(s) with a collision" + (f", the first in frame {hits[0]['frame']}" if hits else ""))
-        for f in hits[:20]:
-            lines.append(f"  frame {f['frame']}: $D01E = ${f['d01e']:02X}, $D01F = ${f['d01f']:02X}"
-                         + (f", pairs {', '.join(f'{a}+{b}' for a, b in f['pairs'])}" if f["pairs"] else ""))
-        if len(hits) > 20:
-            lines.append(f"  ... {len(hits) - 20} more (--json lists every frame)")
+        lines += _per_frame_lines(run.per_frame)
     if run.png is not None:
         lines.append(f"wrote {run.png}")
+    return lines
+
+
+def _pixel_lines(run: VicRun) -> list[str]:
+    lines = []
+    for p in overlap_pairs(run):
+        lines.append(f"pixels of {p['sprites'][0]}+{p['sprites'][1]} (line, X): "
+                     + " ".join(f"{line},{x}" for line, x in p["at"]))
+    for b in background_overlaps(run):
+        lines.append(f"pixels of {b['sprite']} over graphics (line, X): "
+                     + " ".join(f"{line},{x}" for line, x in b["at"]))
+    return lines
+
+
+def _per_frame_lines(per_frame: list[dict]) -> list[str]:
+    """The frames of a moving scene that collided (the first 20)."""
+    hits = [f for f in per_frame if f["d01e"] or f["d01f"]]
+    lines = [f"moving sprites, {len(per_frame)} frames read once each (clear on read): "
+             f"{len(hits)} frame(s) with a collision" + (f", the first in frame {hits[0]['frame']}" if hits else "")]
+    for f in hits[:20]:
+        lines.append(f"  frame {f['frame']}: $D01E = ${f['d01e']:02X}, $D01F = ${f['d01f']:02X}"
+                     + (f", pairs {', '.join(f'{a}+{b}' for a, b in f['pairs'])}" if f["pairs"] else ""))
+    if len(hits) > 20:
+        lines.append(f"  ... {len(hits) - 20} more (--json lists every frame)")
     return lines
