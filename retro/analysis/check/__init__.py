@@ -17,10 +17,12 @@ batched core from AUTO_BATCH_CASES planned cases on; then the first AGREEMENT_PE
 part also run on `Machine` with the timing model, and the two engines must agree call for call
 (outputs and cycles): a disagreement is a mismatch of kind "engine".
 
-The check by job: `results` (the per-chunk tallies and a routine's check), `reference` (the
-reference's answers), `engines` (running cases on either engine, the runners cached per worker),
-`verdicts` (static bounds), `run` (a whole check: plans, pools, progress). The reports (text and
-JSON) live beside the commands that print them: retro/commands/check.py and cycles.py.
+The check by job (docs/architecture.md draws its path): `engines` (either engine -> the same
+`CallBlock`; the one engine rule `batched`; runners cached per worker), `reference` (the reference's
+answers), `tally` (one tally for both engines: what counts as a mismatch, and where a statistic is
+added), `verdicts` (static bounds, budget), `run` (a whole check: plan, workers, agreement),
+`results` (`RoutineCheck`). The reports (text and JSON) live beside the commands that print them:
+retro/commands/check.py and cycles.py.
 """
 
 from retro.analysis.check.engines import (
