@@ -185,19 +185,22 @@ class InputPlan:
         return cls(tuple(registers), tuple(flags), tuple(places), tuple(tables), DEFAULT_FLAGS & ~forced,
                    tuple(outputs))
 
-    def place(self, values: Sequence, table_byte: Callable) -> tuple[list[tuple[int, object]], dict[str, object], object]:
-        """(memory writes, register values, P) for `values` (one per input: numbers, or arrays of
-        lanes); `table_byte(value, k)` is byte k of a table input's value."""
-        writes = [(address, (values[index] >> shift) & 0xFF) for index, address, shift in self.bytes]
+    def place(self, values: Sequence, table_byte: Callable, write: Callable) -> tuple[dict[str, object], object]:
+        """Put `values` (one per input: numbers, or arrays of lanes) in place: `write(address, byte)`
+        for every memory byte as it is made (a block's arrays are consumed while in cache), and
+        (register values, P) returned; `table_byte(value, k)` is byte k of a table input's value."""
+        for index, address, shift in self.bytes:
+            write(address, (values[index] >> shift) & 0xFF)
         for index, addresses in self.tables:
-            writes.extend((address, table_byte(values[index], k)) for k, address in enumerate(addresses))
+            for k, address in enumerate(addresses):
+                write(address, table_byte(values[index], k))
         registers = {"a": 0, "x": 0, "y": 0}
         for index, register, shift in self.registers:
             registers[register] |= (values[index] >> shift) & 0xFF
         p = self.base_flags
         for index, bit in self.flags:
             p |= (values[index] != 0) * bit
-        return writes, registers, p
+        return registers, p
 
 
 @dataclass(frozen=True)
@@ -253,8 +256,9 @@ class RoutineRunner:
         """(memory writes, register values, P) that put the case where the spec says; the output
         places in memory are restored first (see the module's docstring)."""
         image = self.call_image
-        writes, registers, p = self.plan.place(case, _case_byte)
-        return [(address, image[address]) for address in self.plan.output_addresses] + writes, registers, p
+        writes = [(address, image[address]) for address in self.plan.output_addresses]
+        registers, p = self.plan.place(case, _case_byte, lambda address, byte: writes.append((address, byte)))
+        return writes, registers, p
 
     def run(self, case: Sequence, record: list | None = None) -> tuple[tuple, int]:
         """(outputs in the spec's order, cycles) of one call."""
@@ -310,13 +314,11 @@ class RoutineRunner:
         image = bytearray(self.call_image)
         stack_pointer = push_return_trap(image)
         cpu = BatchCpu(self.routine.cpu, image, n)
-        writes, registers, p = self.plan.place(columns, _column_byte)
+        registers, p = self.plan.place(columns, _column_byte, cpu.memory.fill)
         for name, value in registers.items():
             lanes = getattr(cpu, name)
             lanes |= np.asarray(value).astype(lanes.dtype)
         cpu.p[:] = (p | FLAG_U) & ~FLAG_B  # as Machine sets P
-        for address, value in writes:
-            cpu.memory.fill(address, value)
         cpu.sp[:] = stack_pointer
         cpu.call(self.entry, self.limit, RETURN_TRAP, CALL_STACK_TOP)
         outputs = port_values(self.routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,
