@@ -15,7 +15,7 @@ from collections.abc import Callable
 
 from retro import __version__, interrupts
 from retro.analysis.check import AGREEMENT_PER_PART, AUTO_BATCH_CASES, ENGINES
-from retro.analysis.cost import COST_FIELDS
+from retro.commands.cycles import COST_FIELDS
 from retro.analysis.study.chart_run import REDUCED_COST_SAMPLES
 from retro.chips.palettes import C64_DEFAULT_PALETTE
 from retro.commands import advise, asm, chart, check, cycles, demo, nes, parry, run, stability, vic

@@ -140,10 +140,9 @@ def _raw_length(raw: bytes) -> bool:
 
 def scene_colours(registers, index: int) -> SpriteColours:
     """The colours sprite `index` shows in, from a VIC-II register image ($D000 at 0)."""
-    from retro.chips.vic.constants import COLOR_MASK, REG_BACKGROUND0, REG_SPRITE_COLOR0, REG_SPRITE_MC0, REG_SPRITE_MC1
+    from retro.chips.vic.sprite_registers import sprite_colours
 
-    return SpriteColours(registers[REG_BACKGROUND0] & COLOR_MASK, registers[REG_SPRITE_MC0] & COLOR_MASK,
-                         registers[REG_SPRITE_COLOR0 + index] & COLOR_MASK, registers[REG_SPRITE_MC1] & COLOR_MASK)
+    return SpriteColours(*sprite_colours(registers, index))
 
 
 def read_sprite_frames(path: str | Path, multicolor: bool = False, colours: SpriteColours | None = None,

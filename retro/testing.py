@@ -19,7 +19,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from retro.analysis.check import RoutineCheck, check_routine, format_check
+from retro.analysis.check import RoutineCheck, check_routine
+from retro.commands.check import format_check
 from retro.routines.spec import Routine, parse_spec
 
 __all__ = ["RoutineCheck", "RoutineFailed", "assert_routine", "check", "report_text", "spec_from_dict"]
@@ -39,7 +40,7 @@ def spec_from_dict(doc: dict, base: str | Path = ".", name: str = "spec") -> Rou
 
 
 def check(spec: str | Path | Routine, *, exhaustive: bool = False, random: int | None = None,
-          seed: int | None = None, jobs: int = 1, engine: str | None = None) -> RoutineCheck:
+          seed: int | None = None, jobs: int = 1, engine: str = "auto") -> RoutineCheck:
     """Run a routine's check; the report is plain data (see retro.analysis.check.RoutineCheck).
     `engine`: "scalar", "batch" or "auto" (the default), as `retro check --engine`."""
     return check_routine(spec if isinstance(spec, Routine) else str(spec), exhaustive=exhaustive, seed=seed,

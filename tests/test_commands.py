@@ -13,7 +13,7 @@ import pytest
 
 import retro.commands
 from retro import cli
-from retro.analysis import check as check_module
+from retro.analysis.check import engines as check_module
 from retro.commands import advise, asm, chart, demo, nes, parry, run, stability, vic
 from retro.errors import InputError
 from retro.paths import ASM_DIR, EXAMPLES_DIR
@@ -122,30 +122,27 @@ def test_asm_writes_what_it_reports(tmp_path):
                                  f"{len(result.program.symbols)} labels -> {tmp_path / 'd.prg'}, {tmp_path / 'd.lbl'}"]
 
 
-def test_engine_default_is_set_only_inside_its_block():
-    before = check_module.DEFAULT_ENGINE
-    with check_module.engine_default("scalar"):
-        assert check_module.DEFAULT_ENGINE == "scalar"
-    assert check_module.DEFAULT_ENGINE == before
+def test_one_rule_chooses_the_engine():
+    rule = check_module.batched
+    assert not rule("auto", 255, True, 256) and rule("auto", 256, True, 256)
+    assert rule("auto", None, True, 10 ** 9)  # an unknown count (a sweep) takes the batched core
+    assert rule("batch", 1, True, 256) and not rule("batch", 10 ** 6, False, 256)  # chips: Machine only
+    assert not rule("scalar", 10 ** 9, True, 1)
     with pytest.raises(InputError, match="--engine: 'gpu'"):
-        with check_module.engine_default("gpu"):
-            pass
-    with pytest.raises(RuntimeError):
-        with check_module.engine_default("batch"):
-            raise RuntimeError
-    assert check_module.DEFAULT_ENGINE == before
+        rule("gpu", 1, True, 1)
 
 
-def test_stability_and_chart_run_their_method_calls_on_the_chosen_engine(monkeypatch, tmp_path):
+def test_stability_chart_and_advise_pass_the_chosen_engine_down(monkeypatch, tmp_path):
     seen = []
-    monkeypatch.setattr(stability, "run_stability", lambda *a, **k: seen.append(check_module.DEFAULT_ENGINE))
+    monkeypatch.setattr(stability, "run_stability", lambda *a, **k: seen.append(k["engine"]))
     stability.stability(tmp_path, engine="scalar")
-    monkeypatch.setattr(chart, "run_chart", lambda *a, **k: seen.append(check_module.DEFAULT_ENGINE))
+    monkeypatch.setattr(chart, "run_chart", lambda *a, **k: seen.append(k["engine"]))
     chart.chart(tmp_path, engine="batch")
-    monkeypatch.setattr(advise, "advise_scene", lambda *a, **k: seen.append(check_module.DEFAULT_ENGINE))
+    monkeypatch.setattr(advise, "advise_scene", lambda *a, **k: seen.append(k["engine"]))
     advise.advise(EXAMPLES_DIR / "vic_two_balls.toml", engine="scalar")
     assert seen == ["scalar", "batch", "scalar"]
-    assert check_module.DEFAULT_ENGINE == "auto"
+    with pytest.raises(InputError, match="--engine: 'gpu'"):
+        chart.chart(tmp_path, engine="gpu")
 
 
 def test_the_demo_is_the_command_functions(monkeypatch, tmp_path):

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 
-from retro.analysis.check import cycle_figures
+from retro.commands.check import cycle_figures
 from retro.errors import InputError
 from retro.testing import RoutineFailed, assert_routine, check, spec_from_dict
 

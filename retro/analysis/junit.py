@@ -27,9 +27,10 @@ import re
 import socket
 import time
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from pathlib import Path
 
-from retro.analysis.check import RoutineCheck, format_check
+from retro.analysis.check import RoutineCheck
 from retro.paths import ASM_DIR
 
 SUITE_NAME = "retro check"
@@ -56,8 +57,10 @@ def classname(check: RoutineCheck) -> str:
     return ".".join(part.replace(".", "_") for part in parts) or check.routine.name
 
 
-def junit_xml(checks: list[RoutineCheck], *, timestamp: float | None = None, hostname: str | None = None) -> str:
-    """The checks as one JUnit XML document (UTF-8 text with its declaration)."""
+def junit_xml(checks: list[RoutineCheck], report_of: Callable[[RoutineCheck], list[str]], *,
+              timestamp: float | None = None, hostname: str | None = None) -> str:
+    """The checks as one JUnit XML document (UTF-8 text with its declaration); `report_of` gives a
+    check's text report (retro/commands/check.py: format_check, which lives above this layer)."""
     failures = sum(1 for c in checks if c.mismatches)
     seconds = sum(c.seconds for c in checks)
     counts = {"tests": str(len(checks)), "failures": str(failures), "errors": "0", "time": f"{seconds:.3f}"}
@@ -68,7 +71,7 @@ def junit_xml(checks: list[RoutineCheck], *, timestamp: float | None = None, hos
     ET.SubElement(suite, "properties")
     reports = []
     for check in checks:
-        report = format_check(check)
+        report = report_of(check)
         reports.extend(report)
         case = ET.SubElement(suite, "testcase", {"name": xml_text(check.routine.name),
                                                  "classname": xml_text(classname(check)), "time": f"{check.seconds:.3f}"})

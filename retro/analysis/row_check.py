@@ -22,19 +22,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from retro.analysis.check import (
-    AGREEMENT_PER_PART,
-    BATCH_LANES,
-    ChunkResult,
-    Failure,
-    SceneStart,
-    describe_case,
-    describe_outputs,
-    expected_columns,
-    inputs_by_name,
-    runner_for,
-    static_bounds,
-)
+from retro.analysis.check.engines import AGREEMENT_PER_PART, BATCH_LANES, SceneStart, runner_for
+from retro.analysis.check.reference import reference_answers
+from retro.analysis.check.results import Failure, describe_case, describe_outputs, inputs_by_name
+from retro.analysis.check.tally import Tally
+from retro.analysis.check.verdicts import static_bounds
 from retro.cpu.batch import LaneError
 from retro.cpu.flow import Bounds
 from retro.cpu.timing import model_cycles
@@ -68,7 +60,7 @@ class RowOutcome:
 class RowsCheck:
     outcomes: list[RowOutcome]
     static_note: str = ""  # a spec of rows only: why the static bounds are unknown
-    agreement: ChunkResult | None = field(default=None, repr=False)
+    agreement: Tally | None = field(default=None, repr=False)
 
     @property
     def failing(self) -> list[RowOutcome]:
@@ -100,10 +92,11 @@ def _on_machine(runner: RoutineRunner, case: tuple) -> _Call:
         outputs, cycles = runner.run(case, steps)
     except RunError as exc:
         return _Call(None, None, error=str(exc))
-    return _Call(outputs, cycles, cycles - runner.last_stolen, model_cycles(runner.machine.memory.__getitem__, steps))
+    modelled = model_cycles(runner.machine.memory.__getitem__, steps, runner.routine.cpu)
+    return _Call(outputs, cycles, cycles - runner.last_stolen, modelled)
 
 
-def check_rows(spec: str, seed: int, start: SceneStart | None, batched: bool) -> tuple[RowsCheck, ChunkResult]:
+def check_rows(spec: str, seed: int, start: SceneStart | None, batched: bool) -> tuple[RowsCheck, Tally]:
     """Run the rows of the routine `spec` names; the rows' verdicts, and their part of the check's
     totals (cases, cycles, timing-model mismatches, run errors, the first failure). On the batched
     core, `RowsCheck.agreement` holds the calls also run on Machine."""
@@ -118,7 +111,7 @@ def check_rows(spec: str, seed: int, start: SceneStart | None, batched: bool) ->
             calls.append(_on_machine(runner, row.case))
             if calls[-1].error:
                 break
-    totals = ChunkResult()
+    totals = Tally()
     outcomes = []
     for row, call in zip(rows, calls):
         outcomes.append(_outcome(row, call, routine))
@@ -143,15 +136,15 @@ def _reference_answer(runner: RoutineRunner, row: Row) -> tuple | None:
     outside its domain: a row is not held to the domain)."""
     routine = runner.routine
     columns = cases_to_columns(routine, [row.case])
-    answers, answered = expected_columns(routine, columns, [row.case], runner.memory_values, np.zeros(1, dtype=bool))
+    answers, answered = reference_answers(routine, columns, [row.case], runner.memory_values, np.zeros(1, dtype=bool))
     return row_of(answers, 0) if answered[0] else None
 
 
-def _batched(runner: RoutineRunner, rows: tuple[Row, ...]) -> tuple[list[_Call], ChunkResult]:
+def _batched(runner: RoutineRunner, rows: tuple[Row, ...]) -> tuple[list[_Call], Tally]:
     """The rows on the batched core, up to the first call that stops; the first AGREEMENT_PER_PART
     of them also on Machine (with the timing model), compared call for call."""
     routine = runner.routine
-    agreement = ChunkResult()
+    agreement = Tally()
     calls = []
     outcome, first = None, 0
     for i, row in enumerate(rows):
@@ -159,12 +152,12 @@ def _batched(runner: RoutineRunner, rows: tuple[Row, ...]) -> tuple[list[_Call],
             outcome, first = runner.run_batch(cases_to_columns(routine, [r.case for r in rows[i:i + BATCH_LANES]])), i
         stopped = bool(outcome.error[i - first])
         machine = _on_machine(runner, row.case) if i < AGREEMENT_PER_PART or stopped else None
-        if stopped:  # Machine's message names the address (as check_batch reports a stopped lane)
+        if stopped:  # Machine's message names the address (as run_on_batched_core reports a stopped lane)
             message = machine.error or (f"the engines disagree: the batched core stopped the call "
                                         f"({LaneError(int(outcome.error[i - first])).name}), Machine returned")
             calls.append(_Call(None, None, error=message))
         else:
-            calls.append(_Call(outcome.case_outputs(i - first), int(outcome.cycles[i - first])))
+            calls.append(_Call(row_of(outcome.outputs, i - first), int(outcome.cycles[i - first])))
         if i < AGREEMENT_PER_PART:
             _agree(agreement, routine, row, machine, calls[-1], stopped)
         if stopped:
@@ -172,7 +165,7 @@ def _batched(runner: RoutineRunner, rows: tuple[Row, ...]) -> tuple[list[_Call],
     return calls, agreement
 
 
-def _agree(agreement: ChunkResult, routine: Routine, row: Row, machine: _Call, batch: _Call, stopped: bool) -> None:
+def _agree(agreement: Tally, routine: Routine, row: Row, machine: _Call, batch: _Call, stopped: bool) -> None:
     agreement.cases += 1
     agreement.engine_cases += 1
     if machine.error:
@@ -208,8 +201,8 @@ def _outcome(row: Row, call: _Call, routine: Routine) -> RowOutcome:
     return RowOutcome(row, call.outputs, call.cycles, tuple(problems))
 
 
-def _count(totals: ChunkResult, routine: Routine, row: Row, call: _Call, timing_model: bool) -> None:
-    """The row's call in the check's totals, as check_chunk counts a generated case."""
+def _count(totals: Tally, routine: Routine, row: Row, call: _Call, timing_model: bool) -> None:
+    """The row's call in the check's totals, as the tally counts a generated case (retro.analysis.check.tally)."""
     totals.cases += 1
     if call.error:
         totals.run_errors += 1
@@ -293,11 +286,11 @@ def rows_lines(routine: Routine, rows: RowsCheck) -> list[str]:
     return lines
 
 
-def merged_agreement(agreement: ChunkResult | None, rows: RowsCheck | None) -> ChunkResult | None:
+def merged_agreement(agreement: Tally | None, rows: RowsCheck | None) -> Tally | None:
     """The check's engine agreement with the rows' calls included (batched core only)."""
     if rows is None or rows.agreement is None or agreement is None:
         return agreement
-    merged = ChunkResult()
+    merged = Tally()
     merged.merge(rows.agreement)
     merged.merge(agreement)
     return merged

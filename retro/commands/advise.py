@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from retro.analysis.check import engine_default
+from retro.analysis.check import check_engine
 from retro.analysis.study.advisor import Advice, advice_lines
 from retro.analysis.study.advisor import advise as advise_scene
 from retro.analysis.study.broad_phase import MAX_OBJECTS
@@ -42,9 +42,9 @@ def advise(scene: str | Path, *, accuracy: float | str = DEFAULT_ACCURACY, metho
         file_option(method, "--method")
     workers = parse_int(jobs, field="--jobs", lo=1, hi=MAX_JOBS)
     count = None if objects is None else parse_int(objects, field="--objects", lo=1, hi=MAX_OBJECTS)
-    with engine_default(engine):
-        return advise_scene(str(scene), target, workers=workers, progress=progress,
-                            methods=with_user_methods(methods), software=software, objects=count)
+    check_engine(engine)
+    return advise_scene(str(scene), target, workers=workers, progress=progress, methods=with_user_methods(methods),
+                        software=software, objects=count, engine=engine)
 
 
 def lines(advice: Advice) -> list[str]:

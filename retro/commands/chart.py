@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from retro.analysis.check import engine_default
+from retro.analysis.check import check_engine
 from retro.analysis.study.chart_run import AUTO, ChartOutput, run_chart, summary_lines
 from retro.analysis.study.methods import with_user_methods
 from retro.fileio import all_or_nothing
@@ -35,10 +35,10 @@ def chart(out: str | Path = DEFAULT_OUT, *, reduced: bool = False, methods: list
     corpus (the named `shapes` of sprites/, all by default, then every sprite of the files `sprites`)."""
     workers = parse_int(jobs, field="--jobs", lo=1, hi=MAX_JOBS)
     cost_samples = samples_count(samples)
-    with engine_default(engine):
-        return run_chart(Path(out), reduced=reduced, workers=workers, progress=progress, shape_names=shapes,
-                         cost_samples=cost_samples, methods=with_user_methods(methods), sprite_files=tuple(sprites),
-                         per_frame=per_frame)
+    check_engine(engine)
+    return run_chart(Path(out), reduced=reduced, workers=workers, progress=progress, shape_names=shapes,
+                     cost_samples=cost_samples, methods=with_user_methods(methods), sprite_files=tuple(sprites),
+                     per_frame=per_frame, engine=engine)
 
 
 def lines(output: ChartOutput) -> list[str]:

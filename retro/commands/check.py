@@ -4,10 +4,14 @@ results, cycles (against the timing model) and static bounds; exit 1 on any mism
 from __future__ import annotations
 
 import inspect
+import math
 from pathlib import Path
 
-from retro.analysis.check import RoutineCheck, SceneStart, check_record, format_check, run_checks
+from retro.analysis.check import RoutineCheck, SceneStart, inputs_by_name, run_checks
+from retro.analysis.check.results import describe_case, describe_outputs
 from retro.analysis.junit import junit_xml
+from retro.analysis.raster import format_raster, raster_figures
+from retro.analysis.row_check import rows_lines, rows_record
 from retro.errors import InputError
 from retro.fileio import file_option, write_atomic
 from retro.numbers import parse_int
@@ -18,6 +22,7 @@ MAX_RANDOM = 10 ** 9
 MAX_JOBS = 64
 MAX_AT_LINE = 1000  # above every chip's line count: the scene's chip gives the exact range
 MAX_AT_CYCLE = 100
+JSON_EXACT = 1 << 53  # larger whole numbers lose digits in JSON readers that use doubles
 
 
 def check(routines: list[str] | None = None, *, exhaustive: bool = False, seed: int | str | None = None,
@@ -57,10 +62,188 @@ def lines(checks: list[RoutineCheck]) -> list[str]:
     return [line for c in checks for line in format_check(c)]
 
 
+# ---- reports: the text and JSON of a routine's check -----------------------------------------------
+def coverage(check: RoutineCheck) -> list[dict]:
+    out = []
+    for part in check.parts:
+        item = {"part": part.name, "cases": part.cases}
+        if part.name == "exhaustive":
+            item["space"] = part.total
+            item["inputs"] = list(check.routine.exhaustive)
+            item["complete"] = part.cases == part.total
+        out.append(item)
+    return out
+
+
+def cycle_figures(check: RoutineCheck) -> dict:
+    """The cycle fields shared by `retro check --json` and `retro cycles --json`."""
+    t = check.totals
+    routine = check.routine
+    return {"min": t.cycles_min, "mean": round(check.mean, 2), "max": t.cycles_max,
+            "static_min": check.static.best if check.static else None,
+            "static_max": check.static.worst if check.static else None,
+            "min_inputs": inputs_by_name(routine, t.min_case) if t.min_case is not None else None,
+            "max_inputs": inputs_by_name(routine, t.max_case) if t.max_case is not None else None,
+            "budget": routine.budget,
+            "raster": {**raster_figures(routine.machine, t.cycles_min, check.mean if t.cycles_count else None,
+                                        t.cycles_max), **scene_raster(check)}}
+
+
+def scene_raster(check: RoutineCheck) -> dict:
+    """With --scene: the calls on the scene's timeline from the start line ({"scene": {...}}), stalls
+    included: lines taken, the most cycles stolen, and where the slowest call ended."""
+    start = check.start
+    t = check.totals
+    if start is None or not t.cycles_count:
+        return {}
+    video = start.scene.state.video
+    per_line = video.cycles_per_line
+    last = start.line * per_line + start.cycle - 1 + t.cycles_max - 1
+    frames, within = divmod(last, video.frame_cycles)
+    end_line, end_cycle = divmod(within, per_line)
+    return {"scene": {"chip": video.chip, "start_line": start.line, "start_cycle": start.cycle,
+                      "min_lines": round(t.cycles_min / per_line, 3), "mean_lines": round(check.mean / per_line, 3),
+                      "max_lines": round(t.cycles_max / per_line, 3), "stolen_max": t.stolen_max,
+                      "slowest_end_line": end_line, "slowest_end_cycle": end_cycle + 1, "frames_crossed": frames}}
+
+
+def check_record(check: RoutineCheck) -> dict:
+    """One routine's check as plain data (what `retro check --json` prints)."""
+    t = check.totals
+    record = {"routine": check.routine.name, "spec": str(check.routine.spec_path), "cpu": check.routine.cpu,
+              "machine": check.routine.machine, "cases": t.cases, "mismatches": check.mismatches,
+              "result_mismatches": t.result_mismatches,
+              "cycle_mismatches": t.cycle_mismatches + (check.agreement.cycle_mismatches if check.agreement else 0),
+              "run_errors": t.run_errors, "bounds_violations": check.bounds_violations,
+              "budget_violations": check.budget_violations,
+              "outside_domain": t.outside, "outside_domain_wrong": t.outside_wrong,
+              "domain": [{"condition": c.text, "cases": t.constraint_cases.get(c.text, 0),
+                          "wrong": t.constraint_wrong.get(c.text, 0)} for c in check.routine.domain],
+              **cycle_figures(check), "worst_reached": check.worst_reached, "coverage": coverage(check),
+              "input_space": space if (space := check.routine.input_space()) < JSON_EXACT else None,
+              "input_space_log2": round(math.log2(space), 3), "coverage_argument": check.routine.coverage or None,
+              "examples": t.examples, "outside_examples": t.outside_examples, "engine": check.engine,
+              "engine_agreement": None if check.agreement is None else {
+                  "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
+                  "timing_model_mismatches": check.agreement.cycle_mismatches},
+              "notes": list(check.routine.notes), "first_failure": None, "rows": None}
+    failure = t.failure
+    if failure is not None:
+        routine = check.routine
+        record["first_failure"] = {
+            "kind": failure.kind, "inputs": inputs_by_name(routine, failure.case),
+            "outputs": None if failure.outputs is None else dict(zip(routine.output_names, _plain(failure.outputs))),
+            "expected": None if failure.expected is None else {  # None: an output an expected row does not state
+                name: value for name, value in zip(routine.output_names, _plain(failure.expected))
+                if value is not None},
+            "message": failure.message, "trace": check.trace}
+    if check.rows is not None:
+        record["rows"] = rows_record(check.routine, check.rows)
+    return record
+
+
+def _plain(values: tuple) -> list:
+    return [list(v) if isinstance(v, tuple) else v for v in values]
+
+
+def format_space(space: int) -> str:
+    return f"{space:,}" if space < JSON_EXACT else f"2^{math.log2(space):.1f}"
+
+
+def format_coverage(check: RoutineCheck) -> str:
+    parts = []
+    for part in check.parts:
+        if part.name == "exhaustive":
+            scope = ", ".join(check.routine.exhaustive)
+            parts.append(f"exhaustive over {scope}: {part.cases:,} of {part.total:,}"
+                         + ("" if part.cases == part.total else " (sampled; --exhaustive runs all)"))
+        else:
+            parts.append(f"{part.name} {part.cases:,}")
+    return "; ".join(parts)
+
+
+def format_check(check: RoutineCheck) -> list[str]:
+    """One routine's check as the lines `retro check` prints."""
+    t = check.totals
+    routine = check.routine
+    lines = [_headline(check)]
+    lines += [f"  note: {note}" for note in routine.notes]
+    if check.parts:
+        lines.append(f"  cases: {format_coverage(check)}; input space {format_space(check.routine.input_space())}")
+    if routine.coverage:
+        lines.append(f"  coverage: {routine.coverage}")
+    if t.cycles_count:
+        lines += _cycle_lines(check)
+    if routine.budget is not None:
+        lines.append(f"  budget: {routine.budget} cycles: {'broken' if check.budget_violations else 'kept'}")
+    lines += [f"  {line}" for line in check.domain_report()[1:]] if routine.domain else []
+    if t.outside:
+        lines.append(f"  outside the stated domain: {t.outside} cases, {t.outside_wrong} wrong"
+                     + (f", e.g. {t.outside_examples[0]}" if t.outside_examples else ""))
+    if check.rows is not None:
+        lines += rows_lines(routine, check.rows)
+    lines += [f"  MISMATCH {example}" for example in t.examples]
+    lines += [f"  MISMATCH {violation}" for violation in check.bounds_violations]
+    lines += [f"  BUDGET {violation}" for violation in check.budget_violations]
+    if t.failure is not None:
+        lines += _failure_lines(check)
+    return lines
+
+
+def _headline(check: RoutineCheck) -> str:
+    t = check.totals
+    verdict = "OK" if not check.mismatches else f"{check.mismatches} MISMATCH(ES)"
+    static = (f"static {check.static.best}-{check.static.worst}, worst case "
+              f"{'reached' if check.worst_reached else 'not reached'}" if check.static else
+              "static bounds unknown" if check.rows is not None and check.rows.static_note else "static analysis off")
+    cost = (f"cycles {t.cycles_min}-{t.cycles_max} (mean {check.mean:.2f})" if t.cycles_count
+            else "no case inside the domain")
+    if check.agreement is None:
+        checked = f"timing model equal on {t.cases - t.cycle_mismatches - t.run_errors} of {t.cases} calls"
+    else:
+        a = check.agreement
+        checked = (f"batched core; on {a.engine_cases} of the calls Machine agrees on "
+                   f"{a.engine_cases - a.engine_mismatches} and the timing model on "
+                   f"{a.cases - a.cycle_mismatches - a.run_errors}")
+    return f"{check.routine.name}: {t.cases} cases, {verdict}; {cost}, {static}; {checked}"
+
+
+def _cycle_lines(check: RoutineCheck) -> list[str]:
+    """Fastest and slowest inputs, raster lines, and with --scene where the calls fall on the beam."""
+    t = check.totals
+    routine = check.routine
+    lines = [f"  fastest: {describe_case(routine, t.min_case)}", f"  slowest: {describe_case(routine, t.max_case)}"]
+    raster = format_raster(routine.machine, raster_figures(routine.machine, t.cycles_min, check.mean, t.cycles_max))
+    if raster:
+        lines.append(f"  raster (CPU never stalled): {raster}")
+    scene = scene_raster(check).get("scene")
+    if scene:
+        lines.append(f"  on the scene from line {scene['start_line']} cycle {scene['start_cycle']} ({scene['chip']}): "
+                     f"{scene['min_lines']:.2f}-{scene['max_lines']:.2f} lines, up to {scene['stolen_max']} cycles "
+                     f"stolen; the slowest ends at line {scene['slowest_end_line']} cycle {scene['slowest_end_cycle']}"
+                     + (f" {scene['frames_crossed']} frame(s) later" if scene["frames_crossed"] else ""))
+    return lines
+
+
+def _failure_lines(check: RoutineCheck) -> list[str]:
+    failure = check.totals.failure
+    routine = check.routine
+    lines = [f"  first failing case: {describe_case(routine, failure.case)}"]
+    if failure.outputs is not None:
+        lines.append(f"    routine:   {describe_outputs(routine, failure.outputs)}")
+    if failure.expected is not None:
+        stated = "the row:  " if failure.kind == "row" else "reference:"
+        lines.append(f"    {stated} {describe_outputs(routine, failure.expected)}")
+    if failure.message:
+        lines.append(f"    {failure.message}")
+    lines.append("    trace (address, instruction, cycles, running total):")
+    return lines + [f"    {line}" for line in check.trace]
+
+
 def write_junit(checks: list[RoutineCheck], path: str | Path, *, scene: str | Path | None = None) -> Path:
     """`--junit FILE`: the checks as JUnit XML (retro.analysis.junit), written atomically and never
     over one of the check's inputs."""
-    return write_atomic(path, junit_xml(checks), inputs=input_files(checks, scene))
+    return write_atomic(path, junit_xml(checks, format_check), inputs=input_files(checks, scene))
 
 
 def input_files(checks: list[RoutineCheck], scene: str | Path | None = None) -> list[Path]:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from retro.analysis.check import engine_default
+from retro.analysis.check import check_engine
 from retro.analysis.study.methods import with_user_methods
 from retro.analysis.study.stability.run import StabilityOutput, run_stability
 from retro.fileio import all_or_nothing
@@ -19,8 +19,9 @@ def stability(out: str | Path = DEFAULT_OUT, *, reduced: bool = False, methods: 
               engine: str = "auto", progress: Progress = quiet) -> StabilityOutput:
     """The stability study of the built-in methods and the user's method files `methods`;
     `reduced`: fewer speeds and bounded searches (seconds)."""
-    with engine_default(engine):
-        return run_stability(Path(out), reduced=reduced, progress=progress, methods=with_user_methods(methods))
+    check_engine(engine)
+    return run_stability(Path(out), reduced=reduced, progress=progress, methods=with_user_methods(methods),
+                         engine=engine)
 
 
 def lines(output: StabilityOutput) -> list[str]:

@@ -12,14 +12,13 @@ from retro.chips.vic.constants import (
     IRQ_RASTER,
     IRQ_SPRITE_BACKGROUND,
     IRQ_SPRITE_SPRITE,
-    REG_SPRITE_X0,
-    REG_SPRITE_X_MSB,
     REG_SPRITE_Y0,
     SPRITE_COUNT,
     X_BITS_MASK,
     Y_COMPARE_MASK,
 )
 from retro.chips.vic.model import LatchReport, frame_collisions, run_frames
+from retro.chips.vic.sprite_registers import set_sprite_x, sprite_x
 from retro.chips.palettes import C64_DEFAULT_PALETTE, PALETTES
 from retro.errors import InputError
 from retro.fileio import all_or_nothing, file_option
@@ -74,11 +73,8 @@ def moved_registers(scene: VicScene, frame: int) -> bytes:
         dx, dy = spec.velocity
         if not (dx or dy):
             continue
-        n, bit = spec.index, 1 << spec.index
-        x = (registers[REG_SPRITE_X0 + 2 * n] | ((registers[REG_SPRITE_X_MSB] >> n) & 1) << 8) + frame * dx
-        x %= X_BITS_MASK + 1
-        registers[REG_SPRITE_X0 + 2 * n] = x & 0xFF
-        registers[REG_SPRITE_X_MSB] = (registers[REG_SPRITE_X_MSB] & ~bit) | (bit if x >> 8 else 0)
+        n = spec.index
+        set_sprite_x(registers, n, (sprite_x(registers, n) + frame * dx) % (X_BITS_MASK + 1))
         registers[REG_SPRITE_Y0 + 2 * n] = (registers[REG_SPRITE_Y0 + 2 * n] + frame * dy) & Y_COMPARE_MASK
     return bytes(registers)
 
@@ -110,32 +106,25 @@ def overlap_pairs(run: VicRun) -> list[dict]:
     """Each pair of sprites whose opaque pixels meet: how many places they share and where (raster
     lines and X coordinates). A place where three sprites meet counts for each of their pairs."""
     c = run.report.collisions
-    lines, xs = c.ss_pixels
-    if not lines.size:
+    if not c.ss_pixels[0].size:
         return []
-    places = lines * c.video.x_positions + xs
-    unique, inverse = np.unique(places, return_inverse=True)
-    together = np.zeros(unique.size, np.uint8)
-    np.bitwise_or.at(together, inverse, c.ss_pixel_bits)
-    place_lines, place_xs = unique // c.video.x_positions, unique % c.video.x_positions
     out = []
     for a, b in run.report.pairs:
-        both = (together >> a & 1).astype(bool) & (together >> b & 1).astype(bool)
-        out.append({"sprites": [a, b], "pixels": int(both.sum()), "box": _box(place_lines[both], place_xs[both]),
-                    **({"at": _pixel_list(place_lines[both], place_xs[both])} if run.pixels else {})})
+        lines, xs = c.pair_pixels(a, b)
+        out.append({"sprites": [a, b], "pixels": int(lines.size), "box": _box(lines, xs),
+                    **({"at": _pixel_list(lines, xs)} if run.pixels else {})})
     return out
 
 
 def background_overlaps(run: VicRun) -> list[dict]:
     """Each sprite whose opaque pixels meet foreground graphics: how many, and where."""
     c = run.report.collisions
-    lines, xs = c.sb_pixels
     out = []
     for n in range(SPRITE_COUNT):
-        mine = c.sb_pixel_bits == (1 << n)
-        if mine.any():
-            out.append({"sprite": n, "pixels": int(mine.sum()), "box": _box(lines[mine], xs[mine]),
-                        **({"at": _pixel_list(lines[mine], xs[mine])} if run.pixels else {})})
+        lines, xs = c.background_pixels(n)
+        if lines.size:
+            out.append({"sprite": n, "pixels": int(lines.size), "box": _box(lines, xs),
+                        **({"at": _pixel_list(lines, xs)} if run.pixels else {})})
     return out
 
 
@@ -183,21 +172,33 @@ def lines(run: VicRun) -> list[str]:
              f"overlapping sprite pairs (not visible to a program): {pairs}",
              f"sprites over foreground graphics: {background}"]
     if run.pixels:
-        for p in overlap_pairs(run):
-            lines.append(f"pixels of {p['sprites'][0]}+{p['sprites'][1]} (line, X): "
-                         + " ".join(f"{line},{x}" for line, x in p["at"]))
-        for b in background_overlaps(run):
-            lines.append(f"pixels of {b['sprite']} over graphics (line, X): "
-                         + " ".join(f"{line},{x}" for line, x in b["at"]))
+        lines += _pixel_lines(run)
     if run.per_frame is not None:
-        hits = [f for f in run.per_frame if f["d01e"] or f["d01f"]]
-        lines.append(f"moving sprites, {len(run.per_frame)} frames read once each (clear on read): "
-                     f"{len(hits)} frame(s) with a collision" + (f", the first in frame {hits[0]['frame']}" if hits else ""))
-        for f in hits[:20]:
-            lines.append(f"  frame {f['frame']}: $D01E = ${f['d01e']:02X}, $D01F = ${f['d01f']:02X}"
-                         + (f", pairs {', '.join(f'{a}+{b}' for a, b in f['pairs'])}" if f["pairs"] else ""))
-        if len(hits) > 20:
-            lines.append(f"  ... {len(hits) - 20} more (--json lists every frame)")
+        lines += _per_frame_lines(run.per_frame)
     if run.png is not None:
         lines.append(f"wrote {run.png}")
+    return lines
+
+
+def _pixel_lines(run: VicRun) -> list[str]:
+    lines = []
+    for p in overlap_pairs(run):
+        lines.append(f"pixels of {p['sprites'][0]}+{p['sprites'][1]} (line, X): "
+                     + " ".join(f"{line},{x}" for line, x in p["at"]))
+    for b in background_overlaps(run):
+        lines.append(f"pixels of {b['sprite']} over graphics (line, X): "
+                     + " ".join(f"{line},{x}" for line, x in b["at"]))
+    return lines
+
+
+def _per_frame_lines(per_frame: list[dict]) -> list[str]:
+    """The frames of a moving scene that collided (the first 20)."""
+    hits = [f for f in per_frame if f["d01e"] or f["d01f"]]
+    lines = [f"moving sprites, {len(per_frame)} frames read once each (clear on read): "
+             f"{len(hits)} frame(s) with a collision" + (f", the first in frame {hits[0]['frame']}" if hits else "")]
+    for f in hits[:20]:
+        lines.append(f"  frame {f['frame']}: $D01E = ${f['d01e']:02X}, $D01F = ${f['d01f']:02X}"
+                     + (f", pairs {', '.join(f'{a}+{b}' for a, b in f['pairs'])}" if f["pairs"] else ""))
+    if len(hits) > 20:
+        lines.append(f"  ... {len(hits) - 20} more (--json lists every frame)")
     return lines

@@ -48,22 +48,17 @@ from retro.cpu.timing import (
     PAGE_CROSS_CYCLES,
     PAGE_MASK,
 )
+from retro.cpu.lane_memory import BYTE, MAX_PRIVATE_BYTES, LaneMemory
 from retro.errors import InputError
 
-MEMORY_SIZE = 0x10000
-PAGE_SIZE = 0x100
-PAGES = MEMORY_SIZE // PAGE_SIZE
 STACK_PAGE = 0x100
-BYTE = 0xFF
 WORD = 0xFFFF
-MAX_PRIVATE_BYTES = 512 << 20  # per-lane bytes a batch may hold before it must be split
 # A lane whose cycles reach the budget stops there on Machine. Here the budget is looked at when the
 # lowest waiting address is below the last one run (some lanes jumped back: every loop does), every
 # BUDGET_CHECK_EVERY group runs, and when a lane returns (then cycles > budget is the same verdict): a
 # lane past its budget may run a few more instructions, but it is reported as over the budget unless
 # it stops first for another reason (BRK, JAM), which is a run error all the same.
 BUDGET_CHECK_EVERY = 64
-DENSE_AFTER = 24  # a page with more per-lane bytes than this is held as one block
 NZ = FLAG_N | FLAG_Z
 NVZC = FLAG_N | FLAG_V | FLAG_Z | FLAG_C
 
@@ -77,120 +72,6 @@ class LaneError(IntEnum):
     UNSTABLE = 3
     BUDGET = 4
     HALT = 5  # the 65C02's STP, or WAI with no interrupt source
-
-
-class LaneMemoryFull(Exception):
-    """The per-lane page copies of this batch would pass MAX_PRIVATE_BYTES: run fewer lanes at a time."""
-
-
-class LaneMemory:
-    """A shared 64 KiB image and, per address that differs between lanes, a row of one value per lane.
-
-    Rows are int32 (registers' type, so arithmetic never wraps early) and made on first write. A page
-    that gets more than DENSE_AFTER rows (a table the routine writes) becomes one (256 x lanes) block,
-    its rows views into it, so accesses with per-lane addresses stay one gather."""
-
-    def __init__(self, image, lanes: int, limit: int = MAX_PRIVATE_BYTES) -> None:
-        self.shared = np.frombuffer(bytes(image), dtype=np.uint8).copy()
-        if len(self.shared) != MEMORY_SIZE:
-            raise InputError(f"a memory image is {MEMORY_SIZE} bytes, got {len(self.shared)}")
-        self.lanes = lanes
-        self.limit = limit
-        self.rows: dict[int, np.ndarray] = {}
-        self.page_rows: dict[int, list[int]] = {}  # sparse pages: their addresses with rows
-        self.dense: dict[int, np.ndarray] = {}
-        self.is_private = np.zeros(PAGES, dtype=bool)  # the page has rows (sparse or dense)
-        self.all_lanes = np.arange(lanes)
-
-    def _held(self) -> int:
-        return (len(self.rows) + (PAGE_SIZE - 1) * len(self.dense)) * self.lanes * 4
-
-    def row(self, address: int) -> np.ndarray:
-        """The per-lane row of an address (made from the shared image on first use)."""
-        row = self.rows.get(address)
-        if row is None:
-            if self._held() + self.lanes * 4 > self.limit:
-                raise LaneMemoryFull(f"{self.lanes} lanes with {len(self.rows) + 1} private bytes")
-            row = np.full(self.lanes, self.shared[address], dtype=np.int32)
-            self.rows[address] = row
-            page = address >> 8
-            self.is_private[page] = True
-            listed = self.page_rows.setdefault(page, [])
-            listed.append(address)
-            if len(listed) > DENSE_AFTER:
-                self._densify(page)
-                row = self.rows[address]
-        return row
-
-    def _densify(self, page: int) -> None:
-        if self._held() + PAGE_SIZE * self.lanes * 4 > self.limit:
-            raise LaneMemoryFull(f"{self.lanes} lanes with a page of per-lane bytes more")
-        base = page * PAGE_SIZE
-        block = np.repeat(self.shared[base:base + PAGE_SIZE].astype(np.int32)[:, None], self.lanes, axis=1)
-        for address in self.page_rows.pop(page, []):
-            block[address & BYTE] = self.rows[address]
-        for offset in range(PAGE_SIZE):
-            self.rows[base + offset] = block[offset]
-        self.dense[page] = block
-        self.is_private[page] = True
-
-    def lanes_of(self, idx) -> np.ndarray:
-        return self.all_lanes[idx] if isinstance(idx, slice) else idx
-
-    def read(self, idx, address):
-        """The byte at address (an int, or an array aligned with idx) for the lanes idx (an index
-        array or slice(None) for every lane)."""
-        if isinstance(address, (int, np.integer)):
-            row = self.rows.get(int(address))
-            if row is None:
-                return int(self.shared[address])
-            return row.copy() if isinstance(idx, slice) else row[idx]  # never a view: the row may change
-        values = self.shared[address].astype(np.int32)
-        if self.rows:
-            pages = address >> 8
-            lanes = None
-            for page in np.flatnonzero(self.is_private).tolist():
-                hit = pages == page
-                if not hit.any():
-                    continue
-                lanes = self.lanes_of(idx) if lanes is None else lanes
-                block = self.dense.get(page)
-                if block is not None:
-                    values[hit] = block[address[hit] & BYTE, lanes[hit]]
-                    continue
-                for row_address in self.page_rows[page]:
-                    at = hit & (address == row_address)
-                    if at.any():
-                        values[at] = self.rows[row_address][lanes[at]]
-        return values
-
-    def write(self, idx, address, value) -> None:
-        """Store value (an int or an array aligned with idx) at address for the lanes idx."""
-        if isinstance(address, (int, np.integer)):
-            self.row(int(address))[idx] = value
-            return
-        lanes = self.lanes_of(idx)
-        array = not isinstance(value, (int, np.integer))
-        targets = np.unique(address)
-        if len(targets) == 1:
-            self.row(int(targets[0]))[lanes] = value
-            return
-        for page in np.unique(targets >> 8).tolist():
-            in_page = targets[(targets >> 8) == page]
-            if page not in self.dense and len(in_page) + len(self.page_rows.get(page, ())) > DENSE_AFTER:
-                self._densify(page)
-            block = self.dense.get(page)
-            if block is not None:
-                hit = (address >> 8) == page
-                block[address[hit] & BYTE, lanes[hit]] = value[hit] if array else value
-                continue
-            for target in in_page.tolist():
-                at = address == target
-                self.row(target)[lanes[at]] = value[at] if array else value
-
-    def fill(self, address: int, values) -> None:
-        """Per-lane values (an array of one byte per lane) at one address, for every lane."""
-        self.row(address)[:] = values
 
 
 def _signed(offset):

@@ -79,12 +79,6 @@ def aabb_mtv(a_min: PointLike, a_max: PointLike, b_min: PointLike, b_max: PointL
     return min(candidates, key=lambda c: c[1])
 
 
-def aabb_contains_box(outer_min: Point, outer_max: Point, inner_min: Point, inner_max: Point) -> bool:
-    """True when the inner box lies inside the outer one, edges included (inputs assumed checked)."""
-    return (outer_min[0] <= inner_min[0] and outer_min[1] <= inner_min[1]
-            and inner_max[0] <= outer_max[0] and inner_max[1] <= outer_max[1])
-
-
 def points_bounds(points: PointLike) -> Box:
     """Bounding box of a non-empty sequence of points."""
     pts = [as_point(p, f"points[{i}]") for i, p in enumerate(points)]  # type: ignore[arg-type]

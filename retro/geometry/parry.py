@@ -85,6 +85,33 @@ def simulate(script: list[tuple[int, str]], frames: int = DEFAULT_FRAMES,
              params: ParryParams = ParryParams(), source: str = "script") -> list[FrameState]:
     """Run the parry loop for `frames` frames under the scripted input: (frame, action) pairs (the
     text format is read by retro.commands.parry). Inputs scheduled at or after `frames` are an error."""
+    inputs = _inputs_by_frame(script, frames, source)
+    world = _World(params)
+    out: list[FrameState] = []
+    for f in range(frames):
+        events: list[Event] = []
+        pressed = False
+        for action in inputs.get(f, ()):
+            if action == "parry":
+                pressed = True
+            else:
+                world.walk = {"left": -1, "right": 1, "stop": 0}[action]
+        player_poly, enemy_poly = world.move()  # 2. motion
+        padded = world.broad_phase(f, player_poly, enemy_poly, events)  # 3. the window opens on its rising edge
+        if pressed:  # 4. input
+            if world.window > 0:
+                world.armed = True
+                events.append(Event(f, "press"))
+            else:
+                events.append(Event(f, "whiff"))
+        in_window = world.window > 0
+        contact = world.narrow_phase(f, player_poly, enemy_poly, events)  # 5. narrow phase
+        out.append(FrameState(f, player_poly, enemy_poly, padded, in_window, world.window, world.armed, contact,
+                              events))
+    return out
+
+
+def _inputs_by_frame(script: list[tuple[int, str]], frames: int, source: str) -> dict[int, list[str]]:
     if isinstance(frames, bool) or not isinstance(frames, int) or not 1 <= frames <= MAX_FRAMES:
         raise InputError(f"frames: must be an integer in 1..{MAX_FRAMES}, got {frames!r}")
     steps = sorted(script, key=lambda step: step[0])
@@ -96,99 +123,92 @@ def simulate(script: list[tuple[int, str]], frames: int = DEFAULT_FRAMES,
     inputs: dict[int, list[str]] = {}
     for frame, action in steps:
         inputs.setdefault(frame, []).append(action)
+    return inputs
 
-    p = params
-    width, height = p.arena
-    ground = height / 2
-    player = [p.player_start, ground]
-    enemy = [p.enemy_start, ground]
-    player_vel = [0.0, 0.0]
-    enemy_vel = [0.0, 0.0]
-    angle = 0.0
-    walk = 0
-    window = 0
-    armed = False
-    recovering = 0
-    was_padded = False
-    out: list[FrameState] = []
 
-    def clamp_x(pos: list[float]) -> None:
-        pos[0] = min(max(pos[0], p.radius), width - p.radius)
-        pos[1] = min(max(pos[1], p.radius), height - p.radius)
+class _World:
+    """The state the loop carries from frame to frame."""
 
-    for f in range(frames):
-        events: list[Event] = []
-        pressed = False
-        for action in inputs.get(f, ()):
-            if action == "parry":
-                pressed = True
-            else:
-                walk = {"left": -1, "right": 1, "stop": 0}[action]
+    def __init__(self, p: ParryParams) -> None:
+        self.p = p
+        self.width, self.height = p.arena
+        self.ground = self.height / 2
+        self.player = [p.player_start, self.ground]
+        self.enemy = [p.enemy_start, self.ground]
+        self.player_vel = [0.0, 0.0]
+        self.enemy_vel = [0.0, 0.0]
+        self.angle = 0.0
+        self.walk = 0
+        self.window = 0
+        self.armed = False
+        self.recovering = 0
+        self.was_padded = False
 
-        # 2. motion
-        player[0] += walk * p.walk_speed + player_vel[0]
-        player[1] += player_vel[1]
-        player_vel = [v * p.friction for v in player_vel]
-        if recovering:
-            recovering -= 1
-            enemy[0] += enemy_vel[0]
-            enemy[1] += enemy_vel[1]
-            enemy_vel = [v * p.friction for v in enemy_vel]
+    def _clamp(self, pos: list[float]) -> None:
+        pos[0] = min(max(pos[0], self.p.radius), self.width - self.p.radius)
+        pos[1] = min(max(pos[1], self.p.radius), self.height - self.p.radius)
+
+    def move(self) -> tuple[list, list]:
+        """The player walks (and slides), the enemy lunges at it (or slides while it recovers)."""
+        p, player, enemy = self.p, self.player, self.enemy
+        player[0] += self.walk * p.walk_speed + self.player_vel[0]
+        player[1] += self.player_vel[1]
+        self.player_vel = [v * p.friction for v in self.player_vel]
+        if self.recovering:
+            self.recovering -= 1
+            enemy[0] += self.enemy_vel[0]
+            enemy[1] += self.enemy_vel[1]
+            self.enemy_vel = [v * p.friction for v in self.enemy_vel]
         else:
-            dx, dy = player[0] - enemy[0], ground - enemy[1]
+            dx, dy = player[0] - enemy[0], self.ground - enemy[1]
             distance = math.hypot(dx, dy) or 1.0
             enemy[0] += p.lunge_speed * dx / distance
             enemy[1] += p.lunge_speed * dy / distance  # drift back to the ground line
-        clamp_x(player)
-        clamp_x(enemy)
-        angle += p.spin
-        player_poly = regular_polygon(5, p.radius, tuple(player), rotation=-math.pi / 2)
-        enemy_poly = regular_polygon(5, p.radius, tuple(enemy), rotation=angle)
+        self._clamp(player)
+        self._clamp(enemy)
+        self.angle += p.spin
+        return (regular_polygon(5, p.radius, tuple(player), rotation=-math.pi / 2),
+                regular_polygon(5, p.radius, tuple(enemy), rotation=self.angle))
 
-        # 3. broad phase: padded AABB opens the window on its rising edge
+    def broad_phase(self, f: int, player_poly: list, enemy_poly: list, events: list[Event]) -> tuple:
+        """The padded AABB of the player against the enemy's box: its rising edge opens the window."""
+        pad = self.p.pad
         (px0, py0), (px1, py1) = points_bounds(player_poly)
-        padded = ((px0 - p.pad, py0 - p.pad), (px1 + p.pad, py1 + p.pad))
+        padded = ((px0 - pad, py0 - pad), (px1 + pad, py1 + pad))
         e_min, e_max = points_bounds(enemy_poly)
         padded_overlap = aabb_overlap(padded[0], padded[1], e_min, e_max)
-        if padded_overlap and not was_padded and window == 0:
-            window = p.window_frames
+        if padded_overlap and not self.was_padded and self.window == 0:
+            self.window = self.p.window_frames
             events.append(Event(f, "window"))
-        was_padded = padded_overlap
+        self.was_padded = padded_overlap
+        return padded
 
-        # 4. input
-        if pressed:
-            if window > 0:
-                armed = True
-                events.append(Event(f, "press"))
-            else:
-                events.append(Event(f, "whiff"))
-
-        # 5. narrow phase
-        in_window = window > 0
+    def narrow_phase(self, f: int, player_poly: list, enemy_poly: list, events: list[Event]):
+        """SAT contact: a parry (armed in the window) knocks the enemy back, else a hit the player."""
+        p = self.p
         contact = sat(player_poly, enemy_poly)
         if contact is not None:
             (ax, ay), depth = contact  # moving the player by axis * depth separates it
-            if window > 0 and armed:
+            if self.window > 0 and self.armed:
                 events.append(Event(f, "parry"))
-                enemy[0] -= ax * depth
-                enemy[1] -= ay * depth
-                enemy_vel = [-ax * p.knockback, -ay * p.knockback]
+                self.enemy[0] -= ax * depth
+                self.enemy[1] -= ay * depth
+                self.enemy_vel = [-ax * p.knockback, -ay * p.knockback]
             else:
                 events.append(Event(f, "hit"))
-                player[0] += ax * depth
-                player[1] += ay * depth
-                player_vel = [ax * p.knockback, ay * p.knockback]
-                enemy_vel = [-ax * p.knockback / 2, -ay * p.knockback / 2]
-            recovering = p.recover_frames
-            window = 0
-            armed = False
-        elif window > 0:
-            window -= 1
-            if window == 0:
+                self.player[0] += ax * depth
+                self.player[1] += ay * depth
+                self.player_vel = [ax * p.knockback, ay * p.knockback]
+                self.enemy_vel = [-ax * p.knockback / 2, -ay * p.knockback / 2]
+            self.recovering = p.recover_frames
+            self.window = 0
+            self.armed = False
+        elif self.window > 0:
+            self.window -= 1
+            if self.window == 0:
                 events.append(Event(f, "expired"))
-                armed = False
-        out.append(FrameState(f, player_poly, enemy_poly, padded, in_window, window, armed, contact, events))
-    return out
+                self.armed = False
+        return contact
 
 
 def events_of(states: list[FrameState]) -> list[Event]:

@@ -52,13 +52,24 @@ def render_frame(states: list[FrameState], index: int, params: ParryParams = Par
     image = Image.new("P", (width, STATUS_HEIGHT + height + TIMELINE_HEIGHT), BACKGROUND)
     image.putpalette([c for rgb in PALETTE for c in rgb])
     state = states[index]
-    small, big = label_font(12), label_font(26)
+    small = label_font(12)
+    window_open = state.in_window or state.window_left > 0
+    image.paste(_arena(states, index, params, width, height, window_open), (0, STATUS_HEIGHT))
+    top = ImageDraw.Draw(image)
+    top.text((6, 4), _status(state, params, window_open), fill=TEXT, font=small)
+    _timeline(top, states, state, STATUS_HEIGHT + height + 4, width, small)
+    return image
 
+
+def _arena(states: list[FrameState], index: int, params: ParryParams, width: int, height: int,
+           window_open: bool) -> Image.Image:
+    """The fighters, their boxes, the parry pad, the push of a contact and the banner of an event."""
+    state = states[index]
+    small, big = label_font(12), label_font(26)
     arena = Image.new("P", (width, height), BACKGROUND)
     draw = ImageDraw.Draw(arena)
     ground = params.arena[1] / 2 + params.radius
     draw.line([(0, ground * SCALE), (width, ground * SCALE)], fill=GROUND, width=1)
-    window_open = state.in_window or state.window_left > 0
     _rect(draw, *state.padded_box, PAD_OPEN if window_open else PAD_CLOSED)
     _poly(draw, state.player, PLAYER_FILL, PLAYER_LINE)
     _poly(draw, state.enemy, ENEMY_FILL, ENEMY_LINE)
@@ -79,9 +90,10 @@ def render_frame(states: list[FrameState], index: int, params: ParryParams = Par
     if recent:
         word = recent[-1].kind.upper() + "!"
         draw.text((width // 2, 14), word, fill=EVENT_COLOURS[recent[-1].kind], font=big, anchor="mt")
-    image.paste(arena, (0, STATUS_HEIGHT))
+    return arena
 
-    top = ImageDraw.Draw(image)
+
+def _status(state: FrameState, params: ParryParams, window_open: bool) -> str:
     status = f"frame {state.frame:3d}"
     kinds = [e.kind for e in state.events]
     if "parry" in kinds:
@@ -98,11 +110,11 @@ def render_frame(states: list[FrameState], index: int, params: ParryParams = Par
     others = [k for k in kinds if k not in ("parry", "hit")]
     if others:
         status += "   event: " + ", ".join(others)
-    top.text((6, 4), status, fill=TEXT, font=small)
+    return status
 
-    # Timeline: one column per frame, scaled to the width.
-    y0 = STATUS_HEIGHT + height + 4
-    step = width / len(states)
+
+def _window_spans(states: list[FrameState]) -> list[tuple[int, int]]:
+    """(opened, closed) frames of every parry window."""
     opened = None
     spans = []
     for s in states:
@@ -114,7 +126,14 @@ def render_frame(states: list[FrameState], index: int, params: ParryParams = Par
                 opened = None
     if opened is not None:
         spans.append((opened, states[-1].frame))
-    for a, b in spans:
+    return spans
+
+
+def _timeline(top: ImageDraw.ImageDraw, states: list[FrameState], state: FrameState, y0: int, width: int,
+              small) -> None:
+    """One column per frame, scaled to the width: windows, events, the current frame, a legend."""
+    step = width / len(states)
+    for a, b in _window_spans(states):
         top.rectangle([a * step, y0 + 8, (b + 1) * step, y0 + 14], fill=PAD_CLOSED)
     for e in events_of(states):
         x = (e.frame + 0.5) * step
@@ -126,7 +145,6 @@ def render_frame(states: list[FrameState], index: int, params: ParryParams = Par
                           ("hit", HIT), ("whiff / expired", GREY), ("now", ARROW)):
         top.text((legend_x, y0 + 28), label, fill=colour, font=small)
         legend_x += int(top.textlength(label, font=small)) + 12
-    return image
 
 
 def write_parry(out_dir: str | Path, states: list[FrameState], params: ParryParams = ParryParams()) -> list[Path]:

@@ -14,19 +14,16 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from retro.chips.vic.constants import (
-    COLOR_MASK,
     REG_CONTROL1,
     REG_CONTROL2,
-    REG_SPRITE_COLOR0,
     REG_SPRITE_EXPAND_X,
-    REG_SPRITE_MC0,
-    REG_SPRITE_MC1,
     REG_SPRITE_MULTICOLOR,
     REG_SPRITE_PRIORITY,
     SPRITE_COUNT,
 )
 from retro.chips.vic.graphics import colours, foreground_at
 from retro.chips.vic.model import FrameCollisions, VicState, placement
+from retro.chips.vic.sprite_registers import sprite_colours
 from retro.render.images import (
     LABEL_COLOUR,
     LABEL_SIZE,
@@ -72,12 +69,12 @@ def _image_position(state: VicState, lines: np.ndarray, xs: np.ndarray) -> tuple
 
 def _sprite_colour_numbers(state: VicState, n: int) -> np.ndarray:
     """(21, 24|48) colour numbers of sprite n's pixels, -1 where transparent."""
-    regs = state.registers
+    colours = sprite_colours(state.registers, n)
     multicolor = state.sprite_flag(REG_SPRITE_MULTICOLOR, n)
-    own = regs[REG_SPRITE_COLOR0 + n] & COLOR_MASK
+    own = colours.own
     if multicolor:
         values = np.repeat(decode(state.sprite_data[n], True), 2, axis=1).astype(np.int16)
-        table = np.array([-1, regs[REG_SPRITE_MC0] & COLOR_MASK, own, regs[REG_SPRITE_MC1] & COLOR_MASK])
+        table = np.array([-1, colours.multicolor0, own, colours.multicolor1])
         numbers = table[values]
     else:
         numbers = np.where(decode(state.sprite_data[n]) == 1, own, -1)
@@ -220,16 +217,14 @@ def _zoom_sets(state: VicState, collisions: FrameCollisions) -> list[tuple[str, 
     """(title, image rows, image cols) of each colliding pair, of each sprite over graphics, or of
     all sprites when nothing collides."""
     sets = []
-    ss_lines, ss_xs = collisions.ss_pixels
     for a, b in collisions.pairs[:ZOOM_PANELS]:
-        both = ((collisions.ss_pixel_bits >> a) & 1).astype(bool) & ((collisions.ss_pixel_bits >> b) & 1).astype(bool)
-        if both.any():
-            sets.append((f"sprites {a}+{b}", *_image_position(state, ss_lines[both], ss_xs[both])))
-    sb_lines, sb_xs = collisions.sb_pixels
+        lines, xs = collisions.pair_pixels(a, b)
+        if lines.size:
+            sets.append((f"sprites {a}+{b}", *_image_position(state, lines, xs)))
     for n in range(SPRITE_COUNT):
-        mine = collisions.sb_pixel_bits == (1 << n)
-        if mine.any() and len(sets) < ZOOM_PANELS:
-            sets.append((f"sprite {n} over graphics", *_image_position(state, sb_lines[mine], sb_xs[mine])))
+        lines, xs = collisions.background_pixels(n)
+        if lines.size and len(sets) < ZOOM_PANELS:
+            sets.append((f"sprite {n} over graphics", *_image_position(state, lines, xs)))
     if not sets:
         box = _zoom_box(state, collisions)
         if box is not None:

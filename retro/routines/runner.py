@@ -22,7 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from retro.assembler import requested_tables
-from retro.cpu.batch import BatchCpu, LaneMemoryFull
+from retro.cpu.batch import BatchCpu
+from retro.cpu.lane_memory import LaneMemoryFull
 from retro.cpu.machine import (
     CALL_STACK_TOP,
     DEFAULT_BUDGET,
@@ -137,13 +138,69 @@ class BatchOutcome:
     cycles: np.ndarray
     error: np.ndarray
 
-    def case_outputs(self, i: int) -> tuple:
-        return row_of(self.outputs, i)
-
 
 def row_of(arrays: list, i: int) -> tuple:
     """Case i of per-output arrays ((n,) numbers or (n, bytes) tables) as the tuple a scalar run gives."""
     return tuple(tuple(a[i].tolist()) if a.ndim == 2 else int(a[i]) for a in arrays)
+
+
+def _case_byte(value: Sequence[int], k: int) -> int:
+    return value[k]
+
+
+def _column_byte(value: np.ndarray, k: int) -> np.ndarray:
+    return value[:, k]
+
+
+@dataclass(frozen=True)
+class InputPlan:
+    """Where each input goes, worked out once per routine so a call does no lookups by name; the
+    same plan puts one case (numbers) or a column block (arrays, one element per lane) in place."""
+
+    registers: tuple[tuple[int, str, int], ...]  # (input index, register, byte shift)
+    flags: tuple[tuple[int, int], ...]  # (input index, P bit)
+    bytes: tuple[tuple[int, int, int], ...]  # (input index, address, byte shift)
+    tables: tuple[tuple[int, tuple[int, ...]], ...]  # (input index, addresses)
+    base_flags: int  # P before the flag inputs: the default flags without those the inputs set
+    output_addresses: tuple[int, ...]  # output places in memory (restored before each Machine call)
+
+    @classmethod
+    def of(cls, routine: Routine) -> "InputPlan":
+        registers, flags, places, tables = [], [], [], []
+        for index, port in enumerate(routine.inputs):
+            if port.flag:
+                flags.append((index, port.places[0].bit))
+            elif port.table:
+                tables.append((index, tuple(p.address for p in port.places)))
+            else:
+                for byte, place in enumerate(port.places):
+                    if place.kind == "register":
+                        registers.append((index, place.register, 8 * byte))
+                    else:
+                        places.append((index, place.address, 8 * byte))
+        forced = 0
+        for _, bit in flags:
+            forced |= bit
+        outputs = sorted({place.address for port in routine.outputs for place in port.places if place.kind == "memory"})
+        return cls(tuple(registers), tuple(flags), tuple(places), tuple(tables), DEFAULT_FLAGS & ~forced,
+                   tuple(outputs))
+
+    def place(self, values: Sequence, table_byte: Callable, write: Callable) -> tuple[dict[str, object], object]:
+        """Put `values` (one per input: numbers, or arrays of lanes) in place: `write(address, byte)`
+        for every memory byte as it is made (a block's arrays are consumed while in cache), and
+        (register values, P) returned; `table_byte(value, k)` is byte k of a table input's value."""
+        for index, address, shift in self.bytes:
+            write(address, (values[index] >> shift) & 0xFF)
+        for index, addresses in self.tables:
+            for k, address in enumerate(addresses):
+                write(address, table_byte(values[index], k))
+        registers = {"a": 0, "x": 0, "y": 0}
+        for index, register, shift in self.registers:
+            registers[register] |= (values[index] >> shift) & 0xFF
+        p = self.base_flags
+        for index, bit in self.flags:
+            p |= (values[index] != 0) * bit
+        return registers, p
 
 
 @dataclass(frozen=True)
@@ -158,13 +215,10 @@ class RasterStart:
 
 class RoutineRunner:
     def __init__(self, routine: Routine, seed: int = 0, start: RasterStart | None = None) -> None:
-        from retro.loaders import load_program
-
         self.routine = routine
         self.seed = seed
         self.start = start
-        self.program = load_program(routine.program_file, symbols=routine.symbols_file, load=routine.load,
-                                    cpu=routine.cpu)
+        self.program = routine.program  # read once, by the spec
         self.vic = None
         if start is None:
             self.machine = build_machine(cpu=routine.cpu)
@@ -178,7 +232,7 @@ class RoutineRunner:
             self.vic = vic_of(self.machine)
         self.machine.load(self.program)
         self.last_stolen = 0  # cycles of the last call in which the VIC-II held the CPU
-        self.entry = self.machine.resolve(routine.entry, "program.entry")
+        self.entry = routine.entry_address
         self.memory_values = memory_values(routine, seed)
         memory = self.machine.memory
         for block in routine.memory:
@@ -186,57 +240,25 @@ class RoutineRunner:
             memory[block.address:block.address + len(data)] = list(data)
         self.code_image = bytes(self.machine.memory)  # before init and the cases patch anything
         if routine.init is not None:
-            self.machine.call_fast(self.machine.resolve(routine.init, "program.init"), budget=self.limit)
+            self.machine.call_fast(routine.init_address, budget=self.limit)
         self.call_image = bytearray(self.machine.memory)  # what every call starts from (the batch's image)
         # (indirect),Y instructions: the timing model needs their pointer (and the 65C02's BBR/BBS the
         # zero-page byte they test). Every byte of the program that could be such an opcode is listed;
         # a data byte in the set only costs a lookup.
         indirect_y = {opcode for opcode, op in timing_table(routine.cpu).items() if op.mode in ("iny", "zpr")}
         self.pointer_pcs = frozenset(self.program.origin + i for i, b in enumerate(self.program.code) if b in indirect_y)
-        self._plan()
+        self.plan = InputPlan.of(routine)
 
     @property
     def limit(self) -> int:
         return self.routine.limit or DEFAULT_BUDGET
 
-    def _plan(self) -> None:
-        """Precompute how each input is stored, so a call does no lookups by name."""
-        self.register_inputs: list[tuple[int, str, int]] = []  # (case index, register, byte shift)
-        self.flag_inputs: list[tuple[int, int]] = []  # (case index, P bit)
-        self.byte_inputs: list[tuple[int, int, int]] = []  # (case index, address, byte shift)
-        self.table_inputs: list[tuple[int, tuple[int, ...]]] = []  # (case index, addresses)
-        for index, port in enumerate(self.routine.inputs):
-            if port.flag:
-                self.flag_inputs.append((index, port.places[0].bit))
-            elif port.table:
-                self.table_inputs.append((index, tuple(p.address for p in port.places)))
-            else:
-                for byte, place in enumerate(port.places):
-                    if place.kind == "register":
-                        self.register_inputs.append((index, place.register, 8 * byte))
-                    else:
-                        self.byte_inputs.append((index, place.address, 8 * byte))
-        forced = 0
-        for _, bit in self.flag_inputs:
-            forced |= bit
-        self.base_flags = DEFAULT_FLAGS & ~forced
-        self.output_addresses = tuple(sorted({place.address for port in self.routine.outputs for place in port.places
-                                              if place.kind == "memory"}))
-
     def inputs_for_call(self, case: Sequence) -> tuple[list[tuple[int, int]], dict[str, int], int]:
-        """(memory writes, register values, P) that put the case where the spec says."""
+        """(memory writes, register values, P) that put the case where the spec says; the output
+        places in memory are restored first (see the module's docstring)."""
         image = self.call_image
-        writes = [(address, image[address]) for address in self.output_addresses]
-        writes += [(address, (case[index] >> shift) & 0xFF) for index, address, shift in self.byte_inputs]
-        for index, addresses in self.table_inputs:
-            writes.extend(zip(addresses, case[index]))
-        registers = {"a": 0, "x": 0, "y": 0}
-        for index, register, shift in self.register_inputs:
-            registers[register] |= (case[index] >> shift) & 0xFF
-        p = self.base_flags
-        for index, bit in self.flag_inputs:
-            if case[index]:
-                p |= bit
+        writes = [(address, image[address]) for address in self.plan.output_addresses]
+        registers, p = self.plan.place(case, _case_byte, lambda address, byte: writes.append((address, byte)))
         return writes, registers, p
 
     def run(self, case: Sequence, record: list | None = None) -> tuple[tuple, int]:
@@ -293,17 +315,11 @@ class RoutineRunner:
         image = bytearray(self.call_image)
         stack_pointer = push_return_trap(image)
         cpu = BatchCpu(self.routine.cpu, image, n)
-        registers = {"a": cpu.a, "x": cpu.x, "y": cpu.y}
-        for index, register, shift in self.register_inputs:
-            registers[register] |= ((columns[index] >> shift) & 0xFF).astype(np.int32)
-        cpu.p[:] = (self.base_flags | FLAG_U) & ~FLAG_B  # as Machine sets P
-        for index, bit in self.flag_inputs:
-            cpu.p |= np.where(columns[index] != 0, bit, 0).astype(np.int32)
-        for index, address, shift in self.byte_inputs:
-            cpu.memory.fill(address, (columns[index] >> shift) & 0xFF)
-        for index, addresses in self.table_inputs:
-            for byte, address in enumerate(addresses):
-                cpu.memory.fill(address, columns[index][:, byte])
+        registers, p = self.plan.place(columns, _column_byte, cpu.memory.fill)
+        for name, value in registers.items():
+            lanes = getattr(cpu, name)
+            lanes |= np.asarray(value).astype(lanes.dtype)
+        cpu.p[:] = (p | FLAG_U) & ~FLAG_B  # as Machine sets P
         cpu.sp[:] = stack_pointer
         cpu.call(self.entry, self.limit, RETURN_TRAP, CALL_STACK_TOP)
         outputs = port_values(self.routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,
@@ -327,7 +343,7 @@ class RoutineRunner:
         """Bytes of code, lookup tables and caller-filled storage of the routine's program."""
         source = self.routine.program_file
         text = read_text(source, "source file") if source.suffix.lower() in (".s", ".asm", ".oph") else None
-        entries = [self.entry] + ([self.machine.resolve(self.routine.init)] if self.routine.init else [])
+        entries = [self.entry] + ([self.routine.init_address] if self.routine.init is not None else [])
         return program_size(self.program, text, entries, self.code_image.__getitem__, self.routine.cpu)
 
 

@@ -16,113 +16,50 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import inspect
-import re
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 
-from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z, VARIANTS
+from retro.cpu.mpu import VARIANTS
 from retro.machines import BARE, MACHINE_CPUS, MACHINES, machine_for
 from retro.errors import InputError
 from retro.fields import Fields, describe
 from retro.fileio import cached_reads, is_dir, note_input, parse_toml, read_bytes
 from retro.loaders import load_program
 from retro.program import Program
+from retro.routines.places import (
+    BYTE_VALUES,
+    MAX_TABLE,
+    Port,
+    no_overlap,
+    parse_values,
+    places_of,
+    port_of,
+    resolve,
+)
 from retro.routines.rows import Row, misplaced_rows, parse_rows
 from retro.routines.where import Condition, parse_where
 
-BYTE_VALUES = 256
 MAX_EXHAUSTIVE = 1 << 32  # cases in an exhaustive set
 MAX_RANDOM = 10 ** 9
 DEFAULT_RANDOM = 10_000  # random cases when a spec does not say (2,000 of them without --exhaustive)
-MAX_TABLE = 0x10000
 MAX_SPEC_BYTES = 1 << 20  # a spec file is a page of TOML, never megabytes
 MAX_LOOP_BOUND = 1 << 20
 NUMBER_CHARACTERS = 40  # the longest number a spec may write as text
-REGISTERS = ("A", "X", "Y")
-FLAGS = {"C": FLAG_C, "Z": FLAG_Z, "I": FLAG_I, "D": FLAG_D, "V": FLAG_V, "N": FLAG_N}
 CPUS = tuple(VARIANTS)
 
 TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows"}
 PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load"}
-PORT_KEYS = {"at", "size", "values", "table"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays"}
 CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage"}
 CYCLES_KEYS = {"max", "loops", "limit", "static"}
 
-_LABEL = re.compile(r"^(?P<name>[A-Za-z_@.][\w.:@]*)\s*(?:(?P<sign>[+-])\s*(?P<offset>\S+))?$")
 
 
 # ---- plain data ----------------------------------------------------------------------------------
-
-@dataclass(frozen=True)
-class Place:
-    """Where one byte (or one flag bit) of a value lives."""
-
-    kind: str  # "register" (A/X/Y), "flag" (a P bit) or "memory"
-    register: str = ""  # "a", "x", "y" for registers
-    bit: int = 0  # the P bit for flags
-    address: int = 0  # for memory
-
-    def describe(self) -> str:
-        if self.kind == "register":
-            return self.register.upper()
-        if self.kind == "flag":
-            return next(name for name, bit in FLAGS.items() if bit == self.bit)
-        return f"${self.address:04X}"
-
-
-@dataclass(frozen=True)
-class Values:
-    """The values an input (or each byte of a table input) takes: lo..hi, or a list."""
-
-    lo: int
-    hi: int
-    listed: tuple[int, ...] | None = None
-
-    @property
-    def count(self) -> int:
-        return len(self.listed) if self.listed is not None else self.hi - self.lo + 1
-
-    def at(self, index: int) -> int:
-        return self.listed[index] if self.listed is not None else self.lo + index
-
-    def describe(self) -> str:
-        if self.listed is not None:
-            return "[" + ", ".join(str(v) for v in self.listed[:8]) + (", ..." if len(self.listed) > 8 else "") + "]"
-        return f"{self.lo}..{self.hi}"
-
-
-@dataclass(frozen=True)
-class Port:
-    """An input or an output: a number over one or more byte places (low byte first), or a table."""
-
-    name: str
-    places: tuple[Place, ...]
-    table: bool = False  # a list of bytes at consecutive addresses, not one number
-    values: Values | None = None  # inputs only: per value (per byte for a table)
-
-    @property
-    def flag(self) -> bool:
-        return self.places[0].kind == "flag"
-
-    @property
-    def bits(self) -> int:
-        return 1 if self.flag else 8 * (1 if self.table else len(self.places))
-
-    @property
-    def count(self) -> int:
-        """How many distinct values the input takes (a table: per byte, to the power of its size)."""
-        return self.values.count ** len(self.places) if self.table else self.values.count
-
-    def describe(self) -> str:
-        if self.table:
-            return f"{len(self.places)} bytes at {self.places[0].describe()}"
-        return "+".join(p.describe() for p in self.places)
-
 
 @dataclass(frozen=True)
 class MemoryBlock:
@@ -153,6 +90,10 @@ class Routine:
     reference_name: str
     reference_memory: tuple[str, ...]  # memory blocks the reference takes by name
     reference_arrays: bool = False  # the reference takes numpy arrays (one element per case) and answers so
+    program: Program | None = None  # the program, read once when the spec is loaded
+    entry_address: int = 0  # entry, init and the loop labels resolved against its symbols
+    init_address: int | None = None
+    loop_addresses: dict[int, int] = field(default_factory=dict)  # loop header address -> bound
     exhaustive: tuple[str, ...] = ()
     random: int = 0
     seed: int = 0
@@ -236,9 +177,47 @@ def _machine(r: Fields, program_doc: dict, cpu: str) -> str:
 
 
 def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
+    """A spec document -> a loaded `Routine`: the program read once and every label resolved here,
+    each section read by its own function below (every error names the file and the key)."""
     r = Fields(shown or str(path), folder=path.parent, number_characters=NUMBER_CHARACTERS)
     r.table(doc, "", TOP_KEYS)
     misplaced_rows(r, doc)
+    program = _program_section(r, doc)
+    inputs, outputs, memory = _places_sections(r, doc, program.program)
+    rows = parse_rows(r, doc["rows"], inputs, outputs) if "rows" in doc else ()
+    reference = _reference_section(r, doc, inputs, memory, rows)
+    cases = _cases_section(r, doc, inputs, answered=reference["reference"] is not None)
+    cycles = _cycles_section(r, doc, program.program)
+    routine = Routine(name=_text(r, doc, "name", "name") or path.stem, spec_path=path, **program.fields(),
+                      inputs=inputs, outputs=outputs, memory=memory, **reference, **cases, **cycles,
+                      summary=_summary(r, doc), rows=rows, notes=program.program.notes)
+    if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep or routine.rows):
+        raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary, sweep or [[rows]]")
+    if routine.exhaustive_count() > MAX_EXHAUSTIVE:
+        raise r.error("cases.exhaustive", f"{routine.exhaustive_count():,} cases is more than 2^32: "
+                                         "narrow the inputs' values or sweep fewer inputs")
+    return routine
+
+
+@dataclass(frozen=True)
+class _ProgramSection:
+    program_file: Path
+    symbols_file: Path | None
+    load: int | None
+    cpu: str
+    machine: str
+    entry: str
+    init: str | None
+    program: Program
+    entry_address: int
+    init_address: int | None
+
+    def fields(self) -> dict:
+        return dict(self.__dict__)
+
+
+def _program_section(r: Fields, doc: dict) -> _ProgramSection:
+    """[program]: the file read once, its CPU and machine, entry and init resolved to addresses inside it."""
     program_doc = r.table(r.required(doc, "program", hint="the [program] table"), "program", PROGRAM_KEYS)
     program_file = r.file(_text(r, program_doc, "file", "program.file", required=True), "program.file", resolve=True)
     symbols_name = _text(r, program_doc, "symbols", "program.symbols")
@@ -250,8 +229,8 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     try:
         program = load_program(program_file, symbols=symbols_file, load=load, cpu=cpu)
     except InputError as exc:  # named by the key that named the file
-        field = "program.symbols" if symbols_file and str(exc).startswith(str(symbols_file)) else "program.file"
-        raise r.error(field, str(exc)) from None
+        field_name = "program.symbols" if symbols_file and str(exc).startswith(str(symbols_file)) else "program.file"
+        raise r.error(field_name, str(exc)) from None
     if cpu is not None and program.cpu is not None and cpu != program.cpu:
         raise r.error("program.cpu", f"{program_file.name} is a program for the {program.cpu.upper()}, "
                                      f"not the {cpu.upper()}")
@@ -259,37 +238,52 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     machine = _machine(r, program_doc, cpu)
     entry = _entry_text(r, program_doc, "entry", required=True)
     init = _entry_text(r, program_doc, "init")
-    for field_name, text in (("program.entry", entry), ("program.init", init)):
-        if text is not None:
-            _in_program(r, program, _resolve(r, program, text, field_name), field_name)
+    entry_address = _in_program(r, program, resolve(r, program, entry, "program.entry"), "program.entry")
+    init_address = (_in_program(r, program, resolve(r, program, init, "program.init"), "program.init")
+                    if init is not None else None)
+    return _ProgramSection(program_file, symbols_file, load, cpu, machine, entry, init, program,
+                           entry_address, init_address)
 
-    inputs = tuple(_port(r, program, name, value, "inputs", is_input=True)
+
+def _places_sections(r: Fields, doc: dict, program: Program) -> tuple[tuple[Port, ...], tuple[Port, ...],
+                                                                     tuple[MemoryBlock, ...]]:
+    """[inputs], [outputs] and [memory]: where every value lives, none overlapping."""
+    inputs = tuple(port_of(r, program, name, value, "inputs", is_input=True)
                    for name, value in r.table(r.required(doc, "inputs", hint="the [inputs] table"), "inputs").items())
-    outputs = tuple(_port(r, program, name, value, "outputs", is_input=False)
+    outputs = tuple(port_of(r, program, name, value, "outputs", is_input=False)
                     for name, value in r.table(r.required(doc, "outputs", hint="the [outputs] table"),
                                                "outputs").items())
     if not outputs:
         raise r.error("outputs", "names no output")
-    _no_overlap(r, inputs, "inputs")
+    no_overlap(r, inputs, "inputs")
     memory = tuple(_memory_block(r, program, name, value)
                    for name, value in r.table(doc.get("memory", {}), "memory").items())
     _no_overlap_memory(r, memory, inputs)
+    return inputs, outputs, memory
 
-    rows = parse_rows(r, doc["rows"], inputs, outputs) if "rows" in doc else ()
-    if rows and "reference" not in doc:  # a spec of rows only: the rows say what the routine must answer
+
+def _reference_section(r: Fields, doc: dict, inputs: tuple[Port, ...], memory: tuple[MemoryBlock, ...],
+                       rows: tuple[Row, ...]) -> dict:
+    """[reference]: the function, the memory blocks it takes, whether it works on arrays; none in a
+    spec of rows only (the rows say what the routine must answer)."""
+    if rows and "reference" not in doc:
         if "cases" in doc:
             raise r.error("cases", "without a [reference] no answer is known for generated cases: write them as rows, "
                                    "or add a [reference]")
-        reference, reference_name, reference_memory, reference_arrays = None, "", (), False
-    else:
-        reference_doc = r.table(r.required(doc, "reference", hint="the [reference] table, or [[rows]]"), "reference",
-                                REFERENCE_KEYS)
-        reference_name = _text(r, reference_doc, "function", "reference.function", required=True)
-        reference = load_function(reference_name, r, "reference.function")
-        reference_memory = _reference_signature(r, reference, reference_name, inputs, memory)
-        # true: the function takes numpy arrays, one element per case
-        reference_arrays = r.flag(reference_doc.get("arrays", False), "reference.arrays")
+        return {"reference": None, "reference_name": "", "reference_memory": (), "reference_arrays": False}
+    reference_doc = r.table(r.required(doc, "reference", hint="the [reference] table, or [[rows]]"), "reference",
+                            REFERENCE_KEYS)
+    reference_name = _text(r, reference_doc, "function", "reference.function", required=True)
+    reference = load_function(reference_name, r, "reference.function")
+    return {"reference": reference, "reference_name": reference_name,
+            "reference_memory": _reference_signature(r, reference, reference_name, inputs, memory),
+            # true: the function takes numpy arrays, one element per case
+            "reference_arrays": r.flag(reference_doc.get("arrays", False), "reference.arrays")}
 
+
+def _cases_section(r: Fields, doc: dict, inputs: tuple[Port, ...], answered: bool) -> dict:
+    """[cases]: exhaustive inputs, random count and seed, the `where` domain, generators. `answered`:
+    the spec has a reference (rows only: no generated cases unless asked for)."""
     cases_doc = r.table(doc.get("cases", {}), "cases", CASES_KEYS)
     names = tuple(p.name for p in inputs)
     exhaustive = cases_doc.get("exhaustive", [])
@@ -300,44 +294,40 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
             raise r.error("cases.exhaustive", f"unknown input {n!r} (inputs: {', '.join(names)})")
     if len(set(exhaustive)) != len(exhaustive):
         raise r.error("cases.exhaustive", "an input is named twice")
-    random_default = DEFAULT_RANDOM if reference is not None else 0  # rows only: no generated cases
-    random_count = r.integer(cases_doc.get("random", random_default), "cases.random", 0, MAX_RANDOM)
-    seed = r.integer(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1)
     where = cases_doc.get("where")
-    coverage = _text(r, cases_doc, "coverage", "cases.coverage") or ""
     tables = frozenset(p.name for p in inputs if p.table)
-    domain = parse_where(where, names, f"{r.source}: cases.where", tables) if where is not None else ()
     generators = {key: load_function(_text(r, cases_doc, key, f"cases.{key}"), r, f"cases.{key}")
                   for key in ("boundary", "sweep", "random_generator") if key in cases_doc}
+    return {"exhaustive": tuple(exhaustive),
+            "random": r.integer(cases_doc.get("random", DEFAULT_RANDOM if answered else 0), "cases.random", 0,
+                                MAX_RANDOM),
+            "seed": r.integer(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1),
+            "coverage": _text(r, cases_doc, "coverage", "cases.coverage") or "",
+            "domain": parse_where(where, names, f"{r.source}: cases.where", tables) if where is not None else (),
+            "boundary": generators.get("boundary"), "sweep": generators.get("sweep"),
+            "random_generator": generators.get("random_generator")}
 
+
+def _cycles_section(r: Fields, doc: dict, program: Program) -> dict:
+    """[cycles]: budget, runaway limit, loop bounds (labels resolved to addresses), static on/off."""
     cycles_doc = r.table(doc.get("cycles", {}), "cycles", CYCLES_KEYS)
-    budget = r.integer(cycles_doc["max"], "cycles.max", 1, 1 << 40) if "max" in cycles_doc else None
-    limit = r.integer(cycles_doc["limit"], "cycles.limit", 1, 1 << 40) if "limit" in cycles_doc else None
     loops_doc = r.table(cycles_doc.get("loops", {}), "cycles.loops")  # label = bound, e.g. { loop = 8 }
-    loop_bounds = {}
+    loop_bounds, loop_addresses = {}, {}
     for label, bound in loops_doc.items():
-        _resolve(r, program, label, f"cycles.loops.{label}")
+        address = resolve(r, program, label, f"cycles.loops.{label}")
         loop_bounds[label] = r.integer(bound, f"cycles.loops.{label}", 1, MAX_LOOP_BOUND)
-    static = r.flag(cycles_doc.get("static", True), "cycles.static")
+        loop_addresses[address] = loop_bounds[label]
+    return {"budget": r.integer(cycles_doc["max"], "cycles.max", 1, 1 << 40) if "max" in cycles_doc else None,
+            "limit": r.integer(cycles_doc["limit"], "cycles.limit", 1, 1 << 40) if "limit" in cycles_doc else None,
+            "loop_bounds": loop_bounds, "loop_addresses": loop_addresses,
+            "static": r.flag(cycles_doc.get("static", True), "cycles.static")}
 
-    name = _text(r, doc, "name", "name") or path.stem
+
+def _summary(r: Fields, doc: dict) -> str:
     summary = doc.get("summary", "")
     if not isinstance(summary, str):
         raise r.error("summary", f"expected a string, got {describe(summary)}")
-    routine = Routine(
-        name=name, spec_path=path, program_file=program_file, symbols_file=symbols_file, load=load, entry=entry,
-        cpu=cpu, machine=machine, init=init, inputs=inputs, outputs=outputs, memory=memory, reference=reference,
-        reference_name=reference_name, reference_memory=reference_memory, reference_arrays=reference_arrays, exhaustive=tuple(exhaustive),
-        random=random_count, seed=seed, domain=domain, boundary=generators.get("boundary"),
-        sweep=generators.get("sweep"), random_generator=generators.get("random_generator"), budget=budget,
-        loop_bounds=loop_bounds, limit=limit, static=static, summary=summary, coverage=coverage, rows=rows,
-        notes=program.notes)
-    if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep or routine.rows):
-        raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary, sweep or [[rows]]")
-    if routine.exhaustive_count() > MAX_EXHAUSTIVE:
-        raise r.error("cases.exhaustive", f"{routine.exhaustive_count():,} cases is more than 2^32: "
-                                         "narrow the inputs' values or sweep fewer inputs")
-    return routine
+    return summary
 
 
 def _text(r: Fields, doc: dict, key: str, field: str, required: bool = False) -> str | None:
@@ -358,124 +348,11 @@ def _entry_text(r: Fields, doc: dict, key: str, required: bool = False) -> str |
     return _text(r, doc, key, f"program.{key}")
 
 
-def _in_program(r: Fields, program: Program, address: int, field_name: str) -> None:
+def _in_program(r: Fields, program: Program, address: int, field_name: str) -> int:
     """A routine starts in the program's bytes: elsewhere the 6502 would run zeroed RAM."""
     if not program.origin <= address < program.end:
         raise r.error(field_name, f"${address:04X} is outside the program (${program.origin:04X}-${program.end - 1:04X})")
-
-
-def _resolve(r: Fields, program: Program, text: str, field_name: str) -> int:
-    """A label (optionally `label+N`) of the program, or an address."""
-    text = str(text).strip()
-    if text in program.symbols:
-        return program.symbols[text]
-    if text in program.ambiguous:
-        from retro.program import ambiguity_message
-
-        raise r.error(field_name, ambiguity_message(text, program.ambiguous[text]))
-    if text[:1] in "$%" or text[:1].isdigit():
-        return r.integer(text, field_name, 0, 0xFFFF)
-    match = _LABEL.match(text)
-    if match and match.group("sign"):
-        base = _resolve(r, program, match.group("name"), field_name)
-        offset = r.integer(match.group("offset"), field_name, 0, 0xFFFF)
-        address = base + offset if match.group("sign") == "+" else base - offset
-        if not 0 <= address <= 0xFFFF:
-            raise r.error(field_name, f"{text} is outside $0000-$FFFF")
-        return address
-    hint = " (registers are written A, X, Y and flags C, Z, I, D, V, N)" if text.upper() in (*REGISTERS, *FLAGS) else ""
-    if not program.symbols:
-        hint = f" ({program.source or 'the program'} has no symbols: give [program] symbols, or an address)"
-    raise r.error(field_name, f"unknown label {text!r}{hint}")
-
-
-def _places(r: Fields, program: Program, at, size: int | None, key: str) -> tuple[Place, ...]:
-    items = at if isinstance(at, list) else [at]
-    if not items:
-        raise r.error(key, "expected a register, flag, label or address")
-    places: list[Place] = []
-    for item in items:
-        if isinstance(item, int) and not isinstance(item, bool):
-            item = str(item)
-        if not isinstance(item, str) or not item.strip():
-            raise r.error(key, f"expected a register, flag, label or address, got {item!r:.40}")
-        text = item.strip()
-        if text in REGISTERS:
-            places.append(Place("register", register=text.lower()))
-        elif text in FLAGS:
-            places.append(Place("flag", bit=FLAGS[text]))
-        else:
-            places.append(Place("memory", address=_resolve(r, program, text, key)))
-    if size is not None:
-        if len(places) != 1 or places[0].kind != "memory":
-            raise r.error(key, "size goes with one memory location (a label or an address)")
-        start = places[0].address
-        if start + size > 0x10000:
-            raise r.error(key, f"{size} bytes from ${start:04X} run past $FFFF")
-        places = [Place("memory", address=start + i) for i in range(size)]
-    if any(p.kind == "flag" for p in places) and len(places) > 1:
-        raise r.error(key, "a flag is one bit: it cannot be combined with other places")
-    return tuple(places)
-
-
-def parse_values(r: Fields, value, key: str) -> Values:
-    if isinstance(value, str):
-        lo_text, sep, hi_text = value.partition("..")
-        if not sep:
-            raise r.error(key, f"expected a range LO..HI or a list, got {value!r:.40}")
-        lo = r.integer(lo_text.strip(), key, 0, (1 << 32) - 1)
-        hi = r.integer(hi_text.strip(), key, 0, (1 << 32) - 1)
-        if hi < lo:
-            raise r.error(key, f"empty range {value!r}")
-        return Values(lo, hi)
-    if isinstance(value, list):
-        if not value:
-            raise r.error(key, "the list of values is empty")
-        if len(value) > MAX_TABLE:
-            raise r.error(key, f"more than {MAX_TABLE} listed values")
-        listed = tuple(dict.fromkeys(r.integer(v, key, 0, (1 << 32) - 1) for v in value))
-        return Values(min(listed), max(listed), listed)
-    raise r.error(key, f"expected a range \"LO..HI\" or a list of numbers, got {describe(value)}")
-
-
-def _port(r: Fields, program: Program, name: str, value, section: str, is_input: bool) -> Port:
-    key = f"{section}.{name}"
-    if not name.isidentifier() or name.startswith("__"):
-        raise r.error(key, "a name must be a Python identifier (it names the reference's argument)")
-    doc = {"at": value} if isinstance(value, (str, list)) else value
-    if not isinstance(doc, dict):
-        raise r.error(key, "expected a location (\"A\", \"C\", \"label\", \"$fb\") or a table { at = ... }")
-    r.known(doc, key, PORT_KEYS if is_input else PORT_KEYS - {"values"})
-    r.required(doc, "at", key)
-    size = r.integer(doc["size"], f"{key}.size", 1, MAX_TABLE) if "size" in doc else None
-    places = _places(r, program, doc["at"], size, f"{key}.at")
-    values = parse_values(r, doc["values"], f"{key}.values") if "values" in doc else None
-    table_flag = r.flag(doc["table"], f"{key}.table") if "table" in doc else None
-    # `size` N with byte values is a table of N bytes; otherwise an N-byte little-endian number
-    table = table_flag if table_flag is not None else (
-        size is not None and size > 1 and values is not None and values.hi < BYTE_VALUES)
-    if table and (size is None or places[0].kind != "memory"):
-        raise r.error(f"{key}.table", "a table needs a memory location and a size")
-    port = Port(name, places, table, None)
-    width = 1 << port.bits
-    if values is None and is_input:
-        values = Values(0, (BYTE_VALUES if table else width) - 1)
-    if values is not None:
-        limit = BYTE_VALUES if table else width
-        if values.hi >= limit:
-            raise r.error(f"{key}.values", f"{values.describe()} does not fit in {port.describe()} "
-                                          f"({'each byte ' if table else ''}0..{limit - 1})")
-    return Port(name, places, table, values)
-
-
-def _no_overlap(r: Fields, ports: tuple[Port, ...], section: str) -> None:
-    owner: dict[Place, str] = {}
-    for port in ports:
-        for place in port.places:
-            if place in owner:
-                raise r.error(f"{section}.{port.name}.at",
-                              f"{place.describe()} is also where {section}.{owner[place]} goes")
-            owner[place] = port.name
+    return address
 
 
 def _memory_block(r: Fields, program: Program, name: str, doc) -> MemoryBlock:
@@ -486,7 +363,7 @@ def _memory_block(r: Fields, program: Program, name: str, doc) -> MemoryBlock:
         raise r.error(key, "expected a table { at = ..., bytes = [...] | file = ... | generator = ... | values + size }")
     r.known(doc, key, MEMORY_KEYS)
     r.required(doc, "at", key)
-    (place,) = _places(r, program, doc["at"], None, f"{key}.at")[:1] or (None,)
+    (place,) = places_of(r, program, doc["at"], None, f"{key}.at")[:1] or (None,)
     if place is None or place.kind != "memory" or isinstance(doc["at"], list):
         raise r.error(f"{key}.at", "expected one label or address")
     source = r.exactly_one(doc, ("bytes", "file", "generator", "values", "fill"), key)

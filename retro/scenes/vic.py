@@ -23,8 +23,6 @@ from retro.chips.vic.constants import (
     REG_SPRITE_EXPAND_Y,
     REG_SPRITE_MULTICOLOR,
     REG_SPRITE_PRIORITY,
-    REG_SPRITE_X0,
-    REG_SPRITE_X_MSB,
     REG_SPRITE_Y0,
     REGISTER_COUNT,
     SCREEN_CELLS,
@@ -39,6 +37,7 @@ from retro.chips.vic.constants import (
 )
 from retro.chips.vic.graphics import VicMemory
 from retro.chips.vic.model import VicState
+from retro.chips.vic.sprite_registers import set_sprite_x
 from retro.errors import InputError
 from retro.fields import Fields
 from retro.fileio import read_bytes
@@ -116,11 +115,23 @@ def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: Fields) 
     if n in seen:
         raise where.error(f"{name}.index", f"sprite {n} is declared twice")
     seen.add(n)
+    _sprite_registers(entry, n, name, registers, where)
+    velocity = (0, 0)
+    if "velocity" in entry:
+        value = entry["velocity"]
+        if not isinstance(value, list) or len(value) != 2:
+            raise where.error(f"{name}.velocity", "expected [dx, dy]: pixels added to X and Y every frame")
+        velocity = tuple(where.integer(v, f"{name}.velocity", -MAX_SPEED, MAX_SPEED) for v in value)
+    data, source = _sprite_data(entry, n, name, registers, where)
+    return SpriteSpec(n, data[:SPRITE_BYTES], source, velocity)
+
+
+def _sprite_registers(entry: dict, n: int, name: str, registers: bytearray, where: Fields) -> None:
+    """A sprite's place, flags and colour into the register image."""
     bit = 1 << n
     if "x" in entry:
         x = where.integer(entry["x"], f"{name}.x", 0, X_BITS_MASK)
-        registers[REG_SPRITE_X0 + 2 * n] = x & 0xFF
-        registers[REG_SPRITE_X_MSB] = (registers[REG_SPRITE_X_MSB] & ~bit) | (bit if x >> 8 else 0)
+        set_sprite_x(registers, n, x)
     if "y" in entry:
         registers[REG_SPRITE_Y0 + 2 * n] = where.integer(entry["y"], f"{name}.y", 0, Y_COMPARE_MASK)
     flags = {"enabled": True, **{k: entry[k] for k in SPRITE_FLAGS if k in entry}}
@@ -130,30 +141,26 @@ def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: Fields) 
         registers[register] = (registers[register] & ~bit) | (bit if on else 0)
     if "color" in entry:
         registers[REG_SPRITE_COLOR0 + n] = where.integer(entry["color"], f"{name}.color", 0, COLOR_MASK)
-    velocity = (0, 0)
-    if "velocity" in entry:
-        value = entry["velocity"]
-        if not isinstance(value, list) or len(value) != 2:
-            raise where.error(f"{name}.velocity", "expected [dx, dy]: pixels added to X and Y every frame")
-        velocity = tuple(where.integer(v, f"{name}.velocity", -MAX_SPEED, MAX_SPEED) for v in value)
-    multicolor = bool(registers[REG_SPRITE_MULTICOLOR] & bit)
+
+
+def _sprite_data(entry: dict, n: int, name: str, registers: bytearray, where: Fields) -> tuple[bytes, str]:
+    """The sprite's bytes from `data`, `rows` or a `file` (read in the sprite's colours), and where
+    they came from; an error in them names the sprite's key."""
+    multicolor = bool(registers[REG_SPRITE_MULTICOLOR] & (1 << n))
     kind = where.exactly_one(entry, ("data", "rows", "file"), name)
     for key in ("frame", "palette"):
         if key in entry and kind != "file":
             raise where.error(f"{name}.{key}", "goes with file")
     try:
         if kind == "data":
-            data = parse_hex(entry["data"], field="data")
-            source = "data"
-        elif kind == "rows":
-            data = parse_rows(entry["rows"], multicolor, field="rows")
-            source = "rows"
-        else:
-            path = where.file(entry["file"], f"{name}.file", "sprite file")
-            frame = where.integer(entry.get("frame", 0), f"{name}.frame", 0, 1 << 16)
-            # any sprite file, by content (retro/sprites.py); a PNG is read in this sprite's colours
-            data = read_sprite(path, frame, multicolor, scene_colours(registers, n), entry.get("palette"))
-            source = f"file {entry['file']}"
+            return parse_hex(entry["data"], field="data"), "data"
+        if kind == "rows":
+            return parse_rows(entry["rows"], multicolor, field="rows"), "rows"
+        path = where.file(entry["file"], f"{name}.file", "sprite file")
+        frame = where.integer(entry.get("frame", 0), f"{name}.frame", 0, 1 << 16)
+        # any sprite file, by content (retro/sprites.py); a PNG is read in this sprite's colours
+        data = read_sprite(path, frame, multicolor, scene_colours(registers, n), entry.get("palette"))
+        return data, f"file {entry['file']}"
     except InputError as exc:
         message = str(exc)
         if message.startswith(f"{where.source}: "):
@@ -161,7 +168,6 @@ def _sprite(entry, i: int, registers: bytearray, seen: set[int], where: Fields) 
         if message.startswith(kind) or message.startswith("rows["):
             raise InputError(f"{where.source}: {name}.{message}") from None
         raise InputError(f"{where.source}: {name}: {message}") from None
-    return SpriteSpec(n, data[:SPRITE_BYTES], source, velocity)
 
 
 def _fill_cells(spec, name: str, where: Fields, hi: int, given: tuple | None) -> np.ndarray:

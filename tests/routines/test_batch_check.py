@@ -10,9 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from retro.analysis import check as check_module
+from retro.analysis.check import check_routine
+from retro.analysis.check import engines as check_module
 from retro.cli import main
-from retro.cpu import batch
+from retro.cpu import batch, lane_memory
 from retro.errors import InputError
 from retro.routines import cases as case_sets
 from retro.routines import runner as runner_module
@@ -164,10 +165,10 @@ def test_a_batch_too_big_for_lane_memory_is_split(monkeypatch):
 
 
 def test_lane_memory_refuses_past_its_limit():
-    memory = batch.LaneMemory(bytes(0x10000), lanes=100, limit=100 * 4 * 3)
+    memory = lane_memory.LaneMemory(bytes(0x10000), lanes=100, limit=100 * 4 * 3)
     for address in (0x10, 0x11, 0x12):
         memory.row(address)
-    with pytest.raises(batch.LaneMemoryFull):
+    with pytest.raises(lane_memory.LaneMemoryFull):
         memory.row(0x13)
 
 
@@ -176,7 +177,7 @@ def test_auto_takes_the_batched_core_for_large_case_sets(capsys):
     code, (large,) = check_json(capsys, "mul8", "--random", str(check_module.AUTO_BATCH_CASES))
     assert (small["engine"], large["engine"]) == ("scalar", "batch")
     with pytest.raises(InputError):
-        check_module.check_routine("mul8", engine="gpu")
+        check_routine("mul8", engine="gpu")
 
 
 @pytest.mark.exhaustive

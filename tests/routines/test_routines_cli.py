@@ -7,7 +7,7 @@ import shutil
 
 import pytest
 
-from retro.analysis.cost import COST_FIELDS
+from retro.commands.cycles import COST_FIELDS
 from retro.cli import main
 from retro.paths import ASM_DIR
 

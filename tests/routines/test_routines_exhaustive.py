@@ -6,7 +6,7 @@ import os
 
 import pytest
 
-from retro.analysis.check import check_chunk, run_checks, static_bounds
+from retro.analysis.check import run_checks, static_bounds
 from retro.routines import reference
 from retro.routines.registry import builtin_names, get
 

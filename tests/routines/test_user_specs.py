@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from retro.analysis.cost import COST_FIELDS
+from retro.commands.cycles import COST_FIELDS
 from retro.cli import main
 
 SPECS = Path(__file__).resolve().parents[1] / "data" / "specs"
@@ -224,7 +224,7 @@ def test_a_spec_on_a_scene_counts_bad_line_stalls_from_the_start_line(tmp_path, 
 
 
 def test_cycle_model_disagreements_are_counted_and_fail(monkeypatch, capsys):
-    import retro.analysis.check as check
+    import retro.analysis.check.engines as check
 
     monkeypatch.setattr(check, "model_cycles", lambda read, steps, cpu: 1)  # a timing model that disagrees
     code, (record,) = _check_json(capsys, str(SPECS / "boxhit_xa.toml"), "--random", "10")
@@ -233,7 +233,7 @@ def test_cycle_model_disagreements_are_counted_and_fail(monkeypatch, capsys):
 
 
 def test_measured_cycles_outside_the_static_bounds_fail(monkeypatch, capsys):
-    import retro.analysis.check as check
+    import retro.analysis.check.verdicts as check
     from retro.cpu.flow import Bounds
 
     monkeypatch.setattr(check, "analyse", lambda *args, **kwargs: Bounds(best=FASTEST + 1, worst=SLOWEST - 1,

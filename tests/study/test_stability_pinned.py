@@ -167,6 +167,7 @@ def test_edges_markdown_shows_every_test_and_case(edge_rows):
 
 def _chip_pixels(video) -> list[frozenset[int]]:
     """The screen X coordinates a full sprite covers at each X register value (the model's placement)."""
+    from retro.chips.vic.constants import REG_SPRITE_X0, REG_SPRITE_X_MSB
     from retro.chips.vic.model import placement
 
     registers = bytearray(wrap.REGISTER_COUNT)
@@ -174,7 +175,7 @@ def _chip_pixels(video) -> list[frozenset[int]]:
     data = (b"\xff" * wrap.SPRITE_BYTES,) + (bytes(wrap.SPRITE_BYTES),) * (wrap.SPRITE_COUNT - 1)
     out = []
     for x in range(512):
-        registers[wrap.REG_SPRITE_X0], registers[wrap.REG_SPRITE_X_MSB] = x & 0xFF, x >> 8
+        registers[REG_SPRITE_X0], registers[REG_SPRITE_X_MSB] = x & 0xFF, x >> 8
         place = placement(wrap.VicState(video=video, registers=bytes(registers), sprite_data=data), 0)
         out.append(frozenset() if place is None else frozenset(int(v) for v in np.atleast_1d(place.xs)))
     return out

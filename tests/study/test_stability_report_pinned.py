@@ -84,6 +84,7 @@ def test_the_routines_agree_across_255_256_on_every_pair():
 
 def _chip_bits(video) -> list[int]:
     """Per X register value, the screen X coordinates a full sprite covers, as the bits of an int."""
+    from retro.chips.vic.constants import REG_SPRITE_X0, REG_SPRITE_X_MSB
     from retro.chips.vic.model import VicState, placement
 
     registers = bytearray(wrap.REGISTER_COUNT)
@@ -91,7 +92,7 @@ def _chip_bits(video) -> list[int]:
     data = (b"\xff" * wrap.SPRITE_BYTES,) + (bytes(wrap.SPRITE_BYTES),) * (wrap.SPRITE_COUNT - 1)
     out = []
     for x in range(512):
-        registers[wrap.REG_SPRITE_X0], registers[wrap.REG_SPRITE_X_MSB] = x & 0xFF, x >> 8
+        registers[REG_SPRITE_X0], registers[REG_SPRITE_X_MSB] = x & 0xFF, x >> 8
         place = placement(VicState(video=video, registers=bytes(registers), sprite_data=data), 0)
         out.append(0 if place is None else sum(1 << int(v) for v in set(np.atleast_1d(place.xs).tolist())))
     return out
@@ -120,7 +121,7 @@ def report(tmp_path_factory):
     """The reduced report, its arithmetic-range part given (that search is tested on its own)."""
     out = tmp_path_factory.mktemp("stability")
     patch = pytest.MonkeyPatch()
-    patch.setattr(ranges, "range_rows", lambda reduced=False, progress=None: STUB_RANGES)
+    patch.setattr(ranges, "range_rows", lambda reduced=False, progress=None, engine="auto": STUB_RANGES)
     try:
         output = run.run_stability(out, reduced=True)
     finally:

@@ -129,11 +129,44 @@ def _shape_key(shape: Shape) -> tuple:
 
 def advise(path: str, target: float, workers: int | None = None, progress: Progress = quiet,
            samples: int = ADVICE_COST_SAMPLES, methods: tuple[Method, ...] = METHODS, software: bool = False,
-           objects: int | None = None) -> Advice:
+           objects: int | None = None, engine: str = "auto") -> Advice:
     """`target` in (0, 1] and `objects` in 1..MAX_OBJECTS are checked by retro.commands.advise."""
     from retro.analysis.study.cost_runs import measure_costs
 
     scene = scene_objects(path)
+    methods, notes = _usable_methods(scene, methods, software)
+    indexed = scene.shapes
+    weights, jobs = _pair_jobs(indexed)
+    keys = list(jobs)
+    table = evaluate([], methods, workers=workers, progress=progress, pair_list=[jobs[k] for k in keys])
+    costs = measure_costs([], samples=samples, workers=workers, progress=progress, pair_list=[jobs[k] for k in keys],
+                          methods=methods, engine=engine)
+    sprite_count = len(indexed) if objects is None else objects
+    frames = {}
+    if objects is not None:
+        from retro.analysis.study.per_frame import best_phase, per_frame
+
+        model = per_frame(methods, {k: c.overall for k, c in costs.items()}, [s for _, s in indexed], counts=(objects,),
+                          budget=scene.budget, workers=workers, progress=progress, engine=engine)
+        frames = {m.key: best_phase(model.rows, m.key, objects) for m in methods}
+    figures = []
+    for m in methods:
+        counts = pooled([_scaled(p.counts[m.key], weights[k]) for p, k in zip(table.pairs, keys)])
+        cycles = costs[m.key].overall if m.key in costs else CycleStats.of([])
+        qualifies, note = _verdict(m, counts.accuracy >= target, cycles, costs, sprite_count, objects, frames)
+        figures.append(MethodFigures(m.key, m.label, counts, cycles, qualifies, note, frames.get(m.key)))
+    figures.sort(key=_cost_order)
+    eligible = [f for f in figures if f.qualifies]
+    return Advice(source=str(path), sprites=[n for n, _ in indexed], sprite_pairs=sum(weights.values()),
+                  cases=figures[0].counts.cases, target=target, figures=figures,
+                  chosen=eligible[0] if eligible else None, runner_up=eligible[1] if len(eligible) > 1 else None,
+                  machine=scene.machine, budget=scene.budget, objects=objects, software=software, notes=tuple(notes))
+
+
+def _usable_methods(scene: SceneObjects, methods: tuple[Method, ...],
+                    software: bool) -> tuple[tuple[Method, ...], list[str]]:
+    """The methods that exist on the scene's machine (without the hardware ones with `software`),
+    and notes saying which were left out and why."""
     notes = []
     absent = [m for m in methods if scene.machine not in m.machines]
     if absent:
@@ -146,50 +179,35 @@ def advise(path: str, target: float, workers: int | None = None, progress: Progr
         methods = tuple(m for m in methods if not m.hardware)
     if scene.hardware:
         notes.append(scene.hardware)
-    indexed = scene.shapes
-    # Identical shape pairs (same data and flags, either order) are one job with a weight.
+    return methods, notes
+
+
+def _pair_jobs(indexed: list[tuple[int, Shape]]) -> tuple[dict[tuple, int], dict[tuple, tuple[Shape, Shape]]]:
+    """Identical shape pairs (same data and flags, either order) are one job with a weight."""
     weights: dict[tuple, int] = {}
     jobs: dict[tuple, tuple[Shape, Shape]] = {}
     for (_, a), (_, b) in combinations(indexed, 2):
         key = tuple(sorted((_shape_key(a), _shape_key(b)), key=repr))
         weights[key] = weights.get(key, 0) + 1
         jobs.setdefault(key, (a, b))
-    keys = list(jobs)
-    table = evaluate([], methods, workers=workers, progress=progress, pair_list=[jobs[k] for k in keys])
-    costs = measure_costs([], samples=samples, workers=workers, progress=progress, pair_list=[jobs[k] for k in keys],
-                          methods=methods)
-    sprite_count = len(indexed) if objects is None else objects
-    frames = {}
-    if objects is not None:
-        from retro.analysis.study.per_frame import best_phase, per_frame
+    return weights, jobs
 
-        model = per_frame(methods, {k: c.overall for k, c in costs.items()}, [s for _, s in indexed], counts=(objects,),
-                          budget=scene.budget, workers=workers, progress=progress)
-        frames = {m.key: best_phase(model.rows, m.key, objects) for m in methods}
-    figures = []
-    for m in methods:
-        counts = pooled([_scaled(p.counts[m.key], weights[k]) for p, k in zip(table.pairs, keys)])
-        cycles = costs[m.key].overall if m.key in costs else CycleStats.of([])
-        note = ""
-        qualifies = counts.accuracy >= target
-        unusable = m.advice_note(sprite_count)
-        if m.host_only or cycles.samples == 0:
-            qualifies, note = False, costs[m.key].counted if m.key in costs else "no 6502 cost"
-        elif unusable:
-            qualifies, note = False, unusable
-        elif objects is not None and frames.get(m.key) is None:
-            qualifies, note = False, f"cannot serve {objects} objects"
-        elif not qualifies:
-            note = "below the target"
-        elif m.prepare and objects is None:
-            note = f"per test; {m.prepare} once per {m.prepare_per.replace('_', ' ')} besides"
-        figures.append(MethodFigures(m.key, m.label, counts, cycles, qualifies, note, frames.get(m.key)))
-    figures.sort(key=_cost_order)
-    eligible = [f for f in figures if f.qualifies]
-    return Advice(source=str(path), sprites=[n for n, _ in indexed], sprite_pairs=sum(weights.values()),
-                  cases=figures[0].counts.cases, target=target, figures=figures,
-                  chosen=eligible[0] if eligible else None, runner_up=eligible[1] if len(eligible) > 1 else None,
-                  machine=scene.machine, budget=scene.budget, objects=objects, software=software, notes=tuple(notes))
+
+def _verdict(m: Method, accurate: bool, cycles: CycleStats, costs: dict, sprite_count: int, objects: int | None,
+             frames: dict) -> tuple[bool, str]:
+    """Whether a method qualifies, and the note saying why not (or what its cost leaves out)."""
+    unusable = m.advice_note(sprite_count)
+    if m.host_only or cycles.samples == 0:
+        return False, costs[m.key].counted if m.key in costs else "no 6502 cost"
+    if unusable:
+        return False, unusable
+    if objects is not None and frames.get(m.key) is None:
+        return False, f"cannot serve {objects} objects"
+    if not accurate:
+        return False, "below the target"
+    if m.prepare and objects is None:
+        return True, f"per test; {m.prepare} once per {m.prepare_per.replace('_', ' ')} besides"
+    return True, ""
 
 
 def _cost_order(f: MethodFigures) -> tuple:

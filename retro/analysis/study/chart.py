@@ -56,15 +56,7 @@ def _draw_panel(ax, rows: list[FigureRow], styles: Styles, xlim: tuple[float, fl
     (`_place_labels`), when the axes' size is final."""
     measured = [r for r in rows if not math.isnan(r.cycles_mean)]
     for r in measured:
-        hardware = r.hardware
-        lit = r.pareto_software or hardware
-        colour = _colour(styles, r.method) if lit else GREY
-        ax.errorbar([r.cycles_mean], [r.accuracy],
-                    xerr=[[r.cycles_mean - r.cycles_min], [r.cycles_max - r.cycles_mean]],
-                    fmt=_marker(styles, r.method), color=colour, ecolor=colour, elinewidth=1.2, capsize=3,
-                    markersize=9 if labels else 6, markeredgecolor="black" if lit else GREY,
-                    markerfacecolor="none" if hardware else colour, markeredgewidth=1.6 if hardware else 1.0,
-                    zorder=3 if lit else 2)
+        _draw_point(ax, r, styles, labels)
     front = sorted((r for r in measured if r.pareto_software), key=lambda r: r.cycles_mean)
     if len(front) > 1:
         xs = [r.cycles_mean for r in front] + [xlim[1]]
@@ -73,6 +65,25 @@ def _draw_panel(ax, rows: list[FigureRow], styles: Styles, xlim: tuple[float, fl
     for r in rows:
         if math.isnan(r.cycles_mean) and not math.isnan(r.accuracy):
             ax.axhline(r.accuracy, color=_colour(styles, r.method), linestyle="--", linewidth=1.2)
+    _style_axes(ax, rows, xlim, ylim, labels, title)
+
+
+def _draw_point(ax, r: FigureRow, styles: Styles, labels: bool) -> None:
+    """A method's mean cycles and accuracy, its cycle range as a bar; lit when on the software front
+    or hardware (an open marker), grey otherwise."""
+    hardware = r.hardware
+    lit = r.pareto_software or hardware
+    colour = _colour(styles, r.method) if lit else GREY
+    ax.errorbar([r.cycles_mean], [r.accuracy],
+                xerr=[[r.cycles_mean - r.cycles_min], [r.cycles_max - r.cycles_mean]],
+                fmt=_marker(styles, r.method), color=colour, ecolor=colour, elinewidth=1.2, capsize=3,
+                markersize=9 if labels else 6, markeredgecolor="black" if lit else GREY,
+                markerfacecolor="none" if hardware else colour, markeredgewidth=1.6 if hardware else 1.0,
+                zorder=3 if lit else 2)
+
+
+def _style_axes(ax, rows: list[FigureRow], xlim: tuple[float, float], ylim: tuple[float, float] | None, labels: bool,
+                title: str) -> None:
     ax.set_xscale("log")
     ax.set_xlim(*xlim)
     ax.set_ylim(*(ylim or y_limits(rows)))

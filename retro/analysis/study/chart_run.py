@@ -43,11 +43,12 @@ class ChartOutput:
 def run_chart(out_dir: Path, reduced: bool = False, workers: int | None = None, progress: Progress = quiet,
               shape_names: tuple[str, ...] | None = None, cost_samples: int | None | str = AUTO,
               methods: tuple[Method, ...] = METHODS, sprite_files: tuple[str, ...] = (),
-              per_frame: bool = False) -> ChartOutput:
+              per_frame: bool = False, engine: str = "auto") -> ChartOutput:
     """The study on the corpus (the named shapes from sprites/, then every sprite of `sprite_files`)
     for the given methods. `cost_samples`: cases per pair whose cycles are measured (None: every
     case; AUTO: every case, or REDUCED_COST_SAMPLES with `reduced`). `per_frame`: the cost per frame
-    too, from the same run's cycles per test (per_frame.py)."""
+    too, from the same run's cycles per test (per_frame.py). `engine`: where the routines' calls run
+    (retro.analysis.check.engines.batched)."""
     from retro.analysis.study.cost_runs import measure_costs
     from retro.analysis.study.sprites_io import load_sprite_files
 
@@ -59,7 +60,7 @@ def run_chart(out_dir: Path, reduced: bool = False, workers: int | None = None, 
     start = time.perf_counter()
     table = evaluate(shapes, methods, workers=workers, progress=progress)
     samples = (REDUCED_COST_SAMPLES if reduced else FULL_COST_SAMPLES) if cost_samples == AUTO else cost_samples
-    costs = measure_costs(shapes, samples=samples, workers=workers, progress=progress, methods=methods)
+    costs = measure_costs(shapes, samples=samples, workers=workers, progress=progress, methods=methods, engine=engine)
     rows = report.figure_rows(table, costs)
     shown = ", ".join(s.name for s in shapes)
     measured = "every case" if samples is None else f"{samples} evenly spread cases per pair"
@@ -78,17 +79,18 @@ def run_chart(out_dir: Path, reduced: bool = False, workers: int | None = None, 
     files.append(write_atomic(out_dir / PAIRS_PNG, pairs_chart(rows, styles)))
     frames = None
     if per_frame:
-        frames = _per_frame(out_dir, shapes, methods, costs, rows, reduced, workers, progress, files, shown)
+        frames = _per_frame(out_dir, shapes, methods, costs, rows, reduced, workers, progress, files, shown, engine)
     return ChartOutput(rows=rows, files=files, seconds=time.perf_counter() - start, per_frame=frames)
 
 
-def _per_frame(out_dir: Path, shapes, methods, costs, rows, reduced, workers, progress, files, shown: str):
+def _per_frame(out_dir: Path, shapes, methods, costs, rows, reduced, workers, progress, files, shown: str,
+               engine: str):
     from retro.analysis.study import per_frame_report
     from retro.analysis.study.per_frame import PAL_BUDGET, per_frame
     from retro.analysis.study.per_frame_chart import per_frame_chart
 
     result = per_frame(methods, {k: c.overall for k, c in costs.items()}, shapes, reduced=reduced, workers=workers,
-                       progress=progress)
+                       progress=progress, engine=engine)
     accuracy = {r.method: r.accuracy for r in rows if r.scope == report.ALL}
     note = (f"objects: the shapes {shown} in turn, on a field one byte wide; cycles per test from this run's "
             f"corpus, preparation from `retro check`, broad phases measured on {result.broad.layouts} layouts x "

@@ -19,7 +19,6 @@ when that number is at least one, which is exactly when the VIC-II sets both spr
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from itertools import combinations_with_replacement
 from pathlib import Path
 
 import numpy as np
@@ -119,11 +118,6 @@ def pair_at(a: Shape, b: Shape, offsets: list[tuple[int, int]]) -> Pair:
     overlap = np.zeros(dx.shape, dtype=counts.dtype)
     overlap[inside] = counts[row[inside], col[inside]]
     return Pair(a=a, b=b, dx=dx, dy=dy, overlap=overlap)
-
-
-def make_pairs(shapes: list[Shape]) -> list[Pair]:
-    """Every unordered pair of the shapes, each shape also paired with itself (two bullets meet too)."""
-    return [make_pair(a, b) for a, b in combinations_with_replacement(shapes, 2)]
 
 
 def load_shape(path: Path) -> Shape:

@@ -39,7 +39,8 @@ def method_samples(method: Method, samples: int | None) -> int | None:
     return cap if samples is None else min(samples, cap)
 
 
-def _measure_pair(method: Method, a: Shape, b: Shape, samples: int | None) -> tuple[str, list[int]]:
+def _measure_pair(method: Method, a: Shape, b: Shape, samples: int | None,
+                  engine: str = "auto") -> tuple[str, list[int]]:
     pair = make_pair(a, b)
     if method.unmeasurable(pair):
         return pair.name, []
@@ -47,7 +48,7 @@ def _measure_pair(method: Method, a: Shape, b: Shape, samples: int | None) -> tu
     session = method.session(pair)
     verdict = None if method.averaged else method.verdict(sub_pair(pair, indices)) > 0
     cycles = []
-    answers, spent_cycles = session.run_many(indices)
+    answers, spent_cycles = session.run_many(indices, engine)
     for k, (index, answer, spent) in enumerate(zip(indices, answers, spent_cycles)):
         expected = session.expected(index) if verdict is None else bool(verdict[k])
         if answer != expected:
@@ -59,7 +60,7 @@ def _measure_pair(method: Method, a: Shape, b: Shape, samples: int | None) -> tu
 
 def measure_costs(shapes: list[Shape], samples: int | None, workers: int | None = None, progress: Progress = quiet,
                   pair_list: list[tuple[Shape, Shape]] | None = None,
-                  methods: tuple[Method, ...] = METHODS) -> dict[str, MethodCost]:
+                  methods: tuple[Method, ...] = METHODS, engine: str = "auto") -> dict[str, MethodCost]:
     """MethodCost for every method; a host-only method gets no cycles and says so. `samples`: cases
     measured per pair (None: every case)."""
     jobs = pair_list if pair_list is not None else list(combinations_with_replacement(shapes, 2))
@@ -67,38 +68,45 @@ def measure_costs(shapes: list[Shape], samples: int | None, workers: int | None 
     pairs = [make_pair(a, b) for a, b in jobs]
     measured = [m for m in methods if not m.host_only]
     tasks = [(m, a, b) for m in measured for a, b in jobs]
+    results = _run_pairs(tasks, samples, engine, workers, len(jobs), progress)
+    by_method = {m.key: results[i * len(jobs):(i + 1) * len(jobs)] for i, m in enumerate(measured)}
+    return {m.key: _method_cost(m, pairs, jobs, by_method.get(m.key, []), samples) for m in methods}
+
+
+def _run_pairs(tasks: list, samples: int | None, engine: str, workers: int, per_method: int,
+               progress: Progress) -> list[tuple[str, list[int]]]:
+    """Each (method, shape, shape) measured, in order, over worker processes when more than one."""
+    results = []
     if workers > 1 and len(tasks) > 1:
         with worker_pool(workers) as pool:
-            futures = [pool.submit(_measure_pair, m, a, b, samples) for m, a, b in tasks]
-            results = []
+            futures = [pool.submit(_measure_pair, m, a, b, samples, engine) for m, a, b in tasks]
             for (m, _, _), future in zip(tasks, futures):
                 results.append(future.result())
-                if len(results) % len(jobs) == 0:
-                    progress(f"cost: {m.key} ({m.routine}) measured on {len(jobs)} pairs")
-    else:
-        results = []
-        for m, a, b in tasks:
-            results.append(_measure_pair(m, a, b, samples))
-            if len(results) % len(jobs) == 0:
-                progress(f"cost: {m.key} ({m.routine}) measured on {len(jobs)} pairs")
-    by_method = {m.key: results[i * len(jobs):(i + 1) * len(jobs)] for i, m in enumerate(measured)}
-    costs: dict[str, MethodCost] = {}
-    for m in methods:
-        host = host_microseconds(m, pairs, HOST_SAMPLES if samples is None else max(4, samples // 4))
-        if m.host_only:
-            costs[m.key] = MethodCost(key=m.key, routine="", overall=CycleStats.of([]), host_us=host, counted=m.counted)
-            continue
-        per_pair: dict[str, CycleStats] = {}
-        every: list[int] = []
-        skipped = []
-        for (name, cycles), (a, b) in zip(by_method[m.key], jobs):
-            per_pair[name] = CycleStats.of(cycles)
-            every += cycles
-            if not cycles:
-                skipped.append(f"{name} ({m.unmeasurable(make_pair(a, b))})")
-        code, tables = m.size()
-        counted = m.counted + (f"; not measured on {', '.join(skipped)}" if skipped else "")
-        costs[m.key] = MethodCost(key=m.key, routine=m.routine, overall=CycleStats.of(every), per_pair=per_pair,
-                                  code_bytes=code, table_bytes=tables, host_us=host, counted=counted,
-                                  prepare=m.prepare)
-    return costs
+                if len(results) % per_method == 0:
+                    progress(f"cost: {m.key} ({m.routine}) measured on {per_method} pairs")
+        return results
+    for m, a, b in tasks:
+        results.append(_measure_pair(m, a, b, samples, engine))
+        if len(results) % per_method == 0:
+            progress(f"cost: {m.key} ({m.routine}) measured on {per_method} pairs")
+    return results
+
+
+def _method_cost(m: Method, pairs: list, jobs: list, measured: list[tuple[str, list[int]]],
+                 samples: int | None) -> MethodCost:
+    """One method's cycles per pair and overall, bytes and host time (no cycles for a host-only one)."""
+    host = host_microseconds(m, pairs, HOST_SAMPLES if samples is None else max(4, samples // 4))
+    if m.host_only:
+        return MethodCost(key=m.key, routine="", overall=CycleStats.of([]), host_us=host, counted=m.counted)
+    per_pair: dict[str, CycleStats] = {}
+    every: list[int] = []
+    skipped = []
+    for (name, cycles), (a, b) in zip(measured, jobs):
+        per_pair[name] = CycleStats.of(cycles)
+        every += cycles
+        if not cycles:
+            skipped.append(f"{name} ({m.unmeasurable(make_pair(a, b))})")
+    code, tables = m.size()
+    counted = m.counted + (f"; not measured on {', '.join(skipped)}" if skipped else "")
+    return MethodCost(key=m.key, routine=m.routine, overall=CycleStats.of(every), per_pair=per_pair,
+                      code_bytes=code, table_bytes=tables, host_us=host, counted=counted, prepare=m.prepare)

@@ -20,8 +20,6 @@ from retro.chips.vic.constants import (
     REG_SPRITE_EXPAND_X,
     REG_SPRITE_EXPAND_Y,
     REG_SPRITE_MULTICOLOR,
-    REG_SPRITE_X0,
-    REG_SPRITE_X_MSB,
     REG_SPRITE_Y0,
     REGISTER_COUNT,
     SPRITE_BYTES,
@@ -30,6 +28,7 @@ from retro.chips.vic.constants import (
     VIC_LAST,
 )
 from retro.chips.vic.model import VicState, frame_collisions
+from retro.chips.vic.sprite_registers import set_sprite_x
 
 BASE_X = 100  # both sprites well inside the 9-bit X range and the frame: no wrap (see stability.wrap)
 BASE_Y = 100
@@ -50,9 +49,8 @@ def sprites_state(placed: list[tuple[Shape, int, int]], video=PAL) -> VicState:
     registers = bytearray(REGISTER_COUNT)
     data = [bytes(SPRITE_BYTES)] * SPRITE_COUNT
     for n, (shape, x, y) in enumerate(placed):
-        registers[REG_SPRITE_X0 + 2 * n] = x & 0xFF
+        set_sprite_x(registers, n, x)
         registers[REG_SPRITE_Y0 + 2 * n] = y & 0xFF
-        registers[REG_SPRITE_X_MSB] |= (x >> 8 & 1) << n
         registers[REG_SPRITE_ENABLE] |= 1 << n
         registers[REG_SPRITE_MULTICOLOR] |= shape.multicolor << n
         registers[REG_SPRITE_EXPAND_X] |= shape.expand_x << n

@@ -90,7 +90,7 @@ PAL_BUDGET = c64_budget(vic.PAL)
 
 # ---- the measured parts -------------------------------------------------------------------------
 
-def prepare_costs(methods: Sequence[Method]) -> dict[str, CycleStats]:
+def prepare_costs(methods: Sequence[Method], engine: str = "auto") -> dict[str, CycleStats]:
     """{prepare spec: its cycles per call}, from `retro check`'s bounded run of the spec (every call's
     outputs checked against the spec's reference: a mismatch stops the study)."""
     from retro.analysis.check import check_routine
@@ -98,7 +98,7 @@ def prepare_costs(methods: Sequence[Method]) -> dict[str, CycleStats]:
 
     out: dict[str, CycleStats] = {}
     for spec in dict.fromkeys(m.prepare for m in methods if m.prepare):
-        check = check_routine(str(spec_path(spec)), jobs=1)
+        check = check_routine(str(spec_path(spec)), jobs=1, engine=engine)
         t = check.totals
         if check.mismatches or t.run_errors or not t.cycles_count:
             raise RunError(f"{spec}: the preparation routine fails its check ({check.mismatches} mismatches): "
@@ -350,10 +350,10 @@ class PerFrame:
 
 def per_frame(methods: Sequence[Method], tests: dict[str, CycleStats], shapes: Sequence[Shape],
               counts: Sequence[int] = OBJECT_COUNTS, reduced: bool = False, budget: Budget = PAL_BUDGET,
-              workers: int | None = None, progress: Progress = quiet) -> PerFrame:
+              workers: int | None = None, progress: Progress = quiet, engine: str = "auto") -> PerFrame:
     """The model for every method with measured cycles (`tests`: cycles per test by method key)."""
     used = [m for m in methods if not m.host_only and m.key in tests and tests[m.key].samples]
-    prepares = prepare_costs(used)
+    prepares = prepare_costs(used, engine)
     progress(f"per frame: preparation routines checked ({', '.join(prepares) or 'none'})")
     extent_sets = [method_extents(m, shapes) for m in used if not m.once_per_frame]
     layouts, frames = (REDUCED_LAYOUTS, REDUCED_FRAMES) if reduced else (LAYOUTS, FRAMES)

@@ -44,26 +44,10 @@ def per_frame_figure(result: PerFrame, note: str = "", size: tuple[float, float]
     budgets = ((frame, f"{b.label} frame: {frame:,.0f}"), (lines, f"{b.lines} raster lines: {lines:,.0f}"))
     counts = sorted({r.objects for r in result.rows})
     for ax, phase in zip(axes[0], PHASES):
-        for key in keys:
-            colour, marker = styles.get(key, ("black", "o"))
-            for chosen_phase, style in ((phase, "-"), (ONCE, ":")):
-                chosen = sorted((r for r in result.rows if r.method == key and r.phase == chosen_phase),
-                                key=lambda r: r.objects)
-                if chosen:
-                    ax.plot([r.objects for r in chosen], [r.frame_cycles for r in chosen], color=colour,
-                            linestyle=style, marker=marker, markevery=MARK_EVERY, markersize=6,
-                            markeredgecolor="black", linewidth=1.6)
+        _panel(ax, result, phase, keys, styles)
         for (value, _), colour in zip(budgets, BUDGET_COLOURS):
             ax.axhline(value, color=colour, linestyle="--", linewidth=1.1)
-        ax.set_yscale("log")
-        ax.set_ylim(*ylim)
-        ax.set_xlim(0, max(counts) + 1 if counts else 1)
-        ax.yaxis.set_major_locator(LogLocator(base=10))
-        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:,.0f}"))
-        ax.yaxis.set_minor_formatter(NullFormatter())
-        ax.grid(True, which="major", alpha=0.3)
-        ax.set_title(PHASE_LABELS[phase], fontsize=11)
-        ax.set_xlabel("objects tested each frame")
+        _axes_style(ax, ylim, counts, phase)
     axes[0][0].set_ylabel("6502 cycles per frame (log scale)")
     handles = [Line2D([], [], color=styles.get(k, ("black", "o"))[0], marker=styles.get(k, ("black", "o"))[1],
                       markeredgecolor="black", label=labels[k]) for k in keys]
@@ -72,8 +56,39 @@ def per_frame_figure(result: PerFrame, note: str = "", size: tuple[float, float]
         handles.append(Line2D([], [], color="black", linestyle=":", label="one call a frame (hardware, not which pair)"))
     bottom = legend_below(fig, handles, 8.5, note=note)
     finish(fig, list(axes[0]), bottom)
+    _budget_names(fig, list(axes[0]), budgets)
+    return fig
+
+
+def _panel(ax, result: PerFrame, phase: str, keys: list[str], styles: dict) -> None:
+    """Each method's curve in one broad phase (and a dotted one for a once-a-frame method)."""
+    for key in keys:
+        colour, marker = styles.get(key, ("black", "o"))
+        for chosen_phase, style in ((phase, "-"), (ONCE, ":")):
+            chosen = sorted((r for r in result.rows if r.method == key and r.phase == chosen_phase),
+                            key=lambda r: r.objects)
+            if chosen:
+                ax.plot([r.objects for r in chosen], [r.frame_cycles for r in chosen], color=colour,
+                        linestyle=style, marker=marker, markevery=MARK_EVERY, markersize=6,
+                        markeredgecolor="black", linewidth=1.6)
+
+
+def _axes_style(ax, ylim: tuple[float, float], counts: list[int], phase: str) -> None:
+    ax.set_yscale("log")
+    ax.set_ylim(*ylim)
+    ax.set_xlim(0, max(counts) + 1 if counts else 1)
+    ax.yaxis.set_major_locator(LogLocator(base=10))
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:,.0f}"))
+    ax.yaxis.set_minor_formatter(NullFormatter())
+    ax.grid(True, which="major", alpha=0.3)
+    ax.set_title(PHASE_LABELS[phase], fontsize=11)
+    ax.set_xlabel("objects tested each frame")
+
+
+def _budget_names(fig, axes: list, budgets: tuple) -> None:
+    """The budgets' names on their lines, where they fit."""
     renderer = renderer_of(fig)
-    for ax in axes[0]:  # the budgets' names on their lines, where they fit
+    for ax in axes:
         area = ax.get_window_extent(renderer)
         for value, text in budgets:
             t = ax.text(0.5, value * 1.08, text, fontsize=8, color="#333333", va="bottom", ha="left",
@@ -81,4 +96,3 @@ def per_frame_figure(result: PerFrame, note: str = "", size: tuple[float, float]
             box = t.get_window_extent(renderer)
             if box.x1 > area.x1 or box.y1 > area.y1 or math.isnan(box.x0):
                 t.remove()
-    return fig

@@ -69,6 +69,7 @@ from retro.chips.vic.constants import (
 )
 from retro.chips.vic.graphics import VicMemory, foreground_points
 from retro.chips.vic.sprite_bits import opaque_mask
+from retro.chips.vic.sprite_registers import sprite_x
 
 # Registers whose value changes what collides (the device recomputes its schedule when they change)
 COLLISION_REGISTERS = (tuple(range(REG_SPRITE_X0, REG_SPRITE_X_MSB + 1))
@@ -98,7 +99,7 @@ class VicState:
         return bytes(self.registers[r] for r in COLLISION_REGISTERS)
 
     def sprite_x(self, n: int) -> int:
-        return self.registers[REG_SPRITE_X0 + 2 * n] | ((self.registers[REG_SPRITE_X_MSB] >> n) & 1) << 8
+        return sprite_x(self.registers, n)
 
     def sprite_y(self, n: int) -> int:
         return self.registers[REG_SPRITE_Y0 + 2 * n]
@@ -142,6 +143,25 @@ class FrameCollisions:
     pairs: tuple[tuple[int, int], ...]
     ss_pixel_bits: np.ndarray = field(default_factory=lambda: np.zeros(0, np.uint8))  # sprites at each ss pixel
     sb_pixel_bits: np.ndarray = field(default_factory=lambda: np.zeros(0, np.uint8))  # the sprite at each sb pixel
+
+    def pair_pixels(self, a: int, b: int) -> tuple[np.ndarray, np.ndarray]:
+        """(lines, xs) where sprites a and b are both opaque, each (line, X) once, in beam order (a
+        place where three sprites meet is one place of each of their pairs)."""
+        lines, xs = self.ss_pixels
+        if not lines.size:
+            return lines, xs
+        places = lines * self.video.x_positions + xs
+        unique, inverse = np.unique(places, return_inverse=True)
+        together = np.zeros(unique.size, np.uint8)
+        np.bitwise_or.at(together, inverse, self.ss_pixel_bits)
+        both = (together >> a & 1).astype(bool) & (together >> b & 1).astype(bool)
+        return unique[both] // self.video.x_positions, unique[both] % self.video.x_positions
+
+    def background_pixels(self, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """(lines, xs) where sprite n's opaque pixels meet foreground graphics."""
+        lines, xs = self.sb_pixels
+        mine = self.sb_pixel_bits == (1 << n)
+        return lines[mine], xs[mine]
 
     @property
     def d01e(self) -> int:

@@ -33,7 +33,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from retro.analysis import check
+from retro.analysis.check.engines import batched
 from retro.analysis.study.corpus import Pair
 from retro.fileio import cached_reads
 
@@ -67,9 +67,9 @@ def routine_runner(name_or_path: str):
     return RoutineRunner(routine_spec(name_or_path))
 
 
-# A pair's calls run on retro.analysis.check.DEFAULT_ENGINE (set by the commands' --engine through
-# engine_default): "auto" takes the batched core (retro.cpu.batch) from BATCH_FROM calls on, "scalar" is
-# Machine only, "batch" the batched core whatever the count.
+# A pair's calls run on the engine the commands' --engine names, by the check's one rule
+# (retro.analysis.check.engines.batched): "auto" takes the batched core from BATCH_FROM calls on (a
+# method's calls need no agreement run, so the batched core pays from far fewer calls than in a check).
 BATCH_FROM = 256
 
 
@@ -80,8 +80,8 @@ class Session:
         """(the routine's answer: hit or not, cycles of the call) on case `index` of the pair."""
         raise NotImplementedError
 
-    def run_many(self, indices: list[int]) -> tuple[list[bool], list[int]]:
-        """`run` on many cases: (answers, cycles) in the order given."""
+    def run_many(self, indices: list[int], engine: str = "auto") -> tuple[list[bool], list[int]]:
+        """`run` on many cases: (answers, cycles) in the order given (on Machine, whatever `engine`)."""
         results = [self.run(index) for index in indices]
         return [r[0] for r in results], [r[1] for r in results]
 
@@ -112,12 +112,10 @@ class RoutineSession(Session):
         outputs, cycles = self.runner.run(tuple(case[name] for name in self.names))
         return bool(outputs[self.hit]), cycles
 
-    def run_many(self, indices: list[int]) -> tuple[list[bool], list[int]]:
-        """On the batched core when there are enough calls (the default engine); a call that does not
-        return is run again on Machine, whose error names it."""
-        engine = check.DEFAULT_ENGINE
-        batched = self.runner.batchable and (engine == "batch" or (engine == "auto" and len(indices) >= BATCH_FROM))
-        if not batched or not indices:
+    def run_many(self, indices: list[int], engine: str = "auto") -> tuple[list[bool], list[int]]:
+        """On the batched core when the engine rule says so; a call that does not return is run again
+        on Machine, whose error names it."""
+        if not indices or not batched(engine, len(indices), self.runner.batchable, BATCH_FROM):
             return super().run_many(indices)
         cases = [self.case(index) for index in indices]
         columns = [np.asarray([case[name] for case in cases], dtype=np.int64) for name in self.names]

@@ -28,7 +28,7 @@ class WrapRoutineRow:
 RANGE_RANDOM_CASES = {True: 300, False: 20_000}  # random cases per routine on top of the structured ones
 
 
-def range_rows(reduced: bool = False, progress=None) -> list[RangeRow]:
+def range_rows(reduced: bool = False, progress=None, engine: str = "auto") -> list[RangeRow]:
     """Per routine: the cases inside its stated domain (all must be right), and for each condition of
     the domain the cases that break it and how many of those the assembly answers wrong (a condition
     with wrong answers is needed). The full run uses the exhaustive sweeps of `retro check --exhaustive`."""
@@ -36,7 +36,7 @@ def range_rows(reduced: bool = False, progress=None) -> list[RangeRow]:
 
     rows = []
     for check in run_checks(None, exhaustive=not reduced, random_count=RANGE_RANDOM_CASES[reduced],
-                            progress=progress):
+                            progress=progress, engine=engine):
         t = check.totals
         stated = " and ".join(c.text for c in check.routine.domain) or "every input"
         rows.append(RangeRow(check.routine.name, f"inside the stated domain ({stated})", t.cases - t.outside,

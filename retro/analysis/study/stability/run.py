@@ -58,26 +58,36 @@ def edges_markdown(rows: list) -> str:
 
 
 def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = quiet,
-                  methods: tuple | None = None) -> StabilityOutput:
-    from retro.analysis.study.stability import (
-        charts,
-        edges,
-        latch_pitfalls,
-        ranges,
-        tunnelling,
-        wrap,
-    )
-
+                  methods: tuple | None = None, engine: str = "auto") -> StabilityOutput:
     from retro.analysis.study.methods import METHODS
 
     methods = METHODS if methods is None else tuple(methods)
     output_folder(out_dir, OUTPUT_NAMES)
     start = time.perf_counter()
-    files: list[Path] = []
-    md = ["# Stability: where each method breaks\n"]
-    summary: list[str] = []
+    report = _Report(out_dir, ["# Stability: where each method breaks\n"], [], [])
+    _tunnelling(report, reduced, methods, progress)
+    _wrap(report, reduced, progress)
+    _ranges(report, reduced, engine, progress)
+    _edges(report, methods, progress)
+    _latch(report, progress)
+    report.files.append(write_atomic(out_dir / "stability.md", "".join(report.md)))
+    return StabilityOutput(files=report.files, lines=report.summary, seconds=time.perf_counter() - start)
 
-    # Tunnelling
+
+@dataclass
+class _Report:
+    """What the sections add to: the files written, the Markdown, the summary lines."""
+
+    out_dir: Path
+    md: list[str]
+    files: list[Path]
+    summary: list[str]
+
+
+def _tunnelling(report: _Report, reduced: bool, methods: tuple, progress: Progress) -> None:
+    from retro.analysis.study.stability import charts, tunnelling
+
+    out_dir, md, files, summary = report.out_dir, report.md, report.files, report.summary
     mover = load_shapes(["bullet"])[0]
     speeds = REDUCED_SPEEDS if reduced else FULL_SPEEDS
     progress("stability: tunnelling")
@@ -97,7 +107,11 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
                    + "; ".join(f"{charts.group_label(g, methods)} {tunnelling.safe_speed(tunnel, g, thinnest)}"
                                for g in groups))
 
-    # Coordinate wrap
+
+def _wrap(report: _Report, reduced: bool, progress: Progress) -> None:
+    from retro.analysis.study.stability import charts, ranges, wrap
+
+    out_dir, md, files, summary = report.out_dir, report.md, report.files, report.summary
     progress("stability: coordinate wrap")
     wrap_rows, maps = wrap.wrap_table()
     files.append(write_atomic(out_dir / "wrap.csv", _csv(wrap_rows)))
@@ -118,9 +132,13 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
     summary.append(f"wrap: on PAL a 9-bit box test disagrees with the chip in {pal9.software_only + pal9.hardware_only} "
                    "of 262,144 X pairs (see wrap.png)")
 
-    # Arithmetic range
+
+def _ranges(report: _Report, reduced: bool, engine: str, progress: Progress) -> None:
+    from retro.analysis.study.stability import ranges
+
+    out_dir, md, files = report.out_dir, report.md, report.files
     progress("stability: arithmetic range")
-    range_rows = ranges.range_rows(reduced=reduced, progress=progress)
+    range_rows = ranges.range_rows(reduced=reduced, progress=progress, engine=engine)
     files.append(write_atomic(out_dir / "ranges.csv", _csv(range_rows)))
     md.append("## Arithmetic range\n\n")
     md.append("Found by running the assembly (`retro check`'s domain search: structured and random cases, "
@@ -129,7 +147,11 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
                         [[r.routine, r.searched, r.cases, r.wrong, r.domain] for r in range_rows]))
     md.append("\n")
 
-    # Edge conventions
+
+def _edges(report: _Report, methods: tuple, progress: Progress) -> None:
+    from retro.analysis.study.stability import edges
+
+    out_dir, md, files = report.out_dir, report.md, report.files
     progress("stability: edge conventions")
     edge_rows = edges.edge_table(methods)
     files.append(write_atomic(out_dir / "edges.csv", _csv(edge_rows)))
@@ -137,7 +159,11 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
     md.append(edges_markdown(edge_rows))
     md.append("\n")
 
-    # Latch pitfalls
+
+def _latch(report: _Report, progress: Progress) -> None:
+    from retro.analysis.study.stability import latch_pitfalls
+
+    out_dir, md, files, summary = report.out_dir, report.md, report.files, report.summary
     progress("stability: latch pitfalls")
     ship, ball = load_shapes(["ship", "ball"])
     found = latch_pitfalls.pitfalls(ship, ball)
@@ -150,6 +176,3 @@ def run_stability(out_dir: Path, reduced: bool = False, progress: Progress = qui
     md.append(_md_table(["scenario", "what happened", "reads of $D01E", "what the program concludes", "error"],
                         [[s, t, r, c, k] for s, k, t, r, c in flat]))
     summary.append("latch: " + ", ".join(f"{p.scenario} -> {p.kind}" for p in found))
-
-    files.append(write_atomic(out_dir / "stability.md", "".join(md)))
-    return StabilityOutput(files=files, lines=summary, seconds=time.perf_counter() - start)

@@ -20,8 +20,6 @@ from retro.chips.vic.constants import (
     NTSC,
     PAL,
     REG_SPRITE_ENABLE,
-    REG_SPRITE_X0,
-    REG_SPRITE_X_MSB,
     REGISTER_COUNT,
     SPRITE_BYTES,
     SPRITE_COUNT,
@@ -29,6 +27,7 @@ from retro.chips.vic.constants import (
     Video,
 )
 from retro.chips.vic.model import VicState, placement
+from retro.chips.vic.sprite_registers import set_sprite_x
 
 X_RANGE = 512  # 9-bit sprite X: 0..511 can be written to $D000/$D010
 
@@ -43,8 +42,7 @@ def _occupancy(video: Video) -> np.ndarray:
     data = (b"\xff" * SPRITE_BYTES,) + (bytes(SPRITE_BYTES),) * (SPRITE_COUNT - 1)
     occ = np.zeros((X_RANGE, X_RANGE), dtype=bool)
     for x in range(X_RANGE):
-        registers[REG_SPRITE_X0] = x & 0xFF
-        registers[REG_SPRITE_X_MSB] = x >> 8
+        set_sprite_x(registers, 0, x)
         place = placement(VicState(video=video, registers=bytes(registers), sprite_data=data), 0)
         if place is not None:
             occ[x, place.xs] = True

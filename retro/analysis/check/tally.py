@@ -1,0 +1,237 @@
+"""The one tally of a check: what a `CallBlock` of either engine shows against the reference's
+answers and the domain, counted the same way for both. What counts as a mismatch is written here:
+
+- result: inside the domain, an output differs from the reference's answer;
+- cycles: the timing model's count differs from the cycles the CPU ran (Machine only);
+- engine: Machine and the batched core differ on a call (outputs, cycles, or whether it returned);
+- run: a call did not return (BRK, JAM, a runaway), which ends the check.
+
+Cases outside the domain are counted (per condition they break, and how many of them the routine
+gets wrong) but are no mismatch. To add a statistic: a field of `Tally`, its line in `Tally.merge`,
+its count in `count_block`, and its key in the report (retro/commands/check.py: check_record).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from retro.analysis.check.engines import CallBlock, disagreement
+from retro.analysis.check.reference import reference_answers
+from retro.analysis.check.results import Failure, describe_case, describe_outputs
+from retro.routines import cases as case_sets
+from retro.routines.runner import row_of
+from retro.routines.spec import Routine
+
+EXAMPLES_KEPT = 5
+_KIND_ORDER = {"engine": 0, "cycles": 1, "result": 2}  # of one call: as Machine's check met them
+
+
+@dataclass
+class Tally:
+    """What a block of calls showed, merged over the blocks into a routine's totals. A statistic is
+    added here: a field, its line in `merge`, and its count in `count_block` below."""
+
+    cases: int = 0
+    result_mismatches: int = 0
+    cycle_mismatches: int = 0
+    run_errors: int = 0
+    outside: int = 0
+    outside_wrong: int = 0
+    constraint_cases: dict[str, int] = field(default_factory=dict)
+    constraint_wrong: dict[str, int] = field(default_factory=dict)
+    cycles_min: int | None = None
+    cycles_max: int | None = None
+    min_case: tuple | None = None
+    max_case: tuple | None = None
+    cycles_sum: int = 0
+    cycles_count: int = 0
+    cpu_min: int | None = None  # cycles the CPU ran (stalls excluded): what the static bounds bound
+    cpu_max: int | None = None
+    stolen_max: int = 0  # with a scene: the most cycles one call lost to Bad Lines and sprite DMA
+    engine_cases: int = 0  # calls run on both engines and compared
+    engine_mismatches: int = 0
+    examples: list[str] = field(default_factory=list)
+    outside_examples: list[str] = field(default_factory=list)
+    failure: Failure | None = None
+
+    def merge(self, other: "Tally") -> None:
+        self.cases += other.cases
+        self.result_mismatches += other.result_mismatches
+        self.cycle_mismatches += other.cycle_mismatches
+        self.run_errors += other.run_errors
+        self.outside += other.outside
+        self.outside_wrong += other.outside_wrong
+        for target, source in ((self.constraint_cases, other.constraint_cases),
+                               (self.constraint_wrong, other.constraint_wrong)):
+            for key, value in source.items():
+                target[key] = target.get(key, 0) + value
+        if other.cycles_count:
+            if self.cycles_min is None or other.cycles_min < self.cycles_min:
+                self.cycles_min, self.min_case = other.cycles_min, other.min_case
+            if self.cycles_max is None or other.cycles_max > self.cycles_max:
+                self.cycles_max, self.max_case = other.cycles_max, other.max_case
+        self.cycles_sum += other.cycles_sum
+        self.cycles_count += other.cycles_count
+        if other.cpu_min is not None:
+            self.cpu_min = other.cpu_min if self.cpu_min is None else min(self.cpu_min, other.cpu_min)
+            self.cpu_max = other.cpu_max if self.cpu_max is None else max(self.cpu_max, other.cpu_max)
+        self.stolen_max = max(self.stolen_max, other.stolen_max)
+        self.engine_cases += other.engine_cases
+        self.engine_mismatches += other.engine_mismatches
+        self.examples = (self.examples + other.examples)[:EXAMPLES_KEPT]
+        self.outside_examples = (self.outside_examples + other.outside_examples)[:EXAMPLES_KEPT]
+        self.failure = self.failure or other.failure
+
+
+@dataclass(frozen=True)
+class _Calls:
+    """A block's returned calls with what the tally needs of each: inputs, domain, answers."""
+
+    routine: Routine
+    block: CallBlock
+    columns: list
+    cases: list[tuple] | None
+    broken_by: list[np.ndarray]
+    inside: np.ndarray
+    expected: list[np.ndarray]
+    answerable: np.ndarray
+    equal: np.ndarray
+
+    def case(self, i: int) -> tuple:
+        return self.cases[i] if self.cases is not None else case_sets.case_of(self.columns, i)
+
+    def described(self, i: int) -> str:
+        return f"{self.routine.name}({describe_case(self.routine, self.case(i))})"
+
+    def expected_row(self, i: int) -> tuple | None:
+        return row_of(self.expected, i) if self.answerable[i] else None
+
+
+def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[tuple] | None, memory: dict,
+                against: CallBlock | None = None) -> Tally:
+    """Tally the calls of one block (either engine) against the reference's answers. `cases`: the
+    block's cases as tuples when they are at hand (else made when the reference or a condition needs
+    them); `against`: the batched core's block for the same calls, compared call for call."""
+    calls = _calls(routine, block, columns, cases, memory)
+    out = Tally()
+    n = block.returned
+    inside, broken_by = calls.inside, calls.broken_by
+    wrong_inside = np.flatnonzero(inside & ~calls.equal)
+    wrong_outside = ~inside & ~calls.equal & calls.answerable
+    out.cases = n
+    out.result_mismatches = len(wrong_inside)
+    out.outside = int((~inside).sum())
+    out.outside_wrong = int(wrong_outside.sum())
+    for condition, broken in zip(routine.domain, broken_by):
+        out.constraint_cases[condition.text] = int(broken.sum())
+        out.constraint_wrong[condition.text] = int((broken & wrong_outside).sum())
+    cpu = block.cycles[:n] - block.stolen[:n]  # the timing model and the static bounds know no stalls
+    cycle_wrong = (np.flatnonzero(block.modelled[:n] != cpu) if block.modelled is not None
+                   else np.zeros(0, dtype=np.int64))
+    out.cycle_mismatches = len(cycle_wrong)
+    engine_wrong: dict[int, str] = {}
+    if against is not None:
+        out.engine_cases = block.calls
+        for i in range(block.calls):
+            message = disagreement(routine, block, against, i)
+            if message is not None:
+                engine_wrong[i] = message
+        out.engine_mismatches = len(engine_wrong)
+    _cycle_figures(out, calls, cpu)
+    _examples(out, calls, wrong_inside, cycle_wrong, cpu, engine_wrong)
+    _outside_examples(out, calls, wrong_outside)
+    if block.stop is not None:  # the call that did not return ends the block, as it ends the check
+        case = cases[n] if cases is not None else case_sets.case_of(columns, n)
+        _stop(out, calls, case, engine_wrong.get(n))
+    return out
+
+
+def _calls(routine: Routine, block: CallBlock, columns: list, cases: list[tuple] | None, memory: dict) -> _Calls:
+    n = block.returned
+    columns = [c[:n] for c in columns]
+    if cases is not None:
+        cases = cases[:n]
+    elif not routine.reference_arrays or any(c.test_columns is None for c in routine.domain):
+        cases = case_sets.columns_to_cases(columns)
+    broken_by = [~condition.over(columns, cases) for condition in routine.domain]
+    inside = np.ones(n, dtype=bool)
+    for broken in broken_by:
+        inside &= ~broken
+    if n:
+        expected, answerable = reference_answers(routine, columns, cases, memory, inside)
+    else:
+        expected, answerable = [np.zeros((0, *o.shape[1:]), dtype=np.int64) for o in block.outputs], inside
+    equal = np.ones(n, dtype=bool)
+    for got, wanted in zip(block.outputs, expected):
+        same = got[:n] == wanted
+        equal &= same.all(axis=1) if same.ndim == 2 else same
+    return _Calls(routine, block, columns, cases, broken_by, inside, expected, answerable, equal)
+
+
+def _cycle_figures(out: Tally, calls: _Calls, cpu: np.ndarray) -> None:
+    """Fastest and slowest calls inside the domain (the first on a tie), the sum, CPU-only extremes."""
+    block, n = calls.block, calls.block.returned
+    positions = np.flatnonzero(calls.inside)
+    if not len(positions):
+        return
+    cycles = block.cycles[:n][positions]
+    low, high = int(np.argmin(cycles)), int(np.argmax(cycles))
+    out.cycles_min, out.min_case = int(cycles[low]), calls.case(int(positions[low]))
+    out.cycles_max, out.max_case = int(cycles[high]), calls.case(int(positions[high]))
+    out.cycles_sum = int(cycles.sum())
+    out.cycles_count = len(cycles)
+    out.cpu_min, out.cpu_max = int(cpu[positions].min()), int(cpu[positions].max())
+    out.stolen_max = int(block.stolen[:n][positions].max())
+
+
+def _examples(out: Tally, calls: _Calls, wrong_inside: np.ndarray, cycle_wrong: np.ndarray, cpu: np.ndarray,
+              engine_wrong: dict[int, str]) -> None:
+    """The first examples and the first failure among the returned calls, in call order."""
+    n = calls.block.returned
+    events = [(i, "engine") for i in sorted(engine_wrong) if i < n][:EXAMPLES_KEPT]
+    events += [(int(i), "cycles") for i in cycle_wrong[:EXAMPLES_KEPT]]
+    events += [(int(i), "result") for i in wrong_inside[:EXAMPLES_KEPT]]
+    events.sort(key=lambda event: (event[0], _KIND_ORDER[event[1]]))
+    for i, kind in events:
+        answer, expected = calls.block.row(i), calls.expected_row(i)
+        if kind == "engine":
+            message = engine_wrong[i]
+            example, failure = message, Failure(calls.case(i), "engine", answer, None, message)
+        elif kind == "cycles":
+            message = f"measured {int(cpu[i])} cycles, the timing model says {int(calls.block.modelled[i])}"
+            example, failure = message, Failure(calls.case(i), "cycles", answer, expected, message)
+        else:
+            example = (f"returned {describe_outputs(calls.routine, answer)}, "
+                       f"reference {describe_outputs(calls.routine, expected)}")
+            failure = Failure(calls.case(i), "result", answer, expected)
+        if len(out.examples) < EXAMPLES_KEPT:
+            out.examples.append(f"{calls.described(i)}: {example}")
+        out.failure = out.failure or failure
+
+
+def _outside_examples(out: Tally, calls: _Calls, wrong_outside: np.ndarray) -> None:
+    routine = calls.routine
+    for i in np.flatnonzero(wrong_outside)[:EXAMPLES_KEPT].tolist():
+        broken = [c.text for c, b in zip(routine.domain, calls.broken_by) if b[i]]
+        out.outside_examples.append(
+            f"{calls.described(i)}: returned {describe_outputs(routine, calls.block.row(i))}, "
+            f"reference {describe_outputs(routine, calls.expected_row(i))} (outside: {', '.join(broken)})")
+
+
+def _stop(out: Tally, calls: _Calls, case: tuple, engine_message: str | None) -> None:
+    """The call that did not return: a run error (on Machine too), or an engine disagreement."""
+    block = calls.block
+    described = f"{calls.routine.name}({describe_case(calls.routine, case)})"
+    out.cases += 1
+    out.run_errors += 1
+    if block.stop == "engine":
+        out.engine_cases += 1
+        out.engine_mismatches += 1
+    for kind, message in ((block.stop, block.stop_message), ("engine", engine_message)):
+        if message is None:
+            continue
+        if len(out.examples) < EXAMPLES_KEPT:
+            out.examples.append(f"{described}: {message}")
+        out.failure = out.failure or Failure(case, kind, message=message)
