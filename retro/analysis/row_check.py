@@ -22,15 +22,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from retro.analysis.check.engines import AGREEMENT_PER_PART, BATCH_LANES, SceneStart, runner_for
+from retro.analysis.check.engines import AGREEMENT_PER_PART, BATCH_LANES, SceneStart, run_on_machine, runner_for
 from retro.analysis.check.reference import reference_answers
 from retro.analysis.check.results import Failure, describe_case, describe_outputs, inputs_by_name
 from retro.analysis.check.tally import Tally
 from retro.analysis.check.verdicts import static_bounds
 from retro.cpu.batch import LaneError
 from retro.cpu.flow import Bounds
-from retro.cpu.timing import model_cycles
-from retro.errors import InputError, RunError
+from retro.errors import InputError
 from retro.routines.cases import cases_to_columns
 from retro.routines.rows import Row
 from retro.routines.runner import RoutineRunner, describe_value, row_of
@@ -87,13 +86,12 @@ class _Call:
 
 
 def _on_machine(runner: RoutineRunner, case: tuple) -> _Call:
-    steps: list = []
-    try:
-        outputs, cycles = runner.run(case, steps)
-    except RunError as exc:
-        return _Call(None, None, error=str(exc))
-    modelled = model_cycles(runner.machine.memory.__getitem__, steps, runner.routine.cpu)
-    return _Call(outputs, cycles, cycles - runner.last_stolen, modelled)
+    """One row's call on Machine, as the check runs every call there (timing model included)."""
+    block = run_on_machine(runner, [case])
+    if block.stop is not None:
+        return _Call(None, None, error=block.stop_message)
+    cycles = int(block.cycles[0])
+    return _Call(block.row(0), cycles, cycles - int(block.stolen[0]), int(block.modelled[0]))
 
 
 def check_rows(spec: str, seed: int, start: SceneStart | None, batched: bool) -> tuple[RowsCheck, Tally]:
@@ -218,15 +216,8 @@ def _count(totals: Tally, routine: Routine, row: Row, call: _Call, timing_model:
         return
     cycles = call.cycles
     cpu = call.cpu_cycles if call.cpu_cycles is not None else cycles
-    if totals.cycles_min is None or cycles < totals.cycles_min:
-        totals.cycles_min, totals.min_case = cycles, row.case
-    if totals.cycles_max is None or cycles > totals.cycles_max:
-        totals.cycles_max, totals.max_case = cycles, row.case
-    totals.cycles_sum += cycles
-    totals.cycles_count += 1
-    totals.cpu_min = cpu if totals.cpu_min is None else min(totals.cpu_min, cpu)
-    totals.cpu_max = cpu if totals.cpu_max is None else max(totals.cpu_max, cpu)
-    totals.stolen_max = max(totals.stolen_max, cycles - cpu)
+    totals.merge(Tally(cycles_min=cycles, cycles_max=cycles, min_case=row.case, max_case=row.case, cycles_sum=cycles,
+                       cycles_count=1, cpu_min=cpu, cpu_max=cpu, stolen_max=cycles - cpu))  # the one way to add a call
 
 
 def rows_only_static(routine: Routine, runner: RoutineRunner) -> tuple[Bounds | None, str]:

@@ -488,3 +488,19 @@ def test_retro_asm_with_cpu_65c02_writes_the_65c02_opcodes(tmp_path, capsys):
     assert "--cpu: expected one of 6510, 2a03, 65c02, got 'z80'" in err and err.count("\n") == 1
     assert main(["asm", str(source), "-o", str(tmp_path / "other.prg")]) == 2  # STZ is no NMOS opcode
     assert not (tmp_path / "other.prg").exists()
+
+
+@pytest.mark.parametrize("engine", ["scalar", "batch"])
+def test_expected_rows_of_a_65c02_routine_are_timed_by_the_65c02_model(tmp_path, engine):
+    """A row's call on Machine is held against the 65C02 timing model (BRA is 3 cycles there; the
+    NMOS table reads $80 as a 2-cycle NOP #imm, which would make every row a cycle mismatch)."""
+    code = [0xFF, 0x10, 0x05, 0x64, 0x11, 0x80, 0x05, 0x00, 0xA9, 0x01, 0x85, 0x11, 0x60]  # as above
+    (tmp_path / "sign.bin").write_bytes(bytes(code))
+    spec = {"program": {"file": "sign.bin", "load": "$1000", "entry": "$1000", "cpu": "65c02"},
+            "inputs": {"v": "$10"}, "outputs": {"negative": "$11"},
+            "rows": [{"v": 5, "negative": 0, "cycles": 5 + 3 + 3 + 6}, {"v": 200, "negative": 1, "cycles": 17}]}
+    report = check_routine(spec_from_dict(spec, base=tmp_path), engine=engine)
+    assert report.totals.cases == 2 and report.totals.cycle_mismatches == 0 and report.mismatches == 0
+    assert report.rows.wrong == 0 and (report.static.best, report.static.worst) == (17, 17)
+    if engine == "batch":
+        assert report.agreement.cycle_mismatches == 0 and report.agreement.engine_cases == 2
