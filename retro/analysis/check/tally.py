@@ -4,7 +4,10 @@ answers and the domain, counted the same way for both. What counts as a mismatch
 - result: inside the domain, an output differs from the reference's answer;
 - cycles: the timing model's count differs from the cycles the CPU ran (Machine only);
 - engine: Machine and the batched core differ on a call (outputs, cycles, or whether it returned);
-- run: a call did not return (BRK, JAM, a runaway), which ends the check.
+- run: a call did not return (BRK, JAM, a runaway), which ends the check;
+- row: a spec's expected row whose call gave other outputs or cycles than the row states (the rows
+  are compared with what they state, not with the reference: retro.analysis.row_check, which adds
+  its calls' cycle figures to the same Tally).
 
 Cases outside the domain are counted (per condition they break, and how many of them the routine
 gets wrong) but are no mismatch. To add a statistic: a field of `Tally`, its line in `Tally.merge`,
