@@ -39,6 +39,7 @@ from retro.errors import InputError, RunError
 from retro.routines import cases as case_sets
 from retro.routines.registry import select
 from retro.cpu.batch import LaneError
+from retro.routines.sandbox import UserCodeError, shown
 from retro.routines.runner import (
     NEEDS_A_VIC_SCENE,
     BatchOutcome,
@@ -197,6 +198,8 @@ def expected_outputs(routine: Routine, case: tuple, memory: dict) -> tuple:
     arguments.update({name: memory[name] for name in routine.reference_memory})
     try:
         value = routine.reference(**arguments)
+    except UserCodeError:
+        raise
     except Exception as exc:  # the user's reference: whatever it raises is reported in one line
         raise InputError(f"{routine.spec_path}: reference {routine.reference_name} raised {type(exc).__name__}: "
                          f"{str(exc)[:200]} (inputs {describe_case(routine, case)})") from None
@@ -231,14 +234,14 @@ def _output_value(port, item, where: str, routine: Routine, case: tuple):
         except (TypeError, ValueError):
             values = None
         if values is None or len(values) != len(port.places) or any(not 0 <= v <= 0xFF for v in values):
-            raise InputError(f"{where} returned {item!r:.60} for {port.name}: expected {len(port.places)} bytes "
+            raise InputError(f"{where} returned {shown(item)} for {port.name}: expected {len(port.places)} bytes "
                              f"(inputs {describe_case(routine, case)})")
         return values
     if isinstance(item, bool):
         item = int(item)
     limit = 1 << port.bits
     if not isinstance(item, int) or not 0 <= item < limit:
-        raise InputError(f"{where} returned {item!r:.60} for {port.name}: expected a whole number 0..{limit - 1} "
+        raise InputError(f"{where} returned {shown(item)} for {port.name}: expected a whole number 0..{limit - 1} "
                          f"({'a flag: true or false' if port.flag else port.describe()}) "
                          f"(inputs {describe_case(routine, case)})")
     return item
@@ -330,6 +333,8 @@ def check_chunk(spec: str, seed: int, chunk: list[tuple], start: SceneStart | No
                 expected = row_of(answers, i)
             else:
                 expected = expected_outputs(routine, case, runner.memory_values)
+        except UserCodeError:  # a hang, an exit: never a refusal
+            raise
         except InputError:
             if not broken:
                 raise
@@ -421,6 +426,8 @@ def expected_columns(routine: Routine, columns: list, cases: list[tuple] | None,
         try:
             with np.errstate(all="ignore"):
                 value = routine.reference(**arguments)
+        except UserCodeError:
+            raise
         except Exception as exc:  # the user's reference: whatever it raises is reported in one line
             raise InputError(f"{where} raised {type(exc).__name__}: {str(exc)[:200]}") from None
         if isinstance(value, dict):
@@ -466,6 +473,8 @@ def expected_columns(routine: Routine, columns: list, cases: list[tuple] | None,
     for i, case in enumerate(cases):
         try:
             answers.append(expected_outputs(routine, case, memory))
+        except UserCodeError:
+            raise
         except InputError:
             if inside[i]:
                 raise
