@@ -22,6 +22,7 @@ from itertools import chain, islice
 import numpy as np
 
 from retro.errors import InputError
+from retro.routines.sandbox import shown
 from retro.routines.spec import Port, Routine, call_with
 
 RANDOM_BOUNDED = 2_000  # random cases without --exhaustive
@@ -335,5 +336,4 @@ def _check_widths(routine: Routine, cases: list[tuple], where: str) -> None:
 
 
 def _short(value) -> str:
-    text = repr(value)
-    return text if len(text) <= 80 else text[:77] + "..."
+    return shown(value, 80)

@@ -188,9 +188,9 @@ _rlimit = None  # RLIMIT_AS outside guarded calls, read once per process
 
 
 def call_guarded(function: Callable, label: str, seconds: float, args: tuple, kwargs: dict,
-                 faults_only: bool = True):
+                 faults_only: bool = True, case: str | None = None):
     """Call a user's function under the guards; a fault becomes a UserCodeError naming `label` and the
-    arguments."""
+    case (`case`, or else the arguments)."""
     global _inside, _rlimit
     if _inside:  # a guarded function calling another: the outer guard already holds
         return function(*args, **kwargs)
@@ -236,7 +236,7 @@ def call_guarded(function: Callable, label: str, seconds: float, args: tuple, kw
         reason = f"raised {type(exc).__name__}: {str(exc)[:200]}"
     except BaseException as exc:  # GeneratorExit and the like, raised by hand
         reason = f"raised {type(exc).__name__}"
-    called = f" (called with {describe_call(args, kwargs)})" if args or kwargs else ""
+    called = f" ({case})" if case else f" (called with {describe_call(args, kwargs)})" if args or kwargs else ""
     raise UserCodeError(f"{label} {reason}{called}") from None
 
 
