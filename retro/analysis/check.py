@@ -50,6 +50,7 @@ from retro.routines.runner import (
     row_of,
 )
 from retro.routines.spec import Routine, load_spec
+from retro.routines.where import require_inside
 from retro.workers import worker_pool
 
 EXAMPLES_KEPT = 5
@@ -679,6 +680,8 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     else:
         work = ((check_chunk, (spec, seed, chunk, start)) for chunk in _chunks(parts))
     _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
+    require_inside(f"{routine.spec_path}: cases.where", routine.domain, totals.cases, totals.outside,
+                   totals.constraint_cases)
     part_runs = [PartRun(p.name, p.count if p.count is not None else 0, p.total) for p in parts]
     if unknown:  # the sweep's count is whatever was left after the counted parts
         counted = sum(p.cases for p in part_runs if p.name != "sweep")

@@ -274,7 +274,8 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     where = cases_doc.get("where")
     coverage = _text(r, cases_doc, "coverage", "cases.coverage") or ""
     tables = frozenset(p.name for p in inputs if p.table)
-    domain = parse_where(where, names, f"{r.source}: cases.where", tables) if where is not None else ()
+    bounds = {p.name: (p.values.lo, p.values.hi) for p in inputs if not p.table}  # what int64 columns must hold
+    domain = parse_where(where, names, f"{r.source}: cases.where", tables, bounds) if where is not None else ()
     generators = {key: load_function(_text(r, cases_doc, key, f"cases.{key}"), r, f"cases.{key}", seconds)
                   for key in ("boundary", "sweep", "random_generator") if key in cases_doc}
 
