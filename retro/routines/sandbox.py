@@ -251,8 +251,14 @@ class _GuardedIterator:
 
     def __next__(self):
         self._step += 1
-        return call_guarded(next, f"{self._label} (item {self._step})", self._seconds, (self._iterator,), {},
-                            faults_only=False)
+        item = call_guarded(next, f"{self._label} (item {self._step})", self._seconds, (self._iterator, _END), {},
+                            faults_only=False, case="while making it")
+        if item is _END:
+            raise StopIteration
+        return item
+
+
+_END = object()  # what next() gives at the end of a user's iterator (StopIteration is no fault)
 
 
 def guarded(function: Callable, label: str, seconds: float = DEFAULT_SECONDS, *, faults_only: bool = True) -> Callable:
