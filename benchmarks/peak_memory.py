@@ -44,13 +44,17 @@ def commands(out: Path) -> list[tuple[str, list[str], str]]:
     (where / "spec.toml").write_text((big / "spec.toml").read_text().replace(
         '[memory]\nt = { at = "$2000", generator = "refs.py:table" }\n', "").replace(
         "random = 10", 'random = 10\nwhere = "len([0] * (1 << 28)) > 0"'))
+    loop = out / "loop.s"
+    loop.write_text("        .org $c000\nentry:  jmp entry\n")
     scene = ROOT / "examples" / "vic_two_balls.toml"
     nes_scene = next(iter(sorted((ROOT / "examples").glob("nes*.toml"))), scene)
     return [
         ("asm", ["asm", str(ROOT / "asm" / "aabb8.s"), "-o", str(out / "a.prg"), "--labels", str(out / "a.lbl")],
          "a built-in source"),
-        ("run", ["run", str(ROOT / "asm" / "aabb8.s"), "--entry", "aabb8", "--budget", "100000000"],
-         "--budget 100,000,000"),
+        ("run", ["run", str(loop), "--entry", "entry", "--budget", "100000000"],
+         "an endless loop, --budget 100,000,000"),
+        ("run-trace", ["run", str(loop), "--entry", "entry", "--budget", "100000000", "--trace"],
+         "an endless loop, --budget 100,000,000 --trace"),
         ("vic", ["vic", str(scene), "--frames", "10000", "--scale", "8", "--png", str(out / "v.png")],
          "--frames 10,000 --scale 8 --png"),
         ("nes", ["nes", str(nes_scene), "--scale", "16", "--png", str(out / "n.png")], "--scale 16 --png"),

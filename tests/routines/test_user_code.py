@@ -194,3 +194,30 @@ def test_the_time_limit_can_be_raised(tmp_path, capsys):
     path.write_text(path.read_text().replace("time_limit = 1", "time_limit = 3"))
     (tmp_path / "refs.py").write_text((tmp_path / "refs.py").read_text() + "\n")  # a new module, SLEPT again False
     assert main(["check", str(path), "--jobs", "1", "--random", "5"]) == 0, capsys.readouterr().err
+
+
+def peak_of(*args: str) -> tuple[int, int]:
+    """(exit status, peak resident KiB) of `retro ARGS`, run as the only child of a fresh interpreter
+    (RUSAGE_CHILDREN then holds that command's peak alone)."""
+    script = ("import resource, subprocess, sys\n"
+              "code = subprocess.run([sys.executable, '-m', 'retro', *sys.argv[1:]], capture_output=True).returncode\n"
+              "print(code, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)\n")
+    result = subprocess.run([sys.executable, "-c", script, *args], capture_output=True, text=True, timeout=120,
+                            cwd=ROOT, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+    code, peak = result.stdout.split()
+    return int(code), int(peak)
+
+
+def test_a_256_mb_memory_generator_is_refused_before_it_costs_gigabytes(tmp_path):
+    # converted to Python ints first, 256 MB of bytes cost 2.2 GB; refused by size, the array itself
+    path = spec(tmp_path, memory='[memory]\ntable = { at = "$2000", generator = "refs.py:table" }',
+                module="def table(rng=None):\n    return np.ones(1 << 28, dtype=np.uint8)\n")
+    code, peak = peak_of("check", str(path), "--jobs", "1")
+    assert code == 2 and peak < 600 * 1024, peak
+
+
+def test_a_where_that_would_build_gigabytes_costs_nothing(tmp_path):
+    path = spec(tmp_path)
+    path.write_text(path.read_text().replace("[cases]", '[cases]\nwhere = "len([0] * (1 << 28)) > 0"'))
+    code, peak = peak_of("check", str(path), "--jobs", "1")
+    assert code == 2 and peak < 300 * 1024, peak
