@@ -530,7 +530,7 @@ def load_function(text: str | None, r: Fields, key: str, seconds: int = sandbox.
     if not function_name.isidentifier():
         raise r.error(key, f"{function_name!r} is not a function name")
     if module_text.endswith(".py"):
-        module = _module_from_file(r.file(module_text, key, resolve=True), r, key)
+        module = _module_from_file(r.file(module_text, key, resolve=True), r, key, seconds)
     else:
         try:
             module = importlib.import_module(module_text)
@@ -557,9 +557,9 @@ def import_user_module(path: str, mtime: float):
     return module
 
 
-def _module_from_file(path: Path, r: Fields, key: str):
+def _module_from_file(path: Path, r: Fields, key: str, seconds: int = sandbox.DEFAULT_SECONDS):
     try:
-        return sandbox.import_guarded(lambda: import_user_module(str(path), path.stat().st_mtime), path.name)
+        return sandbox.import_guarded(lambda: import_user_module(str(path), path.stat().st_mtime), path.name, seconds)
     except sandbox.UserCodeError as exc:  # sys.exit, os._exit, a hang at import time
         raise r.error(key, f"{path.name} failed to import: {exc}") from None
     except Exception as exc:  # the user's module failed to import: one line, whatever it raised

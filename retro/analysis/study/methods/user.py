@@ -190,6 +190,8 @@ class UserMethod(Method):
             for (name, _, compiled), bits in zip(self.inputs, self.input_bits):
                 try:
                     value = compiled(*values)
+                except InputError:  # x // 0, a negative shift: one line naming the expression and the case
+                    raise
                 except Exception as exc:
                     raise RunError(f"{self.path}: inputs.{name}: {type(exc).__name__}: {exc} on {pair.name} at "
                                    f"offset ({dx}, {dy})") from None
