@@ -37,6 +37,12 @@ def commands(out: Path) -> list[tuple[str, list[str], str]]:
     (big / "spec.toml").write_text('[program]\nfile = "r.s"\nentry = "entry"\n[inputs]\na = "A"\n[outputs]\nr = "A"\n'
                                    '[memory]\nt = { at = "$2000", generator = "refs.py:table" }\n'
                                    '[reference]\nfunction = "refs.py:ref"\n[cases]\nrandom = 10\n')
+    hog = out / "hog"
+    hog.mkdir(exist_ok=True)
+    (hog / "r.s").write_text((big / "r.s").read_text())
+    (hog / "refs.py").write_text("def ref(a):\n    return len([0] * (1 << 28))\n")
+    (hog / "spec.toml").write_text((big / "spec.toml").read_text().replace(
+        '[memory]\nt = { at = "$2000", generator = "refs.py:table" }\n', ""))
     where = out / "where"
     where.mkdir(exist_ok=True)
     for name in ("refs.py", "r.s"):
@@ -63,6 +69,8 @@ def commands(out: Path) -> list[tuple[str, list[str], str]]:
         ("check-scalar", ["check", str(spec), "--random", "1000000000", "--jobs", "8", "--engine", "scalar", "--quiet"],
          "--random 10^9 --jobs 8 --engine scalar"),
         ("check-generator", ["check", str(big / "spec.toml"), "--jobs", "1"], "a [memory] generator of 256 MB"),
+        ("check-hog", ["check", str(hog / "spec.toml"), "--jobs", "1"],
+         "a reference that builds [0] * (1 << 28): 2 GiB"),
         ("check-where", ["check", str(where / "spec.toml"), "--jobs", "1"], "where = len([0] * (1 << 28)) > 0"),
         ("cycles", ["cycles", "--jobs", "8", "--quiet"], "every built-in routine, --jobs 8"),
         ("chart", ["chart", "--samples", "1000000", "--jobs", "8", "--per-frame", "--quiet", "--out", str(out / "c")],

@@ -7,6 +7,12 @@ Printed: microseconds per call bare and guarded, the ratio, and the share of a b
 for an array reference of realistic size.
 
     PYTHONPATH=. python benchmarks/sandbox_overhead.py
+
+Measured on the development machine (2 shared cores): aabb8 case by case 18 us bare, 27 us guarded
+(+9 us: two interval timers armed and disarmed, RLIMIT_AS set and restored, /proc/self/statm read at
+most once a second); an array reference on 65,536 cases +1% (within noise). A whole check,
+`retro check tests/data/specs/boxhit_acme.toml --random 200000 --engine batch --jobs 1` (265,536 cases,
+its reference called case by case): 20.0 and 22.3 s at 64be42f, 22.0 and 22.6 s guarded.
 """
 
 from __future__ import annotations
