@@ -274,3 +274,15 @@ def test_a_user_method_in_the_stability_study():
     cases = list(edges.BOX_CASES)
     assert [table[(c, "rule: tight box, 1 px in")] for c in cases] == [0.0, 0.0, 0.0]
     assert [table[(c, "6502 aabb8 (shrunk)")] for c in cases] == [0.0, 0.0, 0.0]
+
+
+def test_input_expressions_index_the_masks_and_refuse_arithmetic_on_them(tmp_path):
+    from retro.routines.where import parse_where
+    from retro.analysis.study.methods.user import MASKS, NAMES
+
+    values = list(range(len(NAMES)))
+    values[NAMES.index("a_mask")] = tuple(range(100, 163))
+    (term,) = parse_where("a_mask[3] + dx", NAMES, "m.toml: inputs.x", MASKS)
+    assert term.test(*values) == 103 + values[NAMES.index("dx")]
+    with pytest.raises(InputError, match="m.toml: inputs.x: a_mask: arithmetic takes numbers"):
+        parse_where("a_mask * 100000000", NAMES, "m.toml: inputs.x", MASKS)

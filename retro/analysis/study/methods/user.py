@@ -59,6 +59,7 @@ MAX_TEXT = 200  # characters of a name, label, colour or marker
 # function rule the circle is the fitted circle (strict).
 PER_SPRITE = ("sx", "sy", "x", "y", "w", "h", "right", "right1", "bottom", "bottom1", "cx", "cy", "r", "mask")
 NAMES = ("dx", "dy") + tuple(f"{s}_{n}" for s in "ab" for n in PER_SPRITE)
+MASKS = frozenset(name for name in NAMES if name.endswith("_mask"))  # tables of bytes; the rest are numbers
 DEFAULT_COLOURS = ("#e377c2", "#7f7f7f", "#bcbd22", "#393b79", "#637939", "#843c39", "#7b4173")
 DEFAULT_MARKERS = ("v", "<", ">", "p", "8", "H", "1")
 
@@ -303,7 +304,7 @@ def _inputs(fields: Fields, doc, routine) -> tuple[tuple, tuple]:
             text = str(text)
         if not isinstance(text, str):
             raise fields.error(f"inputs.{port.name}", f"expected an expression as a string, got {text!r}")
-        terms = parse_where(text, NAMES, f"{fields.source}: inputs.{port.name}")
+        terms = parse_where(text, NAMES, f"{fields.source}: inputs.{port.name}", MASKS)
         if len(terms) != 1:
             raise fields.error(f"inputs.{port.name}", "one value, not a condition joined by `and`")
         compiled.append((port.name, text, terms[0].test))
