@@ -150,19 +150,20 @@ def _install_alarm() -> None:
         signal.signal(signal.SIGVTALRM, signal.SIG_DFL)
 
 
-_statm = None  # a file descriptor on /proc/self/statm (read with pread: no open per call)
+_statm = None  # a file descriptor on /proc/self/statm (read with pread: no open per call) ...
+_statm_pid = 0  # ... of this process: a forked worker opens its own (the parent's would read the parent)
 _space = (0.0, 0)  # (when, bytes): the address space, measured at most every SPACE_SECONDS
 SPACE_SECONDS = 1.0
 SPACE_SLACK = 256 << 20  # what the process may have grown since it was measured
 
 
 def _address_space(now: float) -> int | None:
-    global _statm, _space
-    if now - _space[0] < SPACE_SECONDS:
+    global _statm, _statm_pid, _space
+    if now - _space[0] < SPACE_SECONDS and _statm_pid == os.getpid():
         return _space[1]
     try:
-        if _statm is None:
-            _statm = os.open("/proc/self/statm", os.O_RDONLY)
+        if _statm is None or _statm_pid != os.getpid():
+            _statm, _statm_pid = os.open("/proc/self/statm", os.O_RDONLY), os.getpid()
         _space = (now, int(os.pread(_statm, 64, 0).split()[0]) * _PAGE)
     except (OSError, ValueError, IndexError):  # no /proc: no memory guard
         return None
