@@ -53,6 +53,9 @@ def commands(out: Path) -> list[tuple[str, list[str], str]]:
     loop = out / "loop.s"
     loop.write_text("        .org $c000\nentry:  jmp entry\n")
     scene = ROOT / "examples" / "vic_two_balls.toml"
+    moving = out / "moving.toml"  # every sprite moves: each of the 10,000 frames is a collision pass
+    moving.write_text(scene.read_text().replace('"../sprites/', f'"{ROOT / "sprites"}/').replace(
+        "[[sprite]]\n", "[[sprite]]\nvelocity = [1, 1]\n"))
     nes_scene = next(iter(sorted((ROOT / "examples").glob("nes*.toml"))), scene)
     return [
         ("asm", ["asm", str(ROOT / "asm" / "aabb8.s"), "-o", str(out / "a.prg"), "--labels", str(out / "a.lbl")],
@@ -61,8 +64,8 @@ def commands(out: Path) -> list[tuple[str, list[str], str]]:
          "an endless loop, --budget 100,000,000"),
         ("run-trace", ["run", str(loop), "--entry", "entry", "--budget", "100000000", "--trace"],
          "an endless loop, --budget 100,000,000 --trace"),
-        ("vic", ["vic", str(scene), "--frames", "10000", "--scale", "8", "--png", str(out / "v.png")],
-         "--frames 10,000 --scale 8 --png"),
+        ("vic", ["vic", str(moving), "--frames", "10000", "--scale", "8", "--png", str(out / "v.png")],
+         "four moving sprites, --frames 10,000 --scale 8 --png"),
         ("nes", ["nes", str(nes_scene), "--scale", "16", "--png", str(out / "n.png")], "--scale 16 --png"),
         ("check", ["check", str(spec), "--random", "1000000000", "--jobs", "8", "--quiet"],
          "--random 10^9 --jobs 8 (batched core)"),

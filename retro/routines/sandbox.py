@@ -42,7 +42,8 @@ MAX_SECONDS = 3_600
 USER_MEMORY_BYTES = 512 << 20  # what one call may add to the process's address space
 GRACE_SECONDS = 5  # after the limit, before the watchdog ends a call stuck in C code
 SHOWN_CHARACTERS = 60  # of a value in an error line
-SHOWN_ARGUMENTS = 8
+SHOWN_ARGUMENTS = 8  # items of a list or dict in an error line
+SHOWN_CALL_ARGUMENTS = 32  # arguments of a call: every input of any built-in routine
 
 _PLAIN = (list, tuple, dict, np.ndarray, bytes, bytearray, str, range)
 _PAGE = os.sysconf("SC_PAGE_SIZE") if hasattr(os, "sysconf") else 4096
@@ -96,6 +97,8 @@ _install_exit_guards()
 def shown(value, limit: int = SHOWN_CHARACTERS) -> str:
     """A value as an error line shows it: short, and never failing (a 5,000-digit integer has no repr
     under Python's int_max_str_digits; an array is summarised)."""
+    if isinstance(value, np.generic) and value.dtype.kind in "biuf":
+        value = value.item()
     if isinstance(value, bool) or value is None:
         return repr(value)
     if isinstance(value, int):
@@ -113,17 +116,17 @@ def shown(value, limit: int = SHOWN_CHARACTERS) -> str:
         text = f"[{inner}]" if isinstance(value, list) else f"({inner})"
     elif isinstance(value, dict):
         text = "{" + ", ".join(f"{k!s:.20}: {shown(v, limit)}" for k, v in list(value.items())[:SHOWN_ARGUMENTS]) + "}"
-    else:
-        try:
-            text = repr(value)
-        except Exception:  # a user's object whose repr fails
-            text = f"a {type(value).__name__}"
+    elif isinstance(value, (str, float, bytes)):
+        text = repr(value[:limit] if isinstance(value, (str, bytes)) else value)
+    else:  # a user's object: its own repr could fail, hang or run for pages
+        text = f"a {type(value).__name__}"
     return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def describe_call(args: tuple, kwargs: dict) -> str:
-    parts = [shown(a) for a in args[:SHOWN_ARGUMENTS]]
-    parts += [f"{k}={shown(v)}" for k, v in list(kwargs.items())[:SHOWN_ARGUMENTS - len(parts)]]
+    """The arguments of a call (a reference's: the case's inputs by name, then its memory blocks)."""
+    parts = [shown(a) for a in args[:SHOWN_CALL_ARGUMENTS]]
+    parts += [f"{k}={shown(v)}" for k, v in list(kwargs.items())[:SHOWN_CALL_ARGUMENTS - len(parts)]]
     return ", ".join(parts) or "no arguments"
 
 
