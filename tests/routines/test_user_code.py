@@ -151,6 +151,9 @@ def test_a_nonsense_array_answer_is_one_line(tmp_path, capsys, body, message):
      "cases.sweep refs.py:gen (item 2) took more than 1 s"),
     ("sweep", "    yield from gen()", "cases.sweep refs.py:gen (item 1) recursed without end"),
     ("random_generator", "    return [(1, 2, 3, 4, 5, 6, 7, 8)] * 3", "asked for 50 cases, the function returned 3"),
+    ("random_generator", "    return 5", "the function must return a list or iterable of cases"),
+    ("boundary", "    return [len([0] * (1 << 28))]", "cases.boundary refs.py:gen allocated more than 512 MiB"),
+    ("boundary", "    while True:\n        pass", "cases.boundary refs.py:gen took more than 1 s"),
 ])
 def test_a_case_generator_that_fails_is_one_line(tmp_path, key, body, message):
     path = spec(tmp_path, cases=f'random = 50\n{key} = "refs.py:gen"',
