@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from retro.errors import InputError
+from retro.routines.sandbox import shown
 
 FUNCTIONS: dict[str, Callable] = {"abs": abs, "min": min, "max": max, "len": len, "sum": sum, "any": any, "all": all}
 _ALLOWED = (ast.Expression, ast.BoolOp, ast.And, ast.Or, ast.UnaryOp, ast.Not, ast.USub, ast.UAdd, ast.Invert,
@@ -294,8 +295,6 @@ def _reason(exc: Exception) -> str:
 
 
 def _describe(names: tuple[str, ...], case: tuple) -> str:
-    from retro.routines.sandbox import shown
-
     return ", ".join(f"{name}={shown(value, 40)}" for name, value in zip(names, case))
 
 
