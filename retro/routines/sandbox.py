@@ -40,6 +40,7 @@ from retro.errors import InputError
 DEFAULT_SECONDS = 20  # a case or a block of 65,536 cases takes milliseconds; 20 s is a hang
 MAX_SECONDS = 3_600
 USER_MEMORY_BYTES = 512 << 20  # what one call may add to the process's address space
+TIMER_SLACK = 0.01  # seconds: a timer's signal may come this early
 GRACE_SECONDS = 5  # after the limit, before the watchdog ends a call stuck in C code
 SHOWN_CHARACTERS = 60  # of a value in an error line
 SHOWN_ARGUMENTS = 8  # items of a list or dict in an error line
@@ -136,11 +137,16 @@ SIGALRM = int(signal.SIGALRM)
 _previous_alarm = None  # the SIGALRM handler ours replaced: called when our timer is not running
 
 
+_deadline = 0.0  # when the running guarded call's time is up (time.monotonic)
+
+
 def _alarm(signum, frame) -> None:
-    if _inside:
+    if _inside and time.monotonic() >= _deadline - TIMER_SLACK:
         raise _TimeUp()
-    if callable(_previous_alarm):
+    if callable(_previous_alarm):  # the timer of whoever had SIGALRM before (it ran out first)
         _previous_alarm(signum, frame)
+    if _inside:  # their handler returned: our own limit still holds
+        signal.setitimer(signal.ITIMER_REAL, max(_deadline - time.monotonic(), TIMER_SLACK))
 
 
 def _install_alarm() -> None:
@@ -195,7 +201,7 @@ def call_guarded(function: Callable, label: str, seconds: float, args: tuple, kw
                  faults_only: bool = True, case: str | None = None):
     """Call a user's function under the guards; a fault becomes a UserCodeError naming `label` and the
     case (`case`, or else the arguments)."""
-    global _inside, _rlimit
+    global _inside, _rlimit, _deadline
     if _inside:  # a guarded function calling another: the outer guard already holds
         return function(*args, **kwargs)
     timed = threading.current_thread() is threading.main_thread()
@@ -205,7 +211,10 @@ def call_guarded(function: Callable, label: str, seconds: float, args: tuple, kw
         try:
             if timed:
                 _install_alarm()
+                _deadline = started + seconds
                 previous_timer = signal.setitimer(signal.ITIMER_REAL, seconds)
+                if 0 < previous_timer[0] < seconds:  # someone else's timer runs out first: it keeps its time
+                    signal.setitimer(signal.ITIMER_REAL, previous_timer[0])
                 signal.setitimer(signal.ITIMER_VIRTUAL, seconds + GRACE_SECONDS)
             if _rlimit is None:
                 _rlimit = resource.getrlimit(resource.RLIMIT_AS)

@@ -224,3 +224,33 @@ def test_a_where_that_would_build_gigabytes_costs_nothing(tmp_path):
     path.write_text(path.read_text().replace("[cases]", '[cases]\nwhere = "len([0] * (1 << 28)) > 0"'))
     code, peak = peak_of("check", str(path), "--jobs", "1")
     assert code == 2 and peak < 300 * 1024, peak
+
+
+def test_the_time_limit_leaves_an_outer_timer_its_time():
+    """A caller's own SIGALRM timer (a test harness's, say) still fires at its time inside a guarded call,
+    and keeps its remaining time after one."""
+    import signal
+    import time
+
+    from retro.routines.sandbox import UserCodeError, guarded
+
+    class Outer(Exception):
+        pass
+
+    def outer(signum, frame):
+        raise Outer()
+
+    previous = signal.signal(signal.SIGALRM, outer)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 0.5)
+        start = time.monotonic()
+        with pytest.raises(Outer):
+            guarded(lambda: time.sleep(5), "t:sleep", 3)()
+        assert time.monotonic() - start < 2
+        signal.alarm(10)
+        with pytest.raises(UserCodeError, match="t:sleep took more than 0.5 s"):
+            guarded(lambda: time.sleep(5), "t:sleep", 0.5)()
+        assert 8 <= signal.alarm(0) <= 10
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
