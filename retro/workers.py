@@ -14,7 +14,7 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 
 PR_SET_PDEATHSIG = 1  # prctl(2): the signal the calling process gets when its parent dies
-MAX_WORKERS = 4  # each worker holds its own emulator, case blocks and study corpus (70-170 MB): 4 keep a command's
+MAX_WORKERS = 2  # each worker holds its own emulator, case blocks and study corpus (70-320 MB): 2 keep a command's
 # whole process tree under 1 GiB (benchmarks/peak_memory.py, docs/limits.md)
 
 
