@@ -67,6 +67,7 @@ def commands(out: Path) -> list[tuple[str, list[str], str]]:
         ("vic", ["vic", str(moving), "--frames", "10000", "--scale", "8", "--png", str(out / "v.png")],
          "four moving sprites, --frames 10,000 --scale 8 --png"),
         ("nes", ["nes", str(nes_scene), "--scale", "16", "--png", str(out / "n.png")], "--scale 16 --png"),
+        ("check-pixel", ["check", "pixel", "--exhaustive", "--jobs", "2", "--quiet"], "pixel --exhaustive --jobs 2 (table inputs, sweeps)"),
         ("check", ["check", str(spec), "--random", "1000000000", "--jobs", "2", "--quiet"],
          "--random 10^9 --jobs 2 (batched core)"),
         ("check-scalar", ["check", str(spec), "--random", "1000000000", "--jobs", "2", "--engine", "scalar", "--quiet"],
