@@ -533,7 +533,9 @@ def load_function(text: str | None, r: Fields, key: str, seconds: int = sandbox.
         module = _module_from_file(r.file(module_text, key, resolve=True), r, key, seconds)
     else:
         try:
-            module = importlib.import_module(module_text)
+            module = sandbox.import_guarded(lambda: importlib.import_module(module_text), module_text, seconds)
+        except sandbox.UserCodeError as exc:  # sys.exit, os._exit, a hang at import time
+            raise r.error(key, f"{module_text} failed to import: {exc}") from None
         except ImportError as exc:
             raise r.error(key, f"cannot import {module_text}: {exc}") from None
     function = getattr(module, function_name, None)

@@ -254,3 +254,14 @@ def test_the_time_limit_leaves_an_outer_timer_its_time():
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
+
+
+def test_an_exit_when_a_module_by_name_is_imported_never_passes(tmp_path):
+    (tmp_path / "exitmod.py").write_text("import sys\nsys.exit(0)\n")
+    path = spec(tmp_path)
+    path.write_text(path.read_text().replace("refs.py:boxhit", "exitmod:boxhit"))
+    result = subprocess.run([sys.executable, "-m", "retro", "check", str(path), "--jobs", "1"], capture_output=True,
+                            text=True, timeout=120, cwd=ROOT,
+                            env={"PYTHONPATH": f"{ROOT}:{tmp_path}", "PATH": "/usr/bin:/bin"})
+    assert result.returncode == 2, result
+    one_line(result.stderr, "reference.function: exitmod failed to import: exitmod called sys.exit(0)")
