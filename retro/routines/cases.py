@@ -30,7 +30,7 @@ RANDOM_BOUNDED = 2_000  # random cases without --exhaustive
 BOUNDED_PRODUCT = 1 << 16  # an exhaustive set this small runs in full even without --exhaustive
 BOUNDED_SAMPLE = 4_096  # cases sampled from a larger exhaustive set without --exhaustive
 CHUNK = 4_000
-BLOCK_BYTES = 16 << 20  # a column block for the batched core: 16 MiB (65,536 cases of 32 numbers; fewer of tables)
+BLOCK_BYTES = 8 << 20  # a column block for the batched core: 8 MiB (65,536 cases of 16 numbers; fewer of tables)
 RANDOM_BLOCK = 1_000_000  # a random generator is called once per block of this many cases
 EXHAUSTIVE_RNG_OFFSET = 2  # the non-swept inputs of the exhaustive part draw from seed + 2
 
