@@ -40,6 +40,7 @@ from retro.errors import InputError, RunError
 from retro.routines import cases as case_sets
 from retro.routines.registry import select
 from retro.cpu.batch import LaneError
+from retro.routines.sandbox import UserCodeError, shown
 from retro.routines.runner import (
     NEEDS_A_VIC_SCENE,
     BatchOutcome,
@@ -50,6 +51,7 @@ from retro.routines.runner import (
     row_of,
 )
 from retro.routines.spec import Routine, load_spec
+from retro.routines.where import require_inside
 from retro.workers import worker_pool
 
 if TYPE_CHECKING:
@@ -206,6 +208,8 @@ def expected_outputs(routine: Routine, case: tuple, memory: dict) -> tuple:
     arguments.update({name: memory[name] for name in routine.reference_memory})
     try:
         value = routine.reference(**arguments)
+    except UserCodeError:
+        raise
     except Exception as exc:  # the user's reference: whatever it raises is reported in one line
         raise InputError(f"{routine.spec_path}: reference {routine.reference_name} raised {type(exc).__name__}: "
                          f"{str(exc)[:200]} (inputs {describe_case(routine, case)})") from None
@@ -240,14 +244,14 @@ def _output_value(port, item, where: str, routine: Routine, case: tuple):
         except (TypeError, ValueError):
             values = None
         if values is None or len(values) != len(port.places) or any(not 0 <= v <= 0xFF for v in values):
-            raise InputError(f"{where} returned {item!r:.60} for {port.name}: expected {len(port.places)} bytes "
+            raise InputError(f"{where} returned {shown(item)} for {port.name}: expected {len(port.places)} bytes "
                              f"(inputs {describe_case(routine, case)})")
         return values
     if isinstance(item, bool):
         item = int(item)
     limit = 1 << port.bits
     if not isinstance(item, int) or not 0 <= item < limit:
-        raise InputError(f"{where} returned {item!r:.60} for {port.name}: expected a whole number 0..{limit - 1} "
+        raise InputError(f"{where} returned {shown(item)} for {port.name}: expected a whole number 0..{limit - 1} "
                          f"({'a flag: true or false' if port.flag else port.describe()}) "
                          f"(inputs {describe_case(routine, case)})")
     return item
@@ -339,6 +343,8 @@ def check_chunk(spec: str, seed: int, chunk: list[tuple], start: SceneStart | No
                 expected = row_of(answers, i)
             else:
                 expected = expected_outputs(routine, case, runner.memory_values)
+        except UserCodeError:  # a hang, an exit: never a refusal
+            raise
         except InputError:
             if not broken:
                 raise
@@ -430,6 +436,8 @@ def expected_columns(routine: Routine, columns: list, cases: list[tuple] | None,
         try:
             with np.errstate(all="ignore"):
                 value = routine.reference(**arguments)
+        except UserCodeError:
+            raise
         except Exception as exc:  # the user's reference: whatever it raises is reported in one line
             raise InputError(f"{where} raised {type(exc).__name__}: {str(exc)[:200]}") from None
         if isinstance(value, dict):
@@ -475,6 +483,8 @@ def expected_columns(routine: Routine, columns: list, cases: list[tuple] | None,
     for i, case in enumerate(cases):
         try:
             answers.append(expected_outputs(routine, case, memory))
+        except UserCodeError:
+            raise
         except InputError:
             if inside[i]:
                 raise
@@ -690,6 +700,8 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     else:
         work = ((check_chunk, (spec, seed, chunk, start)) for chunk in _chunks(parts))
     _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
+    require_inside(f"{routine.spec_path}: cases.where", routine.domain, totals.cases, totals.outside,
+                   totals.constraint_cases)
     part_runs = [PartRun(p.name, p.count if p.count is not None else 0, p.total) for p in parts]
     if rows is not None:
         part_runs.insert(0, PartRun("rows", sum(o.checked for o in rows.outcomes), len(rows.outcomes)))

@@ -31,6 +31,7 @@ from retro.fileio import cached_reads, is_dir, note_input, parse_toml, read_byte
 from retro.loaders import load_program
 from retro.program import Program
 from retro.routines.rows import Row, misplaced_rows, parse_rows
+from retro.routines import sandbox
 from retro.routines.where import Condition, parse_where
 
 BYTE_VALUES = 256
@@ -49,7 +50,7 @@ TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "refere
 PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load"}
 PORT_KEYS = {"at", "size", "values", "table"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
-REFERENCE_KEYS = {"function", "arrays"}
+REFERENCE_KEYS = {"function", "arrays", "time_limit"}
 CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage"}
 CYCLES_KEYS = {"max", "loops", "limit", "static"}
 
@@ -239,6 +240,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     r = Fields(shown or str(path), folder=path.parent, number_characters=NUMBER_CHARACTERS)
     r.table(doc, "", TOP_KEYS)
     misplaced_rows(r, doc)
+    seconds = sandbox.time_limit(r, r.table(doc.get("reference", {}), "reference"), "reference")
     program_doc = r.table(r.required(doc, "program", hint="the [program] table"), "program", PROGRAM_KEYS)
     program_file = r.file(_text(r, program_doc, "file", "program.file", required=True), "program.file", resolve=True)
     symbols_name = _text(r, program_doc, "symbols", "program.symbols")
@@ -271,7 +273,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     if not outputs:
         raise r.error("outputs", "names no output")
     _no_overlap(r, inputs, "inputs")
-    memory = tuple(_memory_block(r, program, name, value)
+    memory = tuple(_memory_block(r, program, name, value, seconds)
                    for name, value in r.table(doc.get("memory", {}), "memory").items())
     _no_overlap_memory(r, memory, inputs)
 
@@ -285,7 +287,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
         reference_doc = r.table(r.required(doc, "reference", hint="the [reference] table, or [[rows]]"), "reference",
                                 REFERENCE_KEYS)
         reference_name = _text(r, reference_doc, "function", "reference.function", required=True)
-        reference = load_function(reference_name, r, "reference.function")
+        reference = load_function(reference_name, r, "reference.function", seconds, faults_only=True)
         reference_memory = _reference_signature(r, reference, reference_name, inputs, memory)
         # true: the function takes numpy arrays, one element per case
         reference_arrays = r.flag(reference_doc.get("arrays", False), "reference.arrays")
@@ -306,8 +308,9 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     where = cases_doc.get("where")
     coverage = _text(r, cases_doc, "coverage", "cases.coverage") or ""
     tables = frozenset(p.name for p in inputs if p.table)
-    domain = parse_where(where, names, f"{r.source}: cases.where", tables) if where is not None else ()
-    generators = {key: load_function(_text(r, cases_doc, key, f"cases.{key}"), r, f"cases.{key}")
+    bounds = {p.name: (p.values.lo, p.values.hi) for p in inputs if not p.table}  # what int64 columns must hold
+    domain = parse_where(where, names, f"{r.source}: cases.where", tables, bounds) if where is not None else ()
+    generators = {key: load_function(_text(r, cases_doc, key, f"cases.{key}"), r, f"cases.{key}", seconds)
                   for key in ("boundary", "sweep", "random_generator") if key in cases_doc}
 
     cycles_doc = r.table(doc.get("cycles", {}), "cycles", CYCLES_KEYS)
@@ -478,7 +481,7 @@ def _no_overlap(r: Fields, ports: tuple[Port, ...], section: str) -> None:
             owner[place] = port.name
 
 
-def _memory_block(r: Fields, program: Program, name: str, doc) -> MemoryBlock:
+def _memory_block(r: Fields, program: Program, name: str, doc, seconds: int = sandbox.DEFAULT_SECONDS) -> MemoryBlock:
     key = f"memory.{name}"
     if not name.isidentifier():
         raise r.error(key, "a name must be a Python identifier (the reference may take it by name)")
@@ -519,7 +522,8 @@ def _memory_block(r: Fields, program: Program, name: str, doc) -> MemoryBlock:
                 return rng.choice(list(_values.listed), size=_size)
             return rng.integers(_values.lo, _values.hi + 1, size=_size)
         return MemoryBlock(name, address, None, make, size)
-    function = load_function(doc["generator"] if isinstance(doc["generator"], str) else None, r, f"{key}.generator")
+    function = load_function(doc["generator"] if isinstance(doc["generator"], str) else None, r, f"{key}.generator",
+                             seconds)
     return MemoryBlock(name, address, None, function, 0)
 
 
@@ -556,24 +560,29 @@ def _no_overlap_memory(r: Fields, memory: tuple[MemoryBlock, ...], inputs: tuple
 
 # ---- Python functions named by a spec -------------------------------------------------------------
 
-def load_function(text: str | None, r: Fields, key: str) -> Callable:
-    """`file.py:function` (a path relative to the spec) or `package.module:function`."""
+def load_function(text: str | None, r: Fields, key: str, seconds: int = sandbox.DEFAULT_SECONDS,
+                  faults_only: bool = False) -> Callable:
+    """`file.py:function` (a path relative to the spec) or `package.module:function`, run under the
+    sandbox's guards (retro.routines.sandbox): `seconds` per call; with `faults_only` an ordinary
+    exception reaches the caller as it is (a reference refusing a case)."""
     if not text or ":" not in text:
         raise r.error(key, "expected FILE.py:FUNCTION (relative to the spec) or MODULE:FUNCTION")
     module_text, _, function_name = text.rpartition(":")
     if not function_name.isidentifier():
         raise r.error(key, f"{function_name!r} is not a function name")
     if module_text.endswith(".py"):
-        module = _module_from_file(r.file(module_text, key, resolve=True), r, key)
+        module = _module_from_file(r.file(module_text, key, resolve=True), r, key, seconds)
     else:
         try:
-            module = importlib.import_module(module_text)
+            module = sandbox.import_guarded(lambda: importlib.import_module(module_text), module_text, seconds)
+        except sandbox.UserCodeError as exc:  # sys.exit, os._exit, a hang at import time
+            raise r.error(key, f"{module_text} failed to import: {exc}") from None
         except ImportError as exc:
             raise r.error(key, f"cannot import {module_text}: {exc}") from None
     function = getattr(module, function_name, None)
     if not callable(function):
         raise r.error(key, f"{module_text} has no function {function_name!r}")
-    return function
+    return sandbox.guarded(function, f"{r.source}: {key} {text}", seconds, faults_only=faults_only)
 
 
 @cached_reads(maxsize=64)
@@ -592,9 +601,11 @@ def import_user_module(path: str, mtime: float):
     return module
 
 
-def _module_from_file(path: Path, r: Fields, key: str):
+def _module_from_file(path: Path, r: Fields, key: str, seconds: int = sandbox.DEFAULT_SECONDS):
     try:
-        return import_user_module(str(path), path.stat().st_mtime)
+        return sandbox.import_guarded(lambda: import_user_module(str(path), path.stat().st_mtime), path.name, seconds)
+    except sandbox.UserCodeError as exc:  # sys.exit, os._exit, a hang at import time
+        raise r.error(key, f"{path.name} failed to import: {exc}") from None
     except Exception as exc:  # the user's module failed to import: one line, whatever it raised
         line = ""
         tb = exc.__traceback__
