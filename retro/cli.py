@@ -21,7 +21,8 @@ from retro.chips.palettes import C64_DEFAULT_PALETTE
 from retro.commands import advise, asm, chart, check, cycles, demo, nes, parry, run, stability, vic
 from retro.cpu.machine import DEFAULT_BUDGET, MAX_BUDGET
 from retro.errors import RetroError
-from retro.geometry.parry import DEFAULT_FRAMES
+from retro.geometry.parry import DEFAULT_FRAMES, MAX_FRAMES
+from retro.workers import MAX_WORKERS
 from retro.progress import progress_printer
 from retro.routines.registry import builtin_names
 
@@ -60,7 +61,7 @@ def _out(p: argparse.ArgumentParser, default: str) -> None:
 def _jobs(p: argparse.ArgumentParser, default: int | None) -> None:
     """--jobs; default None leaves the count to the command (the checker: up to 2)."""
     p.add_argument("--jobs", default=default, metavar="N",
-                   help=f"worker processes (default: {'up to 2' if default is None else default})")
+                   help=f"worker processes (default: {'up to 2' if default is None else default}; at most {MAX_WORKERS})")
 
 
 def _quiet(p: argparse.ArgumentParser) -> None:
@@ -325,7 +326,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--script", metavar="SCRIPT", help="input script or @FILE (default: a built-in script)")
     _out(p, parry.DEFAULT_OUT)
     p.add_argument("--frames", default=str(DEFAULT_FRAMES), metavar="N",
-                   help=f"frames to simulate (default: {DEFAULT_FRAMES})")
+                   help=f"frames to simulate (default: {DEFAULT_FRAMES}, at most {MAX_FRAMES:,})")
     return parser
 
 

@@ -17,6 +17,8 @@ from concurrent.futures import ProcessPoolExecutor
 from retro import interrupts
 
 PR_SET_PDEATHSIG = 1  # prctl(2): the signal the calling process gets when its parent dies
+MAX_WORKERS = 2  # each worker holds its own emulator, case blocks and study corpus (70-320 MB): 2 keep a command's
+# whole process tree under 1 GiB (benchmarks/peak_memory.py, docs/limits.md)
 
 
 def _prepare_worker() -> None:

@@ -11,10 +11,11 @@ from retro.analysis.study.methods import with_user_methods
 from retro.fileio import all_or_nothing
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
+from retro.workers import MAX_WORKERS
 
 DEFAULT_OUT = "retro-out/chart"
 DEFAULT_JOBS = 2
-MAX_JOBS = 64
+MAX_JOBS = MAX_WORKERS
 MAX_SAMPLES = 1_000_000
 
 

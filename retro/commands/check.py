@@ -17,9 +17,10 @@ from retro.fileio import file_option, write_atomic
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
 from retro.routines import cases as case_sets
+from retro.workers import MAX_WORKERS
 
 MAX_RANDOM = 10 ** 9
-MAX_JOBS = 64
+MAX_JOBS = MAX_WORKERS
 MAX_AT_LINE = 1000  # above every chip's line count: the scene's chip gives the exact range
 MAX_AT_CYCLE = 100
 JSON_EXACT = 1 << 53  # larger whole numbers lose digits in JSON readers that use doubles

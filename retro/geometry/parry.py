@@ -34,7 +34,7 @@ from retro.geometry.sat import sat
 
 ACTIONS = ("parry", "left", "right", "stop")
 EVENT_KINDS = ("window", "press", "whiff", "parry", "hit", "expired")
-MAX_FRAMES = 10_000
+MAX_FRAMES = 2_000  # every frame is drawn and held for the GIF (~350 KB each): 2,000 peak at ~750 MB
 
 DEFAULT_FRAMES = 230
 

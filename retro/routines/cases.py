@@ -15,6 +15,7 @@ widths (one-line error naming the function and the case).
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from itertools import chain, islice
@@ -22,12 +23,14 @@ from itertools import chain, islice
 import numpy as np
 
 from retro.errors import InputError
+from retro.routines.sandbox import shown
 from retro.routines.spec import Port, Routine, call_with
 
 RANDOM_BOUNDED = 2_000  # random cases without --exhaustive
 BOUNDED_PRODUCT = 1 << 16  # an exhaustive set this small runs in full even without --exhaustive
 BOUNDED_SAMPLE = 4_096  # cases sampled from a larger exhaustive set without --exhaustive
 CHUNK = 4_000
+BLOCK_BYTES = 8 << 20  # a column block for the batched core: 8 MiB (65,536 cases of 16 numbers; fewer of tables)
 RANDOM_BLOCK = 1_000_000  # a random generator is called once per block of this many cases
 EXHAUSTIVE_RNG_OFFSET = 2  # the non-swept inputs of the exhaustive part draw from seed + 2
 
@@ -46,7 +49,8 @@ class Part:
     def cases(self) -> Iterator[tuple]:
         """The part's cases one by one (for the scalar engine), in the same order as its blocks."""
         for block in self.blocks():
-            yield from columns_to_cases(block)
+            for start in range(0, len(block[0]), CHUNK):  # a CHUNK of tuples at a time, not a whole block
+                yield from columns_to_cases([column[start:start + CHUNK] for column in block])
 
 
 def columns_to_cases(block: Columns) -> list[tuple]:
@@ -108,21 +112,48 @@ def chunks(cases: Iterable[tuple], size: int = CHUNK) -> Iterator[list[tuple]]:
 
 
 def batches(parts: list[Part], size: int) -> Iterator[Columns]:
-    """The parts' cases as column blocks of `size` cases (the last one shorter), in case order."""
-    held: list[Columns] = []
-    count = 0
+    """The parts' cases as column blocks of `size` cases (the last one shorter), in case order; fewer
+    when a case holds many values (table inputs), so that a block stays within BLOCK_BYTES. Each block
+    is a fresh copy: the parts' blocks are let go as soon as they are used up."""
+    pending: deque[Columns] = deque()
+    offset = count = 0  # where the first pending block's unused cases start; cases pending in all
+    started = False
     for part in parts:
         for block in part.blocks():
-            held.append(block)
+            if not started:
+                size, started = block_size(block, size), True
+            pending.append(block)
             count += len(block[0])
             while count >= size:
-                joined = [np.concatenate(column) for column in zip(*held)]
-                yield [c[:size] for c in joined]
-                rest = [c[size:] for c in joined]
+                taken, offset = _take(pending, offset, size)
                 count -= size
-                held = [rest] if count else []
+                yield taken
     if count:
-        yield [np.concatenate(column) for column in zip(*held)]
+        yield _take(pending, offset, count)[0]
+
+
+def _take(pending: deque, offset: int, size: int) -> tuple[Columns, int]:
+    """`size` cases from the front of `pending` (the first block from `offset`), copied; the new offset."""
+    pieces = []
+    while size:
+        block = pending[0]
+        available = len(block[0]) - offset
+        used = min(available, size)
+        pieces.append([column[offset:offset + used] for column in block])
+        size -= used
+        if used == available:
+            pending.popleft()
+            offset = 0
+        else:
+            offset += used
+    return [np.concatenate(columns) for columns in zip(*pieces)], offset
+
+
+def block_size(block: Columns, size: int) -> int:
+    """At most `size` cases, and at most BLOCK_BYTES of columns: a block travels to a worker process
+    (pickled: twice its size), several are in flight, and the worker holds it beside its lanes."""
+    per_case = sum(column.itemsize * (column.shape[1] if column.ndim == 2 else 1) for column in block)
+    return max(CHUNK, min(size, BLOCK_BYTES // max(per_case, 1)))
 
 
 # ---- exhaustive product ----------------------------------------------------------------------------
@@ -263,7 +294,7 @@ def _block_columns(routine: Routine, block, where: str) -> Columns:
             bad = column.min() if column.min() < 0 else column.max()
             raise InputError(f"{where}: column {port.name} holds {int(bad)}, which does not fit in {port.describe()} "
                              f"(0..{limit - 1})")
-        columns.append(column.astype(np.int64))
+        columns.append(column.astype(np.int64, copy=False))
     return columns
 
 
@@ -335,5 +366,4 @@ def _check_widths(routine: Routine, cases: list[tuple], where: str) -> None:
 
 
 def _short(value) -> str:
-    text = repr(value)
-    return text if len(text) <= 80 else text[:77] + "..."
+    return shown(value, 80)

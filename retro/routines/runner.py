@@ -39,6 +39,7 @@ from retro.fileio import read_text
 from retro.machines import build_machine
 from retro.machines.c64 import vic_of
 from retro.program import Program
+from retro.routines.sandbox import bytes_of
 from retro.routines.spec import Port, Routine, call_with
 from retro.scenes.vic import VicScene
 from retro.tables import GENERATORS, STORAGE_TABLES
@@ -116,7 +117,7 @@ def memory_values(routine: Routine, seed: int) -> dict[str, tuple[int, ...]]:
             continue
         try:
             made = call_with(block.make, {"rng": rng, "seed": seed})
-            data = tuple(int(v) for v in (made.tolist() if isinstance(made, np.ndarray) else made))
+            data = bytes_of(made, f"{routine.spec_path}: memory.{block.name}: the generator", 0x10000 - block.address)
         except InputError:
             raise
         except Exception as exc:

@@ -40,6 +40,7 @@ from retro.routines.places import (
     resolve,
 )
 from retro.routines.rows import Row, misplaced_rows, parse_rows
+from retro.routines import sandbox
 from retro.routines.where import Condition, parse_where
 
 MAX_EXHAUSTIVE = 1 << 32  # cases in an exhaustive set
@@ -53,7 +54,7 @@ CPUS = tuple(VARIANTS)
 TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows"}
 PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
-REFERENCE_KEYS = {"function", "arrays"}
+REFERENCE_KEYS = {"function", "arrays", "time_limit"}
 CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage"}
 CYCLES_KEYS = {"max", "loops", "limit", "static"}
 
@@ -182,11 +183,12 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     r = Fields(shown or str(path), folder=path.parent, number_characters=NUMBER_CHARACTERS)
     r.table(doc, "", TOP_KEYS)
     misplaced_rows(r, doc)
+    seconds = sandbox.time_limit(r, r.table(doc.get("reference", {}), "reference"), "reference")
     program = _program_section(r, doc)
-    inputs, outputs, memory = _places_sections(r, doc, program.program)
+    inputs, outputs, memory = _places_sections(r, doc, program.program, seconds)
     rows = parse_rows(r, doc["rows"], inputs, outputs) if "rows" in doc else ()
-    reference = _reference_section(r, doc, inputs, memory, rows)
-    cases = _cases_section(r, doc, inputs, answered=reference["reference"] is not None)
+    reference = _reference_section(r, doc, inputs, memory, rows, seconds)
+    cases = _cases_section(r, doc, inputs, seconds, answered=reference["reference"] is not None)
     cycles = _cycles_section(r, doc, program.program)
     routine = Routine(name=_text(r, doc, "name", "name") or path.stem, spec_path=path, **program.fields(),
                       inputs=inputs, outputs=outputs, memory=memory, **reference, **cases, **cycles,
@@ -245,7 +247,7 @@ def _program_section(r: Fields, doc: dict) -> _ProgramSection:
                            entry_address, init_address)
 
 
-def _places_sections(r: Fields, doc: dict, program: Program) -> tuple[tuple[Port, ...], tuple[Port, ...],
+def _places_sections(r: Fields, doc: dict, program: Program, seconds: int) -> tuple[tuple[Port, ...], tuple[Port, ...],
                                                                      tuple[MemoryBlock, ...]]:
     """[inputs], [outputs] and [memory]: where every value lives, none overlapping."""
     inputs = tuple(port_of(r, program, name, value, "inputs", is_input=True)
@@ -256,14 +258,14 @@ def _places_sections(r: Fields, doc: dict, program: Program) -> tuple[tuple[Port
     if not outputs:
         raise r.error("outputs", "names no output")
     no_overlap(r, inputs, "inputs")
-    memory = tuple(_memory_block(r, program, name, value)
+    memory = tuple(_memory_block(r, program, name, value, seconds)
                    for name, value in r.table(doc.get("memory", {}), "memory").items())
     _no_overlap_memory(r, memory, inputs)
     return inputs, outputs, memory
 
 
 def _reference_section(r: Fields, doc: dict, inputs: tuple[Port, ...], memory: tuple[MemoryBlock, ...],
-                       rows: tuple[Row, ...]) -> dict:
+                       rows: tuple[Row, ...], seconds: int) -> dict:
     """[reference]: the function, the memory blocks it takes, whether it works on arrays; none in a
     spec of rows only (the rows say what the routine must answer)."""
     if rows and "reference" not in doc:
@@ -274,14 +276,14 @@ def _reference_section(r: Fields, doc: dict, inputs: tuple[Port, ...], memory: t
     reference_doc = r.table(r.required(doc, "reference", hint="the [reference] table, or [[rows]]"), "reference",
                             REFERENCE_KEYS)
     reference_name = _text(r, reference_doc, "function", "reference.function", required=True)
-    reference = load_function(reference_name, r, "reference.function")
+    reference = load_function(reference_name, r, "reference.function", seconds, faults_only=True)
     return {"reference": reference, "reference_name": reference_name,
             "reference_memory": _reference_signature(r, reference, reference_name, inputs, memory),
             # true: the function takes numpy arrays, one element per case
             "reference_arrays": r.flag(reference_doc.get("arrays", False), "reference.arrays")}
 
 
-def _cases_section(r: Fields, doc: dict, inputs: tuple[Port, ...], answered: bool) -> dict:
+def _cases_section(r: Fields, doc: dict, inputs: tuple[Port, ...], seconds: int, answered: bool) -> dict:
     """[cases]: exhaustive inputs, random count and seed, the `where` domain, generators. `answered`:
     the spec has a reference (rows only: no generated cases unless asked for)."""
     cases_doc = r.table(doc.get("cases", {}), "cases", CASES_KEYS)
@@ -296,14 +298,16 @@ def _cases_section(r: Fields, doc: dict, inputs: tuple[Port, ...], answered: boo
         raise r.error("cases.exhaustive", "an input is named twice")
     where = cases_doc.get("where")
     tables = frozenset(p.name for p in inputs if p.table)
-    generators = {key: load_function(_text(r, cases_doc, key, f"cases.{key}"), r, f"cases.{key}")
+    bounds = {p.name: (p.values.lo, p.values.hi) for p in inputs if not p.table}  # what int64 columns must hold
+    domain = parse_where(where, names, f"{r.source}: cases.where", tables, bounds) if where is not None else ()
+    generators = {key: load_function(_text(r, cases_doc, key, f"cases.{key}"), r, f"cases.{key}", seconds)
                   for key in ("boundary", "sweep", "random_generator") if key in cases_doc}
     return {"exhaustive": tuple(exhaustive),
             "random": r.integer(cases_doc.get("random", DEFAULT_RANDOM if answered else 0), "cases.random", 0,
                                 MAX_RANDOM),
             "seed": r.integer(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1),
             "coverage": _text(r, cases_doc, "coverage", "cases.coverage") or "",
-            "domain": parse_where(where, names, f"{r.source}: cases.where", tables) if where is not None else (),
+            "domain": domain,
             "boundary": generators.get("boundary"), "sweep": generators.get("sweep"),
             "random_generator": generators.get("random_generator")}
 
@@ -355,7 +359,7 @@ def _in_program(r: Fields, program: Program, address: int, field_name: str) -> i
     return address
 
 
-def _memory_block(r: Fields, program: Program, name: str, doc) -> MemoryBlock:
+def _memory_block(r: Fields, program: Program, name: str, doc, seconds: int = sandbox.DEFAULT_SECONDS) -> MemoryBlock:
     key = f"memory.{name}"
     if not name.isidentifier():
         raise r.error(key, "a name must be a Python identifier (the reference may take it by name)")
@@ -396,7 +400,8 @@ def _memory_block(r: Fields, program: Program, name: str, doc) -> MemoryBlock:
                 return rng.choice(list(_values.listed), size=_size)
             return rng.integers(_values.lo, _values.hi + 1, size=_size)
         return MemoryBlock(name, address, None, make, size)
-    function = load_function(doc["generator"] if isinstance(doc["generator"], str) else None, r, f"{key}.generator")
+    function = load_function(doc["generator"] if isinstance(doc["generator"], str) else None, r, f"{key}.generator",
+                             seconds)
     return MemoryBlock(name, address, None, function, 0)
 
 
@@ -433,24 +438,29 @@ def _no_overlap_memory(r: Fields, memory: tuple[MemoryBlock, ...], inputs: tuple
 
 # ---- Python functions named by a spec -------------------------------------------------------------
 
-def load_function(text: str | None, r: Fields, key: str) -> Callable:
-    """`file.py:function` (a path relative to the spec) or `package.module:function`."""
+def load_function(text: str | None, r: Fields, key: str, seconds: int = sandbox.DEFAULT_SECONDS,
+                  faults_only: bool = False) -> Callable:
+    """`file.py:function` (a path relative to the spec) or `package.module:function`, run under the
+    sandbox's guards (retro.routines.sandbox): `seconds` per call; with `faults_only` an ordinary
+    exception reaches the caller as it is (a reference refusing a case)."""
     if not text or ":" not in text:
         raise r.error(key, "expected FILE.py:FUNCTION (relative to the spec) or MODULE:FUNCTION")
     module_text, _, function_name = text.rpartition(":")
     if not function_name.isidentifier():
         raise r.error(key, f"{function_name!r} is not a function name")
     if module_text.endswith(".py"):
-        module = _module_from_file(r.file(module_text, key, resolve=True), r, key)
+        module = _module_from_file(r.file(module_text, key, resolve=True), r, key, seconds)
     else:
         try:
-            module = importlib.import_module(module_text)
+            module = sandbox.import_guarded(lambda: importlib.import_module(module_text), module_text, seconds)
+        except sandbox.UserCodeError as exc:  # sys.exit, os._exit, a hang at import time
+            raise r.error(key, f"{module_text} failed to import: {exc}") from None
         except ImportError as exc:
             raise r.error(key, f"cannot import {module_text}: {exc}") from None
     function = getattr(module, function_name, None)
     if not callable(function):
         raise r.error(key, f"{module_text} has no function {function_name!r}")
-    return function
+    return sandbox.guarded(function, f"{r.source}: {key} {text}", seconds, faults_only=faults_only)
 
 
 @cached_reads(maxsize=64)
@@ -469,9 +479,11 @@ def import_user_module(path: str, mtime: float):
     return module
 
 
-def _module_from_file(path: Path, r: Fields, key: str):
+def _module_from_file(path: Path, r: Fields, key: str, seconds: int = sandbox.DEFAULT_SECONDS):
     try:
-        return import_user_module(str(path), path.stat().st_mtime)
+        return sandbox.import_guarded(lambda: import_user_module(str(path), path.stat().st_mtime), path.name, seconds)
+    except sandbox.UserCodeError as exc:  # sys.exit, os._exit, a hang at import time
+        raise r.error(key, f"{path.name} failed to import: {exc}") from None
     except Exception as exc:  # the user's module failed to import: one line, whatever it raised
         line = ""
         tb = exc.__traceback__

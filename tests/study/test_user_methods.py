@@ -147,11 +147,42 @@ def test_bad_method_files_are_one_line_naming_file_and_field(tmp_path, text, fie
     assert not (tmp_path / "out").exists()  # nothing written before the inputs are checked
 
 
-def test_a_function_that_fails_is_a_one_line_run_error(tmp_path, ball_bar):
+def test_a_function_that_fails_is_a_one_line_input_error(tmp_path, ball_bar):
     (tmp_path / "bad.py").write_text("def hit(a, b, dx, dy):\n    return [1, 2]\n")
     m = load_method_file(write(tmp_path, '[hitbox]\nshape = "function"\nfunction = "bad.py:hit"\n'))
-    with pytest.raises(RunError, match=r"hitbox.function: bad.py:hit returned shape \(2,\) for 1927 offsets"):
+    with pytest.raises(InputError, match=r"hitbox.function: bad.py:hit returned shape \(2,\) for 1927 offsets"):
         m.verdict(ball_bar)
+
+
+@pytest.mark.parametrize("body, message", [
+    ("import sys; sys.exit(0)", "called sys.exit(0)"),
+    ("import os; os._exit(0)", "called os._exit(0)"),
+    ("while True: pass", "took more than 1 s"),
+    ("return hit(a, b, dx, dy)", "recursed without end"),
+    ("raise KeyError('x')", "raised KeyError"),
+    ("return 10 ** 5000", "returned an integer of 16610 bits"),
+    ("return dx * float('nan')", "returned values outside [0, 1]"),
+])
+def test_a_rule_that_exits_hangs_or_recurses_is_one_line_naming_it_and_the_pair(tmp_path, ball_bar, body, message):
+    (tmp_path / "bad.py").write_text(f"def hit(a, b, dx, dy):\n    {body}\n")
+    m = load_method_file(write(tmp_path, '[hitbox]\nshape = "function"\nfunction = "bad.py:hit"\ntime_limit = 1\n'))
+    with pytest.raises(InputError) as caught:
+        m.verdict(ball_bar)
+    text = str(caught.value)
+    assert "\n" not in text and "hitbox.function: bad.py:hit" in text and message in text, text
+    assert f"on {ball_bar.name}" in text, text
+
+
+def test_a_rule_module_that_exits_at_import_is_one_line(tmp_path):
+    (tmp_path / "bad.py").write_text("import sys\nsys.exit(0)\ndef hit(a, b, dx, dy):\n    return dx * 0\n")
+    with pytest.raises(InputError, match=r"hitbox.function: bad.py failed to import: bad.py called sys.exit\(0\)"):
+        load_method_file(write(tmp_path, '[hitbox]\nshape = "function"\nfunction = "bad.py:hit"\n'))
+
+
+def test_a_rules_time_limit_is_checked(tmp_path):
+    (tmp_path / "ok.py").write_text("def hit(a, b, dx, dy):\n    return dx * 0\n")
+    with pytest.raises(InputError, match=r"hitbox.time_limit: 0 is out of range 1..3600"):
+        load_method_file(write(tmp_path, '[hitbox]\nshape = "function"\nfunction = "ok.py:hit"\ntime_limit = 0\n'))
 
 
 def test_an_input_that_does_not_fit_is_a_run_error(tmp_path, ball_bar):
@@ -243,3 +274,15 @@ def test_a_user_method_in_the_stability_study():
     cases = list(edges.BOX_CASES)
     assert [table[(c, "rule: tight box, 1 px in")] for c in cases] == [0.0, 0.0, 0.0]
     assert [table[(c, "6502 aabb8 (shrunk)")] for c in cases] == [0.0, 0.0, 0.0]
+
+
+def test_input_expressions_index_the_masks_and_refuse_arithmetic_on_them(tmp_path):
+    from retro.routines.where import parse_where
+    from retro.analysis.study.methods.user import MASKS, NAMES
+
+    values = list(range(len(NAMES)))
+    values[NAMES.index("a_mask")] = tuple(range(100, 163))
+    (term,) = parse_where("a_mask[3] + dx", NAMES, "m.toml: inputs.x", MASKS)
+    assert term.test(*values) == 103 + values[NAMES.index("dx")]
+    with pytest.raises(InputError, match="m.toml: inputs.x: a_mask: arithmetic takes numbers"):
+        parse_where("a_mask * 100000000", NAMES, "m.toml: inputs.x", MASKS)

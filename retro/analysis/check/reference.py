@@ -8,6 +8,7 @@ import numpy as np
 from retro.analysis.check.results import describe_case
 from retro.errors import InputError
 from retro.routines import cases as case_sets
+from retro.routines.sandbox import UserCodeError, shown
 from retro.routines.spec import Routine
 
 
@@ -18,6 +19,8 @@ def expected_outputs(routine: Routine, case: tuple, memory: dict) -> tuple:
     arguments.update({name: memory[name] for name in routine.reference_memory})
     try:
         value = routine.reference(**arguments)
+    except UserCodeError:  # a hang, an exit, a runaway: its own line, never a refusal
+        raise
     except Exception as exc:  # the user's reference: whatever it raises is reported in one line
         raise InputError(f"{routine.spec_path}: reference {routine.reference_name} raised {type(exc).__name__}: "
                          f"{str(exc)[:200]} (inputs {describe_case(routine, case)})") from None
@@ -52,14 +55,14 @@ def _output_value(port, item, where: str, routine: Routine, case: tuple):
         except (TypeError, ValueError):
             values = None
         if values is None or len(values) != len(port.places) or any(not 0 <= v <= 0xFF for v in values):
-            raise InputError(f"{where} returned {item!r:.60} for {port.name}: expected {len(port.places)} bytes "
+            raise InputError(f"{where} returned {shown(item)} for {port.name}: expected {len(port.places)} bytes "
                              f"(inputs {describe_case(routine, case)})")
         return values
     if isinstance(item, bool):
         item = int(item)
     limit = 1 << port.bits
     if not isinstance(item, int) or not 0 <= item < limit:
-        raise InputError(f"{where} returned {item!r:.60} for {port.name}: expected a whole number 0..{limit - 1} "
+        raise InputError(f"{where} returned {shown(item)} for {port.name}: expected a whole number 0..{limit - 1} "
                          f"({'a flag: true or false' if port.flag else port.describe()}) "
                          f"(inputs {describe_case(routine, case)})")
     return item
@@ -88,6 +91,8 @@ def _answers_case_by_case(routine: Routine, cases: list[tuple], memory: dict,
     for i, case in enumerate(cases):
         try:
             answers.append(expected_outputs(routine, case, memory))
+        except UserCodeError:  # a hang, an exit: never a refusal
+            raise
         except InputError:
             if inside[i]:
                 raise
@@ -129,6 +134,8 @@ def _call_on_arrays(routine: Routine, columns: list, memory: dict, where: str) -
     try:
         with np.errstate(all="ignore"):
             value = routine.reference(**arguments)
+    except UserCodeError:
+        raise
     except Exception as exc:  # the user's reference: whatever it raises is reported in one line
         raise InputError(f"{where} raised {type(exc).__name__}: {str(exc)[:200]}") from None
     if isinstance(value, dict):

@@ -32,6 +32,7 @@ from retro.errors import InputError
 from retro.routines import cases as case_sets
 from retro.routines.registry import select
 from retro.routines.spec import Routine
+from retro.routines.where import require_inside
 from retro.workers import worker_pool
 
 PROGRESS_SECONDS = 1.0  # at most one progress line a second
@@ -170,6 +171,8 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     work = (((batch_chunk, (spec, seed, block)) for block in case_sets.batches(parts, BATCH_LANES)) if on_batch else
             ((machine_chunk, (spec, seed, chunk, start)) for chunk in _chunks(parts)))
     _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
+    require_inside(f"{routine.spec_path}: cases.where", routine.domain, totals.cases, totals.outside,
+                   totals.constraint_cases)
     if routine.reference is None:  # rows only: unknown static bounds are said, not an error
         static, rows.static_note = rows_only_static(routine, runner)
     else:

@@ -39,13 +39,14 @@ from retro.chips.vic.constants import SPRITE_BYTES, SPRITE_HEIGHT, SPRITE_WIDTH
 from retro.errors import InputError, RunError
 from retro.fields import Fields
 from retro.fileio import parse_toml, read_bytes
+from retro.routines import sandbox
 from retro.routines.spec import import_user_module
 
 
 MAX_METHOD_BYTES = 1 << 16
 TOP_KEYS = {"name", "label", "routine", "prepare", "prepare_per", "hit", "colour", "marker", "hitbox", "inputs"}
 SHAPE_KEYS = {"box": {"shape", "fit", "inset", "touching"}, "circle": {"shape", "inset", "touching"},
-              "mask": {"shape"}, "function": {"shape", "function"}}
+              "mask": {"shape"}, "function": {"shape", "function", "time_limit"}}
 FITS = {"tight": tight_box, "full": full_box}
 NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_-]{0,31}$")
 MAX_INSET = SPRITE_WIDTH  # an inset beyond a whole sprite width moves the hitbox off the sprite
@@ -58,6 +59,7 @@ MAX_TEXT = 200  # characters of a name, label, colour or marker
 # function rule the circle is the fitted circle (strict).
 PER_SPRITE = ("sx", "sy", "x", "y", "w", "h", "right", "right1", "bottom", "bottom1", "cx", "cy", "r", "mask")
 NAMES = ("dx", "dy") + tuple(f"{s}_{n}" for s in "ab" for n in PER_SPRITE)
+MASKS = frozenset(name for name in NAMES if name.endswith("_mask"))  # tables of bytes; the rest are numbers
 DEFAULT_COLOURS = ("#e377c2", "#7f7f7f", "#bcbd22", "#393b79", "#637939", "#843c39", "#7b4173")
 DEFAULT_MARKERS = ("v", "<", ">", "p", "8", "H", "1")
 
@@ -70,6 +72,7 @@ class Hitbox:
     touching: bool = False
     function: object = None  # the user's function for shape = "function"
     function_text: str = ""
+    time_limit: int = sandbox.DEFAULT_SECONDS  # seconds one call of the function may take
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -143,16 +146,23 @@ class UserMethod(Method):
         return self._function_verdict(pair)
 
     def _function_verdict(self, pair: Pair) -> np.ndarray:
+        """The user's rule on a pair, under the sandbox's guards; whatever goes wrong (a raise, an exit, a
+        hang, an answer of the wrong shape or range) is one line naming the function and the pair, exit 2."""
         key = f"{self.path}: hitbox.function: {self.hitbox.function_text}"
+        arguments = (pair.a.mask.copy(), pair.b.mask.copy(), pair.dx.copy(), pair.dy.copy())
+        result = sandbox.call_guarded(self.hitbox.function, key, self.hitbox.time_limit, arguments, {},
+                                      faults_only=False, case=f"on {pair.name}")
         try:
-            result = self.hitbox.function(pair.a.mask.copy(), pair.b.mask.copy(), pair.dx.copy(), pair.dy.copy())
             out = np.asarray(result, dtype=float)
-        except Exception as exc:  # the user's code: one line, whatever it raised
-            raise RunError(f"{key} failed on {pair.name}: {type(exc).__name__}: {exc}") from None
+        except (TypeError, ValueError, OverflowError):
+            raise sandbox.UserCodeError(f"{key} returned {sandbox.shown(result)} on {pair.name}: expected one "
+                                        "verdict per offset") from None
         if out.shape != pair.dx.shape:
-            raise RunError(f"{key} returned shape {out.shape} for {pair.dx.size} offsets (one verdict per offset)")
+            raise sandbox.UserCodeError(f"{key} returned shape {out.shape} for {pair.dx.size} offsets (one verdict "
+                                        f"per offset) on {pair.name}")
         if out.size and (np.isnan(out).any() or out.min() < 0 or out.max() > 1):
-            raise RunError(f"{key} returned values outside [0, 1] (True/False or a share of hits)")
+            raise sandbox.UserCodeError(f"{key} returned values outside [0, 1] (True/False or a share of hits) "
+                                        f"on {pair.name}")
         return out
 
     # ---- the routine's inputs -------------------------------------------------------------------
@@ -181,6 +191,8 @@ class UserMethod(Method):
             for (name, _, compiled), bits in zip(self.inputs, self.input_bits):
                 try:
                     value = compiled(*values)
+                except InputError:  # x // 0, a negative shift: one line naming the expression and the case
+                    raise
                 except Exception as exc:
                     raise RunError(f"{self.path}: inputs.{name}: {type(exc).__name__}: {exc} on {pair.name} at "
                                    f"offset ({dx}, {dy})") from None
@@ -212,7 +224,7 @@ def _checked(value, bits: int, field_name: str, where: str):
     if isinstance(value, bool):
         value = int(value)
     if not isinstance(value, int) or not 0 <= value < 1 << bits:
-        raise RunError(f"{field_name}: {value!r} does not fit the input's {bits} bits {where} (use & 255, >> 8)")
+        raise RunError(f"{field_name}: {sandbox.shown(value)} does not fit the input's {bits} bits {where} (use & 255, >> 8)")
     return value
 
 
@@ -227,7 +239,10 @@ def _load_function(fields: Fields, text) -> object:
         raise fields.error(key, f"{text!r}: expected FILE.py:NAME (relative to the method file)")
     file = fields.file(file_text, key, resolve=True)
     try:
-        module = import_user_module(str(file), file.stat().st_mtime)
+        module = sandbox.call_guarded(import_user_module, file.name, sandbox.DEFAULT_SECONDS,
+                                      (str(file), file.stat().st_mtime), {}, faults_only=True, case="at import")
+    except sandbox.UserCodeError as exc:  # sys.exit, os._exit, a hang at import time
+        raise fields.error(key, f"{file.name} failed to import: {exc}") from None
     except Exception as exc:  # the user's module failed to import: one line, whatever it raised
         raise fields.error(key, f"{file.name} failed to import: {type(exc).__name__}: {exc}") from None
     function = getattr(module, name, None)
@@ -247,11 +262,13 @@ def _hitbox(fields: Fields, doc) -> Hitbox:
         raise fields.error("hitbox.inset", f"a circle's inset is one integer (pixels off the radius), got {inset}")
     # TOML integers only: an inset is a small count of pixels, never an address in $hex
     inset = fields.integers(inset, "hitbox.inset", 4, -MAX_INSET, MAX_INSET, strings=False)
-    function, text = None, ""
+    function, text, seconds = None, "", sandbox.DEFAULT_SECONDS
     if shape == "function":
+        seconds = sandbox.time_limit(fields, doc, "hitbox")
         text = fields.required(doc, "function", "hitbox", "FILE.py:NAME, hit(a, b, dx, dy) -> a verdict per offset")
         function = _load_function(fields, text)
-    return Hitbox(shape=shape, fit=fit, inset=inset, touching=touching, function=function, function_text=text)
+    return Hitbox(shape=shape, fit=fit, inset=inset, touching=touching, function=function, function_text=text,
+                  time_limit=seconds)
 
 
 def _string(fields: Fields, doc: dict, key: str, default: str | None = None) -> str | None:
@@ -287,7 +304,7 @@ def _inputs(fields: Fields, doc, routine) -> tuple[tuple, tuple]:
             text = str(text)
         if not isinstance(text, str):
             raise fields.error(f"inputs.{port.name}", f"expected an expression as a string, got {text!r}")
-        terms = parse_where(text, NAMES, f"{fields.source}: inputs.{port.name}")
+        terms = parse_where(text, NAMES, f"{fields.source}: inputs.{port.name}", MASKS)
         if len(terms) != 1:
             raise fields.error(f"inputs.{port.name}", "one value, not a condition joined by `and`")
         compiled.append((port.name, text, terms[0].test))
