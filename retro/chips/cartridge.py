@@ -12,13 +12,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from retro.chips.ines import CHR_BANK_SIZE, HEADER_SIZE, NROM, NROM_PRG_SIZES, parse_header
+from retro.chips.ines import CHR_BANK_SIZE, nrom_prg
 from retro.errors import InputError
 
 PRG_START = 0x8000              # PRG ROM fills $8000-$FFFF
-PRG_WINDOW = 0x8000             # 32 KiB seen by the CPU
-TRAINER_SIZE = 512
-FLAG6_TRAINER = 0x04
 NROM_CHR_SIZES = (0, CHR_BANK_SIZE)  # 0: CHR RAM on the board
 CARTRIDGE_MIRRORINGS = ("horizontal", "vertical")
 RESET_VECTOR = 0xFFFC
@@ -42,23 +39,14 @@ class NromCartridge:
 
 def read_nrom(data: bytes, source: str = "iNES image") -> NromCartridge:
     """An iNES image -> NromCartridge; InputError naming `source` for anything but an NROM board."""
-    header = parse_header(data, source)
-    if header.mapper != NROM:
-        raise InputError(f"{source}: iNES mapper {header.mapper} is not supported; only mapper 0 (NROM) is")
-    if header.prg_size not in NROM_PRG_SIZES:
-        raise InputError(f"{source}: NROM needs 16 or 32 KiB of PRG ROM, the header says {header.prg_size} bytes")
+    header, prg = nrom_prg(data, source)
     if header.chr_size not in NROM_CHR_SIZES:
         raise InputError(f"{source}: NROM has 8 KiB of CHR ROM or none (CHR RAM), the header says "
                          f"{header.chr_size} bytes")
     if header.mirroring not in CARTRIDGE_MIRRORINGS:
         raise InputError(f"{source}: {header.mirroring} mirroring is not supported on NROM "
                          f"(only {' or '.join(CARTRIDGE_MIRRORINGS)})")
-    start = HEADER_SIZE + (TRAINER_SIZE if data[6] & FLAG6_TRAINER else 0)
-    end = start + header.prg_size + header.chr_size
-    if len(data) < end:
-        raise InputError(f"{source}: truncated: the header promises {header.prg_size} bytes of PRG ROM and "
-                         f"{header.chr_size} of CHR ROM, the file has {max(0, len(data) - start)} after the header")
-    prg = data[start:start + header.prg_size]
-    chr_data = data[start + header.prg_size:end] if header.chr_size else bytes(CHR_BANK_SIZE)
-    return NromCartridge(prg=bytes(prg * (PRG_WINDOW // len(prg))), chr=bytes(chr_data),
+    chr_start = header.prg_start + header.prg_size
+    chr_data = data[chr_start:chr_start + header.chr_size] if header.chr_size else bytes(CHR_BANK_SIZE)
+    return NromCartridge(prg=prg, chr=bytes(chr_data),
                          chr_ram=not header.chr_size, mirroring=header.mirroring, source=source)

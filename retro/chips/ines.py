@@ -146,3 +146,25 @@ def unmodelled(header: InesHeader) -> list[tuple[str, str]]:
         found.append(("byte 15 (default expansion device)", f"expansion device ${header.expansion_device:02X}, "
                                                             "which is not modelled"))
     return found
+
+
+def nrom_prg(data: bytes, source: str = "iNES image") -> tuple[InesHeader, bytes]:
+    """An NROM image's header and the 32 KiB the CPU sees at $8000-$FFFF (a 16 KiB PRG ROM twice):
+    the one reading of an NROM cartridge's PRG ROM, for programs and for cartridges. InputError
+    naming `source` for another mapper, hardware the header promises that is not modelled, a PRG
+    size NROM does not have, or a file shorter than its header says."""
+    header = parse_header(data, source)
+    if header.mapper != NROM:
+        raise InputError(f"{source}: iNES mapper {header.mapper} is not supported; only mapper 0 (NROM) is")
+    problems = unmodelled(header)
+    if problems:
+        field, promise = problems[0]
+        raise InputError(f"{source}: {'NES 2.0' if header.nes2 else 'iNES'} header {field}: {promise}")
+    if header.prg_size not in NROM_PRG_SIZES:
+        raise InputError(f"{source}: NROM needs 16 or 32 KiB of PRG ROM, the header says {header.prg_size} bytes")
+    start = header.prg_start
+    if len(data) < start + header.prg_size + header.chr_size:
+        raise InputError(f"{source}: truncated: the header promises {header.prg_size} bytes of PRG ROM and "
+                         f"{header.chr_size} of CHR ROM, the file has {max(0, len(data) - start)} after the header")
+    prg = data[start:start + header.prg_size]
+    return header, bytes(prg * (2 * PRG_BANK_SIZE // len(prg)))  # 16 KiB is mirrored at $8000 and $C000

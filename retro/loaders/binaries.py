@@ -16,14 +16,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from retro.chips.ines import (
-    INES_MAGIC,
-    NROM,
-    NROM_PRG_SIZES,
-    PRG_BANK_SIZE,
-    parse_header,
-    unmodelled,
-)
+from retro.chips.ines import INES_MAGIC, nrom_prg
 from retro.assembler import MAX_SOURCE_BYTES, assemble_file
 from retro.errors import InputError
 from retro.fileio import read_bytes
@@ -104,21 +97,7 @@ def refuse_foreign_source(path: str | Path, data: bytes) -> str:
 
 def _nes_program(data: bytes, source: str) -> tuple[Program, dict[str, int]]:
     """iNES image -> (Program of the CPU's view of PRG ROM, {vector name: handler address})."""
-    header = parse_header(data, source)
-    if header.mapper != NROM:
-        raise InputError(f"{source}: iNES mapper {header.mapper} is not supported; only mapper 0 (NROM) is")
-    problems = unmodelled(header)
-    if problems:
-        field, promise = problems[0]
-        raise InputError(f"{source}: {'NES 2.0' if header.nes2 else 'iNES'} header {field}: {promise}")
-    if header.prg_size not in NROM_PRG_SIZES:
-        raise InputError(f"{source}: NROM needs 16 or 32 KiB of PRG ROM, the header says {header.prg_size} bytes")
-    start = header.prg_start
-    if len(data) < start + header.prg_size + header.chr_size:
-        raise InputError(f"{source}: truncated: the header promises {header.prg_size} bytes of PRG ROM and "
-                         f"{header.chr_size} of CHR ROM, the file has {max(0, len(data) - start)} after the header")
-    prg = data[start:start + header.prg_size]
-    image = prg * (2 * PRG_BANK_SIZE // len(prg))  # 16 KiB is mirrored: the same bytes at $8000 and $C000
+    _, image = nrom_prg(data, source)
     program = Program(code=bytes(image), origin=NROM_PRG_START, source=source, cpu=NES_CPU)
     vectors = {name: int.from_bytes(image[at - NROM_PRG_START:at - NROM_PRG_START + 2], "little")
                for name, at in CPU_VECTORS.items()}
