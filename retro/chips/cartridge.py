@@ -18,9 +18,6 @@ from retro.errors import InputError
 PRG_START = 0x8000              # PRG ROM fills $8000-$FFFF
 NROM_CHR_SIZES = (0, CHR_BANK_SIZE)  # 0: CHR RAM on the board
 CARTRIDGE_MIRRORINGS = ("horizontal", "vertical")
-RESET_VECTOR = 0xFFFC
-NMI_VECTOR = 0xFFFA
-IRQ_VECTOR = 0xFFFE
 
 
 @dataclass(frozen=True)
@@ -30,11 +27,6 @@ class NromCartridge:
     chr_ram: bool       # the board has CHR RAM (the header gives no CHR ROM)
     mirroring: str      # "horizontal" or "vertical"
     source: str
-
-    def vector(self, address: int) -> int:
-        """The word the CPU reads at a vector address ($FFFA, $FFFC, $FFFE)."""
-        offset = address - PRG_START
-        return self.prg[offset] | self.prg[offset + 1] << 8
 
 
 def read_nrom(data: bytes, source: str = "iNES image") -> NromCartridge:

@@ -78,6 +78,7 @@ BRANCH_OPCODES = frozenset({0x10, 0x30, 0x50, 0x70, 0x90, 0xB0, 0xD0, 0xF0})
 I_CHANGED_AFTER_POLL = frozenset({OPCODE_CLI, OPCODE_SEI, OPCODE_PLP})
 IRQ_VECTOR = 0xFFFE
 NMI_VECTOR = 0xFFFA
+RESET_VECTOR = 0xFFFC
 INTERRUPT_CYCLES = 7
 # Interrupt hijacking [blargg's cpu_interrupts_v2, 2-nmi_and_brk and 3-nmi_and_irq; visual6502 wiki
 # "6502 Timing of Interrupt Handling"]: the vector of BRK (and of an IRQ sequence) is chosen late in

@@ -16,6 +16,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from retro.chips.cartridge import PRG_START
 from retro.chips.ines import INES_MAGIC, nrom_prg
 from retro.assembler import MAX_SOURCE_BYTES, assemble_file
 from retro.errors import InputError
@@ -25,7 +26,6 @@ from retro.numbers import parse_address
 from retro.program import ADDRESS_LIMIT, Program, parse_prg
 
 NES_CPU = "2a03"
-NROM_PRG_START = 0x8000  # where the cartridge's PRG ROM appears in the CPU's address space
 # 6502 hardware vectors (MOS datasheet): the CPU reads the handler's address from these words
 CPU_VECTORS = {"nmi": 0xFFFA, "reset": 0xFFFC, "irq": 0xFFFE}
 VECTOR_PREFIX = "vector:"  # not a label character in any supported assembler: never clashes
@@ -98,8 +98,8 @@ def refuse_foreign_source(path: str | Path, data: bytes) -> str:
 def _nes_program(data: bytes, source: str) -> tuple[Program, dict[str, int]]:
     """iNES image -> (Program of the CPU's view of PRG ROM, {vector name: handler address})."""
     _, image = nrom_prg(data, source)
-    program = Program(code=bytes(image), origin=NROM_PRG_START, source=source, cpu=NES_CPU)
-    vectors = {name: int.from_bytes(image[at - NROM_PRG_START:at - NROM_PRG_START + 2], "little")
+    program = Program(code=bytes(image), origin=PRG_START, source=source, cpu=NES_CPU)
+    vectors = {name: int.from_bytes(image[at - PRG_START:at - PRG_START + 2], "little")
                for name, at in CPU_VECTORS.items()}
     return program, vectors
 

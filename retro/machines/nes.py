@@ -12,12 +12,12 @@ the address; nesdev wiki "APU", "Standard controller", "Open bus behavior").
 
 from __future__ import annotations
 
-from retro.chips.cartridge import PRG_START, RESET_VECTOR, NromCartridge
+from retro.chips.cartridge import PRG_START, NromCartridge
 from retro.chips.ppu.constants import OAMDMA, PPU_REGISTER_BASE, PPU_REGISTER_END
 from retro.chips.ppu.device import PpuDevice
 from retro.chips.ppu.state import PpuState
 from retro.cpu.machine import Machine
-from retro.cpu.mpu import FLAG_I, FLAG_U
+from retro.cpu.mpu import FLAG_I, FLAG_U, RESET_VECTOR
 
 CPU = "2a03"
 RAM_SIZE = 0x800                # 2 KiB at $0000-$07FF ...
