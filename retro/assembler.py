@@ -170,9 +170,8 @@ def _note_included(opened: Path, scratch: Path) -> None:
         names = opened.read_text(encoding="utf-8", errors="surrogateescape").split("\0")
     except OSError:
         return
-    python = {Path(p) for p in (sys.prefix, sys.base_prefix, sys.exec_prefix)}  # Ophis's own lazy imports
     for name in dict.fromkeys(filter(None, names)):
-        if not any(Path(name).is_relative_to(folder) for folder in (scratch, *python)):
+        if not Path(name).is_relative_to(scratch):  # the generated tables are retro's own
             note_input(name, "included file")
 
 

@@ -11,6 +11,8 @@ the bounds retro puts on every file it reads are put here, around Ophis's file r
 - one `.incbin` brings in at most BINARY_LIMIT bytes (the 6502 sees 64 KiB; a larger file can still
   be cut with the directive's offset and length);
 - no byte is emitted past $FFFF: code or data that an `.org` puts beyond the address space.
+Every file Ophis reads is also named in the file RETRO_OPENED gives, for retro to record as an
+input of the command (one no output may replace).
 Each refusal is an Ophis error at the line that caused it (`file:line: message`), so retro reports
 it like any other assembly error. It runs as a file in the assembler's own interpreter, which
 imports of retro only the file checks it shares with retro.fileio.
@@ -33,11 +35,12 @@ class Refused(OSError):
 
 
 class _Guard:
-    def __init__(self, source_limit: int, binary_limit: int) -> None:
+    def __init__(self, source_limit: int, binary_limit: int, listing=None) -> None:
         self.source_limit = source_limit
         self.binary_limit = binary_limit
         self.source_bytes = 0
         self.past_end_reported = False
+        self.listing = listing  # where every file Ophis reads is named (NUL-separated), or None
 
     def refuse(self, message: str) -> Refused:
         from Ophis import Errors
@@ -53,6 +56,9 @@ class _Guard:
             info = os.stat(file)
         except OSError:
             return _real_open(file, mode, *args, **kwargs)  # Ophis's own "Could not read" follows
+        if self.listing is not None:  # retro records it as an input of the command, which no output may replace
+            self.listing.write(os.path.abspath(name) + chr(0))
+            self.listing.flush()
         kind = file_kind(info.st_mode)
         if kind:
             raise self.refuse(f"{name}: is {kind}, not a regular file")
@@ -108,24 +114,11 @@ def _stop_past_address_space(guard: _Guard) -> None:
             setattr(Passes.Assembler, name, checked(getattr(Passes.Assembler, name)))
 
 
-def _list_opened(listing: str) -> None:
-    """Write, NUL-separated, every file opened for reading into `listing` (retro records them as
-    inputs of the command, which no output may replace)."""
-    opened = _real_open(listing, "w", encoding="utf-8", errors="surrogateescape")
-
-    def heard(event: str, args: tuple) -> None:
-        if event == "open" and isinstance(args[0], str) and (args[1] is None or "r" in args[1]):
-            opened.write(os.path.abspath(args[0]) + chr(0))
-            opened.flush()
-
-    sys.addaudithook(heard)
-
-
 def main(argv: list[str]) -> int:
     source_limit, binary_limit, *ophis_args = argv
-    if os.environ.get("RETRO_OPENED"):
-        _list_opened(os.environ["RETRO_OPENED"])
-    guard = _Guard(int(source_limit), int(binary_limit))
+    listed = os.environ.get("RETRO_OPENED")
+    listing = _real_open(listed, "w", encoding="utf-8", errors="surrogateescape") if listed else None
+    guard = _Guard(int(source_limit), int(binary_limit), listing)
     builtins.open = guard.open
     _stop_past_address_space(guard)
     from Ophis.Main import run_ophis
