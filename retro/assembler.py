@@ -125,7 +125,7 @@ def _limit_memory() -> None:  # runs in the assembler's process, before Ophis st
     resource.setrlimit(resource.RLIMIT_AS, (ASSEMBLER_MEMORY_BYTES, ASSEMBLER_MEMORY_BYTES))
 
 
-def _assemble(resolved: str, shown: str, text: str, cwd: Path | None = None, opcodes: str = "-u") -> Program:
+def _assemble(resolved: str, shown: str, text: str, opcodes: str = "-u") -> Program:
     from retro import (
         tables,  # tables are pure generators; imported late to keep start-up light
     )
@@ -144,7 +144,7 @@ def _assemble(resolved: str, shown: str, text: str, cwd: Path | None = None, opc
         opened = out / "opened"
         try:
             done = subprocess.run(command, capture_output=True, text=True, timeout=ASSEMBLER_TIMEOUT_SECONDS,
-                                  input=text if resolved == _STDIN else None, cwd=cwd, preexec_fn=_limit_memory,
+                                  input=text if resolved == _STDIN else None, preexec_fn=_limit_memory,
                                   env={**os.environ, "RETRO_OPENED": str(opened)})
         except subprocess.TimeoutExpired:
             raise InputError(f"{shown}: the assembler did not finish in {ASSEMBLER_TIMEOUT_SECONDS} s") from None
