@@ -16,8 +16,9 @@ Mapping (docs/coverage.md):
 - Each conditional branch is two `BRDA` entries on its line: branch 0 taken, branch 1 not taken
   (`-` when the branch never ran); the block number tells apart two branches on one line.
 - The routine's entry (and init) are the functions: `FN` at their line, `FNDA` how often they ran.
-- `TN` is the routine's name with every character other than a letter, digit or `_` made `_` (the
-  test names geninfo accepts).
+- `TN` and the function names are the routine's name with every character other than a letter,
+  digit or `_` made `_` (the test names geninfo accepts; a comma would end genhtml's function name),
+  the init `NAME_init`.
 """
 
 from __future__ import annotations
@@ -66,7 +67,7 @@ def _records(annotated: Annotated) -> dict[str, _FileRecord]:
             record.branches.append((line, block, row))
     code = annotated.code
     by_address = {row.address: row for row in annotated.rows}
-    for address, name in ((code.entry, code.name), (code.init, f"{code.name}_init")):
+    for address, name in ((code.entry, test_name(code.name)), (code.init, test_name(code.name) + "_init")):
         if address is None or address not in by_address:
             continue
         row = by_address[address]

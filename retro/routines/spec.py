@@ -28,6 +28,7 @@ from retro.errors import InputError
 from retro.fields import Fields, describe
 from retro.fileio import cached_reads, is_dir, note_input, parse_toml, read_bytes
 from retro.loaders import load_program
+from retro.loaders.source_lines import SourceMap, read_source_map
 from retro.program import Program
 from retro.routines.places import (
     BYTE_VALUES,
@@ -52,7 +53,7 @@ NUMBER_CHARACTERS = 40  # the longest number a spec may write as text
 CPUS = tuple(VARIANTS)
 
 TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows"}
-PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load"}
+PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load", "listing"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays", "time_limit"}
 CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage"}
@@ -110,6 +111,7 @@ class Routine:
     coverage: str = ""  # why the cases cover the input space (an argument the report quotes)
     notes: tuple[str, ...] = ()  # what loading the program left out (a symbol file's skipped lines)
     rows: tuple[Row, ...] = ()  # expected rows written in the spec (retro.routines.rows)
+    source_map: SourceMap | None = None  # [program] listing: which source line each byte came from
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -213,6 +215,7 @@ class _ProgramSection:
     program: Program
     entry_address: int
     init_address: int | None
+    source_map: SourceMap | None
 
     def fields(self) -> dict:
         return dict(self.__dict__)
@@ -243,8 +246,16 @@ def _program_section(r: Fields, doc: dict) -> _ProgramSection:
     entry_address = _in_program(r, program, resolve(r, program, entry, "program.entry"), "program.entry")
     init_address = (_in_program(r, program, resolve(r, program, init, "program.init"), "program.init")
                     if init is not None else None)
+    listing_name = _text(r, program_doc, "listing", "program.listing")
+    source_map = None
+    if listing_name:  # the assembler's listing (ACME --report): coverage by source line
+        listing_file = r.file(listing_name, "program.listing", resolve=True)
+        try:
+            source_map = read_source_map(listing_file)
+        except InputError as exc:
+            raise r.error("program.listing", str(exc)) from None
     return _ProgramSection(program_file, symbols_file, load, cpu, machine, entry, init, program,
-                           entry_address, init_address)
+                           entry_address, init_address, source_map)
 
 
 def _places_sections(r: Fields, doc: dict, program: Program, seconds: int) -> tuple[tuple[Port, ...], tuple[Port, ...],
