@@ -31,7 +31,7 @@ h1 {{ font-size: 1.4em; }}
 table {{ border-collapse: collapse; }}
 td, th {{ padding: 1px 8px; text-align: right; white-space: pre; }}
 th {{ border-bottom: 1px solid #888; }}
-td.code, th.code, td.src, th.src {{ text-align: left; font-family: monospace; }}
+td.code, th.code, td.src, th.src, td.line, th.line {{ text-align: left; font-family: monospace; }}
 td.addr, td.bytes {{ font-family: monospace; text-align: left; }}
 tr.run {{ background: {RUN_COLOUR}; }}
 tr.missed {{ background: {MISSED_COLOUR}; }}
@@ -103,13 +103,15 @@ def _row_class(row: Row) -> str:
     return kind + (" worst" if row.on_worst_path else "")
 
 
-def _source_cell(row: Row, source_text: Callable[[str], list[str] | None]) -> str:
+def _source_cells(row: Row, source_text: Callable[[str], list[str] | None]) -> str:
+    """The line (file:line, the full path in its tooltip) and its text when the file can be read."""
     if row.source is None:
-        return ""
+        return '<td class="line"></td><td class="src"></td>'
     where = f"{Path(row.source.file).name}:{row.source.line}"
     lines = source_text(row.source.file)
-    text = lines[row.source.line - 1].rstrip() if lines and 0 < row.source.line <= len(lines) else ""
-    return f'<span title="{html.escape(row.source.file)}">{html.escape(where)}</span>  {html.escape(text)}'
+    text = lines[row.source.line - 1].rstrip().expandtabs() if lines and 0 < row.source.line <= len(lines) else ""
+    return (f'<td class="line" title="{html.escape(row.source.file)}">{html.escape(where)}</td>'
+            f'<td class="src">{html.escape(text)}</td>')
 
 
 def routine_page(annotated: Annotated, source_text: Callable[[str], list[str] | None] = lambda file: None) -> str:
@@ -119,8 +121,8 @@ def routine_page(annotated: Annotated, source_text: Callable[[str], list[str] | 
     has_source = any(row.source is not None for row in annotated.rows)
     head = ("<tr><th></th><th>address</th><th>bytes</th><th class=\"code\">instruction</th><th>hits</th>"
             "<th title=\"taken\">taken</th><th title=\"not taken\">not taken</th><th>min cycles</th><th>max cycles</th>"
-            + ("<th class=\"src\">source</th>" if has_source else "") + "</tr>")
-    columns = 10 if has_source else 9
+            + ("<th class=\"line\">line</th><th class=\"src\">source</th>" if has_source else "") + "</tr>")
+    columns = 11 if has_source else 9
     body = []
     for piece in annotated.pieces():
         if isinstance(piece, Gap):
@@ -143,7 +145,7 @@ def routine_page(annotated: Annotated, source_text: Callable[[str], list[str] | 
                  f'<td class="cmin">{"" if row.cycles_min is None else row.cycles_min}</td>',
                  f'<td class="cmax"{_heat(row.cycles_max, top_cycles)}>{"" if row.cycles_max is None else row.cycles_max}</td>']
         if has_source:
-            cells.append(f'<td class="src">{_source_cell(row, source_text)}</td>')
+            cells.append(_source_cells(row, source_text))
         body.append(f'<tr id="a{row.address:04X}" class="{_row_class(row)}">{"".join(cells)}</tr>')
     worst = (f"<p>Worst case: {annotated.worst_cycles:,} cycles over {annotated.worst_length:,} instructions; its path "
              f"is marked by the bar at the left.</p>" if annotated.worst_cycles is not None else "")
