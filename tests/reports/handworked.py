@@ -47,6 +47,39 @@ SOURCE_LINE = dict(zip(ADDRESSES, range(4, 15)))  # sumto.s
 ACME_LINE = dict(zip(ADDRESSES, range(3, 14)))  # sumto_acme.asm
 
 
+# The listing: each line's fields, as counted by hand (whitespace aside; the columns are checked below)
+EXPECTED_LISTING_ROWS = [
+    ["sumto:"],
+    [">", "$C000", "A9", "00", "LDA", "#$00", "3", "2", "2", "sumto.s:4"],
+    [">", "$C002", "E0", "00", "CPX", "#$00", "3", "2", "2", "sumto.s:5"],
+    [">", "$C004", "F0", "09", "BEQ", "$C00F", "3", "1", "2", "2", "3", "sumto.s:6"],
+    ["loop:"],
+    [">", "$C006", "18", "CLC", "4", "2", "2", "sumto.s:7"],
+    [">", "$C007", "7D", "FD", "C0", "ADC", "$C0FD,X", "4", "4", "5", "sumto.s:8"],
+    [">", "$C00A", "B0", "04", "BCS", "$C010", "4", "0!", "4", "2", "2", "sumto.s:9"],
+    [">", "$C00C", "CA", "DEX", "4", "2", "2", "sumto.s:10"],
+    [">", "$C00D", "D0", "F7", "BNE", "$C006", "4", "2", "2", "2", "3", "sumto.s:11"],
+    ["done:"],
+    [">", "$C00F", "60", "RTS", "3", "6", "6", "sumto.s:12"],
+    ["over:"],
+    ["$C010", "A9", "FF", "LDA", "#$FF", "#####", "sumto.s:13"],
+    ["$C012", "60", "RTS", "#####", "sumto.s:14"],
+]
+
+
+def expected_lcov(source: str, lines: dict[int, int], name: str = "sumto") -> str:
+    """The record counted by hand: entry line, branches (taken, not taken), every line's runs."""
+    line = lines.__getitem__
+    return "".join(f"{text}\n" for text in [
+        f"TN:{name}", f"SF:{source}", f"FN:{line(0xC000)},{name}", f"FNDA:3,{name}", "FNF:1", "FNH:1",
+        f"BRDA:{line(0xC004)},0,0,1", f"BRDA:{line(0xC004)},0,1,2",
+        f"BRDA:{line(0xC00A)},0,0,0", f"BRDA:{line(0xC00A)},0,1,4",
+        f"BRDA:{line(0xC00D)},0,0,2", f"BRDA:{line(0xC00D)},0,1,2",
+        "BRF:6", "BRH:5",
+        *[f"DA:{line(address)},{runs}" for address, runs in zip(ADDRESSES, RUNS)],
+        "LF:11", "LH:9", "end_of_record"])
+
+
 def machine_coverage(program, entry: int, cases: list[dict], reachable: tuple[int, ...]) -> CodeCoverage:
     """Test-only: the same figures from the scalar Machine's trace of each call (each case is the
     registers of one call), to show the hand count and the emulator agree. `reachable`: the

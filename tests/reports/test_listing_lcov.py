@@ -9,7 +9,18 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from handworked import ACME_LINE, ADDRESSES, DATA, ENTRY, HAND, ROWS, RUNS, SOURCE_LINE, machine_coverage
+from handworked import (
+    ACME_LINE,
+    ADDRESSES,
+    DATA,
+    ENTRY,
+    EXPECTED_LISTING_ROWS,
+    HAND,
+    ROWS,
+    SOURCE_LINE,
+    expected_lcov,
+    machine_coverage,
+)
 
 from retro.analysis.coverage_model import CodeCoverage
 from retro.loaders import load_program
@@ -48,26 +59,6 @@ def test_the_engines_fill_the_hand_count():
     assert result.code_coverage == HAND
 
 
-# The listing: each line's fields, as counted by hand (whitespace aside; the columns are checked below)
-EXPECTED_LISTING_ROWS = [
-    ["sumto:"],
-    [">", "$C000", "A9", "00", "LDA", "#$00", "3", "2", "2", "sumto.s:4"],
-    [">", "$C002", "E0", "00", "CPX", "#$00", "3", "2", "2", "sumto.s:5"],
-    [">", "$C004", "F0", "09", "BEQ", "$C00F", "3", "1", "2", "2", "3", "sumto.s:6"],
-    ["loop:"],
-    [">", "$C006", "18", "CLC", "4", "2", "2", "sumto.s:7"],
-    [">", "$C007", "7D", "FD", "C0", "ADC", "$C0FD,X", "4", "4", "5", "sumto.s:8"],
-    [">", "$C00A", "B0", "04", "BCS", "$C010", "4", "0!", "4", "2", "2", "sumto.s:9"],
-    [">", "$C00C", "CA", "DEX", "4", "2", "2", "sumto.s:10"],
-    [">", "$C00D", "D0", "F7", "BNE", "$C006", "4", "2", "2", "2", "3", "sumto.s:11"],
-    ["done:"],
-    [">", "$C00F", "60", "RTS", "3", "6", "6", "sumto.s:12"],
-    ["over:"],
-    ["$C010", "A9", "FF", "LDA", "#$FF", "#####", "sumto.s:13"],
-    ["$C012", "60", "RTS", "#####", "sumto.s:14"],
-]
-
-
 def test_listing_of_the_hand_worked_routine():
     lines = listing_lines(annotate(code(read_source_map(DATA / "sumto.dbg")), HAND))
     assert lines[0] == f"sumto: entry $C000 ({PRG})"
@@ -103,19 +94,6 @@ def test_labels_keep_one_spelling_per_name():
 
 
 # ---- LCOV -----------------------------------------------------------------------------------------
-
-def expected_lcov(source: str, lines: dict[int, int], name: str = "sumto") -> str:
-    """The record counted by hand: entry line, branches (taken, not taken), every line's runs."""
-    line = lines.__getitem__
-    return "".join(f"{text}\n" for text in [
-        f"TN:{name}", f"SF:{source}", f"FN:{line(0xC000)},{name}", f"FNDA:3,{name}", "FNF:1", "FNH:1",
-        f"BRDA:{line(0xC004)},0,0,1", f"BRDA:{line(0xC004)},0,1,2",
-        f"BRDA:{line(0xC00A)},0,0,0", f"BRDA:{line(0xC00A)},0,1,4",
-        f"BRDA:{line(0xC00D)},0,0,2", f"BRDA:{line(0xC00D)},0,1,2",
-        "BRF:6", "BRH:5",
-        *[f"DA:{line(address)},{runs}" for address, runs in zip(ADDRESSES, RUNS)],
-        "LF:11", "LH:9", "end_of_record"])
-
 
 def test_lcov_by_ca65_source_lines():
     text = lcov_text([annotate(code(read_source_map(DATA / "sumto.dbg")), HAND)])
