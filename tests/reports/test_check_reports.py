@@ -102,3 +102,22 @@ def test_bad_listing_keys_are_one_line_errors(folder, capsys, value, message):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1
     assert re.search(message, err[0]), err[0]
+
+
+@pytest.mark.parametrize("option", ["--listing", "--lcov"])
+@pytest.mark.parametrize("name", ["sumto.toml", "sumto.prg", "sumto.dbg", "sumto.s", "./sumto.s", "link.s"])
+def test_no_report_over_any_input(folder, with_coverage, capsys, option, name):
+    """The spec, the program, the debug file and the source it names, also through `./` and a link."""
+    (folder / "link.s").symlink_to(folder / "sumto.s")
+    before = snapshot(folder)
+    target = folder / name if not name.startswith("./") else Path(str(folder) + "/./" + name[2:])
+    assert cli.main(["check", str(folder / "sumto.toml"), "--quiet", option, str(target)]) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1
+    assert snapshot(folder) == before
+
+
+def test_html_folder_over_an_input_file_is_refused_before_the_run(folder, with_coverage, capsys):
+    assert cli.main(["check", str(folder / "sumto.toml"), "--quiet", "--html", str(folder / "sumto.s")]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""  # refused before any case ran
+    assert captured.err.strip() == f"retro check: {folder / 'sumto.s'}: is a file, not a folder"
