@@ -144,7 +144,7 @@ def parse_source_map(text: str, source: str) -> SourceMap:
         return SourceMap(source, "ACME --report", _parse_acme(text, source))
     if first.startswith("; 64tass"):
         raise InputError(f"{source}: a 64tass listing gives no line numbers for the main file's lines, so it "
-                         f"cannot map code to lines; coverage is reported by address without it")
+                         f"cannot map code to lines (without a listing, coverage is reported by address)")
     raise InputError(f"{source}: not a source map retro reads (an ld65 --dbgfile debug file or an ACME --report "
                      f"listing)")
 

@@ -88,13 +88,13 @@ def _heat(value: int | None, top: int) -> str:
     return f' style="background: rgb({r}, {g}, {b})"'
 
 
-def _count(value: int | None, row: Row, arrow: str) -> str:
+def _count(value: int | None, row: Row, arrow: str, never: str) -> str:
     if value is None:
         return ""
     if not row.run:
         return "-"
     if value == 0:
-        return f'<span class="never" title="never {"taken" if arrow == "&#8594;" else "fallen through"}">{arrow} 0</span>'
+        return f'<span class="never" title="{never}">{arrow} 0</span>'
     return f"{arrow} {value:,}"
 
 
@@ -140,8 +140,8 @@ def routine_page(annotated: Annotated, source_text: Callable[[str], list[str] | 
         cells = [f'<td class="mark" title="{"on the worst case&#39;s path" if row.on_worst_path else ""}"></td>',
                  f'<td class="addr">${row.address:04X}</td>', f'<td class="bytes">{data}</td>',
                  f'<td class="code">{html.escape(text)}</td>', f'<td class="hits"{_heat(row.hits, top_hits)}>{hits}</td>',
-                 f'<td class="taken">{_count(row.taken, row, "&#8594;")}</td>',
-                 f'<td class="nottaken">{_count(row.not_taken, row, "&#8595;")}</td>',
+                 f'<td class="taken">{_count(row.taken, row, "&#8594;", "never taken")}</td>',
+                 f'<td class="nottaken">{_count(row.not_taken, row, "&#8595;", "never fell through")}</td>',
                  f'<td class="cmin">{"" if row.cycles_min is None else row.cycles_min}</td>',
                  f'<td class="cmax"{_heat(row.cycles_max, top_cycles)}>{"" if row.cycles_max is None else row.cycles_max}</td>']
         if has_source:

@@ -44,8 +44,10 @@ def test_name(name: str) -> str:
 
 
 def pseudo_file(annotated: Annotated) -> str:
-    program = annotated.code.program_file or annotated.code.name
-    return str(Path(program).resolve()) + ADDRESSES_SUFFIX if annotated.code.program_file else program + ADDRESSES_SUFFIX
+    """`/path/game.prg.addresses`: the file whose line N stands for address N (the routine's name
+    when the program has no file)."""
+    code = annotated.code
+    return (str(Path(code.program_file).resolve()) if code.program_file else code.name) + ADDRESSES_SUFFIX
 
 
 def _place(annotated: Annotated, row: Row) -> tuple[str, int]:

@@ -1,6 +1,6 @@
 """`retro check --listing FILE`: the annotated listing, one line per instruction (docs/coverage.md).
 
-    > $C004  F0 09     BEQ $C00F          3      1          2     2     3  sum.s:9
+    > $C004   F0 09     BEQ $C00F                3        1         2     2     3  sumto.s:6
 
 Columns: the worst case's path (`>`), address, bytes, instruction, hits, for a conditional branch
 how often it was taken and not taken, the fewest and most cycles one run of it took (page and branch

@@ -50,10 +50,12 @@ def test_the_hand_count_is_what_the_machine_runs():
     assert found == HAND
 
 
-def test_the_engines_fill_the_hand_count():
-    """`retro check sumto.toml` records the hand-counted coverage (once the engines collect it)."""
+@pytest.mark.parametrize("engine", ["scalar", "batch"])
+def test_the_engines_fill_the_hand_count(engine):
+    """`retro check sumto.toml` records the hand-counted coverage on either engine (once the engines
+    collect it)."""
     from retro.commands.check import check
-    [result] = check([str(DATA / "sumto.toml")])
+    [result] = check([str(DATA / "sumto.toml")], engine=engine)
     if getattr(result, "code_coverage", None) is None:
         pytest.skip("RoutineCheck.code_coverage is not filled yet (the engines' collection is another branch)")
     assert result.code_coverage == HAND
