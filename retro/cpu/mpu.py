@@ -779,109 +779,125 @@ def _signed_high(value: int) -> int:
     return high - 0x100 if high & 0x80 else high
 
 
+_C02_MODES = {"zpg": "ZeroPageAddr", "zpx": "ZeroPageXAddr", "abs": "AbsoluteAddr", "abx": "AbsoluteXAddr",
+              "zpi": "ZeroPageIndirectAddr", "imm": "ProgramCounter"}  # py65's addressing helpers by mode
+_C02_ALU = {"ORA": "opORA", "AND": "opAND", "EOR": "opEOR", "ADC": "opADC", "SBC": "opSBC", "LDA": "opLDA",
+            "STA": "opSTA", "BIT": "opBIT"}  # NMOS operations the 65C02 also has in new modes
+
+
+def _address(s, mode: str) -> int:
+    return getattr(s, _C02_MODES[mode])()
+
+
+def _bit_immediate(s) -> None:  # BIT #imm sets only Z
+    s.p = (s.p & ~FLAG_Z) | (0 if s.a & s.memory[s.pc] else FLAG_Z)
+
+
+def _test_and(s, mode: str, setting: bool) -> None:  # TSB / TRB: Z from A AND M, then set or clear A's bits in M
+    addr = _address(s, mode)
+    value = s.ByteAt(addr)
+    s.p = (s.p & ~FLAG_Z) | (0 if s.a & value else FLAG_Z)
+    s._write_back(addr, value, (value | s.a) if setting else (value & ~s.a & 0xFF))
+
+
+def _memory_bit(s, mask: int, setting: bool) -> None:  # RMB / SMB
+    addr = s.memory[s.pc]
+    value = s.ByteAt(addr)
+    s._write_back(addr, value, (value | mask) if setting else (value & ~mask & 0xFF))
+
+
+def _bit_branch(s, mask: int, when_set: bool) -> None:  # BBR / BBS: test a zero-page bit, then branch relative
+    value = s.ByteAt(s.memory[s.pc])
+    if bool(value & mask) == when_set:
+        s.pc = (s.pc + 1) & ADDRESS_MASK
+        s.BranchRelAddr()  # +1 taken, +1 more into another page; leaves PC at the target
+        s.pc -= 2  # the handler's length step (3 - 1) follows
+
+
+def _jmp_indirect(s) -> int:  # the 65C02 reads the pointer's high byte across a page correctly
+    pointer = s.AbsoluteAddr()
+    return s.ByteAt(pointer) | s.ByteAt((pointer + 1) & ADDRESS_MASK) << 8
+
+
+def _jmp_indexed_indirect(s) -> int:
+    pointer = (s.AbsoluteAddr() + s.x) & ADDRESS_MASK
+    return s.ByteAt(pointer) | s.ByteAt((pointer + 1) & ADDRESS_MASK) << 8
+
+
+def _halting(reason: str):
+    return lambda s: s.halt_on(reason)
+
+
+# The 65C02's new operations by mnemonic (RMB/SMB/BBR/BBS by their first three letters, the bit number
+# being the fourth): each makes the body of the handler for one (mnemonic, mode).
+_C02_OPERATIONS = {
+    "BRA": lambda name, mode: lambda s: (s.BranchRelAddr(), setattr(s, "pc", s.pc - 1)),
+    "CMP": lambda name, mode: lambda s: s.opCMPR(getattr(s, _C02_MODES[mode]), s.a),
+    "STZ": lambda name, mode: lambda s: s.WriteByte(_address(s, mode), 0),
+    "TSB": lambda name, mode: lambda s: _test_and(s, mode, True),
+    "TRB": lambda name, mode: lambda s: _test_and(s, mode, False),
+    "INC": lambda name, mode: lambda s: setattr(s, "a", s._nz((s.a + 1) & 0xFF)),  # INC A
+    "DEC": lambda name, mode: lambda s: setattr(s, "a", s._nz((s.a - 1) & 0xFF)),  # DEC A
+    "PHX": lambda name, mode: lambda s: s.stPush(s.x),
+    "PHY": lambda name, mode: lambda s: s.stPush(s.y),
+    "PLX": lambda name, mode: lambda s: setattr(s, "x", s._nz(s.stPop())),
+    "PLY": lambda name, mode: lambda s: setattr(s, "y", s._nz(s.stPop())),
+    "RMB": lambda name, mode: lambda s: _memory_bit(s, 1 << int(name[3]), False),
+    "SMB": lambda name, mode: lambda s: _memory_bit(s, 1 << int(name[3]), True),
+    "BBR": lambda name, mode: lambda s: _bit_branch(s, 1 << int(name[3]), False),
+    "BBS": lambda name, mode: lambda s: _bit_branch(s, 1 << int(name[3]), True),
+    "WAI": lambda name, mode: _halting("WAI with no interrupt source"),
+    "STP": lambda name, mode: _halting("STP"),
+    "BRK": lambda name, mode: _brk_65c02,
+}
+
+
+def _c02_operation(name: str, mode: str):
+    if name == "BIT" and mode == "imm":
+        return _bit_immediate
+    if name in _C02_ALU:
+        return lambda s: getattr(s, _C02_ALU[name])(getattr(s, _C02_MODES[mode]))
+    make = _C02_OPERATIONS.get(name[:3] if name[:3] in ("RMB", "SMB", "BBR", "BBS") else name)
+    if make is None:  # pragma: no cover - a new table row needs its operation here
+        raise AssertionError(f"no 65C02 operation for {name} ({mode})")
+    return make(name, mode)
+
+
+def _install(cls, opcode: int, row, body) -> None:
+    """A handler running `body`, then stepping the PC past the operand, as py65's handlers do."""
+    length = MODE_LENGTH[row.mode]
+
+    def handler(self):
+        body(self)
+        self.pc += length - 1
+    handler.__name__ = f"inst_0x{opcode:02x}"
+    cls.instruction(name=row.mnemonic, mode=row.mode, cycles=row.cycles, extracycles=int(row.page_penalty))(handler)
+
+
+def _install_jump(cls, opcode: int, row, target) -> None:
+    def handler(self):
+        self.pc = target(self)
+    handler.__name__ = f"inst_0x{opcode:02x}"
+    cls.instruction(name=row.mnemonic, mode=row.mode, cycles=row.cycles, extracycles=0)(handler)
+
+
 def _register_65c02(cls) -> None:
     """Put into cls's tables every 65C02 row that the NMOS documented handlers do not already run."""
-    ins = cls.instruction
-    table = cls.opcode_table
-
-    def op(opcode, row, body):
-        length = MODE_LENGTH[row.mode]
-
-        def handler(self):
-            body(self)
-            self.pc += length - 1
-        handler.__name__ = f"inst_0x{opcode:02x}"
-        ins(name=row.mnemonic, mode=row.mode, cycles=row.cycles, extracycles=int(row.page_penalty))(handler)
-
-    def jump(opcode, row, target):
-        def handler(self):
-            self.pc = target(self)
-        handler.__name__ = f"inst_0x{opcode:02x}"
-        ins(name=row.mnemonic, mode=row.mode, cycles=row.cycles, extracycles=0)(handler)
-
-    modes = {"zpg": "ZeroPageAddr", "zpx": "ZeroPageXAddr", "abs": "AbsoluteAddr", "abx": "AbsoluteXAddr",
-             "zpi": "ZeroPageIndirectAddr", "imm": "ProgramCounter"}
-
-    def address(s, mode):
-        return getattr(s, modes[mode])()
-
-    def bit_immediate(s):  # BIT #imm sets only Z
-        s.p = (s.p & ~FLAG_Z) | (0 if s.a & s.memory[s.pc] else FLAG_Z)
-
-    def test_and(s, mode, setting):  # TSB / TRB: Z from A AND M, then set or clear A's bits in M
-        addr = address(s, mode)
-        value = s.ByteAt(addr)
-        s.p = (s.p & ~FLAG_Z) | (0 if s.a & value else FLAG_Z)
-        s._write_back(addr, value, (value | s.a) if setting else (value & ~s.a & 0xFF))
-
-    def memory_bit(s, mask, setting):  # RMB / SMB
-        addr = s.memory[s.pc]
-        value = s.ByteAt(addr)
-        s._write_back(addr, value, (value | mask) if setting else (value & ~mask & 0xFF))
-
-    def bit_branch(s, mask, when_set):  # BBR / BBS: test a zero-page bit, then branch relative
-        value = s.ByteAt(s.memory[s.pc])
-        if bool(value & mask) == when_set:
-            s.pc = (s.pc + 1) & ADDRESS_MASK
-            s.BranchRelAddr()  # +1 taken, +1 more into another page; leaves PC at the target
-            s.pc -= 2  # the handler's length step (3 - 1) follows
-
-    def pull(s, register):
-        setattr(s, register, s._nz(s.stPop()))
-
-    def jmp_indirect(s):  # the 65C02 reads the pointer's high byte across a page correctly
-        pointer = s.AbsoluteAddr()
-        return s.ByteAt(pointer) | s.ByteAt((pointer + 1) & ADDRESS_MASK) << 8
-
-    def jmp_indexed_indirect(s):
-        pointer = (s.AbsoluteAddr() + s.x) & ADDRESS_MASK
-        return s.ByteAt(pointer) | s.ByteAt((pointer + 1) & ADDRESS_MASK) << 8
-
-    alu = {"ORA": "opORA", "AND": "opAND", "EOR": "opEOR", "ADC": "opADC", "SBC": "opSBC", "LDA": "opLDA",
-           "STA": "opSTA", "BIT": "opBIT"}
-    for opcode, row in table.items():
+    for opcode, row in cls.opcode_table.items():
         nmos = OPCODE_TABLE[opcode]
-        name, mode = row.mnemonic, row.mode
         if row.kind == RESERVED:
-            op(opcode, row, lambda s: None)
-        elif (nmos.mnemonic, nmos.mode, nmos.kind) == (name, mode, row.kind) and opcode not in (0x00, 0x6C):
+            _install(cls, opcode, row, lambda s: None)
+        elif (nmos.mnemonic, nmos.mode, nmos.kind) == (row.mnemonic, row.mode, row.kind) and opcode not in (0x00, 0x6C):
             continue  # the NMOS handler does the same (cycles are set from the table below)
-        elif name == "JMP":
-            jump(opcode, row, jmp_indirect if mode == "ind" else jmp_indexed_indirect)
-        elif name == "BRA":
-            op(opcode, row, lambda s: (s.BranchRelAddr(), setattr(s, "pc", s.pc - 1)))
-        elif name == "CMP":
-            op(opcode, row, lambda s, m=mode: s.opCMPR(getattr(s, modes[m]), s.a))
-        elif name == "BIT" and mode == "imm":
-            op(opcode, row, bit_immediate)
-        elif name in alu:
-            op(opcode, row, lambda s, n=alu[name], m=mode: getattr(s, n)(getattr(s, modes[m])))
-        elif name == "STZ":
-            op(opcode, row, lambda s, m=mode: s.WriteByte(address(s, m), 0))
-        elif name in ("TSB", "TRB"):
-            op(opcode, row, lambda s, m=mode, setting=name == "TSB": test_and(s, m, setting))
-        elif name in ("INC", "DEC"):  # INC A, DEC A
-            op(opcode, row, lambda s, step=1 if name == "INC" else -1: setattr(s, "a", s._nz((s.a + step) & 0xFF)))
-        elif name in ("PHX", "PHY"):
-            op(opcode, row, lambda s, r=name[2].lower(): s.stPush(getattr(s, r)))
-        elif name in ("PLX", "PLY"):
-            op(opcode, row, lambda s, r=name[2].lower(): pull(s, r))
-        elif name[:3] in ("RMB", "SMB"):
-            op(opcode, row, lambda s, mask=1 << int(name[3]), setting=name[0] == "S": memory_bit(s, mask, setting))
-        elif name[:3] in ("BBR", "BBS"):
-            op(opcode, row, lambda s, mask=1 << int(name[3]), when_set=name[2] == "S": bit_branch(s, mask, when_set))
-        elif name in ("WAI", "STP"):
-            reason = "STP" if name == "STP" else "WAI with no interrupt source"
-            op(opcode, row, lambda s, r=reason: s.halt_on(r))
-        elif name == "BRK":
-            op(opcode, row, _brk_65c02)
-        else:  # pragma: no cover - a new table row needs its operation here
-            raise AssertionError(f"no 65C02 operation for {name} (${opcode:02X})")
-    for opcode, row in table.items():  # every opcode's cycles and page penalty, from the table
+        elif row.mnemonic == "JMP":
+            _install_jump(cls, opcode, row, _jmp_indirect if row.mode == "ind" else _jmp_indexed_indirect)
+        else:
+            _install(cls, opcode, row, _c02_operation(row.mnemonic, row.mode))
+    for opcode, row in cls.opcode_table.items():  # every opcode's cycles and page penalty, from the table
         cls.cycletime[opcode] = row.cycles
         cls.extracycles[opcode] = int(row.page_penalty)
         cls.disassemble[opcode] = (row.mnemonic, row.mode)
-    cls.RMW_OPCODES = frozenset(opcode for opcode, row in table.items() if row.mode != "acc" and (
+    cls.RMW_OPCODES = frozenset(opcode for opcode, row in cls.opcode_table.items() if row.mode != "acc" and (
         row.mnemonic in ("ASL", "LSR", "ROL", "ROR", "INC", "DEC", "TSB", "TRB") or row.mnemonic[:3] in ("RMB", "SMB")))
 
 
