@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from retro.assembler import MAX_SOURCE_BYTES, assemble_file
-from retro.cpu.mpu import variant_named
+from retro.cpu.variants import variant_named
 from retro.fileio import all_or_nothing, file_option, read_bytes, write_atomic
 from retro.loaders import refuse_foreign_source
 from retro.program import Program, format_vice_labels, prg_bytes

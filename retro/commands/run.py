@@ -13,7 +13,8 @@ from retro.analysis.console_run import MAX_FRAMES, ConsoleRun, ppu_registers, ru
 from retro.chips.cartridge import read_nrom
 from retro.chips.ines import INES_MAGIC
 from retro.cpu.machine import DEFAULT_BUDGET, DEFAULT_FLAGS, JSR_CYCLES, MAX_BUDGET, CallResult, Machine
-from retro.cpu.mpu import FLAG_B, FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_U, FLAG_V, FLAG_Z, variant_named
+from retro.cpu.mpu import FLAG_B, FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_U, FLAG_V, FLAG_Z
+from retro.cpu.variants import variant_named
 from retro.errors import InputError
 from retro.fileio import file_option, read_bytes
 from retro.loaders import load_program
