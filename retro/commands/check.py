@@ -14,8 +14,13 @@ from retro.analysis.raster import format_raster, raster_figures
 from retro.analysis.row_check import rows_lines, rows_record
 from retro.errors import InputError
 from retro.fileio import command_files, file_option, output_folder, read_text, write_all_atomic, write_atomic
+from retro.loaders.source_lines import has_line_information, read_source_map
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
+from retro.reports.annotated import Annotated, RoutineCode, annotate
+from retro.reports.coverage_html import html_pages
+from retro.reports.lcov import lcov_text
+from retro.reports.listing import listing_text
 from retro.routines import cases as case_sets
 from retro.workers import MAX_WORKERS
 import argparse
@@ -23,11 +28,6 @@ from retro.analysis.check import AGREEMENT_PER_PART, AUTO_BATCH_CASES
 from retro.commands import options
 from retro.progress import progress_printer
 from retro.routines.registry import builtin_names
-from retro.loaders.source_lines import has_line_information, read_source_map
-from retro.reports.annotated import Annotated, RoutineCode, annotate
-from retro.reports.coverage_html import html_pages
-from retro.reports.lcov import lcov_text
-from retro.reports.listing import listing_text
 
 MAX_RANDOM = 10 ** 9
 MAX_JOBS = MAX_WORKERS

@@ -93,6 +93,7 @@ class Routine:
     reference_memory: tuple[str, ...]  # memory blocks the reference takes by name
     reference_arrays: bool = False  # the reference takes numpy arrays (one element per case) and answers so
     program: Program | None = None  # the program, read once when the spec is loaded
+    source_map: SourceMap | None = None  # [program] listing: which source line each byte came from
     entry_address: int = 0  # entry, init and the loop labels resolved against its symbols
     init_address: int | None = None
     loop_addresses: dict[int, int] = field(default_factory=dict)  # loop header address -> bound
@@ -111,7 +112,6 @@ class Routine:
     coverage: str = ""  # why the cases cover the input space (an argument the report quotes)
     notes: tuple[str, ...] = ()  # what loading the program left out (a symbol file's skipped lines)
     rows: tuple[Row, ...] = ()  # expected rows written in the spec (retro.routines.rows)
-    source_map: SourceMap | None = None  # [program] listing: which source line each byte came from
 
     @property
     def input_names(self) -> tuple[str, ...]:
