@@ -22,11 +22,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from retro.analysis.check.coverage import from_lanes
 from retro.analysis.check.engines import AGREEMENT_PER_PART, BATCH_LANES, SceneStart, run_on_machine, runner_for
 from retro.analysis.check.reference import reference_answers
 from retro.analysis.check.results import Failure, describe_case, describe_outputs, inputs_by_name
 from retro.analysis.check.tally import Tally
 from retro.analysis.check.verdicts import static_bounds
+from retro.analysis.coverage_model import CodeCoverage
 from retro.cpu.batch import LaneError
 from retro.cpu.flow import Bounds
 from retro.errors import InputError
@@ -83,6 +85,7 @@ class _Call:
     cpu_cycles: int | None = None  # Machine only: cycles without stalls, and what the timing model says
     modelled: int | None = None
     error: str = ""
+    coverage: CodeCoverage | None = None  # Machine: what the call ran of the code
 
 
 def _on_machine(runner: RoutineRunner, case: tuple) -> _Call:
@@ -91,7 +94,7 @@ def _on_machine(runner: RoutineRunner, case: tuple) -> _Call:
     if block.stop is not None:
         return _Call(None, None, error=block.stop_message)
     cycles = int(block.cycles[0])
-    return _Call(block.row(0), cycles, cycles - int(block.stolen[0]), int(block.modelled[0]))
+    return _Call(block.row(0), cycles, cycles - int(block.stolen[0]), int(block.modelled[0]), coverage=block.coverage)
 
 
 def check_rows(spec: str, seed: int, start: SceneStart | None, batched: bool) -> tuple[RowsCheck, Tally]:
@@ -101,15 +104,16 @@ def check_rows(spec: str, seed: int, start: SceneStart | None, batched: bool) ->
     runner = runner_for(spec, seed, start)
     routine = runner.routine
     rows = routine.rows
+    totals = Tally()
     if batched:
-        calls, agreement = _batched(runner, rows)
+        calls, agreement, totals.code_coverage = _batched(runner, rows)
     else:
         calls, agreement = [], None
         for row in rows:
             calls.append(_on_machine(runner, row.case))
             if calls[-1].error:
                 break
-    totals = Tally()
+            totals.code_coverage = totals.code_coverage.merge(calls[-1].coverage)
     outcomes = []
     for row, call in zip(rows, calls):
         outcomes.append(_outcome(row, call, routine))
@@ -138,16 +142,19 @@ def _reference_answer(runner: RoutineRunner, row: Row) -> tuple | None:
     return row_of(answers, 0) if answered[0] else None
 
 
-def _batched(runner: RoutineRunner, rows: tuple[Row, ...]) -> tuple[list[_Call], Tally]:
+def _batched(runner: RoutineRunner, rows: tuple[Row, ...]) -> tuple[list[_Call], Tally, CodeCoverage]:
     """The rows on the batched core, up to the first call that stops; the first AGREEMENT_PER_PART
-    of them also on Machine (with the timing model), compared call for call."""
+    of them also on Machine (with the timing model), compared call for call; what they ran of the code."""
     routine = runner.routine
     agreement = Tally()
     calls = []
+    coverage = CodeCoverage()
     outcome, first = None, 0
     for i, row in enumerate(rows):
         if i % BATCH_LANES == 0:  # a batch at most as wide as the check's (memory stays bounded)
-            outcome, first = runner.run_batch(cases_to_columns(routine, [r.case for r in rows[i:i + BATCH_LANES]])), i
+            columns = cases_to_columns(routine, [r.case for r in rows[i:i + BATCH_LANES]])
+            outcome, first = runner.run_batch(columns, coverage=True), i
+            coverage = coverage.merge(from_lanes(outcome.coverage))
         stopped = bool(outcome.error[i - first])
         machine = _on_machine(runner, row.case) if i < AGREEMENT_PER_PART or stopped else None
         if stopped:  # Machine's message names the address (as run_on_batched_core reports a stopped lane)
@@ -160,7 +167,7 @@ def _batched(runner: RoutineRunner, rows: tuple[Row, ...]) -> tuple[list[_Call],
             _agree(agreement, routine, row, machine, calls[-1], stopped)
         if stopped:
             break
-    return calls, agreement
+    return calls, agreement, coverage
 
 
 def _agree(agreement: Tally, routine: Routine, row: Row, machine: _Call, batch: _Call, stopped: bool) -> None:

@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 
 from retro.analysis.check import RoutineCheck, SceneStart, inputs_by_name, run_checks
+from retro.analysis.check.coverage import coverage_line, coverage_record, summary
 from retro.analysis.check.results import describe_case, describe_outputs
 from retro.analysis.junit import junit_xml
 from retro.analysis.raster import format_raster, raster_figures
@@ -127,7 +128,9 @@ def check_record(check: RoutineCheck) -> dict:
               "engine_agreement": None if check.agreement is None else {
                   "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
                   "timing_model_mismatches": check.agreement.cycle_mismatches},
-              "notes": list(check.routine.notes), "first_failure": None, "rows": None}
+              "notes": list(check.routine.notes), "first_failure": None, "rows": None,
+              "code_coverage": None if check.code_coverage is None else coverage_record(
+                  summary(check.code_coverage, check.routine.program))}
     failure = t.failure
     if failure is not None:
         routine = check.routine
@@ -173,6 +176,8 @@ def format_check(check: RoutineCheck) -> list[str]:
         lines.append(f"  cases: {format_coverage(check)}; input space {format_space(check.routine.input_space())}")
     if routine.coverage:
         lines.append(f"  coverage: {routine.coverage}")
+    if check.code_coverage is not None:
+        lines.append(f"  {coverage_line(summary(check.code_coverage, routine.program))}")
     if t.cycles_count:
         lines += _cycle_lines(check)
     if routine.budget is not None:

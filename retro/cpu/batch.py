@@ -43,6 +43,7 @@ from retro.cpu.mpu import (
 from retro.cpu.opcodes import DOCUMENTED, MODE_LENGTH, OPCODE_TABLE, STABLE
 from retro.cpu.timing import (
     BRANCH_CONDITIONS,
+    is_conditional_branch,
     BRANCH_PAGE_CYCLES,
     BRANCH_TAKEN_CYCLES,
     PAGE_CROSS_CYCLES,
@@ -148,11 +149,54 @@ class Lanes:
         return self.read(STACK_PAGE | _uniform(self.sp))
 
 
+class LaneCoverage:
+    """What the lanes ran, per instruction address: executions, each conditional branch's lanes that
+    jumped and that went on, and the fewest and most cycles one execution took (penalties included).
+    Counted per group run, so it costs a few Python operations per instruction group, not per lane:
+    a fixed-cost instruction's cycles come from its table row; only rows whose cycles vary (page
+    penalties, the 65C02's decimal cycle, BRA) compare each lane's cycles before and after."""
+
+    def __init__(self, table, decimal_cycle: bool) -> None:
+        self.executed: dict[int, int] = {}
+        self.taken: dict[int, int] = {}
+        self.not_taken: dict[int, int] = {}
+        self.cycles_min: dict[int, int] = {}
+        self.cycles_max: dict[int, int] = {}
+        self.base = {opcode: row.cycles for opcode, row in table.items()}
+        self.branches = frozenset(opcode for opcode, row in table.items() if is_conditional_branch(row))
+        self.varying = frozenset(opcode for opcode, row in table.items()
+                                 if row.page_penalty or row.mode in ("rel", "zpr")
+                                 or (decimal_cycle and row.mnemonic in ("ADC", "SBC")))
+
+    def cycles(self, pc: int, low: int, high: int) -> None:
+        known = self.cycles_min.get(pc)
+        if known is None or low < known:
+            self.cycles_min[pc] = low
+        known = self.cycles_max.get(pc)
+        if known is None or high > known:
+            self.cycles_max[pc] = high
+
+    def branch(self, pc: int, base: int, lanes: int, jumped: int, extra: int) -> None:
+        """A branch at pc run by `lanes` lanes, `jumped` of them taking it at `extra` cycles more."""
+        self.taken[pc] = self.taken.get(pc, 0) + jumped
+        self.not_taken[pc] = self.not_taken.get(pc, 0) + lanes - jumped
+        self.cycles(pc, base if jumped < lanes else base + extra, base + extra if jumped else base)
+
+    def merge(self, other: "LaneCoverage") -> None:
+        for mine, theirs in ((self.executed, other.executed), (self.taken, other.taken),
+                             (self.not_taken, other.not_taken)):
+            for pc, count in theirs.items():
+                mine[pc] = mine.get(pc, 0) + count
+        for pc, low in other.cycles_min.items():
+            self.cycles(pc, low, other.cycles_max[pc])
+
+
 class BatchCpu:
-    """N lanes of one 6502 on one memory image (see the module docstring)."""
+    """N lanes of one 6502 on one memory image (see the module docstring). With `coverage`, what the
+    lanes ran is counted in `self.coverage` (a LaneCoverage)."""
 
     def __init__(self, variant: str, image, lanes: int, *, stop_on_brk: bool = True,
-                 memory_limit: int = MAX_PRIVATE_BYTES) -> None:
+                 memory_limit: int = MAX_PRIVATE_BYTES, coverage: bool = False) -> None:
         if variant not in VARIANTS:
             raise InputError(f"unknown CPU variant {variant!r} (known: {', '.join(VARIANTS)})")
         self.variant = variant
@@ -161,6 +205,8 @@ class BatchCpu:
         if VARIANTS[variant].opcode_table is not OPCODE_TABLE:  # the 65C02: its own table of handlers
             from retro.cpu.batch65c02 import HANDLERS_65C02
             self.handlers = HANDLERS_65C02
+        table = VARIANTS[variant].opcode_table
+        self.coverage = LaneCoverage(table, decimal_cycle=table is not OPCODE_TABLE) if coverage else None
         self.lanes = lanes
         self.stop_on_brk = stop_on_brk
         self.memory = LaneMemory(image, lanes, memory_limit)
@@ -246,6 +292,23 @@ class BatchCpu:
         if handler is None:
             group.stop(pc, LaneError.JAM if opcode in JAM_OPCODES else LaneError.UNSTABLE)
             return
+        coverage = self.coverage
+        if coverage is not None and isinstance(pc, int):
+            executed = coverage.executed
+            executed[pc] = executed.get(pc, 0) + len(group)
+            if opcode not in coverage.varying:
+                base = coverage.base[opcode]
+                coverage.cycles(pc, base, base)
+            elif opcode not in coverage.branches:  # _branch_split counts the branches
+                before = group.cycles.copy()
+                result = handler(group, pc, lo, hi)
+                if not isinstance(result, list):
+                    spent = group.cycles - before
+                    coverage.cycles(pc, int(spent.min()), int(spent.max()))
+                    yield result, group
+                    return
+                yield from result
+                return
         result = handler(group, pc, lo, hi)
         if isinstance(result, list):
             yield from result
@@ -609,15 +672,18 @@ def _make_branch(opcode: int, cycles: int) -> Handler:
         target = (following + _signed(lo)) & WORD
         crossed = (following & PAGE_MASK) != (target & PAGE_MASK)
         g.cycles += cycles
-        return _branch_split(g, taken, target, following, extra_taken + crossed * BRANCH_PAGE_CYCLES)
+        return _branch_split(g, taken, target, following, extra_taken + crossed * BRANCH_PAGE_CYCLES, pc, cycles)
     return handler
 
 
-def _branch_split(g, taken: np.ndarray, target, following, extra):
+def _branch_split(g, taken: np.ndarray, target, following, extra, pc=None, base: int = 0):
     """Where a group goes at a branch (taken: per lane): one next PC, a list of (next pc, lanes) when
-    the lanes part, or per-lane PCs when the addresses are per lane; the taken lanes pay `extra`."""
+    the lanes part, or per-lane PCs when the addresses are per lane; the taken lanes pay `extra`.
+    With coverage on, the branch at `pc` (of `base` cycles) is counted."""
     if isinstance(target, int) and isinstance(following, int):
         jump = np.flatnonzero(taken)
+        if g.cpu.coverage is not None and isinstance(pc, int):
+            g.cpu.coverage.branch(pc, base, len(taken), len(jump), int(extra))
         if len(jump) == len(taken):
             g.cycles += extra
             return target

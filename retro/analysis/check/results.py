@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from retro.analysis.coverage_model import CodeCoverage
 from retro.cpu.flow import Bounds
 from retro.routines.runner import RasterStart, Size, describe_value
 from retro.routines.spec import Routine
@@ -50,6 +51,7 @@ class RoutineCheck:
     agreement: Tally | None = None  # with the batched core: the cases also run on Machine
     rows: RowsCheck | None = None  # the spec's expected rows (retro.analysis.row_check)
     seconds: float = 0.0  # wall time of the check (JUnit reports)
+    code_coverage: CodeCoverage | None = None  # what the cases ran of the code (retro.analysis.check.coverage)
 
     @property
     def mismatches(self) -> int:

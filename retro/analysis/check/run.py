@@ -24,6 +24,7 @@ from retro.analysis.check.engines import (
     run_on_machine,
     runner_for,
 )
+from retro.analysis.check.coverage import completed, worst_path
 from retro.analysis.check.results import PartRun, RoutineCheck
 from retro.analysis.check.tally import Tally, count_block
 from retro.analysis.check.verdicts import bounds_violations, budget_violations, static_bounds
@@ -58,7 +59,7 @@ def agreement_chunk(spec: str, seed: int, cases: list[tuple]) -> Tally:
     batched core's call for call."""
     runner = runner_for(spec, seed, None)
     columns = case_sets.cases_to_columns(runner.routine, cases)
-    against = run_on_batched_core(runner, columns, confirm_stop=False)
+    against = run_on_batched_core(runner, columns, confirm_stop=False, coverage=False)
     return count_block(runner.routine, run_on_machine(runner, cases), columns, cases, runner.memory_values, against)
 
 
@@ -186,6 +187,10 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         totals.failure = agreement.failure  # the timing model or the engines disagreed on a call
     if totals.failure is not None:
         check.trace = failure_trace(spec, seed, totals.failure.case, start)
+    check.code_coverage = completed(totals.code_coverage, runner)
+    if totals.max_case is not None and not totals.run_errors:
+        check.code_coverage.worst_path = worst_path(runner, totals.max_case)
+        check.code_coverage.worst_cycles = totals.cycles_max
     check.seconds = time.monotonic() - began
     return check
 
