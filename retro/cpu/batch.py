@@ -156,8 +156,10 @@ class LaneCoverage:
     a fixed-cost instruction's cycles come from its table row; only rows whose cycles vary (page
     penalties, the 65C02's decimal cycle, BRA) compare each lane's cycles before and after."""
 
-    def __init__(self, table, decimal_cycle: bool) -> None:
+    def __init__(self, table, decimal_cycle: bool, first_lanes: bool = False) -> None:
         self.executed: dict[int, int] = {}
+        # with first_lanes: per branch direction (pc, taken), the lowest lane that went that way
+        self.first_lane: dict[tuple[int, bool], int] | None = {} if first_lanes else None
         self.taken: dict[int, int] = {}
         self.not_taken: dict[int, int] = {}
         self.cycles_min: dict[int, int] = {}
@@ -182,7 +184,20 @@ class LaneCoverage:
         self.not_taken[pc] = self.not_taken.get(pc, 0) + lanes - jumped
         self.cycles(pc, base if jumped < lanes else base + extra, base + extra if jumped else base)
 
-    def merge(self, other: "LaneCoverage") -> None:
+    def note_lanes(self, pc: int, ids, taken: np.ndarray) -> None:
+        """The lowest lane of each way a branch went (ids: the group's lane numbers)."""
+        first = self.first_lane
+        for way, lanes in ((True, taken), (False, ~taken)):
+            if lanes.any():
+                lane = int(np.flatnonzero(lanes)[0]) if isinstance(ids, slice) else int(ids[lanes].min())
+                if lane < first.get((pc, way), lane + 1):
+                    first[(pc, way)] = lane
+
+    def merge(self, other: "LaneCoverage", lane_offset: int = 0) -> None:
+        """Add another run's counts (its lanes numbered from `lane_offset` in this one)."""
+        if self.first_lane is not None:
+            for key, lane in other.first_lane.items():
+                self.first_lane.setdefault(key, lane + lane_offset)
         for mine, theirs in ((self.executed, other.executed), (self.taken, other.taken),
                              (self.not_taken, other.not_taken)):
             for pc, count in theirs.items():
@@ -193,10 +208,11 @@ class LaneCoverage:
 
 class BatchCpu:
     """N lanes of one 6502 on one memory image (see the module docstring). With `coverage`, what the
-    lanes ran is counted in `self.coverage` (a LaneCoverage)."""
+    lanes ran is counted in `self.coverage` (a LaneCoverage); with `first_lanes` also which lane first
+    went each way at every branch (the coverage-guided search's feedback)."""
 
     def __init__(self, variant: str, image, lanes: int, *, stop_on_brk: bool = True,
-                 memory_limit: int = MAX_PRIVATE_BYTES, coverage: bool = False) -> None:
+                 memory_limit: int = MAX_PRIVATE_BYTES, coverage: bool = False, first_lanes: bool = False) -> None:
         if variant not in VARIANTS:
             raise InputError(f"unknown CPU variant {variant!r} (known: {', '.join(VARIANTS)})")
         self.variant = variant
@@ -206,7 +222,8 @@ class BatchCpu:
             from retro.cpu.batch65c02 import HANDLERS_65C02
             self.handlers = HANDLERS_65C02
         table = VARIANTS[variant].opcode_table
-        self.coverage = LaneCoverage(table, decimal_cycle=table is not OPCODE_TABLE) if coverage else None
+        self.coverage = (LaneCoverage(table, decimal_cycle=table is not OPCODE_TABLE, first_lanes=first_lanes)
+                         if coverage or first_lanes else None)
         self.lanes = lanes
         self.stop_on_brk = stop_on_brk
         self.memory = LaneMemory(image, lanes, memory_limit)
@@ -682,8 +699,11 @@ def _branch_split(g, taken: np.ndarray, target, following, extra, pc=None, base:
     With coverage on, the branch at `pc` (of `base` cycles) is counted."""
     if isinstance(target, int) and isinstance(following, int):
         jump = np.flatnonzero(taken)
-        if g.cpu.coverage is not None and isinstance(pc, int):
-            g.cpu.coverage.branch(pc, base, len(taken), len(jump), int(extra))
+        coverage = g.cpu.coverage
+        if coverage is not None and isinstance(pc, int):
+            coverage.branch(pc, base, len(taken), len(jump), int(extra))
+            if coverage.first_lane is not None:
+                coverage.note_lanes(pc, g.ids, taken)
         if len(jump) == len(taken):
             g.cycles += extra
             return target

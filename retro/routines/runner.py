@@ -298,28 +298,28 @@ class RoutineRunner:
         """Whether the batched core can run this routine (it has no chips: not with a scene)."""
         return self.vic is None
 
-    def run_batch(self, columns: list, coverage: bool = False) -> "BatchOutcome":
+    def run_batch(self, columns: list, coverage: bool = False, first_lanes: bool = False) -> "BatchOutcome":
         """Run every case of a column block (one array per input) on the batched core (`coverage`:
-        count what the lanes ran)."""
+        count what the lanes ran; `first_lanes`: also which lane first went each way at each branch)."""
         n = len(columns[0])
         try:
-            return self._run_lanes(columns, n, coverage)
+            return self._run_lanes(columns, n, coverage, first_lanes)
         except LaneMemoryFull:
             if n <= 1:
                 raise
             half = n // 2
-            first = self.run_batch([c[:half] for c in columns], coverage)
-            second = self.run_batch([c[half:] for c in columns], coverage)
-            if coverage:
-                first.coverage.merge(second.coverage)
+            first = self.run_batch([c[:half] for c in columns], coverage, first_lanes)
+            second = self.run_batch([c[half:] for c in columns], coverage, first_lanes)
+            if first.coverage is not None:
+                first.coverage.merge(second.coverage, lane_offset=half)
             return BatchOutcome([np.concatenate(pair) for pair in zip(first.outputs, second.outputs)],
                                 np.concatenate([first.cycles, second.cycles]),
                                 np.concatenate([first.error, second.error]), first.coverage)
 
-    def _run_lanes(self, columns: list, n: int, coverage: bool = False) -> "BatchOutcome":
+    def _run_lanes(self, columns: list, n: int, coverage: bool = False, first_lanes: bool = False) -> "BatchOutcome":
         image = bytearray(self.call_image)
         stack_pointer = push_return_trap(image)
-        cpu = BatchCpu(self.routine.cpu, image, n, coverage=coverage)
+        cpu = BatchCpu(self.routine.cpu, image, n, coverage=coverage, first_lanes=first_lanes)
         registers, p = self.plan.place(columns, _column_byte, cpu.memory.fill)
         for name, value in registers.items():
             lanes = getattr(cpu, name)

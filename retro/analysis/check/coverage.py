@@ -27,10 +27,11 @@ def from_lanes(lanes: LaneCoverage) -> CodeCoverage:
 
 
 def count_steps(coverage: CodeCoverage, read: Callable[[int], int], steps: Iterable[tuple[int, int, int, int, int]],
-                cpu: str) -> int:
-    """Add one call's recorded path (Machine's (pc, x, y, p, pointer) per instruction) to `coverage`;
-    return the call's cycles by the timing model. A conditional branch was taken when it cost more
-    than its base cycles (the taken penalty is at least one cycle)."""
+                cpu: str, directions: set[tuple[int, bool]] | None = None) -> int:
+    """Add one call's recorded path (Machine's (pc, x, y, p, pointer) per instruction) to `coverage`
+    (and each branch direction it went, (pc, taken), to `directions`); return the call's cycles by
+    the timing model. A conditional branch was taken when it cost more than its base cycles (the
+    taken penalty is at least one cycle)."""
     table = timing_table(cpu)
     executed, taken, not_taken = coverage.executed, coverage.taken, coverage.not_taken
     low, high = coverage.cycles_min, coverage.cycles_max
@@ -47,6 +48,8 @@ def count_steps(coverage: CodeCoverage, read: Callable[[int], int], steps: Itera
             high[pc] = cycles
         op = table.get(read(pc))
         if op is not None and is_conditional_branch(op):
+            if directions is not None:
+                directions.add((pc, cycles > op.cycles))
             if cycles > op.cycles:
                 taken[pc] = taken.get(pc, 0) + 1
                 not_taken.setdefault(pc, 0)
