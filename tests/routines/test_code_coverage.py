@@ -90,3 +90,123 @@ def test_coverage_merges_across_worker_processes():
     one, = run_checks(["tile"], engine="scalar", random_count=3000, jobs=1)
     two, = run_checks(["tile"], engine="scalar", random_count=3000, jobs=2)
     assert one.code_coverage == two.code_coverage
+
+
+# ---- the coverage-guided search ----------------------------------------------------------------------
+
+MAGIC = """\
+        .org $c000
+magic:  lda #0
+        sta out
+        lda a
+        cmp #$a7
+        bne done
+        lda b
+        cmp #$3c
+        bne done
+        ldx #20         ; the slow path: only a = $A7 with b = $3C
+slow:   dex
+        bne slow
+        inc out
+done:   lda out
+        rts
+a:      .byte 0
+b:      .byte 0
+out:    .byte 0
+"""
+MAGIC_SPEC = """\
+[program]
+file = "magic.s"
+entry = "magic"
+
+[inputs]
+a = {{ at = "a"{a_values} }}
+b = "b"
+
+[outputs]
+hit = "A"
+
+[reference]
+function = "ref.py:magic"
+
+[cases]
+random = 2000
+{cases}
+
+[cycles]
+loops = {{ slow = 20 }}
+"""
+MAGIC_WORST = 139  # 25 cycles on every other path; the slow path: 20 DEX/BNE rounds (5 * 19 + 4) and INC
+
+
+def _magic(tmp_path: Path, cases: str = "", a_values: str = "") -> Path:
+    (tmp_path / "magic.s").write_text(MAGIC)
+    (tmp_path / "ref.py").write_text("def magic(a, b):\n    return 1 if (a, b) == (0xA7, 0x3C) else 0\n")
+    spec = tmp_path / "magic.toml"
+    spec.write_text(MAGIC_SPEC.format(cases=cases, a_values=a_values))
+    return spec
+
+
+@pytest.mark.parametrize("engine", ["scalar", "batch"])
+def test_the_default_search_finds_the_worst_path_uniform_random_misses(tmp_path, engine):
+    spec = _magic(tmp_path)
+    without = check(spec, engine=engine, search_budget=0)
+    assert without.mismatches == 0 and without.totals.cycles_max < MAGIC_WORST and not without.worst_reached
+    report = check(spec, engine=engine)  # the default search
+    assert report.mismatches == 0 and report.static.worst == MAGIC_WORST
+    assert report.worst_reached and report.totals.max_case == (0xA7, 0x3C)
+    assert (0xA7, 0x3C) in report.search.found and report.totals.cases == 2000 + len(report.search.found)
+    assert report.code_coverage.executed[0xC015] == 20  # the loop ran, counted like every case's code
+    assert report.code_coverage.worst_path.count(0xC015) == 20 and report.code_coverage.worst_cycles == MAGIC_WORST
+
+
+def test_both_engines_search_alike_and_the_seed_decides(tmp_path):
+    spec = _magic(tmp_path)
+    scalar, batch = check(spec, engine="scalar"), check(spec, engine="batch")
+    assert scalar.search == batch.search and scalar.code_coverage == batch.code_coverage
+    assert check(spec, engine="scalar").search == scalar.search  # the same seed: the same search
+    assert check(spec, engine="scalar", seed=7).search != scalar.search  # another seed: other candidates
+
+
+@pytest.mark.parametrize("engine", ["scalar", "batch"])
+def test_the_search_runs_only_candidates_inside_values_and_where(tmp_path, monkeypatch, engine):
+    from retro.analysis.check import search
+
+    ran = []
+    probe = search._probe
+    monkeypatch.setattr(search, "_probe", lambda runner, cases, on_batch: ran.extend(cases) or probe(runner, cases, on_batch))
+    spec = _magic(tmp_path, cases='where = "b != 62 and b % 2 == 0"', a_values=', values = [1, 2, 167, 200]')
+    report = check(spec, engine=engine, random=20)
+    assert len(ran) > 1000  # (the planned random cases are drawn first and filtered: some lie outside)
+    assert all(a in (1, 2, 167, 200) and b != 62 and b % 2 == 0 for a, b in ran)
+    assert report.worst_reached and (0xA7, 0x3C) in report.search.found  # 60 is even: inside the domain
+
+
+def test_a_search_budget_in_the_spec_and_at_the_command_line(tmp_path, capsys):
+    spec = _magic(tmp_path, cases="search = 0")
+    assert check(spec).search.ended == "off"
+    assert main(["check", str(spec), "--search", "512", "--json"]) == 0
+    record = json.loads(capsys.readouterr().out)[0]
+    assert record["search"]["budget"] == 512 and record["search"]["candidates"] <= 512
+    worst = record["bounds_reached"]["worst"]
+    assert worst["reached"] and worst["inputs"] == {"a": 0xA7, "b": 0x3C} and worst["found_by_search"]
+    main(["check", str(spec), "--no-search"])
+    text = capsys.readouterr().out
+    assert "static worst 139 not reached (whether any input reaches it is not known)" in text
+
+
+def test_a_bad_search_budget_is_one_line_naming_the_key(tmp_path, capsys):
+    spec = _magic(tmp_path, cases="search = -1")
+    assert main(["check", str(spec)]) == 2
+    assert "cases.search" in capsys.readouterr().err
+    assert main(["check", str(_magic(tmp_path)), "--search", "lots"]) == 2
+    assert "--search" in capsys.readouterr().err
+
+
+def test_a_bound_no_input_reaches_is_known_unreachable_when_every_input_ran(tmp_path):
+    spec = _magic(tmp_path, cases='exhaustive = ["a", "b"]', a_values=', values = [1, 2, 3]')
+    report = check(spec, engine="batch")
+    assert report.every_input_run and not report.worst_reached  # a is never $A7: the slow path cannot run
+    from retro.commands.check import bounds_reached
+
+    assert bounds_reached(report)["worst"]["unreachable"] is True
