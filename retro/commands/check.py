@@ -10,7 +10,7 @@ from pathlib import Path
 from retro.analysis.check import RoutineCheck, SceneStart, inputs_by_name, run_checks
 from retro.analysis.check.coverage import coverage_line, coverage_record, summary
 from retro.analysis.check.results import describe_case, describe_outputs
-from retro.analysis.check.search import DEFAULT_SEARCH, STALE_GENERATIONS
+from retro.analysis.check.search import CYCLES_PER_CANDIDATE, DEFAULT_SEARCH, STALE_GENERATIONS
 from retro.analysis.junit import junit_xml
 from retro.analysis.raster import format_raster, raster_figures
 from retro.analysis.row_check import rows_lines, rows_record
@@ -281,7 +281,8 @@ def search_record(check: RoutineCheck) -> dict | None:
     s = check.search
     if s is None:
         return None
-    return {"budget": s.budget, "candidates": s.candidates, "generations": s.generations, "kept": len(s.found),
+    return {"budget": s.budget, "candidates": s.candidates, "cycles": s.cycles, "generations": s.generations,
+            "kept": len(s.found),
             "new_branch_directions": s.new_directions, "ended": s.ended}
 
 
@@ -289,10 +290,11 @@ def _search_line(check: RoutineCheck) -> str | None:
     s = check.search
     if s is None or s.ended == "off":
         return None
-    ended = {"budget": "its budget spent", "stale": f"nothing new in {STALE_GENERATIONS} generations",
+    ended = {"budget": f"its budget spent (at most {s.budget:,} candidates and {s.budget * CYCLES_PER_CANDIDATE:,} cycles)", "stale": f"nothing new in {STALE_GENERATIONS} generations",
              "stopped": "a call stopped"}[s.ended]
-    return (f"  search: {s.candidates:,} of {s.budget:,} candidates in {s.generations} generations, {len(s.found)} "
-            f"kept ({s.new_directions} new branch directions); ended: {ended}")
+    return (f"  search: {s.candidates:,} of {s.budget:,} candidates ({s.cycles:,} cycles) in {s.generations} "
+            f"generation{'s' if s.generations != 1 else ''}, {len(s.found)} kept ({s.new_directions} new branch "
+            f"directions); ended: {ended}")
 
 
 def _failure_lines(check: RoutineCheck) -> list[str]:

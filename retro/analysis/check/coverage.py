@@ -59,6 +59,23 @@ def count_steps(coverage: CodeCoverage, read: Callable[[int], int], steps: Itera
     return total
 
 
+def directions_of(read: Callable[[int], int], steps: Iterable[tuple[int, int, int, int, int]],
+                  cpu: str) -> set[tuple[int, bool]]:
+    """The branch directions, (pc, taken), of one call's recorded path (as `count_steps` tells them)."""
+    table = timing_table(cpu)
+    branches = _conditional_branches(cpu)
+    went = set()
+    for pc, x, y, p, pointer in steps:
+        opcode = read(pc)
+        if opcode in branches:
+            went.add((pc, instruction_cycles(read, pc, x, y, p, pointer, cpu) > table[opcode].cycles))
+    return went
+
+
+def _conditional_branches(cpu: str) -> frozenset[int]:
+    return frozenset(opcode for opcode, op in timing_table(cpu).items() if is_conditional_branch(op))
+
+
 def code_instructions(runner: RoutineRunner) -> dict[int, int]:
     """{address: opcode} of every instruction reachable from the entry in the code every call starts
     from (after `init`), following branches, JMP and JSR within the program."""

@@ -9,8 +9,9 @@ Parents are chosen toward what is missing: cases that ran a branch whose other w
 gone, the slowest and the fastest cases, and the cases kept. The search is a pure function of the
 routine, the seed and what the cases before it covered; both engines give it the same feedback
 (cycles per case, and per branch direction the first candidate that went that way), so it finds
-the same cases on either. It ends when its budget of candidates is spent, when a call stops (that
-case is kept: the check reports it), or after STALE_GENERATIONS generations that found nothing."""
+the same cases on either. It ends when its budget is spent (N candidates, or N * CYCLES_PER_CANDIDATE
+cycles run), when a call stops (that case is kept: the check reports it), or after STALE_GENERATIONS
+generations that found nothing."""
 
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from retro.analysis.check.coverage import code_instructions, count_steps
+from retro.analysis.check.coverage import code_instructions, directions_of
 from retro.analysis.coverage_model import CodeCoverage
 from retro.cpu.timing import timing_table
 from retro.errors import RunError
@@ -27,6 +28,8 @@ from retro.routines.runner import RoutineRunner
 from retro.routines.spec import Port, Routine
 
 DEFAULT_SEARCH = 4_096  # candidates a check's search may run (--search N, [cases] search = N)
+CYCLES_PER_CANDIDATE = 250  # and at most this many emulated cycles per candidate of the budget, all told:
+# a slow routine's search ends sooner (a bound in cycles, not seconds, keeps it the same on every machine)
 GENERATION = 256  # candidates run together (one batch on the batched core)
 STALE_GENERATIONS = 6  # generations in a row that find nothing end the search
 KEPT_EXTREMES = 8  # the slowest and the fastest cases kept as parents
@@ -40,6 +43,7 @@ Direction = tuple[int, bool]  # (branch address, taken)
 class SearchResult:
     budget: int
     candidates: int = 0  # candidates run
+    cycles: int = 0  # the cycles they ran
     generations: int = 0
     found: list[tuple] = field(default_factory=list)  # the cases kept, in the order found
     new_directions: int = 0
@@ -66,19 +70,16 @@ def _probe(runner: RoutineRunner, cases: list[tuple], on_batch: bool) -> _Probe:
         first = {d: i for d, i in outcome.coverage.first_lane.items() if i < returned}
         return _Probe(outcome.cycles[:returned].copy(), first, returned < len(cases))
     read = runner.machine.memory.__getitem__
-    scratch = CodeCoverage()
     cycles: list[int] = []
     first: dict[Direction, int] = {}
     for i, case in enumerate(cases):
         steps: list = []
-        directions: set[Direction] = set()
         try:
             _, spent = runner.run(case, steps)
         except RunError:
             return _Probe(np.asarray(cycles, dtype=np.int64), first, True)
-        count_steps(scratch, read, steps, runner.routine.cpu, directions)
         cycles.append(spent)
-        for direction in directions:
+        for direction in directions_of(read, steps, runner.routine.cpu):
             first.setdefault(direction, i)
     return _Probe(np.asarray(cycles, dtype=np.int64), first, False)
 
@@ -179,8 +180,10 @@ def search(runner: RoutineRunner, *, on_batch: bool, seed: int, budget: int, cov
     fast = [fastest] if fastest else []
     kept: list[tuple] = []
     stale = 0
-    while result.candidates < budget:
-        n = min(GENERATION, budget - result.candidates)
+    cycle_budget = budget * CYCLES_PER_CANDIDATE
+    per_call = 1  # the mean cycles of a call in the last generation: a generation fits what is left
+    while result.candidates < budget and result.cycles < cycle_budget:
+        n = min(GENERATION, budget - result.candidates, max(1, (cycle_budget - result.cycles) // per_call))
         wanting = [reachers[pc] for pc in sorted(reachers) if ((pc, True) in gone) != ((pc, False) in gone)]
         cases = _generation(mutate, rng, n, wanting, [c for _, c in slow + fast] + kept, fresh)
         result.candidates += n
@@ -210,6 +213,8 @@ def search(runner: RoutineRunner, *, on_batch: bool, seed: int, budget: int, cov
                 found.add(low)
             slow = _extremes(slow, probe.cycles, cases, -1)
             fast = _extremes(fast, probe.cycles, cases, 1)
+            result.cycles += int(probe.cycles.sum())
+            per_call = max(1, int(probe.cycles.sum()) // len(probe.cycles))
         if probe.stopped:
             found.add(len(probe.cycles))  # the call that stopped: the check reports it
         new = [cases[i] for i in sorted(found)]
