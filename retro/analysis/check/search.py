@@ -181,7 +181,9 @@ def search(runner: RoutineRunner, *, on_batch: bool, seed: int, budget: int, cov
     kept: list[tuple] = []
     stale = 0
     cycle_budget = budget * CYCLES_PER_CANDIDATE
-    per_call = 1  # the mean cycles of a call in the last generation: a generation fits what is left
+    # cycles a call is expected to take (the slowest case's at first, then the last generation's mean):
+    # a generation is sized to fit what is left of the budget
+    per_call = max(1, result.slowest or 1)
     while result.candidates < budget and result.cycles < cycle_budget:
         n = min(GENERATION, budget - result.candidates, max(1, (cycle_budget - result.cycles) // per_call))
         wanting = [reachers[pc] for pc in sorted(reachers) if ((pc, True) in gone) != ((pc, False) in gone)]
