@@ -22,6 +22,7 @@ No device is modelled: the engine serves plain-RAM routines (a scene with chips 
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from enum import IntEnum
 
@@ -40,7 +41,7 @@ from retro.cpu.mpu import (
     JAM_OPCODES,
     VARIANTS,
 )
-from retro.cpu.opcodes import DOCUMENTED, MODE_LENGTH, OPCODE_TABLE, STABLE
+from retro.cpu.opcodes import DECIMAL_EXTRA_CYCLES, DOCUMENTED, MODE_LENGTH, OPCODE_TABLE, STABLE
 from retro.cpu.timing import (
     BRANCH_CONDITIONS,
     is_conditional_branch,
@@ -154,9 +155,10 @@ class LaneCoverage:
     jumped and that went on, and the fewest and most cycles one execution took (penalties included).
     Counted per group run, so it costs a few Python operations per instruction group, not per lane:
     a fixed-cost instruction's cycles come from its table row; only rows whose cycles vary (page
-    penalties, the 65C02's decimal cycle, BRA) compare each lane's cycles before and after."""
+    penalties, the 65C02's decimal cycle, BRA) compare each lane's cycles before and after, and only
+    until the address has cost both its least and its most."""
 
-    def __init__(self, table, decimal_cycle: bool, first_lanes: bool = False) -> None:
+    def __init__(self, variant: str, first_lanes: bool = False) -> None:
         self.executed: dict[int, int] = {}
         # with first_lanes: per branch direction (pc, taken), the lowest lane that went that way
         self.first_lane: dict[tuple[int, bool], int] | None = {} if first_lanes else None
@@ -164,11 +166,7 @@ class LaneCoverage:
         self.not_taken: dict[int, int] = {}
         self.cycles_min: dict[int, int] = {}
         self.cycles_max: dict[int, int] = {}
-        self.base = {opcode: row.cycles for opcode, row in table.items()}
-        self.branches = frozenset(opcode for opcode, row in table.items() if is_conditional_branch(row))
-        self.varying = frozenset(opcode for opcode, row in table.items()
-                                 if row.page_penalty or row.mode in ("rel", "zpr")
-                                 or (decimal_cycle and row.mnemonic in ("ADC", "SBC")))
+        self.base, self.branches, self.varying, self.ceiling = _cost_rows(variant)
 
     def cycles(self, pc: int, low: int, high: int) -> None:
         known = self.cycles_min.get(pc)
@@ -206,6 +204,23 @@ class LaneCoverage:
             self.cycles(pc, low, other.cycles_max[pc])
 
 
+@functools.cache
+def _cost_rows(variant: str) -> tuple[dict, frozenset, frozenset, dict]:
+    """Per opcode of a CPU's table: base cycles; the conditional branches; the rows whose cost varies
+    (page penalties, branches, BRA, the 65C02's decimal cycle); the most a varying non-branch row can
+    cost (once an address has cost its base and this, its lanes need not be measured again:
+    instructions in loops stop costing numpy work)."""
+    table = VARIANTS[variant].opcode_table
+    decimal_cycle = table is not OPCODE_TABLE  # the 65C02's ADC/SBC: one cycle more with D set
+    decimal = {opcode for opcode, row in table.items() if decimal_cycle and row.mnemonic in ("ADC", "SBC")}
+    varying = frozenset(opcode for opcode, row in table.items()
+                        if row.page_penalty or row.mode in ("rel", "zpr") or opcode in decimal)
+    ceiling = {opcode: row.cycles + PAGE_CROSS_CYCLES * row.page_penalty + DECIMAL_EXTRA_CYCLES * (opcode in decimal)
+               for opcode, row in table.items() if opcode in varying and row.mode != "rel"}
+    return ({opcode: row.cycles for opcode, row in table.items()},
+            frozenset(opcode for opcode, row in table.items() if is_conditional_branch(row)), varying, ceiling)
+
+
 class BatchCpu:
     """N lanes of one 6502 on one memory image (see the module docstring). With `coverage`, what the
     lanes ran is counted in `self.coverage` (a LaneCoverage); with `first_lanes` also which lane first
@@ -221,9 +236,7 @@ class BatchCpu:
         if VARIANTS[variant].opcode_table is not OPCODE_TABLE:  # the 65C02: its own table of handlers
             from retro.cpu.batch65c02 import HANDLERS_65C02
             self.handlers = HANDLERS_65C02
-        table = VARIANTS[variant].opcode_table
-        self.coverage = (LaneCoverage(table, decimal_cycle=table is not OPCODE_TABLE, first_lanes=first_lanes)
-                         if coverage or first_lanes else None)
+        self.coverage = LaneCoverage(variant, first_lanes) if coverage or first_lanes else None
         self.lanes = lanes
         self.stop_on_brk = stop_on_brk
         self.memory = LaneMemory(image, lanes, memory_limit)
@@ -316,7 +329,9 @@ class BatchCpu:
             if opcode not in coverage.varying:
                 base = coverage.base[opcode]
                 coverage.cycles(pc, base, base)
-            elif opcode not in coverage.branches:  # _branch_split counts the branches
+            elif opcode not in coverage.branches and (  # _branch_split counts the branches
+                    coverage.cycles_min.get(pc) != coverage.base[opcode]
+                    or coverage.cycles_max.get(pc) != coverage.ceiling.get(opcode)):
                 before = group.cycles.copy()
                 result = handler(group, pc, lo, hi)
                 if not isinstance(result, list):
