@@ -155,6 +155,9 @@ def run_on_batched_core(runner: RoutineRunner, columns: list, confirm_stop: bool
     block = CallBlock(outcome.outputs, outcome.cycles, np.zeros(n, dtype=np.int64), None,
                       int(stopped[0]) if len(stopped) else n, lane_errors=outcome.error,
                       coverage=from_lanes(outcome.coverage) if coverage else None)
+    if coverage and len(stopped):  # coverage counts the calls before the first that stopped, as on Machine
+        block.coverage = (from_lanes(runner.run_batch([c[:block.returned] for c in columns], True).coverage)
+                          if block.returned else CodeCoverage())
     if len(stopped) and confirm_stop:
         machine = run_on_machine(runner, [case_sets.case_of(columns, block.returned)])
         if machine.stop is not None:
