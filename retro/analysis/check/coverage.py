@@ -9,6 +9,7 @@ every report shows (instructions and branch directions run, what was not run, wi
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
@@ -19,6 +20,7 @@ from retro.program import Program
 from retro.routines.runner import RoutineRunner, routine_code
 
 UNCOVERED_SHOWN = 8  # addresses named in the text line (JSON lists them all)
+NO_FEWER = 1 << 62  # above any instruction's cycles
 
 
 def from_lanes(lanes: LaneCoverage) -> CodeCoverage:
@@ -27,12 +29,12 @@ def from_lanes(lanes: LaneCoverage) -> CodeCoverage:
 
 
 def count_steps(coverage: CodeCoverage, read: Callable[[int], int], steps: Iterable[tuple[int, int, int, int, int]],
-                cpu: str, directions: set[tuple[int, bool]] | None = None) -> int:
-    """Add one call's recorded path (Machine's (pc, x, y, p, pointer) per instruction) to `coverage`
-    (and each branch direction it went, (pc, taken), to `directions`); return the call's cycles by
-    the timing model. A conditional branch was taken when it cost more than its base cycles (the
-    taken penalty is at least one cycle)."""
-    table = timing_table(cpu)
+                cpu: str) -> int:
+    """Add one call's recorded path (Machine's (pc, x, y, p, pointer) per instruction) to `coverage`;
+    return the call's cycles by the timing model. A conditional branch was taken when it cost more
+    than its base cycles (the taken penalty is at least one cycle)."""
+    base = timing_table(cpu)
+    branches = _conditional_branches(cpu)
     executed, taken, not_taken = coverage.executed, coverage.taken, coverage.not_taken
     low, high = coverage.cycles_min, coverage.cycles_max
     total = 0
@@ -40,17 +42,13 @@ def count_steps(coverage: CodeCoverage, read: Callable[[int], int], steps: Itera
         cycles = instruction_cycles(read, pc, x, y, p, pointer, cpu)
         total += cycles
         executed[pc] = executed.get(pc, 0) + 1
-        known = low.get(pc)
-        if known is None or cycles < known:
+        if cycles < low.get(pc, NO_FEWER):
             low[pc] = cycles
-        known = high.get(pc)
-        if known is None or cycles > known:
+        if cycles > high.get(pc, -1):
             high[pc] = cycles
-        op = table.get(read(pc))
-        if op is not None and is_conditional_branch(op):
-            if directions is not None:
-                directions.add((pc, cycles > op.cycles))
-            if cycles > op.cycles:
+        opcode = read(pc)
+        if opcode in branches:
+            if cycles > base[opcode].cycles:
                 taken[pc] = taken.get(pc, 0) + 1
                 not_taken.setdefault(pc, 0)
             else:
@@ -72,6 +70,7 @@ def directions_of(read: Callable[[int], int], steps: Iterable[tuple[int, int, in
     return went
 
 
+@functools.cache
 def _conditional_branches(cpu: str) -> frozenset[int]:
     return frozenset(opcode for opcode, op in timing_table(cpu).items() if is_conditional_branch(op))
 

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from retro.cpu.batch import LaneError
+from retro.cpu.timing import model_cycles
 from retro.analysis.check.coverage import count_steps, from_lanes
 from retro.analysis.check.results import describe_outputs
 from retro.analysis.coverage_model import CodeCoverage
@@ -116,13 +117,13 @@ def batched(engine: str, calls: int | None, batchable: bool, threshold: int) -> 
     return batchable and (engine == "batch" or (engine == "auto" and (calls is None or calls >= threshold)))
 
 
-def run_on_machine(runner: RoutineRunner, cases: list[tuple]) -> CallBlock:
+def run_on_machine(runner: RoutineRunner, cases: list[tuple], coverage: bool = True) -> CallBlock:
     """Calls on Machine, each timed again by the timing model; the first that does not return ends
-    the block (the next could run away as well)."""
+    the block (the next could run away as well). `coverage`: collect it (from the same recorded path)."""
     read = runner.machine.memory.__getitem__
     answers, cycles, stolen, modelled = [], [], [], []
     stop, message = None, ""
-    coverage = CodeCoverage()
+    covered = CodeCoverage() if coverage else None
     for case in cases:
         steps: list = []
         try:
@@ -133,10 +134,11 @@ def run_on_machine(runner: RoutineRunner, cases: list[tuple]) -> CallBlock:
         answers.append(answer)
         cycles.append(spent)
         stolen.append(runner.last_stolen)
-        modelled.append(count_steps(coverage, read, steps, runner.routine.cpu))  # the timing model's count
+        modelled.append(count_steps(covered, read, steps, runner.routine.cpu) if coverage else
+                        model_cycles(read, steps, runner.routine.cpu))
     return CallBlock(_output_arrays(runner.routine, answers), np.asarray(cycles, dtype=np.int64),
                      np.asarray(stolen, dtype=np.int64), np.asarray(modelled, dtype=np.int64), len(answers),
-                     stop, message, coverage=coverage)
+                     stop, message, coverage=covered)
 
 
 def _output_arrays(routine: Routine, answers: list[tuple]) -> list[np.ndarray]:

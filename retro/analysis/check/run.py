@@ -61,7 +61,8 @@ def agreement_chunk(spec: str, seed: int, cases: list[tuple]) -> Tally:
     runner = runner_for(spec, seed, None)
     columns = case_sets.cases_to_columns(runner.routine, cases)
     against = run_on_batched_core(runner, columns, confirm_stop=False, coverage=False)
-    return count_block(runner.routine, run_on_machine(runner, cases), columns, cases, runner.memory_values, against)
+    return count_block(runner.routine, run_on_machine(runner, cases, coverage=False), columns, cases,
+                       runner.memory_values, against)  # (the batched core counts these cases' coverage)
 
 
 # ---- a whole check ------------------------------------------------------------------------------------

@@ -33,6 +33,7 @@ CYCLES_PER_CANDIDATE = 250  # and at most this many emulated cycles per candidat
 GENERATION = 256  # candidates run together (one batch on the batched core)
 STALE_GENERATIONS = 6  # generations in a row that find nothing end the search
 KEPT_EXTREMES = 8  # the slowest and the fastest cases kept as parents
+REACHERS_KEPT = 4  # cases kept per branch that ran it (parents toward its other way, while no case went there)
 SEARCH_RNG_OFFSET = 3  # the search draws from seed + 3 (cases from seed, memory from seed + 1, exhaustive + 2)
 OPERATORS = ("flip", "step", "edge", "constant", "random", "cross")
 
@@ -175,7 +176,7 @@ def search(runner: RoutineRunner, *, on_batch: bool, seed: int, budget: int, cov
     gone = {(pc, True) for pc, n in covered.taken.items() if n} | {(pc, False) for pc, n in covered.not_taken.items() if n}
     mutate = _Mutator(routine, rng, code_constants(runner))
     fresh = _fresh_cases(routine, seed, budget)
-    reachers: dict[int, tuple] = {}  # branch address -> a case that ran it
+    reachers: dict[int, list[tuple]] = {}  # branch address -> the first REACHERS_KEPT cases that ran it
     slow = [slowest] if slowest else []
     fast = [fastest] if fastest else []
     kept: list[tuple] = []
@@ -186,7 +187,8 @@ def search(runner: RoutineRunner, *, on_batch: bool, seed: int, budget: int, cov
     per_call = max(1, result.slowest or 1)
     while result.candidates < budget and result.cycles < cycle_budget:
         n = min(GENERATION, budget - result.candidates, max(1, (cycle_budget - result.cycles) // per_call))
-        wanting = [reachers[pc] for pc in sorted(reachers) if ((pc, True) in gone) != ((pc, False) in gone)]
+        wanting = [case for pc in sorted(reachers) if ((pc, True) in gone) != ((pc, False) in gone)
+                   for case in reachers[pc]]
         cases = _generation(mutate, rng, n, wanting, [c for _, c in slow + fast] + kept, fresh)
         result.candidates += n
         result.generations += 1
@@ -200,7 +202,9 @@ def search(runner: RoutineRunner, *, on_batch: bool, seed: int, budget: int, cov
         probe = _probe(runner, cases, on_batch)
         found = set()
         for (pc, way), i in sorted(probe.first.items(), key=lambda item: (item[1], item[0])):
-            reachers.setdefault(pc, cases[i])
+            known = reachers.setdefault(pc, [])
+            if len(known) < REACHERS_KEPT:
+                known.append(cases[i])
             if (pc, way) not in gone:
                 gone.add((pc, way))
                 result.new_directions += 1
