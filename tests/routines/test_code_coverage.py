@@ -210,3 +210,55 @@ def test_a_bound_no_input_reaches_is_known_unreachable_when_every_input_ran(tmp_
     from retro.commands.check import bounds_reached
 
     assert bounds_reached(report)["worst"]["unreachable"] is True
+
+
+WIDE = """\
+        .org $c000
+wide:   lda w+1
+        cmp #$9c        ; w >= $9C00 only from 39,936 on
+        bcc small
+        lda tbl+2
+        cmp #3
+        bne small
+        lda #1
+        rts
+small:  lda #0
+        rts
+w:      .byte 0, 0
+tbl:    .byte 0, 0, 0
+"""
+WIDE_SPEC = """\
+[program]
+file = "wide.s"
+entry = "wide"
+
+[inputs]
+w = { at = ["w", "w+1"], values = "100..40000" }
+t = { at = "tbl", size = 3, values = "0..3" }
+
+[outputs]
+r = "A"
+
+[reference]
+function = "ref.py:wide"
+
+[cases]
+random = 20
+"""
+
+
+@pytest.mark.parametrize("engine", ["scalar", "batch"])
+def test_the_search_keeps_wide_numbers_and_table_bytes_inside_their_values(tmp_path, monkeypatch, engine):
+    from retro.analysis.check import search
+
+    (tmp_path / "wide.s").write_text(WIDE)
+    (tmp_path / "ref.py").write_text("def wide(w, t):\n    return 1 if w >= 0x9C00 and t[2] == 3 else 0\n")
+    (tmp_path / "wide.toml").write_text(WIDE_SPEC)
+    ran = []
+    probe = search._probe
+    monkeypatch.setattr(search, "_probe", lambda runner, cases, on_batch: ran.extend(cases) or probe(runner, cases, on_batch))
+    report = check(tmp_path / "wide.toml", engine=engine)
+    assert report.mismatches == 0 and len(ran) > 1000
+    assert all(100 <= w <= 40000 and len(t) == 3 and all(0 <= b <= 3 for b in t) for w, t in ran)
+    summary = report.code_coverage
+    assert all(summary.taken[pc] and summary.not_taken[pc] for pc in summary.taken)  # both ways of both branches
