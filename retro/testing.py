@@ -40,11 +40,12 @@ def spec_from_dict(doc: dict, base: str | Path = ".", name: str = "spec") -> Rou
 
 
 def check(spec: str | Path | Routine, *, exhaustive: bool = False, random: int | None = None,
-          seed: int | None = None, jobs: int = 1, engine: str = "auto") -> RoutineCheck:
+          seed: int | None = None, jobs: int = 1, engine: str = "auto", search_budget: int | None = None) -> RoutineCheck:
     """Run a routine's check; the report is plain data (see retro.analysis.check.RoutineCheck).
-    `engine`: "scalar", "batch" or "auto" (the default), as `retro check --engine`."""
+    `engine`: "scalar", "batch" or "auto" (the default), as `retro check --engine`; `search_budget`:
+    candidates of the coverage-guided search, as `--search` (None: the spec's or the default)."""
     return check_routine(spec if isinstance(spec, Routine) else str(spec), exhaustive=exhaustive, seed=seed,
-                         random_count=random, jobs=jobs, engine=engine)
+                         random_count=random, jobs=jobs, engine=engine, search_budget=search_budget)
 
 
 def assert_routine(spec: str | Path | Routine, **options) -> RoutineCheck:

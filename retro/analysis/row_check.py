@@ -28,6 +28,7 @@ from retro.analysis.check.reference import reference_answers
 from retro.analysis.check.results import Failure, describe_case, describe_outputs, inputs_by_name
 from retro.analysis.check.tally import Tally
 from retro.analysis.check.verdicts import static_bounds
+from retro.analysis.coverage_model import CodeCoverage
 from retro.cpu.flow import Bounds
 from retro.errors import InputError
 from retro.routines.cases import cases_to_columns
@@ -104,11 +105,12 @@ def check_rows(spec: str, seed: int, start: SceneStart | None, batched: bool) ->
     runner = runner_for(spec, seed, start)
     routine = runner.routine
     rows = routine.rows
-    if batched:
-        calls, agreement = _batched(runner, rows)
-    else:
-        calls, agreement = _calls_of(run_on_machine(runner, [row.case for row in rows]), timed=True), None
     totals = Tally()
+    if batched:
+        calls, agreement, totals.code_coverage = _batched(runner, rows)
+    else:
+        block = run_on_machine(runner, [row.case for row in rows])
+        calls, agreement, totals.code_coverage = _calls_of(block, timed=True), None, block.coverage
     outcomes = []
     for row, call in zip(rows, calls):
         outcomes.append(_outcome(row, call, routine))
@@ -137,22 +139,26 @@ def _reference_answer(runner: RoutineRunner, row: Row) -> tuple | None:
     return row_of(answers, 0) if answered[0] else None
 
 
-def _batched(runner: RoutineRunner, rows: tuple[Row, ...]) -> tuple[list[_Call], Tally]:
+def _batched(runner: RoutineRunner, rows: tuple[Row, ...]) -> tuple[list[_Call], Tally, CodeCoverage]:
     """The rows on the batched core in batches at most as wide as the check's, up to the first call
-    that stops; the first AGREEMENT_PER_PART of them also on Machine, compared call for call."""
+    that stops; the first AGREEMENT_PER_PART of them also on Machine, compared call for call; what
+    they ran of the code."""
     routine = runner.routine
     agreement = Tally()
     calls: list[_Call] = []
+    coverage = CodeCoverage()
     for first in range(0, len(rows), BATCH_LANES):
         cases = [row.case for row in rows[first:first + BATCH_LANES]]
         batch = run_on_batched_core(runner, cases_to_columns(routine, cases))
+        coverage = coverage.merge(batch.coverage)
         compared = min(batch.calls, AGREEMENT_PER_PART - first)
         if compared > 0:
-            _agree(agreement, routine, rows[first:], run_on_machine(runner, cases[:compared]), batch)
+            machine = run_on_machine(runner, cases[:compared], coverage=False)
+            _agree(agreement, routine, rows[first:], machine, batch)
         calls += _calls_of(batch, timed=False)
         if batch.stop is not None:
             break
-    return calls, agreement
+    return calls, agreement, coverage
 
 
 def _agree(agreement: Tally, routine: Routine, rows: tuple[Row, ...], machine: CallBlock, batch: CallBlock) -> None:

@@ -8,7 +8,9 @@ import math
 from pathlib import Path
 
 from retro.analysis.check import RoutineCheck, SceneStart, inputs_by_name, run_checks
+from retro.analysis.check.coverage import coverage_line, coverage_record, summary
 from retro.analysis.check.results import describe_case, describe_outputs
+from retro.analysis.check.search import CYCLES_PER_CANDIDATE, DEFAULT_SEARCH, STALE_GENERATIONS
 from retro.analysis.junit import junit_xml
 from retro.analysis.raster import format_raster, raster_figures
 from retro.analysis.row_check import rows_lines, rows_record
@@ -28,6 +30,7 @@ from retro.analysis.check import AGREEMENT_PER_PART, AUTO_BATCH_CASES
 from retro.commands import options
 from retro.progress import progress_printer
 from retro.routines.registry import builtin_names
+from retro.routines.spec import MAX_SEARCH
 
 MAX_RANDOM = 10 ** 9
 MAX_JOBS = MAX_WORKERS
@@ -39,16 +42,19 @@ JSON_EXACT = 1 << 53  # larger whole numbers lose digits in JSON readers that us
 def check(routines: list[str] | None = None, *, exhaustive: bool = False, seed: int | str | None = None,
           random: int | str | None = None, jobs: int | str | None = None, scene: str | Path | None = None,
           at_line: int | str | None = None, at_cycle: int | str | None = None, engine: str = "auto",
-          progress: Progress = quiet, bounded_product: int = case_sets.BOUNDED_PRODUCT) -> list[RoutineCheck]:
+          progress: Progress = quiet, bounded_product: int = case_sets.BOUNDED_PRODUCT,
+          search: int | str | None = None) -> list[RoutineCheck]:
     """Check each routine (all built-ins when none is named). `random`: random cases per routine
     (default: the spec's count, bounded without `exhaustive`); `scene` runs every call on a C64 with
-    that VIC-II scene from `at_line`/`at_cycle` (default: the scene's [cpu] start)."""
+    that VIC-II scene from `at_line`/`at_cycle` (default: the scene's [cpu] start); `search`: candidates
+    of the coverage-guided search (default: the spec's `[cases] search`, else 4,096; 0: none)."""
     return run_checks(
         routines, exhaustive=exhaustive,
         seed=None if seed is None else parse_int(seed, field="--seed", lo=0, hi=2 ** 63 - 1),
         random_count=None if random is None else parse_int(random, field="--random", lo=0, hi=MAX_RANDOM),
         jobs=None if jobs is None else parse_int(jobs, field="--jobs", lo=1, hi=MAX_JOBS),
-        progress=progress, start=scene_start(scene, at_line, at_cycle), bounded_product=bounded_product, engine=engine)
+        progress=progress, start=scene_start(scene, at_line, at_cycle), bounded_product=bounded_product, engine=engine,
+        search_budget=None if search is None else parse_int(search, field="--search", lo=0, hi=MAX_SEARCH))
 
 
 def scene_start(scene: str | Path | None, at_line: int | str | None, at_cycle: int | str | None) -> SceneStart | None:
@@ -137,7 +143,10 @@ def check_record(check: RoutineCheck) -> dict:
               "engine_agreement": None if check.agreement is None else {
                   "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
                   "timing_model_mismatches": check.agreement.cycle_mismatches},
-              "notes": list(check.routine.notes), "first_failure": None, "rows": None}
+              "notes": list(check.routine.notes), "first_failure": None, "rows": None,
+              "code_coverage": None if check.code_coverage is None else coverage_record(
+                  summary(check.code_coverage, check.routine.program)),
+              "search": search_record(check), "bounds_reached": bounds_reached(check)}
     failure = t.failure
     if failure is not None:
         routine = check.routine
@@ -183,6 +192,10 @@ def format_check(check: RoutineCheck) -> list[str]:
         lines.append(f"  cases: {format_coverage(check)}; input space {format_space(check.routine.input_space())}")
     if routine.coverage:
         lines.append(f"  coverage: {routine.coverage}")
+    if check.code_coverage is not None:
+        lines.append(f"  {coverage_line(summary(check.code_coverage, routine.program))}")
+    if _search_line(check):
+        lines.append(_search_line(check))
     if t.cycles_count:
         lines += _cycle_lines(check)
     if routine.budget is not None:
@@ -220,10 +233,13 @@ def _headline(check: RoutineCheck) -> str:
 
 
 def _cycle_lines(check: RoutineCheck) -> list[str]:
-    """Fastest and slowest inputs, raster lines, and with --scene where the calls fall on the beam."""
+    """Fastest and slowest inputs (and whether they reach the static bounds), raster lines, and with
+    --scene where the calls fall on the beam."""
     t = check.totals
     routine = check.routine
-    lines = [f"  fastest: {describe_case(routine, t.min_case)}", f"  slowest: {describe_case(routine, t.max_case)}"]
+    reach = bounds_reached(check)
+    lines = [f"  fastest: {describe_case(routine, t.min_case)}{_reach_text(check, reach, 'best', t.min_case)}",
+             f"  slowest: {describe_case(routine, t.max_case)}{_reach_text(check, reach, 'worst', t.max_case)}"]
     raster = format_raster(routine.machine, raster_figures(routine.machine, t.cycles_min, check.mean, t.cycles_max))
     if raster:
         lines.append(f"  raster (CPU never stalled): {raster}")
@@ -234,6 +250,56 @@ def _cycle_lines(check: RoutineCheck) -> list[str]:
                      f"stolen; the slowest ends at line {scene['slowest_end_line']} cycle {scene['slowest_end_cycle']}"
                      + (f" {scene['frames_crossed']} frame(s) later" if scene["frames_crossed"] else ""))
     return lines
+
+
+def bounds_reached(check: RoutineCheck) -> dict | None:
+    """For the static best and worst: the measured extreme, whether a case reached the bound (its
+    inputs), and whether the bound is known to be unreachable (true when every input was run and no
+    case reached it; null when that is not known). None without static bounds."""
+    if check.static is None or not check.totals.cycles_count:
+        return None
+    t = check.totals
+    routine = check.routine
+    out = {}
+    for key, static, measured, case, reached in (("best", check.static.best, t.cpu_min, t.min_case, check.best_reached),
+                                                 ("worst", check.static.worst, t.cpu_max, t.max_case, check.worst_reached)):
+        out[key] = {"static": static, "measured": measured, "reached": reached,
+                    "inputs": inputs_by_name(routine, case),
+                    "found_by_search": check.search is not None and case in check.search.found,
+                    "unreachable": False if reached else (True if check.every_input_run else None)}
+    return out
+
+
+def _reach_text(check: RoutineCheck, reach: dict | None, key: str, case: tuple) -> str:
+    if reach is None:
+        return ""
+    bound = reach[key]
+    found = " (found by the search)" if bound["found_by_search"] else ""
+    if bound["reached"]:
+        return f"{found}: reaches the static {key} {bound['static']}"
+    verdict = ("it cannot be reached: every input was run" if bound["unreachable"] else
+               "whether any input reaches it is not known")
+    return f"{found}: {bound['measured']} cycles, static {key} {bound['static']} not reached ({verdict})"
+
+
+def search_record(check: RoutineCheck) -> dict | None:
+    s = check.search
+    if s is None:
+        return None
+    return {"budget": s.budget, "candidates": s.candidates, "cycles": s.cycles, "generations": s.generations,
+            "kept": len(s.found),
+            "new_branch_directions": s.new_directions, "ended": s.ended}
+
+
+def _search_line(check: RoutineCheck) -> str | None:
+    s = check.search
+    if s is None or s.ended == "off":
+        return None
+    ended = {"budget": f"its budget spent (at most {s.budget:,} candidates and {s.budget * CYCLES_PER_CANDIDATE:,} cycles)", "stale": f"nothing new in {STALE_GENERATIONS} generations",
+             "stopped": "a call stopped"}[s.ended]
+    return (f"  search: {s.candidates:,} of {s.budget:,} candidates ({s.cycles:,} cycles) in {s.generations} "
+            f"generation{'s' if s.generations != 1 else ''}, {len(s.found)} kept ({s.new_directions} new branch "
+            f"directions); ended: {ended}")
 
 
 def _failure_lines(check: RoutineCheck) -> list[str]:
@@ -360,6 +426,11 @@ def routine_options(p: argparse.ArgumentParser) -> None:
     options.engine(p, f"; scalar is the reference and the timing model checks every call, batch is checked against "
                       f"Machine on the first {AGREEMENT_PER_PART:,} cases of each part, auto takes batch from "
                       f"{AUTO_BATCH_CASES:,} cases")
+    searching = p.add_mutually_exclusive_group()
+    searching.add_argument("--search", metavar="N", help="candidate cases the coverage-guided search may run after "
+                           f"the planned cases (default: the spec's [cases] search, else {DEFAULT_SEARCH:,}; the "
+                           "same cases for a seed on either engine)")
+    searching.add_argument("--no-search", dest="search", action="store_const", const="0", help="no search (--search 0)")
     p.add_argument("--json", action="store_true", help="print a JSON list, one object per routine")
     options.quiet(p)
 
@@ -368,7 +439,7 @@ def checks_of(args: argparse.Namespace) -> list[RoutineCheck]:
     """The run `retro check` and `retro cycles` both show, from the options `routine_options` defines."""
     return check(args.routines, exhaustive=args.exhaustive, seed=args.seed, random=args.random, jobs=args.jobs,
                  scene=args.scene, at_line=args.at_line, at_cycle=args.at_cycle, engine=args.engine,
-                 progress=progress_printer(args.quiet))
+                 progress=progress_printer(args.quiet), search=args.search)
 
 
 def add_options(p: argparse.ArgumentParser) -> None:

@@ -22,6 +22,7 @@ No device is modelled: the engine serves plain-RAM routines (a scene with chips 
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from enum import IntEnum
 
@@ -39,10 +40,11 @@ from retro.cpu.mpu import (
     IRQ_VECTOR,
     JAM_OPCODES,
 )
+from retro.cpu.opcodes import DECIMAL_EXTRA_CYCLES, DOCUMENTED, MODE_LENGTH, OPCODE_TABLE, STABLE
 from retro.cpu.variants import VARIANTS
-from retro.cpu.opcodes import DOCUMENTED, MODE_LENGTH, OPCODE_TABLE, STABLE
 from retro.cpu.timing import (
     BRANCH_CONDITIONS,
+    is_conditional_branch,
     BRANCH_PAGE_CYCLES,
     BRANCH_TAKEN_CYCLES,
     PAGE_CROSS_CYCLES,
@@ -148,11 +150,84 @@ class Lanes:
         return self.read(STACK_PAGE | _uniform(self.sp))
 
 
+class LaneCoverage:
+    """What the lanes ran, per instruction address: executions, each conditional branch's lanes that
+    jumped and that went on, and the fewest and most cycles one execution took (penalties included).
+    Counted per group run, so it costs a few Python operations per instruction group, not per lane:
+    a fixed-cost instruction's cycles come from its table row; only rows whose cycles vary (page
+    penalties, the 65C02's decimal cycle, BRA) compare each lane's cycles before and after, and only
+    until the address has cost both its least and its most."""
+
+    def __init__(self, variant: str, first_lanes: bool = False) -> None:
+        self.executed: dict[int, int] = {}
+        # with first_lanes: per branch direction (pc, taken), the lowest lane that went that way
+        self.first_lane: dict[tuple[int, bool], int] | None = {} if first_lanes else None
+        self.taken: dict[int, int] = {}
+        self.not_taken: dict[int, int] = {}
+        self.cycles_min: dict[int, int] = {}
+        self.cycles_max: dict[int, int] = {}
+        self.base, self.branches, self.varying, self.ceiling = _cost_rows(variant)
+
+    def cycles(self, pc: int, low: int, high: int) -> None:
+        known = self.cycles_min.get(pc)
+        if known is None or low < known:
+            self.cycles_min[pc] = low
+        known = self.cycles_max.get(pc)
+        if known is None or high > known:
+            self.cycles_max[pc] = high
+
+    def branch(self, pc: int, base: int, lanes: int, jumped: int, extra: int) -> None:
+        """A branch at pc run by `lanes` lanes, `jumped` of them taking it at `extra` cycles more."""
+        self.taken[pc] = self.taken.get(pc, 0) + jumped
+        self.not_taken[pc] = self.not_taken.get(pc, 0) + lanes - jumped
+        self.cycles(pc, base if jumped < lanes else base + extra, base + extra if jumped else base)
+
+    def note_lanes(self, pc: int, ids, taken: np.ndarray) -> None:
+        """The lowest lane of each way a branch went (ids: the group's lane numbers)."""
+        first = self.first_lane
+        for way, lanes in ((True, taken), (False, ~taken)):
+            if lanes.any():
+                lane = int(np.flatnonzero(lanes)[0]) if isinstance(ids, slice) else int(ids[lanes].min())
+                if lane < first.get((pc, way), lane + 1):
+                    first[(pc, way)] = lane
+
+    def merge(self, other: "LaneCoverage", lane_offset: int = 0) -> None:
+        """Add another run's counts (its lanes numbered from `lane_offset` in this one)."""
+        if self.first_lane is not None:
+            for key, lane in other.first_lane.items():
+                self.first_lane.setdefault(key, lane + lane_offset)
+        for mine, theirs in ((self.executed, other.executed), (self.taken, other.taken),
+                             (self.not_taken, other.not_taken)):
+            for pc, count in theirs.items():
+                mine[pc] = mine.get(pc, 0) + count
+        for pc, low in other.cycles_min.items():
+            self.cycles(pc, low, other.cycles_max[pc])
+
+
+@functools.cache
+def _cost_rows(variant: str) -> tuple[dict, frozenset, frozenset, dict]:
+    """Per opcode of a CPU's table: base cycles; the conditional branches; the rows whose cost varies
+    (page penalties, branches, BRA, the 65C02's decimal cycle); the most a varying non-branch row can
+    cost (once an address has cost its base and this, its lanes need not be measured again:
+    instructions in loops stop costing numpy work)."""
+    table = VARIANTS[variant].opcode_table
+    decimal_cycle = table is not OPCODE_TABLE  # the 65C02's ADC/SBC: one cycle more with D set
+    decimal = {opcode for opcode, row in table.items() if decimal_cycle and row.mnemonic in ("ADC", "SBC")}
+    varying = frozenset(opcode for opcode, row in table.items()
+                        if row.page_penalty or row.mode in ("rel", "zpr") or opcode in decimal)
+    ceiling = {opcode: row.cycles + PAGE_CROSS_CYCLES * row.page_penalty + DECIMAL_EXTRA_CYCLES * (opcode in decimal)
+               for opcode, row in table.items() if opcode in varying and row.mode != "rel"}
+    return ({opcode: row.cycles for opcode, row in table.items()},
+            frozenset(opcode for opcode, row in table.items() if is_conditional_branch(row)), varying, ceiling)
+
+
 class BatchCpu:
-    """N lanes of one 6502 on one memory image (see the module docstring)."""
+    """N lanes of one 6502 on one memory image (see the module docstring). With `coverage`, what the
+    lanes ran is counted in `self.coverage` (a LaneCoverage); with `first_lanes` also which lane first
+    went each way at every branch (the coverage-guided search's feedback)."""
 
     def __init__(self, variant: str, image, lanes: int, *, stop_on_brk: bool = True,
-                 memory_limit: int = MAX_PRIVATE_BYTES) -> None:
+                 memory_limit: int = MAX_PRIVATE_BYTES, coverage: bool = False, first_lanes: bool = False) -> None:
         if variant not in VARIANTS:
             raise InputError(f"unknown CPU variant {variant!r} (known: {', '.join(VARIANTS)})")
         self.variant = variant
@@ -161,6 +236,7 @@ class BatchCpu:
         if VARIANTS[variant].opcode_table is not OPCODE_TABLE:  # the 65C02: its own table of handlers
             from retro.cpu.batch65c02 import HANDLERS_65C02
             self.handlers = HANDLERS_65C02
+        self.coverage = LaneCoverage(variant, first_lanes) if coverage or first_lanes else None
         self.lanes = lanes
         self.stop_on_brk = stop_on_brk
         self.memory = LaneMemory(image, lanes, memory_limit)
@@ -246,6 +322,25 @@ class BatchCpu:
         if handler is None:
             group.stop(pc, LaneError.JAM if opcode in JAM_OPCODES else LaneError.UNSTABLE)
             return
+        coverage = self.coverage
+        if coverage is not None and isinstance(pc, int):
+            executed = coverage.executed
+            executed[pc] = executed.get(pc, 0) + len(group)
+            if opcode not in coverage.varying:
+                base = coverage.base[opcode]
+                coverage.cycles(pc, base, base)
+            elif opcode not in coverage.branches and (  # _branch_split counts the branches
+                    coverage.cycles_min.get(pc) != coverage.base[opcode]
+                    or coverage.cycles_max.get(pc) != coverage.ceiling.get(opcode)):
+                before = group.cycles.copy()
+                result = handler(group, pc, lo, hi)
+                if not isinstance(result, list):
+                    spent = group.cycles - before
+                    coverage.cycles(pc, int(spent.min()), int(spent.max()))
+                    yield result, group
+                    return
+                yield from result
+                return
         result = handler(group, pc, lo, hi)
         if isinstance(result, list):
             yield from result
@@ -609,15 +704,21 @@ def _make_branch(opcode: int, cycles: int) -> Handler:
         target = (following + _signed(lo)) & WORD
         crossed = (following & PAGE_MASK) != (target & PAGE_MASK)
         g.cycles += cycles
-        return _branch_split(g, taken, target, following, extra_taken + crossed * BRANCH_PAGE_CYCLES)
+        return _branch_split(g, taken, target, following, extra_taken + crossed * BRANCH_PAGE_CYCLES, pc, cycles)
     return handler
 
 
-def _branch_split(g, taken: np.ndarray, target, following, extra):
+def _branch_split(g, taken: np.ndarray, target, following, extra, pc=None, base: int = 0):
     """Where a group goes at a branch (taken: per lane): one next PC, a list of (next pc, lanes) when
-    the lanes part, or per-lane PCs when the addresses are per lane; the taken lanes pay `extra`."""
+    the lanes part, or per-lane PCs when the addresses are per lane; the taken lanes pay `extra`.
+    With coverage on, the branch at `pc` (of `base` cycles) is counted."""
     if isinstance(target, int) and isinstance(following, int):
         jump = np.flatnonzero(taken)
+        coverage = g.cpu.coverage
+        if coverage is not None and isinstance(pc, int):
+            coverage.branch(pc, base, len(taken), len(jump), int(extra))
+            if coverage.first_lane is not None:
+                coverage.note_lanes(pc, g.ids, taken)
         if len(jump) == len(taken):
             g.cycles += extra
             return target

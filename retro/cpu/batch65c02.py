@@ -151,7 +151,8 @@ def _bit_branch(mask: int, when_set: bool, cycles: int) -> Handler:
         g.cycles += cycles
         if not isinstance(taken, np.ndarray):  # the byte is the same in every lane
             taken = np.full(len(g), bool(taken))
-        return _branch_split(g, taken, target, following, BRANCH_TAKEN_CYCLES + crossed * BRANCH_PAGE_CYCLES)
+        return _branch_split(g, taken, target, following, BRANCH_TAKEN_CYCLES + crossed * BRANCH_PAGE_CYCLES, pc,
+                             cycles)
     return handler
 
 

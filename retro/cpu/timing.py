@@ -210,6 +210,11 @@ BRANCH_CONDITIONS = {0x10: (0x80, 0), 0x30: (0x80, 1), 0x50: (0x40, 0), 0x70: (0
                      0x90: (0x01, 0), 0xB0: (0x01, 1), 0xD0: (0x02, 0), 0xF0: (0x02, 1)}
 
 
+def is_conditional_branch(op: OpTiming) -> bool:
+    """A branch that may go either way (not BRA): Bxx and the 65C02's BBR/BBS."""
+    return op.mode in ("rel", "zpr") and op.mnemonic != "BRA"
+
+
 def branch_taken(opcode: int, p: int) -> bool:
     flag, wanted = BRANCH_CONDITIONS[opcode]
     return bool(p & flag) == bool(wanted)

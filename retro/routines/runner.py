@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from retro.assembler import requested_tables
-from retro.cpu.batch import BatchCpu
+from retro.cpu.batch import BatchCpu, LaneCoverage
 from retro.cpu.lane_memory import LaneMemoryFull
 from retro.cpu.machine import (
     CALL_STACK_TOP,
@@ -133,11 +133,12 @@ def memory_values(routine: Routine, seed: int) -> dict[str, tuple[int, ...]]:
 @dataclass(frozen=True)
 class BatchOutcome:
     """What a batch of calls did: per output an array (n,) or (n, bytes), cycles, and per case the
-    retro.cpu.batch.LaneError that stopped it (0: returned)."""
+    retro.cpu.batch.LaneError that stopped it (0: returned); `coverage`: what the lanes ran, when asked."""
 
     outputs: list
     cycles: np.ndarray
     error: np.ndarray
+    coverage: LaneCoverage | None = None
 
 
 def row_of(arrays: list, i: int) -> tuple:
@@ -297,25 +298,28 @@ class RoutineRunner:
         """Whether the batched core can run this routine (it has no chips: not with a scene)."""
         return self.vic is None
 
-    def run_batch(self, columns: list) -> "BatchOutcome":
-        """Run every case of a column block (one array per input) on the batched core."""
+    def run_batch(self, columns: list, coverage: bool = False, first_lanes: bool = False) -> "BatchOutcome":
+        """Run every case of a column block (one array per input) on the batched core (`coverage`:
+        count what the lanes ran; `first_lanes`: also which lane first went each way at each branch)."""
         n = len(columns[0])
         try:
-            return self._run_lanes(columns, n)
+            return self._run_lanes(columns, n, coverage, first_lanes)
         except LaneMemoryFull:
             if n <= 1:
                 raise
             half = n // 2
-            first = self.run_batch([c[:half] for c in columns])
-            second = self.run_batch([c[half:] for c in columns])
+            first = self.run_batch([c[:half] for c in columns], coverage, first_lanes)
+            second = self.run_batch([c[half:] for c in columns], coverage, first_lanes)
+            if first.coverage is not None:
+                first.coverage.merge(second.coverage, lane_offset=half)
             return BatchOutcome([np.concatenate(pair) for pair in zip(first.outputs, second.outputs)],
                                 np.concatenate([first.cycles, second.cycles]),
-                                np.concatenate([first.error, second.error]))
+                                np.concatenate([first.error, second.error]), first.coverage)
 
-    def _run_lanes(self, columns: list, n: int) -> "BatchOutcome":
+    def _run_lanes(self, columns: list, n: int, coverage: bool = False, first_lanes: bool = False) -> "BatchOutcome":
         image = bytearray(self.call_image)
         stack_pointer = push_return_trap(image)
-        cpu = BatchCpu(self.routine.cpu, image, n)
+        cpu = BatchCpu(self.routine.cpu, image, n, coverage=coverage, first_lanes=first_lanes)
         registers, p = self.plan.place(columns, _column_byte, cpu.memory.fill)
         for name, value in registers.items():
             lanes = getattr(cpu, name)
@@ -326,7 +330,7 @@ class RoutineRunner:
         outputs = port_values(self.routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,
                               widen=lambda lanes: np.asarray(lanes, dtype=np.int64),
                               table=lambda columns: np.stack(columns, axis=1).astype(np.int64))
-        return BatchOutcome(outputs, cpu.cycles, cpu.error)
+        return BatchOutcome(outputs, cpu.cycles, cpu.error, cpu.coverage)
 
     def outputs(self, a: int, x: int, y: int, p: int) -> tuple:
         return tuple(port_values(self.routine.outputs, {"a": a, "x": x, "y": y}, p, self.machine.memory.__getitem__,

@@ -56,7 +56,8 @@ TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "refere
 PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load", "listing"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays", "time_limit"}
-CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage"}
+CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage", "search"}
+MAX_SEARCH = 10_000_000  # candidates of the coverage-guided search (retro.analysis.check.search)
 CYCLES_KEYS = {"max", "loops", "limit", "static"}
 
 
@@ -112,6 +113,7 @@ class Routine:
     coverage: str = ""  # why the cases cover the input space (an argument the report quotes)
     notes: tuple[str, ...] = ()  # what loading the program left out (a symbol file's skipped lines)
     rows: tuple[Row, ...] = ()  # expected rows written in the spec (retro.routines.rows)
+    search: int | None = None  # [cases] search: candidates of the coverage-guided search (None: the default)
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -317,6 +319,7 @@ def _cases_section(r: Fields, doc: dict, inputs: tuple[Port, ...], seconds: int,
             "random": r.integer(cases_doc.get("random", DEFAULT_RANDOM if answered else 0), "cases.random", 0,
                                 MAX_RANDOM),
             "seed": r.integer(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1),
+            "search": r.integer(cases_doc["search"], "cases.search", 0, MAX_SEARCH) if "search" in cases_doc else None,
             "coverage": _text(r, cases_doc, "coverage", "cases.coverage") or "",
             "domain": domain,
             "boundary": generators.get("boundary"), "sweep": generators.get("sweep"),

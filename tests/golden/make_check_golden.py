@@ -10,7 +10,9 @@ checker against its own earlier output:
     python tests/golden/make_check_golden.py --compare # what the test does, as a script
 
 Each run is the real command line (`python -m retro ... --json --quiet` in a fresh interpreter), so
-exit codes are recorded too. The check's JSON has no timing fields; the only field that depends on
+exit codes are recorded too. The recordings predate the coverage-guided search, which adds cases (and
+may find new extremes): each run says --no-search, so they still compare like with like (the search
+is tested in tests/routines/test_code_coverage.py). The check's JSON has no timing fields; the only field that depends on
 where it runs is the absolute path of the checkout (built-in specs are named by absolute path, and
 messages may quote it), replaced by "<repo>" in every string.
 """
@@ -66,7 +68,7 @@ def normalise(value):
 def run(args: list[str], root: Path = ROOT) -> dict:
     """One command line's exit code and JSON, normalised."""
     env = {**os.environ, "PYTHONPATH": str(root)}
-    done = subprocess.run([sys.executable, "-m", "retro", *args, "--json", "--quiet"], cwd=root, env=env,
+    done = subprocess.run([sys.executable, "-m", "retro", *args, "--no-search", "--json", "--quiet"], cwd=root, env=env,
                           capture_output=True, text=True, timeout=600)
     try:
         output = json.loads(done.stdout)

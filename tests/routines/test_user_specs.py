@@ -226,7 +226,8 @@ def test_a_spec_on_a_scene_counts_bad_line_stalls_from_the_start_line(tmp_path, 
 def test_cycle_model_disagreements_are_counted_and_fail(monkeypatch, capsys):
     import retro.analysis.check.engines as check
 
-    monkeypatch.setattr(check, "model_cycles", lambda read, steps, cpu: 1)  # a timing model that disagrees
+    # a timing model that disagrees (count_steps sums the timing model's cycles as it counts coverage)
+    monkeypatch.setattr(check, "count_steps", lambda coverage, read, steps, cpu: 1)
     code, (record,) = _check_json(capsys, str(SPECS / "boxhit_xa.toml"), "--random", "10")
     assert code == 1 and record["cycle_mismatches"] == record["cases"] > 0
     assert record["first_failure"]["kind"] == "cycles" and "the timing model says 1" in record["first_failure"]["message"]

@@ -10,7 +10,9 @@ import numpy as np
 
 from retro.cpu.batch import LaneError
 from retro.cpu.timing import model_cycles
+from retro.analysis.check.coverage import count_steps, from_lanes
 from retro.analysis.check.results import describe_outputs
+from retro.analysis.coverage_model import CodeCoverage
 from retro.errors import InputError, RunError
 from retro.routines import cases as case_sets
 from retro.routines.runner import NEEDS_A_VIC_SCENE, RasterStart, RoutineRunner, row_of
@@ -87,6 +89,7 @@ class CallBlock:
     stop: str | None = None  # None, "run" or "engine"
     stop_message: str = ""
     lane_errors: np.ndarray | None = None  # the batched core: per call, the LaneError that stopped it (0: none)
+    coverage: CodeCoverage | None = None  # what the calls ran of the code (None: not collected)
 
     @property
     def calls(self) -> int:
@@ -114,12 +117,13 @@ def batched(engine: str, calls: int | None, batchable: bool, threshold: int) -> 
     return batchable and (engine == "batch" or (engine == "auto" and (calls is None or calls >= threshold)))
 
 
-def run_on_machine(runner: RoutineRunner, cases: list[tuple]) -> CallBlock:
+def run_on_machine(runner: RoutineRunner, cases: list[tuple], coverage: bool = True) -> CallBlock:
     """Calls on Machine, each timed again by the timing model; the first that does not return ends
-    the block (the next could run away as well)."""
+    the block (the next could run away as well). `coverage`: collect it (from the same recorded path)."""
     read = runner.machine.memory.__getitem__
     answers, cycles, stolen, modelled = [], [], [], []
     stop, message = None, ""
+    covered = CodeCoverage() if coverage else None
     for case in cases:
         steps: list = []
         try:
@@ -130,10 +134,11 @@ def run_on_machine(runner: RoutineRunner, cases: list[tuple]) -> CallBlock:
         answers.append(answer)
         cycles.append(spent)
         stolen.append(runner.last_stolen)
-        modelled.append(model_cycles(read, steps, runner.routine.cpu))
+        modelled.append(count_steps(covered, read, steps, runner.routine.cpu) if coverage else
+                        model_cycles(read, steps, runner.routine.cpu))
     return CallBlock(_output_arrays(runner.routine, answers), np.asarray(cycles, dtype=np.int64),
                      np.asarray(stolen, dtype=np.int64), np.asarray(modelled, dtype=np.int64), len(answers),
-                     stop, message)
+                     stop, message, coverage=covered)
 
 
 def _output_arrays(routine: Routine, answers: list[tuple]) -> list[np.ndarray]:
@@ -142,14 +147,19 @@ def _output_arrays(routine: Routine, answers: list[tuple]) -> list[np.ndarray]:
             for k, port in enumerate(routine.outputs)]
 
 
-def run_on_batched_core(runner: RoutineRunner, columns: list, confirm_stop: bool = True) -> CallBlock:
+def run_on_batched_core(runner: RoutineRunner, columns: list, confirm_stop: bool = True,
+                        coverage: bool = True) -> CallBlock:
     """Calls on the batched core; the first call it stops is run again on Machine (`confirm_stop`),
-    whose error names it (or which returns: then the engines disagree)."""
-    outcome = runner.run_batch(columns)
+    whose error names it (or which returns: then the engines disagree). `coverage`: collect it."""
+    outcome = runner.run_batch(columns, coverage)
     stopped = np.flatnonzero(outcome.error)
     n = len(outcome.cycles)
     block = CallBlock(outcome.outputs, outcome.cycles, np.zeros(n, dtype=np.int64), None,
-                      int(stopped[0]) if len(stopped) else n, lane_errors=outcome.error)
+                      int(stopped[0]) if len(stopped) else n, lane_errors=outcome.error,
+                      coverage=from_lanes(outcome.coverage) if coverage else None)
+    if coverage and len(stopped):  # coverage counts the calls before the first that stopped, as on Machine
+        block.coverage = (from_lanes(runner.run_batch([c[:block.returned] for c in columns], True).coverage)
+                          if block.returned else CodeCoverage())
     if len(stopped) and confirm_stop:
         machine = run_on_machine(runner, [case_sets.case_of(columns, block.returned)])
         if machine.stop is not None:

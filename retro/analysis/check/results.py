@@ -6,11 +6,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from retro.analysis.coverage_model import CodeCoverage
 from retro.cpu.flow import Bounds
 from retro.routines.runner import RasterStart, Size, describe_value
 from retro.routines.spec import Routine
 
 if TYPE_CHECKING:
+    from retro.analysis.check.search import SearchResult
     from retro.analysis.check.tally import Tally
     from retro.analysis.row_check import RowsCheck
 
@@ -50,6 +52,8 @@ class RoutineCheck:
     agreement: Tally | None = None  # with the batched core: the cases also run on Machine
     rows: RowsCheck | None = None  # the spec's expected rows (retro.analysis.row_check)
     seconds: float = 0.0  # wall time of the check (JUnit reports)
+    code_coverage: CodeCoverage | None = None  # what the cases ran of the code (retro.analysis.check.coverage)
+    search: SearchResult | None = None  # the coverage-guided search (retro.analysis.check.search)
 
     @property
     def mismatches(self) -> int:
@@ -69,6 +73,18 @@ class RoutineCheck:
     @property
     def worst_reached(self) -> bool:
         return self.static is not None and self.totals.cpu_max == self.static.worst
+
+    @property
+    def best_reached(self) -> bool:
+        return self.static is not None and self.totals.cpu_min == self.static.best
+
+    @property
+    def every_input_run(self) -> bool:
+        """Whether the cases ran the whole input space (an exhaustive part over every input, complete):
+        then a static bound no case reached cannot be reached."""
+        space = self.routine.input_space()
+        return set(self.routine.exhaustive) == set(self.routine.input_names) and any(
+            p.name == "exhaustive" and p.cases == p.total == space for p in self.parts)
 
     def domain_report(self) -> list[str]:
         t = self.totals

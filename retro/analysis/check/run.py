@@ -24,7 +24,9 @@ from retro.analysis.check.engines import (
     run_on_machine,
     runner_for,
 )
+from retro.analysis.check.coverage import completed, worst_path
 from retro.analysis.check.results import PartRun, RoutineCheck
+from retro.analysis.check.search import DEFAULT_SEARCH, SearchResult, search
 from retro.analysis.check.tally import Tally, count_block
 from retro.analysis.check.verdicts import bounds_violations, budget_violations, static_bounds
 from retro.analysis.row_check import RowsCheck, check_rows, merged_agreement, rows_only_static
@@ -58,8 +60,9 @@ def agreement_chunk(spec: str, seed: int, cases: list[tuple]) -> Tally:
     batched core's call for call."""
     runner = runner_for(spec, seed, None)
     columns = case_sets.cases_to_columns(runner.routine, cases)
-    against = run_on_batched_core(runner, columns, confirm_stop=False)
-    return count_block(runner.routine, run_on_machine(runner, cases), columns, cases, runner.memory_values, against)
+    against = run_on_batched_core(runner, columns, confirm_stop=False, coverage=False)
+    return count_block(runner.routine, run_on_machine(runner, cases, coverage=False), columns, cases,
+                       runner.memory_values, against)  # (the batched core counts these cases' coverage)
 
 
 # ---- a whole check ------------------------------------------------------------------------------------
@@ -137,10 +140,12 @@ def _part_runs(parts: list[case_sets.Part], totals: Tally, unknown: bool, rows: 
 def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | None = None,
                   random_count: int | None = None, jobs: int = 1, progress: Callable[[str], None] | None = None,
                   start: SceneStart | None = None, bounded_product: int = case_sets.BOUNDED_PRODUCT,
-                  engine: str = "auto") -> RoutineCheck:
+                  engine: str = "auto", search_budget: int | None = None) -> RoutineCheck:
     """Check one routine: a spec path, or a Routine built in Python (then in this process only).
     `engine`: "scalar" (Machine), "batch" (the batched core, checked against Machine on the first
-    AGREEMENT_PER_PART cases of each part) or "auto" (batch from AUTO_BATCH_CASES planned cases)."""
+    AGREEMENT_PER_PART cases of each part) or "auto" (batch from AUTO_BATCH_CASES planned cases).
+    `search_budget`: candidates the coverage-guided search may run after the planned cases (None:
+    the spec's `[cases] search`, else DEFAULT_SEARCH; 0: no search)."""
     began = time.monotonic()
     check_engine(engine)
     if isinstance(spec, Routine):
@@ -171,6 +176,15 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     work = (((batch_chunk, (spec, seed, block)) for block in case_sets.batches(parts, BATCH_LANES)) if on_batch else
             ((machine_chunk, (spec, seed, chunk, start)) for chunk in _chunks(parts)))
     _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
+    searched = _search(spec, seed, runner, on_batch, totals, search_budget)
+    if searched.found:  # the search's cases, checked like every other case
+        found = case_sets.cases_to_columns(routine, searched.found)
+        parts.append(case_sets.Part("search", len(searched.found), len(searched.found), lambda: iter([found])))
+        if on_batch:
+            agreement.merge(_agreement(spec, seed, parts[-1:]))
+        work = (((batch_chunk, (spec, seed, block)) for block in case_sets.batches(parts[-1:], BATCH_LANES))
+                if on_batch else ((machine_chunk, (spec, seed, chunk, start)) for chunk in _chunks(parts[-1:])))
+        _run_work(work, 1, report, lambda: totals.run_errors)
     require_inside(f"{routine.spec_path}: cases.where", routine.domain, totals.cases, totals.outside,
                    totals.constraint_cases)
     if routine.reference is None:  # rows only: unknown static bounds are said, not an error
@@ -179,15 +193,33 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         static = static_bounds(routine, runner)
     check = RoutineCheck(routine, runner.size(), static, totals, bounds_violations(routine, static, totals),
                          budget_violations(routine, static, totals), _part_runs(parts, totals, unknown, rows),
-                         start=runner.start, engine="batch" if on_batch else "scalar", agreement=agreement, rows=rows)
+                         start=runner.start, engine="batch" if on_batch else "scalar", agreement=agreement, rows=rows,
+                         search=searched)
     if rows is not None and rows.agreement is not None:
         check.agreement = agreement = merged_agreement(agreement, rows)
     if agreement is not None and agreement.failure is not None and totals.failure is None:
         totals.failure = agreement.failure  # the timing model or the engines disagreed on a call
     if totals.failure is not None:
         check.trace = failure_trace(spec, seed, totals.failure.case, start)
+    check.code_coverage = completed(totals.code_coverage, runner)
+    if totals.max_case is not None and not totals.run_errors:
+        check.code_coverage.worst_path = worst_path(runner, totals.max_case)
+        check.code_coverage.worst_cycles = totals.cycles_max
     check.seconds = time.monotonic() - began
     return check
+
+
+def _search(spec: str, seed: int, runner, on_batch: bool, totals: Tally, budget: int | None) -> SearchResult:
+    """The coverage-guided search from what the planned cases ran (none after a call that stopped,
+    nor for a spec of rows only: no answer is known for a case it would find)."""
+    routine = runner.routine
+    if budget is None:
+        budget = routine.search if routine.search is not None else DEFAULT_SEARCH
+    if routine.reference is None or totals.run_errors:
+        budget = 0
+    return search(runner, on_batch=on_batch, seed=seed, budget=budget, covered=totals.code_coverage,
+                  slowest=None if totals.max_case is None else (totals.cycles_max, totals.max_case),
+                  fastest=None if totals.min_case is None else (totals.cycles_min, totals.min_case))
 
 
 def default_jobs() -> int:
@@ -197,11 +229,13 @@ def default_jobs() -> int:
 def run_checks(names: list[str] | None, *, exhaustive: bool = False, seed: int | None = None,
                random_count: int | None = None, jobs: int | None = None,
                progress: Callable[[str], None] | None = None, start: SceneStart | None = None,
-               bounded_product: int = case_sets.BOUNDED_PRODUCT, engine: str = "auto") -> list[RoutineCheck]:
+               bounded_product: int = case_sets.BOUNDED_PRODUCT, engine: str = "auto",
+               search_budget: int | None = None) -> list[RoutineCheck]:
     """Check the named routines (built-in names or spec paths; all built-ins when none are named);
     every name is loaded and validated before any work starts."""
     specs = select(names)
     workers = default_jobs() if jobs is None else jobs
     return [check_routine(spec, exhaustive=exhaustive, seed=seed, random_count=random_count, jobs=workers,
-                          progress=progress, start=start, bounded_product=bounded_product, engine=engine)
+                          progress=progress, start=start, bounded_product=bounded_product, engine=engine,
+                          search_budget=search_budget)
             for spec in specs]

@@ -23,6 +23,7 @@ import numpy as np
 from retro.analysis.check.engines import CallBlock, disagreement
 from retro.analysis.check.reference import reference_answers
 from retro.analysis.check.results import Failure, describe_case, describe_outputs
+from retro.analysis.coverage_model import CodeCoverage
 from retro.routines import cases as case_sets
 from retro.routines.runner import row_of
 from retro.routines.spec import Routine
@@ -58,6 +59,7 @@ class Tally:
     examples: list[str] = field(default_factory=list)
     outside_examples: list[str] = field(default_factory=list)
     failure: Failure | None = None
+    code_coverage: CodeCoverage = field(default_factory=CodeCoverage)  # what the calls ran of the code
 
     def merge(self, other: "Tally") -> None:
         self.cases += other.cases
@@ -86,6 +88,7 @@ class Tally:
         self.examples = (self.examples + other.examples)[:EXAMPLES_KEPT]
         self.outside_examples = (self.outside_examples + other.outside_examples)[:EXAMPLES_KEPT]
         self.failure = self.failure or other.failure
+        self.code_coverage = self.code_coverage.merge(other.code_coverage)
 
 
 @dataclass(frozen=True)
@@ -124,6 +127,8 @@ def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[t
     wrong_inside = np.flatnonzero(inside & ~calls.equal)
     wrong_outside = ~inside & ~calls.equal & calls.answerable
     out.cases = n
+    if block.coverage is not None:
+        out.code_coverage = block.coverage
     out.result_mismatches = len(wrong_inside)
     out.outside = int((~inside).sum())
     out.outside_wrong = int(wrong_outside.sum())
