@@ -355,8 +355,8 @@ def test_a_row_the_engines_disagree_on_fails_naming_the_row(capsys, monkeypatch)
 
     real = RoutineRunner.run_batch
 
-    def one_cycle_slow(self, columns):
-        outcome = real(self, columns)
+    def one_cycle_slow(self, columns, *args, **kwargs):
+        outcome = real(self, columns, *args, **kwargs)
         return dataclasses.replace(outcome, cycles=outcome.cycles + 1)
 
     monkeypatch.setattr(RoutineRunner, "run_batch", one_cycle_slow)
