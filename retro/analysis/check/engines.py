@@ -87,6 +87,7 @@ class CallBlock:
     stop: str | None = None  # None, "run" or "engine"
     stop_message: str = ""
     lane_errors: np.ndarray | None = None  # the batched core: per call, the LaneError that stopped it (0: none)
+    mock_calls: list | None = None  # per call, the mocks' calls the reference takes (retro.routines.world)
 
     @property
     def calls(self) -> int:
@@ -119,6 +120,7 @@ def run_on_machine(runner: RoutineRunner, cases: list[tuple]) -> CallBlock:
     the block (the next could run away as well)."""
     read = runner.machine.memory.__getitem__
     answers, cycles, stolen, modelled = [], [], [], []
+    calls = [] if runner.routine.world.recorded else None
     stop, message = None, ""
     for case in cases:
         steps: list = []
@@ -130,10 +132,13 @@ def run_on_machine(runner: RoutineRunner, cases: list[tuple]) -> CallBlock:
         answers.append(answer)
         cycles.append(spent)
         stolen.append(runner.last_stolen)
-        modelled.append(model_cycles(read, steps, runner.routine.cpu))
+        # the timing model times the routine's instructions; a world's traps and interrupt entry are added
+        modelled.append(model_cycles(read, steps, runner.routine.cpu) + runner.last_extra_cycles)
+        if calls is not None:
+            calls.append(runner.last_calls)
     return CallBlock(_output_arrays(runner.routine, answers), np.asarray(cycles, dtype=np.int64),
                      np.asarray(stolen, dtype=np.int64), np.asarray(modelled, dtype=np.int64), len(answers),
-                     stop, message)
+                     stop, message, mock_calls=calls)
 
 
 def _output_arrays(routine: Routine, answers: list[tuple]) -> list[np.ndarray]:
@@ -149,7 +154,7 @@ def run_on_batched_core(runner: RoutineRunner, columns: list, confirm_stop: bool
     stopped = np.flatnonzero(outcome.error)
     n = len(outcome.cycles)
     block = CallBlock(outcome.outputs, outcome.cycles, np.zeros(n, dtype=np.int64), None,
-                      int(stopped[0]) if len(stopped) else n, lane_errors=outcome.error)
+                      int(stopped[0]) if len(stopped) else n, lane_errors=outcome.error, mock_calls=outcome.mock_calls)
     if len(stopped) and confirm_stop:
         machine = run_on_machine(runner, [case_sets.case_of(columns, block.returned)])
         if machine.stop is not None:
