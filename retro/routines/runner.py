@@ -44,7 +44,7 @@ from retro.machines.c64 import vic_of
 from retro.program import Program
 from retro.routines.sandbox import bytes_of
 from retro.routines.spec import Port, Routine, call_with
-from retro.routines.world import WORLD_PLACES, BatchWorld, MachineWorld, chip_overlaps
+from retro.routines.world import NO_WORLD, WORLD_PLACES, BatchWorld, MachineWorld, World, chip_overlaps
 from retro.scenes.vic import VicScene
 from retro.tables import GENERATORS, STORAGE_TABLES
 
@@ -59,10 +59,12 @@ class Size:
     storage_bytes: int
 
 
-def routine_code(read, entries: list[int], within: tuple[int, int], cpu: str = "6510") -> dict[int, int]:
+def routine_code(read, entries: list[int], within: tuple[int, int], cpu: str = "6510",
+                 world: World = NO_WORLD) -> dict[int, int]:
     """{address: length} of every instruction reachable from the entries (following branches, JMP and
-    JSR into the program), as the static analysis decodes them."""
-    from retro.cpu.flow import decode
+    JSR into the program), as the static analysis decodes them (an interrupt handler's RTI and the
+    world's exits end a path)."""
+    from retro.cpu.flow import OPCODE_RTI, OPCODE_RTS, decode
     from retro.cpu.timing import timing_of
 
     found: dict[int, int] = {}
@@ -78,20 +80,23 @@ def routine_code(read, entries: list[int], within: tuple[int, int], cpu: str = "
                 callees.append(target)
             return (0, 0)
         try:
-            nodes = decode(read, entry, note_call, cpu)
+            nodes = decode(read, entry, note_call, cpu, frozenset({OPCODE_RTS, OPCODE_RTI}) if world.enter != "jsr"
+                           else frozenset({OPCODE_RTS}), frozenset(world.exits))
         except (InputError, KeyError, ValueError):  # code the decoder does not follow: count none of it
             continue
         for pc in nodes:
-            found[pc] = timing_of(read(pc), cpu).length
+            if pc not in world.exits:
+                found[pc] = timing_of(read(pc), cpu).length
         pending.extend(callees)
     return found
 
 
-def program_size(program: Program, source_text: str | None, entries: list[int], read, cpu: str = "6510") -> Size:
+def program_size(program: Program, source_text: str | None, entries: list[int], read, cpu: str = "6510",
+                 world: World = NO_WORLD) -> Size:
     """The routine's bytes: its reachable instructions (the entry's and init's, with their subroutines)
     and the generated tables they name (by address, or by `#>table` for pointers set up at init)."""
     within = (program.origin, program.end)
-    code = routine_code(read, entries, within, cpu)
+    code = routine_code(read, entries, within, cpu, world)
     names = requested_tables(source_text) if source_text else []
     spans = {n: (program.symbols[n], program.symbols[n] + len(GENERATORS[n]())) for n in names if n in program.symbols}
     used = set()
@@ -390,7 +395,8 @@ class RoutineRunner:
         source = self.routine.program_file
         text = read_text(source, "source file") if source.suffix.lower() in (".s", ".asm", ".oph") else None
         entries = [self.entry] + ([self.routine.init_address] if self.routine.init is not None else [])
-        return program_size(self.program, text, entries, self.code_image.__getitem__, self.routine.cpu)
+        return program_size(self.program, text, entries, self.code_image.__getitem__, self.routine.cpu,
+                            self.routine.world)
 
 
 def port_values(ports: Sequence[Port], registers: dict, p, read: Callable, widen: Callable, table: Callable,

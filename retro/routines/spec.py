@@ -41,7 +41,7 @@ from retro.routines.places import (
 )
 from retro.routines.rows import Row, misplaced_rows, parse_rows
 from retro.routines import sandbox
-from retro.routines.world import NO_WORLD, World, is_world_output, parse_world, recorded_mocks, world_output
+from retro.routines.world import NO_WORLD, World, check_names, is_world_output, parse_world, recorded_mocks, world_output
 from retro.routines.where import Condition, parse_where
 
 MAX_EXHAUSTIVE = 1 << 32  # cases in an exhaustive set
@@ -190,6 +190,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     program = _program_section(r, doc)
     world = parse_world(r, doc, program.program, seconds, load_function)
     inputs, outputs, memory = _places_sections(r, doc, program.program, seconds, world)
+    check_names(r, world, inputs, tuple(m.name for m in memory))
     rows = parse_rows(r, doc["rows"], inputs, outputs) if "rows" in doc else ()
     reference = _reference_section(r, doc, inputs, memory, rows, seconds, world)
     world = reference.pop("world")

@@ -104,7 +104,8 @@ class World:
     def batch_refusal(self) -> str | None:
         """Why the batched core cannot run this world (None: it can)."""
         if self.hardware:
-            return f"[hardware] {self.hardware[0].name} scripts reads, which the batched core does not model"
+            hardware = self.hardware[0]
+            return f"hardware.{hardware.name} (${hardware.address:04X}) is modelled on Machine only"
         functions = [m.name for m in self.mocks if m.function is not None]
         if functions:
             return f"mocks.{functions[0]} is a Python function, run per call on Machine"
@@ -259,6 +260,15 @@ def _distinct(r: Fields, mocks: tuple[Mock, ...], hardware: tuple[Hardware, ...]
         if address in owner:
             raise r.error(key, f"${address:04X} is also {owner[address]}")
         owner[address] = key.removesuffix(".at")
+
+
+def check_names(r: Fields, world: World, inputs: tuple[Port, ...], memory_names: tuple[str, ...]) -> None:
+    """A mock's name is what the reference takes its calls by: it may not be an input's or a block's."""
+    taken = {p.name: "inputs" for p in inputs} | {name: "memory" for name in memory_names}
+    for mock in world.mocks:
+        if mock.name in taken:
+            raise r.error(f"mocks.{mock.name}", f"{taken[mock.name]}.{mock.name} has the same name (the reference "
+                                                "takes both by name)")
 
 
 def world_output(r: Fields, world: World, name: str, doc: dict) -> Port:
