@@ -390,6 +390,12 @@ class RoutineRunner:
                                  memory={address: [v] for address, v in writes}, budget=self.limit, trace=True,
                                  enter=self.routine.world.enter)
 
+    def disassemble_at(self, address: int) -> str:
+        """The instruction at address as a trace shows it (a world's trap by what it stands for)."""
+        if self.world is not None and address in self.world.actions:
+            return self.world.describe_trap(address)
+        return self.machine.disassemble_at(address)
+
     def size(self) -> Size:
         """Bytes of code, lookup tables and caller-filled storage of the routine's program."""
         source = self.routine.program_file

@@ -346,6 +346,10 @@ class MachineWorld:
         for hardware in world.hardware:
             machine.attach(_HardwareDevice(self, hardware), hardware.address, hardware.address)
 
+    def describe_trap(self, address: int) -> str:
+        mock = next((m for m in self.world.mocks if m.address == address), None)
+        return f"(mock {mock.name}: {mock.cycles} cycles)" if mock is not None else "(exit)"
+
     def place_traps(self) -> None:
         """Write the trap byte at every mock and exit address (after the program and memory blocks)."""
         for address in self.actions:

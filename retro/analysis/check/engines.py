@@ -193,7 +193,7 @@ def failure_trace(spec: str, seed: int, case: tuple, start: SceneStart | None = 
     for entry in result.trace[:TRACE_SHOWN]:
         total += entry.cycles
         notes = " ".join(n for n, on in (("taken", entry.branch_taken), ("page+1", entry.page_crossed)) if on)
-        lines.append(f"${entry.address:04X}  {runner.machine.disassemble_at(entry.address):<14} "
+        lines.append(f"${entry.address:04X}  {runner.disassemble_at(entry.address):<14} "
                      f"{entry.cycles}  {total:>6}  {notes}".rstrip())
     if len(result.trace) > TRACE_SHOWN:
         lines.append(f"... {len(result.trace) - TRACE_SHOWN} more instructions")
