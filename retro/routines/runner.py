@@ -242,9 +242,9 @@ class RoutineRunner:
             self.machine = build_machine(start.scene)
             self.vic = vic_of(self.machine)
         self.machine.load(self.program)
-        self.world = None if routine.world.empty else MachineWorld(routine.world, self.machine, str(routine.spec_path))
-        if start is not None:
+        if start is not None:  # before the world's own devices join the bus
             chip_overlaps(routine, self.machine.bus.devices, str(start.scene.source))
+        self.world = None if routine.world.empty else MachineWorld(routine.world, self.machine, str(routine.spec_path))
         self.last_stolen = 0  # cycles of the last call in which the VIC-II held the CPU
         self.entry = routine.entry_address
         self.memory_values = memory_values(routine, seed)

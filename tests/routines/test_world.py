@@ -306,3 +306,41 @@ def test_a_bad_key_from_the_cli_exits_2_with_one_line(tmp_path):
                           text=True, env={"PYTHONPATH": str(REPO), "PATH": "/usr/bin:/bin"})
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1 and "spec.toml: program.interrupt:" in done.stderr
+
+
+# ---- more of the same rules, in other settings ----------------------------------------------------------
+
+def test_a_65c02_handler_is_entered_with_d_clear(tmp_path):
+    (tmp_path / "ref.py").write_text("def f(d): return {}\n")
+    routine = build(tmp_path, HANDLER, {"program": {"interrupt": "nmi", "cpu": "65c02"}, "inputs": {"d": "D"},
+                                         "outputs": {"inside": "$fb", "d_after": "D"}, "reference": {"function": "ref.py:f"}})
+    for (inside, d_after), cycles in run_both(routine, (1,)):
+        assert not inside & 0x08, "the 65C02's interrupt sequence clears D"
+        assert d_after == 1, "RTI restores the pushed D"
+        assert cycles == 7 + 3 + 4 + 3 + 6
+
+
+def test_init_may_call_a_mock_and_a_reference_on_arrays_takes_the_calls(tmp_path):
+    source = CALLER + "setup:  jsr $e000\n        sta $fe\n        rts\n"
+    (tmp_path / "ref.py").write_text(
+        "import numpy as np\n"
+        "def f(v, helper):\n"
+        "    assert len(helper) == len(v) and all(calls == [{'A': int(a)}] for calls, a in zip(helper, v))\n"
+        "    return {'got': np.full(len(v), 7), 'calls': np.ones(len(v), dtype=int), 'seen': np.full(len(v), 7)}\n")
+    routine = build(tmp_path, source, {"program": {"init": "setup"},
+                                       "mocks": {"helper": {"at": "$E000", "cycles": 10, "A": 7, "args": ["A"]}},
+                                       "inputs": {"v": "$fb"},
+                                       "outputs": {"got": "$fc", "calls": {"calls": "helper"}, "seen": "$fe"},
+                                       "reference": {"function": "ref.py:f", "arrays": True}})
+    for engine in ENGINES:
+        report = check(routine, engine=engine, random=500)
+        assert not report.mismatches, report.totals.examples
+
+
+def test_rows_state_world_outputs(tmp_path):
+    routine = build(tmp_path, POLL, {
+        "hardware": {"raster": {"at": "$D012", "reads": [10, 20]}, "border": {"at": "$D020"}},
+        "inputs": {}, "outputs": {"colours": {"writes": "border", "size": 2}, "stores": {"writes": "border"}},
+        "rows": [{"colours": [3, 4], "stores": 2, "cycles": 39}, {"colours": [3, 5], "note": "wrong"}]})
+    report = check(routine)
+    assert [o.row.key for o in report.rows.failing] == ["rows[1]"]
