@@ -264,6 +264,11 @@ class RoutineRunner:
         indirect_y = {opcode for opcode, op in timing_table(routine.cpu).items() if op.mode in ("iny", "zpr")}
         self.pointer_pcs = frozenset(self.program.origin + i for i, b in enumerate(self.program.code) if b in indirect_y)
         self.plan = InputPlan.of(routine)
+        self.written_kept: dict[str, int] = {}  # per hardware entry, the values written that outputs show
+        for port in routine.outputs:
+            for place in port.places:
+                if place.kind == "written":
+                    self.written_kept[place.register] = max(self.written_kept.get(place.register, 0), place.bit + 1)
 
     @property
     def limit(self) -> int:
@@ -356,7 +361,7 @@ class RoutineRunner:
         enter = self.routine.world.enter
         stack_pointer = push_return_trap(image) if enter == "jsr" else push_interrupt_frame(image, 0)
         cpu = BatchCpu(self.routine.cpu, image, n)
-        world = None if self.routine.world.empty else BatchWorld(self.routine.world, cpu)
+        world = None if self.routine.world.empty else BatchWorld(self.routine.world, cpu, self.written_kept)
         registers, p = self.plan.place(columns, _column_byte, cpu.memory.fill)
         for name, value in registers.items():
             lanes = getattr(cpu, name)
@@ -368,6 +373,8 @@ class RoutineRunner:
             cpu.cycles[:] = self.routine.world.entry_cycles
         cpu.sp[:] = stack_pointer
         cpu.call(self.entry, self.limit, RETURN_TRAP, CALL_STACK_TOP)
+        if world is not None:
+            world.finish()
         outputs = port_values(self.routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,
                               widen=lambda lanes: np.asarray(lanes, dtype=np.int64),
                               table=lambda columns: np.stack(columns, axis=1).astype(np.int64),

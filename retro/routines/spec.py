@@ -188,7 +188,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     misplaced_rows(r, doc)
     seconds = sandbox.time_limit(r, r.table(doc.get("reference", {}), "reference"), "reference")
     program = _program_section(r, doc)
-    world = parse_world(r, doc, program.program, seconds, load_function)
+    world = parse_world(r, doc, program.program, seconds, load_function, program.cpu)
     inputs, outputs, memory = _places_sections(r, doc, program.program, seconds, world)
     check_names(r, world, inputs, tuple(m.name for m in memory))
     rows = parse_rows(r, doc["rows"], inputs, outputs) if "rows" in doc else ()

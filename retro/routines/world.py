@@ -13,9 +13,10 @@
   frame), and addresses whose reaching ends the call (a JMP to a named exit instead of an RTS).
 
 Both engines run all of it with the same results, through traps (retro.cpu.traps: the trap byte
-written at every mock and exit address) and, for hardware, a device on Machine's bus; what the
-batched core cannot run (a Python function per call, hardware reads) is said by `batch_refusal`, and
-the check then runs on Machine and says why. docs/specs.md, "The routine's world", is the user's view.
+written at every mock and exit address) and, for hardware, a device on Machine's bus or hooks on the
+batched core's lane memory; what the batched core cannot run (a Python function per call or read, an
+NMOS read-modify-write of hardware) is said by `batch_refusal`, and the check then runs on Machine and
+says why. docs/specs.md, "The routine's world", is the user's view.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ import numpy as np
 
 from retro.cpu.bus import FIRST_DEVICE_ADDRESS
 from retro.cpu.machine import CALL_STACK_TOP, RETURN_TRAP
-from retro.cpu.mpu import INTERRUPT_CYCLES
+from retro.cpu.mpu import INTERRUPT_CYCLES, RMW_MNEMONICS, VARIANTS
 from retro.cpu.traps import TRAP_OPCODE, install_on_batch, install_on_mpu
 from retro.errors import InputError, RunError
 from retro.fields import Fields, describe
@@ -78,6 +79,7 @@ class Hardware:
     reads: tuple[int, ...] | None = None  # the values of the reads in order, the last one held
     function: Callable | None = None  # (count, cycle) -> byte
     parameters: tuple[str, ...] = ()
+    rmw_at: int | None = None  # an NMOS read-modify-write of it in the program (its double write: Machine only)
 
 
 @dataclass(frozen=True)
@@ -103,9 +105,12 @@ class World:
 
     def batch_refusal(self) -> str | None:
         """Why the batched core cannot run this world (None: it can)."""
-        if self.hardware:
-            hardware = self.hardware[0]
-            return f"hardware.{hardware.name} (${hardware.address:04X}) is modelled on Machine only"
+        for hardware in self.hardware:
+            if hardware.function is not None:
+                return f"hardware.{hardware.name}.function is a Python function, run per read on Machine"
+            if hardware.rmw_at is not None:
+                return (f"hardware.{hardware.name} (${hardware.address:04X}) is read-modified-written at "
+                        f"${hardware.rmw_at:04X}, whose double write Machine models")
         functions = [m.name for m in self.mocks if m.function is not None]
         if functions:
             return f"mocks.{functions[0]} is a Python function, run per call on Machine"
@@ -121,7 +126,8 @@ NO_WORLD = World()
 
 # ---- reading a spec -------------------------------------------------------------------------------
 
-def parse_world(r: Fields, doc: dict, program: Program, seconds: int, load_function: Callable) -> World:
+def parse_world(r: Fields, doc: dict, program: Program, seconds: int, load_function: Callable,
+                cpu: str = "6510") -> World:
     """`[mocks]`, `[hardware]` and `[program] interrupt` / `exit` -> a World (every error names its key)."""
     program_doc = doc.get("program", {})
     enter = "jsr"
@@ -133,7 +139,7 @@ def parse_world(r: Fields, doc: dict, program: Program, seconds: int, load_funct
     exits = _exits(r, program, program_doc.get("exit")) if "exit" in program_doc else ()
     mocks = tuple(_mock(r, program, name, value, seconds, load_function)
                   for name, value in r.table(doc.get("mocks", {}), "mocks").items())
-    hardware = tuple(_hardware(r, program, name, value, seconds, load_function)
+    hardware = tuple(_hardware(r, program, name, value, seconds, load_function, cpu)
                      for name, value in r.table(doc.get("hardware", {}), "hardware").items())
     _distinct(r, mocks, hardware, exits, program)
     return World(mocks, hardware, enter, exits)
@@ -222,7 +228,21 @@ def _mock(r: Fields, program: Program, name: str, doc, seconds: int, load_functi
     return Mock(name, address, cycles, registers, flags_set, flags_clear, writes, args, function, parameters)
 
 
-def _hardware(r: Fields, program: Program, name: str, doc, seconds: int, load_function: Callable) -> Hardware:
+def _read_modify_write_of(program: Program, address: int, cpu: str) -> int | None:
+    """Where the program's bytes hold an NMOS read-modify-write of `address` (INC $D020: it writes the
+    old value, then the new one), or None. Data bytes that look like one only cost the batched core."""
+    if VARIANTS[cpu].opcode_table is not VARIANTS["6510"].opcode_table:
+        return None  # the 65C02 writes once
+    table, code = VARIANTS[cpu].opcode_table, program.code
+    for i in range(len(code) - 2):
+        row = table[code[i]]
+        if row.mnemonic in RMW_MNEMONICS and row.mode in ("abs", "abx", "aby") and (code[i + 1] | code[i + 2] << 8) == address:
+            return program.origin + i
+    return None
+
+
+def _hardware(r: Fields, program: Program, name: str, doc, seconds: int, load_function: Callable,
+              cpu: str = "6510") -> Hardware:
     key = f"hardware.{name}"
     if not name.isidentifier() or name.startswith("__"):
         raise r.error(key, "a name must be a Python identifier")
@@ -244,11 +264,11 @@ def _hardware(r: Fields, program: Program, name: str, doc, seconds: int, load_fu
         reads = tuple(r.byte_list(value, f"{key}.reads", most=MAX_READS_LISTED)) if isinstance(value, list) else None
         if reads is None:
             raise r.error(f"{key}.reads", f"expected a list of bytes, got {describe(value)}")
-        return Hardware(name, address, reads)
+        return Hardware(name, address, reads, rmw_at=_read_modify_write_of(program, address, cpu))
     if "function" in doc:
         function, parameters = _function(r, doc, key, seconds, load_function, HARDWARE_FUNCTION_ARGUMENTS)
         return Hardware(name, address, None, function, parameters)
-    return Hardware(name, address)
+    return Hardware(name, address, rmw_at=_read_modify_write_of(program, address, cpu))
 
 
 def _distinct(r: Fields, mocks: tuple[Mock, ...], hardware: tuple[Hardware, ...], exits: tuple[int, ...],
@@ -496,7 +516,7 @@ class BatchWorld:
     """The world on one BatchCpu (mocks with stated effects, exits): per-lane call counts and, for
     the mocks the reference takes, every call's arguments."""
 
-    def __init__(self, world: World, cpu) -> None:
+    def __init__(self, world: World, cpu, written_kept: dict[str, int] | None = None) -> None:
         from retro.cpu.batch import LaneError
 
         self.world = world
@@ -506,6 +526,53 @@ class BatchWorld:
         actions: dict[int, Callable] = {m.address: self._mock_action(m) for m in world.mocks}
         actions.update({address: self._exit for address in world.exits})
         install_on_batch(cpu, actions, lambda g, pc: g.stop(pc, LaneError.JAM))
+        self.hardware = {h.address: _LaneHardware(h, cpu.lanes, (written_kept or {}).get(h.name, 0))
+                         for h in world.hardware}
+        if self.hardware:
+            self._hook_memory(cpu.memory)
+
+    def _hook_memory(self, memory) -> None:
+        """Reads and writes of the hardware addresses go through the script and the record (this
+        LaneMemory only, while the lanes run: `finish` ends it before the outputs are read)."""
+        read, write, lanes_of = memory.read, memory.write, memory.lanes_of
+        hardware = self.hardware
+        addresses = np.asarray(sorted(hardware))
+
+        def hooked_read(idx, address):
+            if isinstance(address, (int, np.integer)):
+                device = hardware.get(int(address))
+                return read(idx, address) if device is None else device.read(lanes_of(idx), read(idx, address))
+            values = read(idx, address)
+            hit = np.isin(address, addresses)
+            if hit.any():
+                values = np.asarray(values).copy()
+                lanes = lanes_of(idx)
+                for target in np.unique(address[hit]).tolist():
+                    at = address == target
+                    values[at] = hardware[target].read(lanes[at], values[at])
+            return values
+
+        def hooked_write(idx, address, value) -> None:
+            if isinstance(address, (int, np.integer)):
+                device = hardware.get(int(address))
+                if device is not None:
+                    device.write(lanes_of(idx), value)
+            else:
+                hit = np.isin(address, addresses)
+                if hit.any():
+                    lanes = lanes_of(idx)
+                    for target in np.unique(address[hit]).tolist():
+                        at = address == target
+                        hardware[target].write(lanes[at], value if isinstance(value, (int, np.integer)) else value[at])
+            write(idx, address, value)
+
+        memory.read, memory.write = hooked_read, hooked_write
+        self._unhook = lambda: (delattr(memory, "read"), delattr(memory, "write"))
+
+    def finish(self) -> None:
+        """The lanes have run: reads of the memory are the host's again (outputs)."""
+        if self.hardware:
+            self._unhook()
 
     @staticmethod
     def _exit(g):
@@ -535,7 +602,13 @@ class BatchWorld:
         return action
 
     def value(self, place: Place) -> np.ndarray:
+        if place.kind == "written":
+            device = next(d for d in self.hardware.values() if d.hardware.name == place.register)
+            return device.kept[:, place.bit]
         kind, _, name = place.register.partition(":")
+        if kind == "writes":
+            device = next(d for d in self.hardware.values() if d.hardware.name == name)
+            return (device.writes >> (8 * place.bit)) & 0xFF
         return (self.counts[name] >> (8 * place.bit)) & 0xFF
 
     def recorded_calls(self) -> list[dict[str, list[dict]]]:
@@ -547,6 +620,37 @@ class BatchWorld:
                 for j, lane in enumerate(ids.tolist()):
                     lanes[lane][name].append({text: column[j] for text, column in columns.items()})
         return lanes
+
+
+class _LaneHardware:
+    """One scripted address on the batched core: per lane its read count, its write count and the
+    first `kept` values written."""
+
+    def __init__(self, hardware: Hardware, lanes: int, kept: int) -> None:
+        self.hardware = hardware
+        self.reads = np.zeros(lanes, dtype=np.int64)
+        self.writes = np.zeros(lanes, dtype=np.int64)
+        self.kept = np.zeros((lanes, kept), dtype=np.int64)
+        self.script = None if hardware.reads is None else np.asarray(hardware.reads, dtype=np.int32)
+
+    def read(self, lanes: np.ndarray, stored):
+        """The values the lanes read (`stored`: what memory holds there, the last value written)."""
+        count = self.reads[lanes]
+        self.reads[lanes] = count + 1
+        if self.script is None:
+            return stored
+        return self.script[np.minimum(count, len(self.script) - 1)]
+
+    def write(self, lanes: np.ndarray, value) -> None:
+        count = self.writes[lanes]
+        if count.size and count.max() >= MAX_RECORDED:
+            raise RunError(f"hardware {self.hardware.name} (${self.hardware.address:04X}) was written more than "
+                           f"{MAX_RECORDED:,} times in one call")
+        kept = count < self.kept.shape[1]
+        if kept.any():
+            values = np.broadcast_to(np.asarray(value), lanes.shape)
+            self.kept[lanes[kept], count[kept]] = values[kept]
+        self.writes[lanes] = count + 1
 
 
 def _uniform(values):

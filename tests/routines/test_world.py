@@ -344,3 +344,41 @@ def test_rows_state_world_outputs(tmp_path):
         "rows": [{"colours": [3, 4], "stores": 2, "cycles": 39}, {"colours": [3, 5], "note": "wrong"}]})
     report = check(routine)
     assert [o.row.key for o in report.rows.failing] == ["rows[1]"]
+
+
+def test_scripted_reads_and_recorded_writes_agree_on_both_engines(tmp_path):
+    source = """
+start:  ldx $fb
+loop:   lda $d012       ; wait until the raster reads 40 or more (the script climbs by 10)
+        cmp #40
+        bcc loop
+        stx $d020
+        inx
+        txa
+        sta $d020,y     ; Y = 0: the same register through an indexed store
+        rts
+"""
+    (tmp_path / "ref.py").write_text("def f(v, y): return {'colours': [v, (v + 1) & 0xff, 0], 'stores': 2}\n")
+    routine = build(tmp_path, source, {
+        "hardware": {"raster": {"at": "$D012", "reads": [0, 10, 20, 30, 40, 50]}, "border": {"at": "$D020"}},
+        "inputs": {"v": "$fb", "y": {"at": "Y", "values": [0]}},
+        "outputs": {"colours": {"writes": "border", "size": 3}, "stores": {"writes": "border"}},
+        "reference": {"function": "ref.py:f"}, "cycles": {"loops": {"loop": 6}}})
+    assert routine.world.batch_refusal() is None
+    for engine in ENGINES:
+        report = check(routine, engine=engine, random=300)
+        assert report.engine == engine and not report.engine_note
+        assert not report.mismatches, report.totals.examples
+        # LDX zp 3, five polls (LDA abs 4, CMP # 2, BCC 3 taken / 2 the last), STX abs 4, INX 2, TXA 2,
+        # STA abs,Y 5, RTS 6
+        assert report.totals.cycles_min == report.totals.cycles_max == 3 + 5 * (4 + 2 + 3) - 1 + 4 + 2 + 2 + 5 + 6
+
+
+def test_an_nmos_read_modify_write_of_hardware_runs_on_machine(tmp_path):
+    (tmp_path / "ref.py").write_text("def f(): return {}\n")
+    routine = build(tmp_path, "start:  inc $d020\n        rts\n",
+                    {"hardware": {"border": {"at": "$D020"}}, "inputs": {},
+                     "outputs": {"colours": {"writes": "border", "size": 2}}, "rows": [{"colours": [0, 1]}]})
+    assert "read-modified-written at $C000" in routine.world.batch_refusal()
+    report = check(routine, engine="batch")
+    assert report.engine == "scalar" and not report.mismatches  # the NMOS double write: the old value, then the new
