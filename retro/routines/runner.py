@@ -291,11 +291,14 @@ class RoutineRunner:
             self._restart_beam()
             stolen = self.machine.mpu.stolen
         world = self.world
-        if world is not None:
+        if world is None:
+            cycles, a, x, y, p = self.machine.call_fast(self.entry, writes, **registers, p=p, budget=self.limit,
+                                                        record=record, pointer_pcs=self.pointer_pcs)
+        else:
             world.reset(self.machine.cycle)
-        cycles, a, x, y, p = self.machine.call_fast(self.entry, writes, **registers, p=self._entry_p(p),
-                                                    budget=self.limit, record=record, pointer_pcs=self.pointer_pcs,
-                                                    enter=self.routine.world.enter)
+            cycles, a, x, y, p = self.machine.call_fast(self.entry, writes, **registers, p=self._entry_p(p),
+                                                        budget=self.limit, record=record, pointer_pcs=self.pointer_pcs,
+                                                        enter=self.routine.world.enter)
         if self.vic is not None:
             self.last_stolen = self.machine.mpu.stolen - stolen
         if world is not None:
