@@ -194,6 +194,8 @@ class Machine:
                 raise InputError(f"{name}: {value} is not a byte (0-255)")
         if not 1 <= budget <= MAX_BUDGET:
             raise InputError(f"budget: {budget} is not a number of cycles in 1..{MAX_BUDGET:,}")
+        if enter not in ENTRIES:
+            raise InputError(f"enter: {enter!r} is not one of {', '.join(ENTRIES)}")
         for target, values in (memory or {}).items():
             self.poke(target, values)
         entries: list[TraceEntry] | None = [] if trace else None

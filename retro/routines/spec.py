@@ -190,7 +190,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     program = _program_section(r, doc)
     world = parse_world(r, doc, program.program, seconds, load_function, program.cpu)
     inputs, outputs, memory = _places_sections(r, doc, program.program, seconds, world)
-    check_names(r, world, inputs, tuple(m.name for m in memory))
+    check_names(r, world, inputs, memory)
     rows = parse_rows(r, doc["rows"], inputs, outputs) if "rows" in doc else ()
     reference = _reference_section(r, doc, inputs, memory, rows, seconds, world)
     world = reference.pop("world")

@@ -184,14 +184,20 @@ def _bit(r: Fields, value, key: str) -> int:
     return r.integer(value, key, 0, 1)
 
 
+def _entry(r: Fields, program: Program, key: str, doc, known: set[str], shape: str) -> int:
+    """A `[mocks]` or `[hardware]` entry's name and table checked; its address."""
+    if not key.partition(".")[2].isidentifier() or key.partition(".")[2].startswith("__"):
+        raise r.error(key, "a name must be a Python identifier (the reference may take a mock's calls by name)")
+    if not isinstance(doc, dict):
+        raise r.error(key, f"expected a table {shape}")
+    r.known(doc, key, known)
+    return _one_address(r, program, doc, key)
+
+
 def _mock(r: Fields, program: Program, name: str, doc, seconds: int, load_function: Callable) -> Mock:
     key = f"mocks.{name}"
-    if not name.isidentifier() or name.startswith("__"):
-        raise r.error(key, "a name must be a Python identifier (the reference may take the calls by name)")
-    if not isinstance(doc, dict):
-        raise r.error(key, "expected a table { at = ..., cycles = N, A = ..., C = ..., writes = {...}, args = [...] }")
-    r.known(doc, key, MOCK_KEYS)
-    address = _one_address(r, program, doc, key)
+    address = _entry(r, program, key, doc, MOCK_KEYS,
+                     "{ at = ..., cycles = N, A = ..., C = ..., writes = {...}, args = [...] }")
     if program.origin <= address < program.end:
         raise r.error(f"{key}.at", f"${address:04X} is inside the program (${program.origin:04X}-"
                                    f"${program.end - 1:04X}): a JSR there runs the program's code; mock only "
@@ -244,12 +250,7 @@ def _read_modify_write_of(program: Program, address: int, cpu: str) -> int | Non
 def _hardware(r: Fields, program: Program, name: str, doc, seconds: int, load_function: Callable,
               cpu: str = "6510") -> Hardware:
     key = f"hardware.{name}"
-    if not name.isidentifier() or name.startswith("__"):
-        raise r.error(key, "a name must be a Python identifier")
-    if not isinstance(doc, dict):
-        raise r.error(key, "expected a table { at = ..., reads = [...] | function = \"FILE.py:NAME\" }")
-    r.known(doc, key, HARDWARE_KEYS)
-    address = _one_address(r, program, doc, key)
+    address = _entry(r, program, key, doc, HARDWARE_KEYS, "{ at = ..., reads = [...] | function = \"FILE.py:NAME\" }")
     if address < FIRST_DEVICE_ADDRESS:
         raise r.error(f"{key}.at", f"${address:04X} is in zero page or the stack, which are RAM only here "
                                    "(their accesses are not timed per bus cycle)")
@@ -282,13 +283,23 @@ def _distinct(r: Fields, mocks: tuple[Mock, ...], hardware: tuple[Hardware, ...]
         owner[address] = key.removesuffix(".at")
 
 
-def check_names(r: Fields, world: World, inputs: tuple[Port, ...], memory_names: tuple[str, ...]) -> None:
-    """A mock's name is what the reference takes its calls by: it may not be an input's or a block's."""
-    taken = {p.name: "inputs" for p in inputs} | {name: "memory" for name in memory_names}
+def check_names(r: Fields, world: World, inputs: tuple[Port, ...], memory: tuple) -> None:
+    """A mock's name is what the reference takes its calls by: it may not be an input's or a block's.
+    An input or a memory block on a hardware address would be hidden by its script: an error."""
+    taken = {p.name: "inputs" for p in inputs} | {block.name: "memory" for block in memory}
     for mock in world.mocks:
         if mock.name in taken:
             raise r.error(f"mocks.{mock.name}", f"{taken[mock.name]}.{mock.name} has the same name (the reference "
                                                 "takes both by name)")
+    for hardware in world.hardware:
+        for port in inputs:
+            if any(p.kind == "memory" and p.address == hardware.address for p in port.places):
+                raise r.error(f"inputs.{port.name}.at", f"${hardware.address:04X} is hardware.{hardware.name}: its "
+                                                        "reads come from the script, not from the input")
+        for block in memory:
+            if block.address <= hardware.address < block.address + max(block.size, 1):
+                raise r.error(f"memory.{block.name}.at", f"${hardware.address:04X} is hardware.{hardware.name}: its "
+                                                         "reads come from the script, not from the block")
 
 
 def world_output(r: Fields, world: World, name: str, doc: dict) -> Port:
@@ -416,12 +427,7 @@ class MachineWorld:
         state = {"a": mpu.a, "x": mpu.x, "y": mpu.y, "p": mpu.p, "s": mpu.sp, "count": count,
                  "cycle": mpu.processorCycles - self.start, "memory": _Memory(mpu.memory)}
         where = f"{self.spec}: mocks.{mock.name}.function"
-        try:
-            result = mock.function(**{name: state[name] for name in mock.parameters})
-        except UserCodeError:
-            raise
-        except Exception as exc:
-            raise InputError(f"{where} raised {type(exc).__name__}: {str(exc)[:200]} (call {count})") from None
+        result = _call_user(mock.function, mock.parameters, state, where, f"call {count}")
         if result is None:
             return
         if not isinstance(result, dict) or not set(result) <= _RESULT_KEYS:
@@ -451,6 +457,17 @@ class MachineWorld:
 
     def recorded_calls(self) -> dict[str, list[dict]]:
         return {name: list(self.calls[name]) for name in self.world.recorded}
+
+
+def _call_user(function: Callable, parameters: tuple[str, ...], state: dict, where: str, which: str):
+    """A spec's function (already under the sandbox's guards) called with the state it names; whatever
+    it raises is one line naming it and the call or read."""
+    try:
+        return function(**{name: state[name] for name in parameters})
+    except UserCodeError:
+        raise
+    except Exception as exc:
+        raise InputError(f"{where} raised {type(exc).__name__}: {str(exc)[:200]} ({which})") from None
 
 
 def _whole(value, most: int, where: str, count: int) -> int:
@@ -490,12 +507,7 @@ class _HardwareDevice:
             return self.memory[address]
         state = {"count": count, "cycle": cycle - world.start}
         where = f"{world.spec}: hardware.{hardware.name}.function"
-        try:
-            value = hardware.function(**{name: state[name] for name in hardware.parameters})
-        except UserCodeError:
-            raise
-        except Exception as exc:
-            raise InputError(f"{where} raised {type(exc).__name__}: {str(exc)[:200]} (read {count})") from None
+        value = _call_user(hardware.function, hardware.parameters, state, where, f"read {count}")
         return _whole(value, 0xFF, where, count)
 
     def write(self, address: int, value: int, cycle: int) -> None:

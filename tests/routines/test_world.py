@@ -277,6 +277,8 @@ BAD = [
     ({"hardware": {"h": {"at": "$D012", "reads": [1], "function": "ref.py:f"}}}, "hardware.h"),
     ({"hardware": {"h": {"at": "$D012", "function": "ref.py:f"}}}, "hardware.h.function"),
     ({"hardware": {"h": {"at": "$D012"}}, "mocks": {"m": {"at": "$D012", "cycles": 5}}}, "hardware.h.at"),
+    ({"hardware": {"h": {"at": "$D012"}}, "inputs": {"v": "$D012"}}, "inputs.v.at"),
+    ({"hardware": {"h": {"at": "$D012"}}, "memory": {"b": {"at": "$D000", "fill": 0, "size": 32}}}, "memory.b.at"),
     ({"outputs": {"o": {"calls": "missing"}}}, "outputs.o.calls"),
     ({"outputs": {"o": {"writes": "missing"}}}, "outputs.o.writes"),
     ({"outputs": {"o": {"writes": "h", "size": 0}}, "hardware": {"h": {"at": "$D012"}}}, "outputs.o.size"),
@@ -290,6 +292,7 @@ def test_a_bad_value_of_a_new_key_is_one_line_naming_the_file_and_the_key(tmp_pa
     (tmp_path / "ref.py").write_text("def f(v): return 0\n")
     base = {"inputs": {"v": "$fb"}, "outputs": {"w": "$fc"}, "reference": {"function": "ref.py:f"}}
     outputs = {**base["outputs"], **doc.pop("outputs", {})}
+    doc = {"inputs": base["inputs"], **doc}
     with pytest.raises(InputError) as raised:
         build(tmp_path, "start:  rts\n", {**base, **doc, "outputs": outputs})
     message = str(raised.value)
