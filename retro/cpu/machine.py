@@ -22,9 +22,9 @@ from retro.cpu.mpu import (
     FLAG_Z,
     INTERRUPT_CYCLES,
     OPCODE_BRK,
-    VARIANTS,
     CpuHalt,
 )
+from retro.cpu.variants import VARIANTS
 from retro.errors import InputError, RunError
 from retro.numbers import parse_int
 from retro.program import Program, ambiguity_message

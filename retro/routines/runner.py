@@ -35,7 +35,8 @@ from retro.cpu.machine import (
     push_interrupt_frame,
     push_return_trap,
 )
-from retro.cpu.mpu import FLAG_B, FLAG_I, FLAG_U, VARIANTS
+from retro.cpu.mpu import FLAG_B, FLAG_I, FLAG_U
+from retro.cpu.variants import VARIANTS
 from retro.cpu.timing import timing_table
 from retro.errors import InputError
 from retro.fileio import read_text

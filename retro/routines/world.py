@@ -29,7 +29,8 @@ import numpy as np
 
 from retro.cpu.bus import FIRST_DEVICE_ADDRESS
 from retro.cpu.machine import CALL_STACK_TOP, RETURN_TRAP
-from retro.cpu.mpu import INTERRUPT_CYCLES, RMW_MNEMONICS, VARIANTS
+from retro.cpu.mpu import INTERRUPT_CYCLES, RMW_MNEMONICS
+from retro.cpu.variants import VARIANTS
 from retro.cpu.traps import TRAP_OPCODE, install_on_batch, install_on_mpu
 from retro.errors import InputError, RunError
 from retro.fields import Fields, describe
