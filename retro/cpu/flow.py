@@ -178,7 +178,8 @@ def _analyse(read, entry: int, bounds: dict[int, int], name: str, within, descri
             return mocks[target], mocks[target]
         if within is not None and not within[0] <= target < within[1]:
             raise InputError(f"{name}: JSR {describe(target)} at ${pc:04X} calls outside the program "
-                             f"(${within[0]:04X}-${within[1] - 1:04X}); its cost is unknown")
+                             f"(${within[0]:04X}-${within[1] - 1:04X}); its cost is unknown: say what it does and costs "
+                             "with a mock ([mocks], docs/specs.md)")
         if target in calling or target == entry:
             raise InputError(f"{name}: JSR {describe(target)} at ${pc:04X} is recursive")
         if target not in done:

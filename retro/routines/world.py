@@ -677,7 +677,8 @@ def _lane_place(g, place: Place):
         return np.asarray(getattr(g, place.register)).copy()
     if place.kind == "flag":
         return ((np.asarray(g.p) & place.bit) != 0).astype(np.int64)
-    return np.asarray(g.read(place.address)).copy()
+    memory = g.cpu.memory  # what memory holds, as Machine's record reads RAM: never a scripted read
+    return np.asarray(type(memory).read(memory, g.ids, place.address)).copy()
 
 
 # ---- a scene's chips ---------------------------------------------------------------------------------
