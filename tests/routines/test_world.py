@@ -385,3 +385,24 @@ def test_an_nmos_read_modify_write_of_hardware_runs_on_machine(tmp_path):
     assert "read-modified-written at $C000" in routine.world.batch_refusal()
     report = check(routine, engine="batch")
     assert report.engine == "scalar" and not report.mismatches  # the NMOS double write: the old value, then the new
+
+
+def test_a_jsr_to_nowhere_stops_the_check_on_the_batched_core_too(tmp_path):
+    (tmp_path / "ref.py").write_text("def f(v): return v\n")
+    routine = build(tmp_path, CALLER, {"inputs": {"v": "$fb"}, "outputs": {"got": "$fc"},
+                                        "reference": {"function": "ref.py:f"}, "cycles": {"static": False}})
+    report = check(routine, engine="batch", random=100)
+    assert report.totals.run_errors == 1
+    assert "JSR $E000 at $C004 calls an address where no code is" in report.totals.failure.message
+
+
+@pytest.mark.parametrize("cpu", ["2a03", "65c02"])
+def test_mocks_and_exits_work_on_every_cpu(tmp_path, cpu):
+    (tmp_path / "ref.py").write_text("def f(v): return {}\n")
+    routine = build(tmp_path, CALLER, {"program": {"cpu": cpu}, "mocks": {"helper": {"at": "$E000", "cycles": 40,
+                                                                                    "A": 7, "C": 1}},
+                                        "inputs": {"v": "$fb"}, "outputs": {"got": "$fc", "carry": "C"},
+                                        "reference": {"function": "ref.py:f"}})
+    for outputs, cycles in run_both(routine, (3,)):
+        assert outputs == (7, 1)
+        assert cycles == 3 + 2 + 6 + 40 + 3 + 6
