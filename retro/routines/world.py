@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -96,10 +96,6 @@ class World:
         return not (self.mocks or self.hardware or self.exits) and self.enter == "jsr"
 
     @property
-    def traps(self) -> tuple[int, ...]:
-        return tuple(m.address for m in self.mocks) + self.exits
-
-    @property
     def entry_cycles(self) -> int:
         """Cycles counted before the routine's first instruction: the interrupt sequence's."""
         return 0 if self.enter == "jsr" else INTERRUPT_CYCLES
@@ -150,7 +146,7 @@ def _exits(r: Fields, program: Program, value) -> tuple[int, ...]:
     items = value if isinstance(value, list) else [value]
     if not items or not all(isinstance(v, (str, int)) and not isinstance(v, bool) for v in items):
         raise r.error("program.exit", f"expected a label or an address (or a list of them), got {describe(value)}")
-    return tuple(dict.fromkeys(resolve(r, program, str(v), f"program.exit") for v in items))
+    return tuple(dict.fromkeys(resolve(r, program, str(v), "program.exit") for v in items))
 
 
 def _one_address(r: Fields, program: Program, doc: dict, key: str) -> int:

@@ -8,6 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from retro.errors import InputError, RunError
@@ -21,8 +22,7 @@ REPO = Path(__file__).resolve().parents[2]
 def build(tmp_path: Path, source: str, doc: dict, name: str = "spec"):
     """A spec around an Ophis source (its first line `.org $c000`) given as text."""
     (tmp_path / "r.s").write_text("        .org $c000\n" + source)
-    full = {"program": {"file": "r.s", "entry": "start"}, **doc}
-    full["program"] = {"file": "r.s", "entry": "start", **doc.get("program", {})}
+    full = {**doc, "program": {"file": "r.s", "entry": "start", **doc.get("program", {})}}
     return spec_from_dict(full, base=tmp_path, name=name)
 
 
@@ -30,7 +30,7 @@ def run_both(routine, case: tuple) -> list[tuple[tuple, int]]:
     """(outputs, cycles) of one case on Machine and on the batched core."""
     runner = RoutineRunner(routine)
     scalar = runner.run(case)
-    columns = [__import__("numpy").asarray([v]) for v in case]
+    columns = [np.asarray([v]) for v in case]
     outcome = runner.run_batch(columns)
     assert not outcome.error.any(), outcome.error
     batch = (tuple(int(o[0]) if o.ndim == 1 else tuple(o[0].tolist()) for o in outcome.outputs), int(outcome.cycles[0]))
