@@ -365,7 +365,8 @@ class RoutineRunner:
         enter = self.routine.world.enter
         stack_pointer = push_return_trap(image) if enter == "jsr" else push_interrupt_frame(image, 0)
         cpu = BatchCpu(self.routine.cpu, image, n)
-        world = None if self.routine.world.empty else BatchWorld(self.routine.world, cpu, self.written_kept)
+        world = None if self.routine.world.empty else BatchWorld(self.routine.world, cpu, self.written_kept,
+                                                                  str(self.routine.spec_path))
         registers, p = self.plan.place(columns, _column_byte, cpu.memory.fill)
         for name, value in registers.items():
             lanes = getattr(cpu, name)

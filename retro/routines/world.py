@@ -14,8 +14,9 @@
 
 Both engines run all of it with the same results, through traps (retro.cpu.traps: the trap byte
 written at every mock and exit address) and, for hardware, a device on Machine's bus or hooks on the
-batched core's lane memory; what the batched core cannot run (a Python function per call or read, an
-NMOS read-modify-write of hardware) is said by `batch_refusal`, and the check then runs on Machine and
+batched core's lane memory (a function mock is called lane by lane there); what the batched core
+cannot run (a hardware function, timed per read; an NMOS read-modify-write of hardware) is said by
+`batch_refusal`, and the check then runs on Machine and
 says why. docs/specs.md, "The routine's world", is the user's view.
 """
 
@@ -108,9 +109,6 @@ class World:
             if hardware.rmw_at is not None:
                 return (f"hardware.{hardware.name} (${hardware.address:04X}) is read-modified-written at "
                         f"${hardware.rmw_at:04X}, whose double write Machine models")
-        functions = [m.name for m in self.mocks if m.function is not None]
-        if functions:
-            return f"mocks.{functions[0]} is a Python function, run per call on Machine"
         return None
 
     def mock_costs(self) -> dict[int, int]:
@@ -423,25 +421,12 @@ class MachineWorld:
     def _call_function(self, mpu, mock: Mock, count: int) -> None:
         state = {"a": mpu.a, "x": mpu.x, "y": mpu.y, "p": mpu.p, "s": mpu.sp, "count": count,
                  "cycle": mpu.processorCycles - self.start, "memory": _Memory(mpu.memory)}
-        where = f"{self.spec}: mocks.{mock.name}.function"
-        result = _call_user(mock.function, mock.parameters, state, where, f"call {count}")
-        if result is None:
-            return
-        if not isinstance(result, dict) or not set(result) <= _RESULT_KEYS:
-            raise InputError(f"{where} returned {shown(result)} (call {count}): expected None or a dict with keys "
-                             f"among {', '.join(sorted(_RESULT_KEYS))}")
-        for key, value in result.items():
-            if key == "writes":
-                if not isinstance(value, dict):
-                    raise InputError(f"{where} returned writes = {shown(value)} (call {count}): expected "
-                                     "{address: byte}")
-                for address, byte in value.items():
-                    mpu.WriteByte(_whole(address, 0xFFFF, where, count), _whole(byte, 0xFF, where, count))
-            elif key in FLAGS:
-                bit = FLAGS[key]
-                mpu.p = (mpu.p | bit) if _whole(value, 1, where, count) else (mpu.p & ~bit)
-            else:
-                setattr(mpu, key.lower(), _whole(value, 0xFF, where, count))
+        registers, flags_set, flags_clear, writes = function_effects(mock, state, self.spec)
+        for register, value in registers:
+            setattr(mpu, register, value)
+        mpu.p = (mpu.p | flags_set) & ~flags_clear
+        for address, value in writes:
+            mpu.WriteByte(address, value)
 
     def value(self, place: Place) -> int:
         """A world output's byte after the call (a count's byte, or the k-th value written)."""
@@ -454,6 +439,34 @@ class MachineWorld:
 
     def recorded_calls(self) -> dict[str, list[dict]]:
         return {name: list(self.calls[name]) for name in self.world.recorded}
+
+
+def function_effects(mock: Mock, state: dict, spec: str) -> tuple[list, int, int, list]:
+    """A function mock called with the machine `state` it names: its effects, checked, as (registers,
+    flags set, flags cleared, writes); the same on both engines (a one-line error for nonsense)."""
+    count = state["count"]
+    where = f"{spec}: mocks.{mock.name}.function"
+    result = _call_user(mock.function, mock.parameters, state, where, f"call {count}")
+    registers, flags_set, flags_clear, writes = [], 0, 0, []
+    if result is None:
+        return registers, flags_set, flags_clear, writes
+    if not isinstance(result, dict) or not set(result) <= _RESULT_KEYS:
+        raise InputError(f"{where} returned {shown(result)} (call {count}): expected None or a dict with keys "
+                         f"among {', '.join(sorted(_RESULT_KEYS))}")
+    for key, value in result.items():
+        if key == "writes":
+            if not isinstance(value, dict):
+                raise InputError(f"{where} returned writes = {shown(value)} (call {count}): expected {{address: byte}}")
+            writes = [(_whole(address, 0xFFFF, where, count), _whole(byte, 0xFF, where, count))
+                      for address, byte in value.items()]
+        elif key in FLAGS:
+            if _whole(value, 1, where, count):
+                flags_set |= FLAGS[key]
+            else:
+                flags_clear |= FLAGS[key]
+        else:
+            registers.append((key.lower(), _whole(value, 0xFF, where, count)))
+    return registers, flags_set, flags_clear, writes
 
 
 def _call_user(function: Callable, parameters: tuple[str, ...], state: dict, where: str, which: str):
@@ -525,11 +538,12 @@ class BatchWorld:
     """The world on one BatchCpu (mocks with stated effects, exits): per-lane call counts and, for
     the mocks the reference takes, every call's arguments."""
 
-    def __init__(self, world: World, cpu, written_kept: dict[str, int] | None = None) -> None:
+    def __init__(self, world: World, cpu, written_kept: dict[str, int] | None = None, spec: str = "") -> None:
         from retro.cpu.batch import LaneError
 
         self.world = world
         self.cpu = cpu
+        self.spec = spec
         self.counts = {m.name: np.zeros(cpu.lanes, dtype=np.int64) for m in world.mocks}
         self.records: dict[str, list[tuple[np.ndarray, dict]]] = {m.name: [] for m in world.mocks}
         actions: dict[int, Callable] = {m.address: self._mock_action(m) for m in world.mocks}
@@ -599,16 +613,38 @@ class BatchWorld:
                 if counts[lanes].max() > MAX_RECORDED:
                     raise RunError(f"mock {mock.name} was called more than {MAX_RECORDED:,} times in one call")
                 self.records[mock.name].append((lanes.copy(), {text: _lane_place(g, place) for text, place in mock.args}))
-            for register, value in mock.registers:
-                setattr(g, register, np.full(len(g), value, dtype=np.int32))
-            g.p = (g.p | mock.flags_set) & ~mock.flags_clear
-            for address, value in mock.writes:
-                g.write(address, value)
+            if mock.function is not None:
+                self._call_function(g, mock, lanes, counts)
+            else:
+                for register, value in mock.registers:
+                    setattr(g, register, np.full(len(g), value, dtype=np.int32))
+                g.p = (g.p | mock.flags_set) & ~mock.flags_clear
+                for address, value in mock.writes:
+                    g.write(address, value)
             g.cycles += mock.cycles
             low = g.pull()  # the mock's RTS
             target = ((g.pull() << 8 | low) + 1) & 0xFFFF
             return _uniform(target)
         return action
+
+    def _call_function(self, g, mock: Mock, lanes: np.ndarray, counts: np.ndarray) -> None:
+        """A function mock, called lane by lane in lane order with each lane's state (as Machine calls
+        it case by case: a function that depends only on what it is given answers the same)."""
+        n = len(g)
+        registers = {name: np.array(np.broadcast_to(getattr(g, name), n), dtype=np.int32) for name in ("a", "x", "y", "p")}
+        sp = np.broadcast_to(g.sp, n)
+        memory = g.cpu.memory
+        for j, lane in enumerate(lanes.tolist()):
+            state = {"a": int(registers["a"][j]), "x": int(registers["x"][j]), "y": int(registers["y"][j]),
+                     "p": int(registers["p"][j]), "s": int(sp[j]), "count": int(counts[lane]),
+                     "cycle": int(g.cycles[j]), "memory": _LaneMemoryView(memory, lane)}
+            changed, flags_set, flags_clear, writes = function_effects(mock, state, self.spec)
+            for register, value in changed:
+                registers[register][j] = value
+            registers["p"][j] = (registers["p"][j] | flags_set) & ~flags_clear
+            for address, value in writes:
+                memory.write(np.asarray([lane]), address, value)  # through the hardware hooks, as WriteByte
+        g.a, g.x, g.y, g.p = registers["a"], registers["x"], registers["y"], registers["p"]
 
     def value(self, place: Place) -> np.ndarray:
         if place.kind == "written":
@@ -629,6 +665,24 @@ class BatchWorld:
                 for j, lane in enumerate(ids.tolist()):
                     lanes[lane][name].append({text: column[j] for text, column in columns.items()})
         return lanes
+
+
+class _LaneMemoryView:
+    """One lane's memory as a function mock sees it (read-only, what memory holds: no scripted read)."""
+
+    def __init__(self, memory, lane: int) -> None:
+        self._memory, self._lane = memory, np.asarray([lane])
+
+    def _byte(self, address: int) -> int:
+        return int(np.asarray(type(self._memory).read(self._memory, self._lane, address & 0xFFFF)).ravel()[0])
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return bytes(self._byte(a) for a in range(0x10000)[index])
+        return self._byte(int(index))
+
+    def __len__(self) -> int:
+        return 0x10000
 
 
 class _LaneHardware:

@@ -162,17 +162,31 @@ def test_a_wrong_call_count_is_a_mismatch(tmp_path):
         assert report.totals.result_mismatches == report.totals.cases
 
 
-def test_a_function_mock_runs_on_machine_and_the_report_says_why(tmp_path):
-    (tmp_path / "mocks.py").write_text("def helper(a, count, memory):\n"
-                                       "    return {'A': (a + count + memory[0xfb]) & 0xff, 'C': 0}\n")
+def test_a_function_mock_runs_on_both_engines_with_the_same_answers(tmp_path):
+    (tmp_path / "mocks.py").write_text("def helper(a, count, memory, cycle):\n"
+                                       "    assert cycle == 3 + 2 + 6, cycle  # cycles before the mock: LDA, LDX, JSR\n"
+                                       "    return {'A': (a + count + memory[0xfb]) & 0xff, 'C': 0, 'writes': {0xfd: a}}\n")
     routine = mock_spec(tmp_path, {"cycles": 12, "function": "mocks.py:helper"},
-                        "def f(v): return {'got': (2 * v + 1) & 0xff, 'carry': 0, 'x': 9, 'wrote': 0, 'calls': 1}\n")
-    assert routine.world.batch_refusal() == "mocks.helper is a Python function, run per call on Machine"
-    report = check(routine, engine="batch", random=200)
+                        "def f(v): return {'got': (2 * v + 1) & 0xff, 'carry': 0, 'x': 9, 'wrote': v, 'calls': 1}\n")
+    assert routine.world.batch_refusal() is None
+    for engine in ENGINES:
+        report = check(routine, engine=engine, random=300)
+        assert report.engine == engine and not report.engine_note
+        assert not report.mismatches, report.totals.examples
+        assert report.totals.cycles_max == 3 + 2 + 6 + 12 + 3 + 6
+
+
+def test_a_hardware_function_runs_on_machine_and_the_report_says_why(tmp_path):
+    (tmp_path / "hw.py").write_text("def raster(count): return count\n")
+    (tmp_path / "ref.py").write_text("def f(v): return {'r': [0, 1, 2]}\n")
+    routine = build(tmp_path, POLL, {"hardware": {"raster": {"at": "$D012", "function": "hw.py:raster"}},
+                                     "inputs": {"v": "$fe"}, "outputs": {"r": {"at": "$fb", "size": 3, "table": True}},
+                                     "reference": {"function": "ref.py:f"}})
+    report = check(routine, engine="batch", random=100)
     assert report.engine == "scalar"
-    assert "mocks.helper is a Python function" in report.engine_note
+    assert report.engine_note == ("Machine ran the calls: hardware.raster.function is a Python function, run per read "
+                                  "on Machine")
     assert not report.mismatches, report.totals.examples
-    assert report.totals.cycles_max == 3 + 2 + 6 + 12 + 3 + 6
 
 
 def test_a_function_mock_that_answers_nonsense_is_one_line_naming_it(tmp_path):
