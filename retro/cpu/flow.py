@@ -183,11 +183,16 @@ def _analyse(read, entry: int, bounds: dict[int, int], name: str, within, descri
         if target in calling or target == entry:
             raise InputError(f"{name}: JSR {describe(target)} at ${pc:04X} is recursive")
         if target not in done:
-            done[target] = _analyse(read, target, bounds, name, within, describe, done, (*calling, entry), cpu, mocks)
+            done[target] = _analyse(read, target, bounds, name, within, describe, done, (*calling, entry), cpu, mocks,
+                                    exits)
         callee = done[target]
         return callee.best, callee.worst
 
     nodes = decode(read, entry, call_cost, cpu, ends, exits)
+    reached = sorted(pc for pc in nodes if pc in exits)
+    if calling and reached:  # the call would end inside a subroutine: its caller's rest is not run
+        raise InputError(f"{name}: the subroutine at {describe(entry)} reaches the exit {describe(reached[0])}; the "
+                         "static analysis bounds exits reached by the routine itself, not by its subroutines")
     loops = _loops(nodes, entry)
     for header in loops:
         if header not in bounds:

@@ -420,3 +420,18 @@ def test_mocks_and_exits_work_on_every_cpu(tmp_path, cpu):
     for outputs, cycles in run_both(routine, (3,)):
         assert outputs == (7, 1)
         assert cycles == 3 + 2 + 6 + 40 + 3 + 6
+
+
+def test_an_exit_reached_inside_a_subroutine_is_said_not_bounded(tmp_path):
+    (tmp_path / "ref.py").write_text("def f(v): return v\n")
+    source = "start:  jsr sub\n        rts\nsub:    lda $fb\n        sta $fc\n        jmp done\ndone:   rts\n"
+    routine = build(tmp_path, source, {"program": {"exit": "done"}, "inputs": {"v": "$fb"}, "outputs": {"w": "$fc"},
+                                       "reference": {"function": "ref.py:f"}})
+    with pytest.raises(InputError, match=r"the subroutine at \$C004 \(sub\) reaches the exit \$C00B \(done\)"):
+        check(routine, engine="scalar", random=10)
+    routine = build(tmp_path, source, {"program": {"exit": "done"}, "inputs": {"v": "$fb"}, "outputs": {"w": "$fc"},
+                                       "reference": {"function": "ref.py:f"}, "cycles": {"static": False}},
+                    name="unbounded")
+    for engine in ENGINES:  # the run itself ends at the exit: JSR 6, LDA 3, STA 3, JMP 3
+        report = check(routine, engine=engine, random=100)
+        assert not report.mismatches and report.totals.cycles_max == 15
