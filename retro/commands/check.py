@@ -13,9 +13,14 @@ from retro.analysis.junit import junit_xml
 from retro.analysis.raster import format_raster, raster_figures
 from retro.analysis.row_check import rows_lines, rows_record
 from retro.errors import InputError
-from retro.fileio import file_option, write_atomic
+from retro.fileio import command_files, file_option, output_folder, read_text, write_all_atomic, write_atomic
+from retro.loaders.source_lines import has_line_information, read_source_map
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
+from retro.reports.annotated import Annotated, RoutineCode, annotate
+from retro.reports.coverage_html import html_pages
+from retro.reports.lcov import lcov_text
+from retro.reports.listing import listing_text
 from retro.routines import cases as case_sets
 from retro.workers import MAX_WORKERS
 import argparse
@@ -271,6 +276,67 @@ def input_files(checks: list[RoutineCheck], scene: str | Path | None = None) -> 
     return files
 
 
+# ---- code coverage reports: --listing, --lcov, --html (retro.reports, docs/coverage.md) ----------
+
+def routine_code(check: RoutineCheck) -> RoutineCode:
+    """What the coverage reports show of a checked routine: its program's bytes and labels, and its
+    source lines from `[program] listing`, else from a symbol file that has them (an ld65 debug file)."""
+    routine = check.routine
+    program = routine.program
+    source_map = routine.source_map
+    if source_map is None and routine.symbols_file is not None and has_line_information(routine.symbols_file):
+        source_map = read_source_map(routine.symbols_file)
+    return RoutineCode(name=routine.name, code=program.code, origin=program.origin, entry=routine.entry_address,
+                       cpu=routine.cpu, init=routine.init_address, symbols=dict(program.symbols),
+                       program_file=str(routine.program_file), source_map=source_map)
+
+
+def annotated_checks(checks: list[RoutineCheck]) -> list[Annotated]:
+    """Each check's code coverage on its routine's code; a check without it is an error naming it."""
+    missing = [c.routine.name for c in checks if getattr(c, "code_coverage", None) is None]
+    if missing:
+        raise InputError(f"no code coverage was recorded for {', '.join(missing)} (the engine ran without it), "
+                         f"so --listing, --lcov and --html cannot be written")
+    return [annotate(routine_code(c), c.code_coverage) for c in checks]
+
+
+def _source_lines(file: str) -> list[str] | None:
+    """A source file's lines for the HTML report (None when it cannot be read: the report names the
+    line without its text)."""
+    try:
+        return read_text(file, "source file").splitlines()
+    except InputError:
+        return None
+
+
+def write_coverage_reports(checks: list[RoutineCheck], *, listing: str | Path | None = None,
+                           lcov: str | Path | None = None, html: str | Path | None = None,
+                           scene: str | Path | None = None) -> list[Path]:
+    """`--listing FILE`, `--lcov FILE`, `--html DIR`: written together (with the command's other outputs),
+    never over an input: the check's files, the listing or debug file, the source files it names."""
+    if listing is None and lcov is None and html is None:
+        return []
+    routines = annotated_checks(checks)
+    inputs = input_files(checks, scene)
+    for annotated in routines:
+        source_map = annotated.code.source_map
+        if source_map is not None:
+            inputs += [Path(source_map.source)] + [Path(f) for f in {line.file for line in source_map.lines.values()}
+                                                   if Path(f).is_file()]
+    outputs: dict[Path, str] = {}
+    what: dict[Path, str] = {}
+    if listing is not None:
+        outputs[Path(listing)], what[Path(listing)] = listing_text(routines), "the listing (--listing)"
+    if lcov is not None:
+        outputs[Path(lcov)], what[Path(lcov)] = lcov_text(routines), "the LCOV file (--lcov)"
+    if html is not None:
+        pages = html_pages(routines, _source_lines)
+        output_folder(html, pages)
+        for name, page in pages.items():
+            outputs[Path(html) / name], what[Path(html) / name] = page, "the HTML report (--html)"
+    return write_all_atomic(outputs, inputs=inputs, what=what)
+
+
 # The command line: this command's options and how it runs from them.
 
 HELP = ("cross-check 6502 routines (built-in or your own spec) against their references (results and cycles); "
@@ -311,11 +377,20 @@ def add_options(p: argparse.ArgumentParser) -> None:
     routine_options(p)
     p.add_argument("--junit", metavar="FILE.xml", help="also write the results as JUnit XML for CI: one testcase per "
                                                        "routine, a failure carrying its report")
+    p.add_argument("--listing", metavar="FILE", help="write the annotated listing: per instruction its hits, branch "
+                                                     "directions and cycles (docs/coverage.md)")
+    p.add_argument("--lcov", metavar="FILE", help="write the code coverage as an LCOV tracefile, by source line where "
+                                                  "the program has line information, else by address")
+    p.add_argument("--html", metavar="DIR", help="write the code coverage as HTML pages into DIR (index.html)")
 
 
 def main(args: argparse.Namespace) -> int:
-    checks = checks_of(args)
-    options.show(lines, as_json if args.json else None, checks, indent=1)
-    if args.junit:
-        write_junit(checks, args.junit, scene=args.scene)
+    with command_files():  # every file the check writes, all or none
+        if args.html is not None:
+            output_folder(args.html)  # refused before the run, not after it
+        checks = checks_of(args)
+        options.show(lines, as_json if args.json else None, checks, indent=1)
+        if args.junit:
+            write_junit(checks, args.junit, scene=args.scene)
+        write_coverage_reports(checks, listing=args.listing, lcov=args.lcov, html=args.html, scene=args.scene)
     return 1 if failed(checks) else 0

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from retro.cpu.bus import MEMORY_SIZE, Bus, Device
+from retro.cpu.disassembly import instruction_text
 from retro.cpu.mpu import (
     FLAG_B,
     FLAG_C,
@@ -332,21 +333,8 @@ class Machine:
 
     def disassemble_at(self, address: int) -> str:
         memory = self.mpu.memory
-        opcode = memory[address]
-        mnemonic, mode = self.mpu.disassemble[opcode]
-        lo = memory[(address + 1) & 0xFFFF]
-        hi = memory[(address + 2) & 0xFFFF]
-        word = lo | hi << 8
-        operand = {
-            "imp": "", "acc": "A" if mnemonic in ("ASL", "LSR", "ROL", "ROR") else "", "imm": f"#${lo:02X}",
-            "zpg": f"${lo:02X}", "zpx": f"${lo:02X},X", "zpy": f"${lo:02X},Y",
-            "abs": f"${word:04X}", "abx": f"${word:04X},X", "aby": f"${word:04X},Y",
-            "ind": f"(${word:04X})", "inx": f"(${lo:02X},X)", "iny": f"(${lo:02X}),Y",
-            "rel": f"${(address + 2 + (lo - 256 if lo & 0x80 else lo)) & 0xFFFF:04X}",
-            "zpi": f"(${lo:02X})", "iax": f"(${word:04X},X)",  # the 65C02's
-            "zpr": f"${lo:02X},${(address + 3 + (hi - 256 if hi & 0x80 else hi)) & 0xFFFF:04X}",
-        }.get(mode, "")
-        return f"{mnemonic} {operand}".strip()
+        mnemonic, mode = self.mpu.disassemble[memory[address]]
+        return instruction_text(mnemonic, mode, address, memory[(address + 1) & 0xFFFF], memory[(address + 2) & 0xFFFF])
 
 
 class _Recorder:

@@ -270,7 +270,7 @@ _DBG_DIGITS = 16
 _DBG_DECIMAL_DIGITS = 20  # ids and counts: `%u` of at most 64 bits
 
 
-def _dbg_fields(line: str, source: str, number: int) -> tuple[str, dict[str, str]]:
+def dbg_fields(line: str, source: str, number: int) -> tuple[str, dict[str, str]]:
     match = _DBG_RECORD.match(line)
     if not match:
         raise _malformed(source, number, line, "a 'kind key=value,...' record")
@@ -278,7 +278,7 @@ def _dbg_fields(line: str, source: str, number: int) -> tuple[str, dict[str, str
     return match.group("kind"), fields
 
 
-def _dbg_int(fields: dict[str, str], key: str, source: str, number: int) -> int:
+def dbg_int(fields: dict[str, str], key: str, source: str, number: int) -> int:
     match = _DBG_NUMBER.match(fields.get(key, ""))
     if not match:
         raise InputError(f"{source}:{number}: field {key!r} missing or not a number "
@@ -296,12 +296,12 @@ def _parse_dbg(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> l
     records: list[tuple[int, dict[str, str]]] = []
     promised: dict[str, int] = {}  # the `info` line counts every kind of record: a cut file is caught
     for number, line in lines:
-        kind, fields = _dbg_fields(line, source, number)
+        kind, fields = dbg_fields(line, source, number)
         if kind == "info":
-            promised = {key: _dbg_int(fields, key, source, number) for key in ("scope", "sym") if key in fields}
+            promised = {key: dbg_int(fields, key, source, number) for key in ("scope", "sym") if key in fields}
         elif kind == "scope":
-            parent = _dbg_int(fields, "parent", source, number) if "parent" in fields else None
-            scopes[_dbg_int(fields, "id", source, number)] = (fields.get("name", ""), parent)
+            parent = dbg_int(fields, "parent", source, number) if "parent" in fields else None
+            scopes[dbg_int(fields, "id", source, number)] = (fields.get("name", ""), parent)
         elif kind == "sym":
             records.append((number, fields))
     for kind, found in (("scope", len(scopes)), ("sym", len(records))):
@@ -326,14 +326,14 @@ def _parse_dbg(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> l
             scope_paths[walked] = path
         return path
 
-    by_id = {_dbg_int(fields, "id", source, number): (number, fields) for number, fields in records}
+    by_id = {dbg_int(fields, "id", source, number): (number, fields) for number, fields in records}
 
     def symbol_path(fields: dict[str, str], number: int) -> tuple[str, ...]:
         """Scope path of a symbol: its scope's, or for a cheap local (`@loop`) its parent label's
         path and name (ca65 hangs a cheap local off a normal label, never off another cheap local)."""
         if "parent" not in fields:
-            return scope_path(_dbg_int(fields, "scope", source, number), number)
-        parent = _dbg_int(fields, "parent", source, number)
+            return scope_path(dbg_int(fields, "scope", source, number), number)
+        parent = dbg_int(fields, "parent", source, number)
         if parent not in by_id or "parent" in by_id[parent][1]:
             raise InputError(f"{source}:{number}: the parent of this cheap local, symbol {parent}, "
                              f"is not a label defined in the file")
@@ -344,7 +344,7 @@ def _parse_dbg(lines: list[tuple[int, str]], source: str, skipped: Skipped) -> l
     for number, fields in records:
         if fields.get("type") == "imp" or "val" not in fields:
             continue  # an import names a symbol defined (with its value) elsewhere in the file
-        address = _address_or_skip(_dbg_int(fields, "val", source, number), skipped)
+        address = _address_or_skip(dbg_int(fields, "val", source, number), skipped)
         if address is None:
             continue
         path = symbol_path(fields, number)

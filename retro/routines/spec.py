@@ -28,6 +28,7 @@ from retro.errors import InputError
 from retro.fields import Fields, describe
 from retro.fileio import cached_reads, is_dir, note_input, parse_toml, read_bytes
 from retro.loaders import load_program
+from retro.loaders.source_lines import SourceMap, read_source_map
 from retro.program import Program
 from retro.routines.places import (
     BYTE_VALUES,
@@ -54,7 +55,7 @@ CPUS = tuple(VARIANTS)
 
 TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows",
             "mocks", "hardware"}
-PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load", "interrupt", "exit"}
+PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load", "listing", "interrupt", "exit"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays", "time_limit"}
 CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage"}
@@ -94,6 +95,7 @@ class Routine:
     reference_memory: tuple[str, ...]  # memory blocks the reference takes by name
     reference_arrays: bool = False  # the reference takes numpy arrays (one element per case) and answers so
     program: Program | None = None  # the program, read once when the spec is loaded
+    source_map: SourceMap | None = None  # [program] listing: which source line each byte came from
     entry_address: int = 0  # entry, init and the loop labels resolved against its symbols
     init_address: int | None = None
     loop_addresses: dict[int, int] = field(default_factory=dict)  # loop header address -> bound
@@ -219,6 +221,7 @@ class _ProgramSection:
     program: Program
     entry_address: int
     init_address: int | None
+    source_map: SourceMap | None
 
     def fields(self) -> dict:
         return dict(self.__dict__)
@@ -249,8 +252,16 @@ def _program_section(r: Fields, doc: dict) -> _ProgramSection:
     entry_address = _in_program(r, program, resolve(r, program, entry, "program.entry"), "program.entry")
     init_address = (_in_program(r, program, resolve(r, program, init, "program.init"), "program.init")
                     if init is not None else None)
+    listing_name = _text(r, program_doc, "listing", "program.listing")
+    source_map = None
+    if listing_name:  # the assembler's listing (ACME --report): coverage by source line
+        listing_file = r.file(listing_name, "program.listing", resolve=True)
+        try:
+            source_map = read_source_map(listing_file)
+        except InputError as exc:
+            raise r.error("program.listing", str(exc)) from None
     return _ProgramSection(program_file, symbols_file, load, cpu, machine, entry, init, program,
-                           entry_address, init_address)
+                           entry_address, init_address, source_map)
 
 
 def _places_sections(r: Fields, doc: dict, program: Program, seconds: int, world: World = NO_WORLD
