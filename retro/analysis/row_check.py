@@ -135,7 +135,12 @@ def _reference_answer(runner: RoutineRunner, row: Row) -> tuple | None:
     outside its domain: a row is not held to the domain)."""
     routine = runner.routine
     columns = cases_to_columns(routine, [row.case])
-    answers, answered = reference_answers(routine, columns, [row.case], runner.memory_values, np.zeros(1, dtype=bool))
+    calls = None
+    if routine.world.recorded:  # the reference takes the mocks' calls: those of this row's call
+        runner.run(row.case)
+        calls = [runner.last_calls]
+    answers, answered = reference_answers(routine, columns, [row.case], runner.memory_values, np.zeros(1, dtype=bool),
+                                          calls)
     return row_of(answers, 0) if answered[0] else None
 
 

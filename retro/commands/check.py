@@ -140,6 +140,7 @@ def check_record(check: RoutineCheck) -> dict:
               "input_space": space if (space := check.routine.input_space()) < JSON_EXACT else None,
               "input_space_log2": round(math.log2(space), 3), "coverage_argument": check.routine.coverage or None,
               "examples": t.examples, "outside_examples": t.outside_examples, "engine": check.engine,
+              "engine_note": check.engine_note or None,
               "engine_agreement": None if check.agreement is None else {
                   "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
                   "timing_model_mismatches": check.agreement.cycle_mismatches},
@@ -229,7 +230,8 @@ def _headline(check: RoutineCheck) -> str:
         checked = (f"batched core; on {a.engine_cases} of the calls Machine agrees on "
                    f"{a.engine_cases - a.engine_mismatches} and the timing model on "
                    f"{a.cases - a.cycle_mismatches - a.run_errors}")
-    return f"{check.routine.name}: {t.cases} cases, {verdict}; {cost}, {static}; {checked}"
+    note = f" ({check.engine_note})" if check.engine_note else ""
+    return f"{check.routine.name}: {t.cases} cases, {verdict}; {cost}, {static}; {checked}{note}"
 
 
 def _cycle_lines(check: RoutineCheck) -> list[str]:

@@ -37,6 +37,7 @@ from retro.errors import InputError
 OPCODE_JMP_ABS = 0x4C
 OPCODE_JSR = 0x20
 OPCODE_RTS = 0x60
+OPCODE_RTI = 0x40
 UNSUPPORTED = {0x6C: "JMP (indirect)", 0x40: "RTI", 0x00: "BRK"}
 # The 65C02's: a jump through a table indexed by X (its target is data), and the two that stop the clock.
 UNSUPPORTED_65C02 = {**UNSUPPORTED, 0x7C: "JMP (abs,X)", 0xCB: "WAI", 0xDB: "STP"}
@@ -59,16 +60,22 @@ class Bounds:
 
 
 def decode(read: Callable[[int], int], entry: int,
-           call_cost: Callable[[int, int], tuple[int, int]] | None = None, cpu: str = "6510") -> dict[int, Node]:
+           call_cost: Callable[[int, int], tuple[int, int]] | None = None, cpu: str = "6510",
+           ends: frozenset[int] = frozenset({OPCODE_RTS}), exits: frozenset[int] = frozenset()) -> dict[int, Node]:
     """The instructions reachable from entry. A JSR costs its own cycles plus the callee's best and
-    worst (`call_cost(pc, target)`), then continues after it, as the callee's RTS returns there."""
+    worst (`call_cost(pc, target)`), then continues after it, as the callee's RTS returns there.
+    `ends`: the opcodes that return (an interrupt handler's RTI); `exits`: addresses whose reaching
+    ends the routine at no cost (a JMP to a named exit: the JMP is counted, nothing after it)."""
     cmos = cpu == WDC_65C02
-    unsupported = UNSUPPORTED_65C02 if cmos else UNSUPPORTED
+    unsupported = {k: v for k, v in (UNSUPPORTED_65C02 if cmos else UNSUPPORTED).items() if k not in ends}
     nodes: dict[int, Node] = {}
     pending = [entry]
     while pending:
         pc = pending.pop()
         if pc in nodes:
+            continue
+        if pc in exits:
+            nodes[pc] = Node(pc, (0, 0), returns=True)
             continue
         opcode = read(pc)
         if opcode in unsupported or (opcode == OPCODE_JSR and call_cost is None):
@@ -91,7 +98,7 @@ def decode(read: Callable[[int], int], entry: int,
             best, worst = call_cost(pc, operand)
             node.cycles = (op.cycles + best, op.cycles + worst)
             node.successors.append((following, 0))
-        elif opcode == OPCODE_RTS:
+        elif opcode == OPCODE_RTS or opcode in ends:
             node.returns = True
         elif opcode == OPCODE_JMP_ABS:
             node.successors.append((operand, 0))
@@ -146,30 +153,46 @@ def _loops(nodes: dict[int, Node], entry: int) -> dict[int, frozenset[int]]:
 
 def analyse(read: Callable[[int], int], entry: int, loop_bounds: dict[int, int] | None = None,
             name: str = "routine", within: tuple[int, int] | None = None,
-            describe: Callable[[int], str] | None = None, cpu: str = "6510") -> Bounds:
+            describe: Callable[[int], str] | None = None, cpu: str = "6510", *,
+            mocks: dict[int, int] | None = None, interrupt: bool = False, exits: frozenset[int] = frozenset()) -> Bounds:
     """Best and worst cycles from the entry through an RTS over every path the bytes allow.
 
     Subroutines called with JSR are analysed the same way (their loops bounded by the same
     `loop_bounds`) and their cost is included, as long as they lie in `within` (start, end) when
-    given; recursion is an error. `describe(address)` names an address in errors (a label)."""
+    given; recursion is an error. `describe(address)` names an address in errors (a label).
+    A routine's world (retro.routines.world): `mocks` {JSR target: its cycles through its RTS},
+    `interrupt` (the entry is a handler: its RTI ends it), `exits` (reaching one ends it); the
+    interrupt sequence's own cycles are the caller's to add."""
     return _analyse(read, entry, dict(loop_bounds or {}), name, within, describe or (lambda a: f"${a:04X}"), {}, (),
-                    cpu)
+                    cpu, dict(mocks or {}), frozenset(exits), interrupt)
 
 
 def _analyse(read, entry: int, bounds: dict[int, int], name: str, within, describe, done: dict, calling: tuple,
-             cpu: str) -> Bounds:
+             cpu: str, mocks: dict[int, int] | None = None, exits: frozenset[int] = frozenset(),
+             interrupt: bool = False) -> Bounds:
+    mocks = mocks or {}
+    ends = frozenset({OPCODE_RTS, OPCODE_RTI}) if interrupt else frozenset({OPCODE_RTS})
+
     def call_cost(pc: int, target: int) -> tuple[int, int]:
+        if target in mocks:
+            return mocks[target], mocks[target]
         if within is not None and not within[0] <= target < within[1]:
             raise InputError(f"{name}: JSR {describe(target)} at ${pc:04X} calls outside the program "
-                             f"(${within[0]:04X}-${within[1] - 1:04X}); its cost is unknown")
+                             f"(${within[0]:04X}-${within[1] - 1:04X}); its cost is unknown: say what it does and costs "
+                             "with a mock ([mocks], docs/specs.md)")
         if target in calling or target == entry:
             raise InputError(f"{name}: JSR {describe(target)} at ${pc:04X} is recursive")
         if target not in done:
-            done[target] = _analyse(read, target, bounds, name, within, describe, done, (*calling, entry), cpu)
+            done[target] = _analyse(read, target, bounds, name, within, describe, done, (*calling, entry), cpu, mocks,
+                                    exits)
         callee = done[target]
         return callee.best, callee.worst
 
-    nodes = decode(read, entry, call_cost, cpu)
+    nodes = decode(read, entry, call_cost, cpu, ends, exits)
+    reached = sorted(pc for pc in nodes if pc in exits)
+    if calling and reached:  # the call would end inside a subroutine: its caller's rest is not run
+        raise InputError(f"{name}: the subroutine at {describe(entry)} reaches the exit {describe(reached[0])}; the "
+                         "static analysis bounds exits reached by the routine itself, not by its subroutines")
     loops = _loops(nodes, entry)
     for header in loops:
         if header not in bounds:

@@ -21,6 +21,8 @@ from retro.cpu.mpu import (
     FLAG_U,
     FLAG_V,
     FLAG_Z,
+    INTERRUPT_CYCLES,
+    OPCODE_BRK,
     CpuHalt,
 )
 from retro.cpu.variants import VARIANTS
@@ -39,6 +41,8 @@ RECENT_SHOWN = 8  # instructions listed in a failure message
 NO_ADDRESS = -1  # a stop address the PC never equals
 ANY_STACK = -1  # stop at the address whatever the stack pointer
 JSR_CYCLES = 6  # the caller's JSR, excluded from every reported count
+OPCODE_JSR = 0x20
+ENTRIES = ("jsr", "irq", "nmi")  # how a routine is entered: called by JSR, or as an interrupt handler
 LOADS = frozenset({"LDA", "LDX", "LDY", "LAX"})
 STORES = frozenset({"STA", "STX", "STY", "SAX", "SHA", "SHX", "SHY", "TAS", "STZ"})
 
@@ -78,6 +82,20 @@ def push_return_trap(memory) -> int:
     top = STACK_BASE | CALL_STACK_TOP
     memory[top], memory[top - 1] = back >> 8, back & 0xFF
     return CALL_STACK_TOP - 2
+
+
+def push_interrupt_frame(memory, p: int) -> int:
+    """Put on an empty stack what the CPU's interrupt sequence pushes when it interrupts RETURN_TRAP
+    (the address, high byte first, then P with B clear) and return S after it: how an IRQ or NMI
+    handler is entered (its RTI then returns to RETURN_TRAP with S back at the top)."""
+    top = STACK_BASE | CALL_STACK_TOP
+    memory[top], memory[top - 1], memory[top - 2] = RETURN_TRAP >> 8, RETURN_TRAP & 0xFF, (p | FLAG_U) & ~FLAG_B
+    return CALL_STACK_TOP - 3
+
+
+def interrupt_entry_flags(mpu_class, p: int) -> int:
+    """P inside a handler the CPU has just entered: I set (and, on the 65C02, D clear)."""
+    return (p | FLAG_I) & ~mpu_class.interrupt_clears
 
 
 def _status(p: int) -> int:
@@ -163,8 +181,10 @@ class Machine:
     # ---- running ---------------------------------------------------------------------------
 
     def call(self, entry: str | int, *, a: int = 0, x: int = 0, y: int = 0, p: int = DEFAULT_FLAGS,
-             memory: dict | None = None, budget: int = DEFAULT_BUDGET, trace: bool = False) -> CallResult:
-        """Run the routine at entry as if called by JSR; stop at its RTS.
+             memory: dict | None = None, budget: int = DEFAULT_BUDGET, trace: bool = False,
+             enter: str = "jsr") -> CallResult:
+        """Run the routine at entry as if called by JSR; stop at its RTS (`enter` "irq" or "nmi": as
+        the CPU enters an interrupt handler, the 7 cycles of its sequence counted; stop at its RTI).
 
         Fails (RunError) on BRK, JAM or an unstable opcode, and when the routine needs more than
         `budget` cycles (a runaway routine is stopped as soon as it has used them).
@@ -175,10 +195,12 @@ class Machine:
                 raise InputError(f"{name}: {value} is not a byte (0-255)")
         if not 1 <= budget <= MAX_BUDGET:
             raise InputError(f"budget: {budget} is not a number of cycles in 1..{MAX_BUDGET:,}")
+        if enter not in ENTRIES:
+            raise InputError(f"enter: {enter!r} is not one of {', '.join(ENTRIES)}")
         for target, values in (memory or {}).items():
             self.poke(target, values)
         entries: list[TraceEntry] | None = [] if trace else None
-        start = self._enter(address, a, x, y, p)
+        start = self._enter(address, a, x, y, p, enter)
         stolen_before = self.mpu.stolen
         count = self._execute(RETURN_TRAP, CALL_STACK_TOP, start + budget,
                               None if entries is None else _Tracer(self, entries))
@@ -189,14 +211,20 @@ class Machine:
                           instructions=count, trace=entries, flags=_flags(status),
                           stolen=mpu.stolen - stolen_before)
 
-    def _enter(self, address: int, a: int, x: int, y: int, p: int) -> int:
-        """Set registers and the stack as a JSR from the return trap would; return the start cycle."""
+    def _enter(self, address: int, a: int, x: int, y: int, p: int, enter: str = "jsr") -> int:
+        """Set registers and the stack as a JSR from the return trap would (or, `enter` "irq"/"nmi",
+        as the interrupt sequence would, interrupting the return trap); return the start cycle."""
         mpu = self.mpu
         mpu.a, mpu.x, mpu.y, mpu.p = a, x, y, _status(p)
-        mpu.sp = push_return_trap(mpu.memory)
         mpu.pc = address
         mpu.pending_interrupt = None  # a poll before the call does not carry into it
-        return mpu.processorCycles
+        if enter == "jsr":
+            mpu.sp = push_return_trap(mpu.memory)
+            return mpu.processorCycles
+        mpu.sp = push_interrupt_frame(mpu.memory, mpu.p)
+        mpu.p = interrupt_entry_flags(type(mpu), mpu.p)
+        mpu.processorCycles += INTERRUPT_CYCLES  # the sequence's cycles (no stall is modelled in them)
+        return mpu.processorCycles - INTERRUPT_CYCLES
 
     def _returned(self, start: int, budget: int, count: int) -> int:
         """The routine's cycles, or a RunError if it did not return within the budget."""
@@ -210,7 +238,7 @@ class Machine:
 
     def call_fast(self, address: int, writes=(), *, a: int = 0, x: int = 0, y: int = 0, p: int = DEFAULT_FLAGS,
                   budget: int = DEFAULT_BUDGET, record: list | None = None,
-                  pointer_pcs: frozenset[int] = frozenset()) -> tuple[int, int, int, int, int]:
+                  pointer_pcs: frozenset[int] = frozenset(), enter: str = "jsr") -> tuple[int, int, int, int, int]:
         """`call` for sweeps of many thousands of calls: the same run without its conveniences.
 
         `address` is the entry as a number, `writes` are raw (address, byte) pairs stored into RAM,
@@ -222,7 +250,7 @@ class Machine:
         memory = self.bus.memory
         for target, value in writes:
             memory[target] = value
-        start = self._enter(address, a, x, y, p)
+        start = self._enter(address, a, x, y, p, enter)
         observer = None if record is None else _Recorder(record, pointer_pcs)
         count = self._execute(RETURN_TRAP, CALL_STACK_TOP, start + budget, observer)
         cycles = self._returned(start, budget, count)
@@ -256,7 +284,21 @@ class Machine:
         try:
             return mpu.run(stop_pc, stop_sp, limit, observer)
         except CpuHalt as halt:
-            raise RunError(f"{halt}; last instructions: {self._describe_recent(mpu.executed)}") from None
+            raise RunError(f"{self._called_nowhere(halt) or halt}; last instructions: "
+                           f"{self._describe_recent(mpu.executed)}") from None
+
+    def _called_nowhere(self, halt: CpuHalt) -> str | None:
+        """A BRK met right after a JSR to its address: a call into memory that holds no code."""
+        recent = self.mpu.recent_addresses(self.mpu.executed)
+        if halt.opcode != OPCODE_BRK or len(recent) < 2:
+            return None
+        caller = recent[-2]
+        memory = self.mpu.memory
+        if memory[caller] != OPCODE_JSR or (memory[(caller + 1) & 0xFFFF] | memory[(caller + 2) & 0xFFFF] << 8) != halt.address:
+            return None
+        return (f"JSR ${halt.address:04X} at ${caller:04X} calls an address where no code is (a BRK there): "
+                f"give the program that code, or say what the call does with a mock ([mocks] NAME = "
+                f"{{ at = \"${halt.address:04X}\", cycles = N }}, docs/specs.md)")
 
     def _operand_address(self, pc: int, mode: str) -> int | None:
         """The effective address of the instruction at pc, from the registers before it runs."""

@@ -27,12 +27,16 @@ from retro.cpu.lane_memory import LaneMemoryFull
 from retro.cpu.machine import (
     CALL_STACK_TOP,
     DEFAULT_BUDGET,
+    STACK_BASE,
     DEFAULT_FLAGS,
     RETURN_TRAP,
     CallResult,
+    interrupt_entry_flags,
+    push_interrupt_frame,
     push_return_trap,
 )
-from retro.cpu.mpu import FLAG_B, FLAG_U
+from retro.cpu.mpu import FLAG_B, FLAG_I, FLAG_U
+from retro.cpu.variants import VARIANTS
 from retro.cpu.timing import timing_table
 from retro.errors import InputError
 from retro.fileio import read_text
@@ -41,6 +45,7 @@ from retro.machines.c64 import vic_of
 from retro.program import Program
 from retro.routines.sandbox import bytes_of
 from retro.routines.spec import Port, Routine, call_with
+from retro.routines.world import NO_WORLD, WORLD_PLACES, BatchWorld, MachineWorld, World, chip_overlaps
 from retro.scenes.vic import VicScene
 from retro.tables import GENERATORS, STORAGE_TABLES
 
@@ -55,10 +60,12 @@ class Size:
     storage_bytes: int
 
 
-def routine_code(read, entries: list[int], within: tuple[int, int], cpu: str = "6510") -> dict[int, int]:
+def routine_code(read, entries: list[int], within: tuple[int, int], cpu: str = "6510",
+                 world: World = NO_WORLD) -> dict[int, int]:
     """{address: length} of every instruction reachable from the entries (following branches, JMP and
-    JSR into the program), as the static analysis decodes them."""
-    from retro.cpu.flow import decode
+    JSR into the program), as the static analysis decodes them (an interrupt handler's RTI and the
+    world's exits end a path)."""
+    from retro.cpu.flow import OPCODE_RTI, OPCODE_RTS, decode
     from retro.cpu.timing import timing_of
 
     found: dict[int, int] = {}
@@ -74,20 +81,23 @@ def routine_code(read, entries: list[int], within: tuple[int, int], cpu: str = "
                 callees.append(target)
             return (0, 0)
         try:
-            nodes = decode(read, entry, note_call, cpu)
+            nodes = decode(read, entry, note_call, cpu, frozenset({OPCODE_RTS, OPCODE_RTI}) if world.enter != "jsr"
+                           else frozenset({OPCODE_RTS}), frozenset(world.exits))
         except (InputError, KeyError, ValueError):  # code the decoder does not follow: count none of it
             continue
         for pc in nodes:
-            found[pc] = timing_of(read(pc), cpu).length
+            if pc not in world.exits:
+                found[pc] = timing_of(read(pc), cpu).length
         pending.extend(callees)
     return found
 
 
-def program_size(program: Program, source_text: str | None, entries: list[int], read, cpu: str = "6510") -> Size:
+def program_size(program: Program, source_text: str | None, entries: list[int], read, cpu: str = "6510",
+                 world: World = NO_WORLD) -> Size:
     """The routine's bytes: its reachable instructions (the entry's and init's, with their subroutines)
     and the generated tables they name (by address, or by `#>table` for pointers set up at init)."""
     within = (program.origin, program.end)
-    code = routine_code(read, entries, within, cpu)
+    code = routine_code(read, entries, within, cpu, world)
     names = requested_tables(source_text) if source_text else []
     spans = {n: (program.symbols[n], program.symbols[n] + len(GENERATORS[n]())) for n in names if n in program.symbols}
     used = set()
@@ -139,6 +149,7 @@ class BatchOutcome:
     cycles: np.ndarray
     error: np.ndarray
     coverage: LaneCoverage | None = None
+    mock_calls: list | None = None  # per case, the calls of the mocks the reference takes (retro.routines.world)
 
 
 def row_of(arrays: list, i: int) -> tuple:
@@ -233,6 +244,9 @@ class RoutineRunner:
             self.machine = build_machine(start.scene)
             self.vic = vic_of(self.machine)
         self.machine.load(self.program)
+        if start is not None:  # before the world's own devices join the bus
+            chip_overlaps(routine, self.machine.bus.devices, str(start.scene.source))
+        self.world = None if routine.world.empty else MachineWorld(routine.world, self.machine, str(routine.spec_path))
         self.last_stolen = 0  # cycles of the last call in which the VIC-II held the CPU
         self.entry = routine.entry_address
         self.memory_values = memory_values(routine, seed)
@@ -241,6 +255,8 @@ class RoutineRunner:
             data = self.memory_values[block.name]
             memory[block.address:block.address + len(data)] = list(data)
         self.code_image = bytes(self.machine.memory)  # before init and the cases patch anything
+        if self.world is not None:
+            self.world.place_traps()  # mocks and exits (init may call a mock too)
         if routine.init is not None:
             self.machine.call_fast(routine.init_address, budget=self.limit)
         self.call_image = bytearray(self.machine.memory)  # what every call starts from (the batch's image)
@@ -250,6 +266,11 @@ class RoutineRunner:
         indirect_y = {opcode for opcode, op in timing_table(routine.cpu).items() if op.mode in ("iny", "zpr")}
         self.pointer_pcs = frozenset(self.program.origin + i for i, b in enumerate(self.program.code) if b in indirect_y)
         self.plan = InputPlan.of(routine)
+        self.written_kept: dict[str, int] = {}  # per hardware entry, the values written that outputs show
+        for port in routine.outputs:
+            for place in port.places:
+                if place.kind == "written":
+                    self.written_kept[place.register] = max(self.written_kept.get(place.register, 0), place.bit + 1)
 
     @property
     def limit(self) -> int:
@@ -264,16 +285,38 @@ class RoutineRunner:
         return writes, registers, p
 
     def run(self, case: Sequence, record: list | None = None) -> tuple[tuple, int]:
-        """(outputs in the spec's order, cycles) of one call."""
+        """(outputs in the spec's order, cycles) of one call. With a world, `record` leaves out the
+        traps (mocks, exits) and `last_extra_cycles` says what the timing model must add for them
+        and for an interrupt entry; `last_calls` holds the recorded mocks' calls."""
         writes, registers, p = self.inputs_for_call(case)
         if self.vic is not None:
             self._restart_beam()
             stolen = self.machine.mpu.stolen
-        cycles, a, x, y, p = self.machine.call_fast(self.entry, writes, **registers, p=p, budget=self.limit,
-                                                    record=record, pointer_pcs=self.pointer_pcs)
+        world = self.world
+        if world is None:
+            cycles, a, x, y, p = self.machine.call_fast(self.entry, writes, **registers, p=p, budget=self.limit,
+                                                        record=record, pointer_pcs=self.pointer_pcs)
+        else:
+            world.reset(self.machine.cycle)
+            cycles, a, x, y, p = self.machine.call_fast(self.entry, writes, **registers, p=self._entry_p(p),
+                                                        budget=self.limit, record=record, pointer_pcs=self.pointer_pcs,
+                                                        enter=self.routine.world.enter)
         if self.vic is not None:
             self.last_stolen = self.machine.mpu.stolen - stolen
+        if world is not None:
+            if record is not None:
+                traps = world.actions
+                record[:] = [step for step in record if step[0] not in traps]
+            self.last_extra_cycles = world.trap_cycles + self.routine.world.entry_cycles
+            self.last_calls = world.recorded_calls()
         return self.outputs(a, x, y, p), cycles
+
+    last_extra_cycles = 0
+    last_calls: dict | None = None
+
+    def _entry_p(self, p):
+        """P at entry; an IRQ handler's pushed P has I clear (the CPU takes an IRQ only then)."""
+        return p & ~FLAG_I if self.routine.world.enter == "irq" else p
 
     def _restart_beam(self) -> None:
         self.vic.restart(self.machine.cycle, self.start.line, self.start.cycle)
@@ -296,7 +339,12 @@ class RoutineRunner:
     @property
     def batchable(self) -> bool:
         """Whether the batched core can run this routine (it has no chips: not with a scene)."""
-        return self.vic is None
+        return self.vic is None and self.batch_refusal is None
+
+    @property
+    def batch_refusal(self) -> str | None:
+        """Why the batched core cannot run this routine's world (None: it can; a scene aside)."""
+        return self.routine.world.batch_refusal()
 
     def run_batch(self, columns: list, coverage: bool = False, first_lanes: bool = False) -> "BatchOutcome":
         """Run every case of a column block (one array per input) on the batched core (`coverage`:
@@ -318,55 +366,83 @@ class RoutineRunner:
 
     def _run_lanes(self, columns: list, n: int, coverage: bool = False, first_lanes: bool = False) -> "BatchOutcome":
         image = bytearray(self.call_image)
-        stack_pointer = push_return_trap(image)
+        enter = self.routine.world.enter
+        stack_pointer = push_return_trap(image) if enter == "jsr" else push_interrupt_frame(image, 0)
         cpu = BatchCpu(self.routine.cpu, image, n, coverage=coverage, first_lanes=first_lanes)
+        world = None if self.routine.world.empty else BatchWorld(self.routine.world, cpu, self.written_kept,
+                                                                  str(self.routine.spec_path))
         registers, p = self.plan.place(columns, _column_byte, cpu.memory.fill)
         for name, value in registers.items():
             lanes = getattr(cpu, name)
             lanes |= np.asarray(value).astype(lanes.dtype)
-        cpu.p[:] = (p | FLAG_U) & ~FLAG_B  # as Machine sets P
+        cpu.p[:] = (self._entry_p(p) | FLAG_U) & ~FLAG_B  # as Machine sets P
+        if enter != "jsr":  # the interrupt sequence: P pushed (per lane), I set, its 7 cycles counted
+            cpu.memory.fill(STACK_BASE | (stack_pointer + 1), cpu.p.copy())
+            cpu.p[:] = interrupt_entry_flags(VARIANTS[self.routine.cpu], cpu.p)
+            cpu.cycles[:] = self.routine.world.entry_cycles
         cpu.sp[:] = stack_pointer
         cpu.call(self.entry, self.limit, RETURN_TRAP, CALL_STACK_TOP)
+        if world is not None:
+            world.finish()
         outputs = port_values(self.routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,
                               widen=lambda lanes: np.asarray(lanes, dtype=np.int64),
-                              table=lambda columns: np.stack(columns, axis=1).astype(np.int64))
-        return BatchOutcome(outputs, cpu.cycles, cpu.error, cpu.coverage)
+                              table=lambda columns: np.stack(columns, axis=1).astype(np.int64),
+                              world=None if world is None else world.value)
+        calls = world.recorded_calls() if world is not None and self.routine.world.recorded else None
+        return BatchOutcome(outputs, cpu.cycles, cpu.error, coverage=cpu.coverage, mock_calls=calls)
 
     def outputs(self, a: int, x: int, y: int, p: int) -> tuple:
         return tuple(port_values(self.routine.outputs, {"a": a, "x": x, "y": y}, p, self.machine.memory.__getitem__,
-                                 widen=int, table=tuple))
+                                 widen=int, table=tuple, world=None if self.world is None else self.world.value))
 
     def traced(self, case: Sequence) -> CallResult:
         """The same call with the instruction trace (for the report of a failing case)."""
         writes, registers, p = self.inputs_for_call(case)
         if self.vic is not None:
             self._restart_beam()
-        return self.machine.call(self.entry, **registers, p=p, memory={address: [v] for address, v in writes},
-                                 budget=self.limit, trace=True)
+        if self.world is not None:
+            self.world.reset(self.machine.cycle)
+        return self.machine.call(self.entry, **registers, p=self._entry_p(p),
+                                 memory={address: [v] for address, v in writes}, budget=self.limit, trace=True,
+                                 enter=self.routine.world.enter)
+
+    def disassemble_at(self, address: int) -> str:
+        """The instruction at address as a trace shows it (a world's trap by what it stands for)."""
+        if self.world is not None and address in self.world.actions:
+            return self.world.describe_trap(address)
+        return self.machine.disassemble_at(address)
 
     def size(self) -> Size:
         """Bytes of code, lookup tables and caller-filled storage of the routine's program."""
         source = self.routine.program_file
         text = read_text(source, "source file") if source.suffix.lower() in (".s", ".asm", ".oph") else None
         entries = [self.entry] + ([self.routine.init_address] if self.routine.init is not None else [])
-        return program_size(self.program, text, entries, self.code_image.__getitem__, self.routine.cpu)
+        return program_size(self.program, text, entries, self.code_image.__getitem__, self.routine.cpu,
+                            self.routine.world)
 
 
-def port_values(ports: Sequence[Port], registers: dict, p, read: Callable, widen: Callable, table: Callable) -> list:
+def port_values(ports: Sequence[Port], registers: dict, p, read: Callable, widen: Callable, table: Callable,
+                world: Callable | None = None) -> list:
     """The outputs of a call, one value per port in the spec's order, read from the registers, P and
     memory (`read(address)`): the same code for one call (ints) and for lanes of the batched core
     (arrays), which differ only in `widen` (a byte or a flag as the output's number type) and
-    `table` (bytes of a table output together)."""
+    `table` (bytes of a table output together); `world(place)`: a world output's byte (retro.routines.world)."""
     values = []
     for port in ports:
+        if port.places[0].kind in WORLD_PLACES:
+            read_place = world
+        else:
+            read_place = None
         if port.flag:
             values.append(widen((p & port.places[0].bit) != 0))
         elif port.table:
-            values.append(table([read(place.address) for place in port.places]))
+            values.append(table([read(place.address) if read_place is None else read_place(place)
+                                 for place in port.places]))
         else:
             value = widen(0)
             for shift, place in enumerate(port.places):
-                byte = registers[place.register] if place.kind == "register" else read(place.address)
+                byte = (read_place(place) if read_place is not None else
+                        registers[place.register] if place.kind == "register" else read(place.address))
                 value = value | widen(byte) << (8 * shift)
             values.append(value)
     return values

@@ -42,6 +42,7 @@ from retro.routines.places import (
 )
 from retro.routines.rows import Row, misplaced_rows, parse_rows
 from retro.routines import sandbox
+from retro.routines.world import NO_WORLD, World, check_names, is_world_output, parse_world, recorded_mocks, world_output
 from retro.routines.where import Condition, parse_where
 
 MAX_EXHAUSTIVE = 1 << 32  # cases in an exhaustive set
@@ -52,8 +53,9 @@ MAX_LOOP_BOUND = 1 << 20
 NUMBER_CHARACTERS = 40  # the longest number a spec may write as text
 CPUS = tuple(VARIANTS)
 
-TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows"}
-PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load", "listing"}
+TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows",
+            "mocks", "hardware"}
+PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load", "listing", "interrupt", "exit"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays", "time_limit"}
 CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage", "search"}
@@ -114,6 +116,7 @@ class Routine:
     notes: tuple[str, ...] = ()  # what loading the program left out (a symbol file's skipped lines)
     rows: tuple[Row, ...] = ()  # expected rows written in the spec (retro.routines.rows)
     search: int | None = None  # [cases] search: candidates of the coverage-guided search (None: the default)
+    world: World = NO_WORLD  # mocks, scripted hardware, interrupt entry, exits (retro.routines.world)
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -189,14 +192,17 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     misplaced_rows(r, doc)
     seconds = sandbox.time_limit(r, r.table(doc.get("reference", {}), "reference"), "reference")
     program = _program_section(r, doc)
-    inputs, outputs, memory = _places_sections(r, doc, program.program, seconds)
+    world = parse_world(r, doc, program.program, seconds, load_function, program.cpu)
+    inputs, outputs, memory = _places_sections(r, doc, program.program, seconds, world)
+    check_names(r, world, inputs, memory)
     rows = parse_rows(r, doc["rows"], inputs, outputs) if "rows" in doc else ()
-    reference = _reference_section(r, doc, inputs, memory, rows, seconds)
+    reference = _reference_section(r, doc, inputs, memory, rows, seconds, world)
+    world = reference.pop("world")
     cases = _cases_section(r, doc, inputs, seconds, answered=reference["reference"] is not None)
     cycles = _cycles_section(r, doc, program.program)
     routine = Routine(name=_text(r, doc, "name", "name") or path.stem, spec_path=path, **program.fields(),
                       inputs=inputs, outputs=outputs, memory=memory, **reference, **cases, **cycles,
-                      summary=_summary(r, doc), rows=rows, notes=program.program.notes)
+                      summary=_summary(r, doc), rows=rows, notes=program.program.notes, world=world)
     if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep or routine.rows):
         raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary, sweep or [[rows]]")
     if routine.exhaustive_count() > MAX_EXHAUSTIVE:
@@ -260,12 +266,13 @@ def _program_section(r: Fields, doc: dict) -> _ProgramSection:
                            entry_address, init_address, source_map)
 
 
-def _places_sections(r: Fields, doc: dict, program: Program, seconds: int) -> tuple[tuple[Port, ...], tuple[Port, ...],
-                                                                     tuple[MemoryBlock, ...]]:
+def _places_sections(r: Fields, doc: dict, program: Program, seconds: int, world: World = NO_WORLD
+                     ) -> tuple[tuple[Port, ...], tuple[Port, ...], tuple[MemoryBlock, ...]]:
     """[inputs], [outputs] and [memory]: where every value lives, none overlapping."""
     inputs = tuple(port_of(r, program, name, value, "inputs", is_input=True)
                    for name, value in r.table(r.required(doc, "inputs", hint="the [inputs] table"), "inputs").items())
-    outputs = tuple(port_of(r, program, name, value, "outputs", is_input=False)
+    outputs = tuple(world_output(r, world, name, value) if is_world_output(value) else
+                    port_of(r, program, name, value, "outputs", is_input=False)
                     for name, value in r.table(r.required(doc, "outputs", hint="the [outputs] table"),
                                                "outputs").items())
     if not outputs:
@@ -278,20 +285,22 @@ def _places_sections(r: Fields, doc: dict, program: Program, seconds: int) -> tu
 
 
 def _reference_section(r: Fields, doc: dict, inputs: tuple[Port, ...], memory: tuple[MemoryBlock, ...],
-                       rows: tuple[Row, ...], seconds: int) -> dict:
+                       rows: tuple[Row, ...], seconds: int, world: World = NO_WORLD) -> dict:
     """[reference]: the function, the memory blocks it takes, whether it works on arrays; none in a
     spec of rows only (the rows say what the routine must answer)."""
     if rows and "reference" not in doc:
         if "cases" in doc:
             raise r.error("cases", "without a [reference] no answer is known for generated cases: write them as rows, "
                                    "or add a [reference]")
-        return {"reference": None, "reference_name": "", "reference_memory": (), "reference_arrays": False}
+        return {"reference": None, "reference_name": "", "reference_memory": (), "reference_arrays": False,
+                "world": world}
     reference_doc = r.table(r.required(doc, "reference", hint="the [reference] table, or [[rows]]"), "reference",
                             REFERENCE_KEYS)
     reference_name = _text(r, reference_doc, "function", "reference.function", required=True)
     reference = load_function(reference_name, r, "reference.function", seconds, faults_only=True)
     return {"reference": reference, "reference_name": reference_name,
-            "reference_memory": _reference_signature(r, reference, reference_name, inputs, memory),
+            "reference_memory": _reference_signature(r, reference, reference_name, inputs, memory, world),
+            "world": recorded_mocks(world, *_parameter_names(reference)),
             # true: the function takes numpy arrays, one element per case
             "reference_arrays": r.flag(reference_doc.get("arrays", False), "reference.arrays")}
 
@@ -508,8 +517,17 @@ def _module_from_file(path: Path, r: Fields, key: str, seconds: int = sandbox.DE
         raise r.error(key, f"{path.name} failed to import{line}: {type(exc).__name__}: {exc}") from None
 
 
+def _parameter_names(function: Callable) -> tuple[set[str], bool]:
+    """The names a function takes, and whether it takes any (**kwargs)."""
+    try:
+        parameters = inspect.signature(function).parameters
+    except (TypeError, ValueError):
+        return set(), False
+    return set(parameters), any(p.kind == inspect.Parameter.VAR_KEYWORD for p in parameters.values())
+
+
 def _reference_signature(r: Fields, function: Callable, text: str, inputs: tuple[Port, ...],
-                         memory: tuple[MemoryBlock, ...]) -> tuple[str, ...]:
+                         memory: tuple[MemoryBlock, ...], world: World = NO_WORLD) -> tuple[str, ...]:
     """Check the reference takes every input by name; return the memory blocks it also takes."""
     try:
         parameters = inspect.signature(function).parameters
@@ -524,11 +542,11 @@ def _reference_signature(r: Fields, function: Callable, text: str, inputs: tuple
                                                "inputs by name)")
     required = [p.name for p in parameters.values() if p.default is inspect.Parameter.empty
                 and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
-    known = {port.name for port in inputs} | {m.name for m in memory}
+    known = {port.name for port in inputs} | {m.name for m in memory} | {m.name for m in world.mocks}
     for name in required:
         if name not in known:
             raise r.error("reference.function", f"{text} needs argument {name!r}, which is neither in [inputs] nor "
-                                               "a [memory] block")
+                                               "a [memory] block nor a mock")
     return tuple(m.name for m in memory if m.name in names or takes_any)
 
 

@@ -90,6 +90,7 @@ class CallBlock:
     stop_message: str = ""
     lane_errors: np.ndarray | None = None  # the batched core: per call, the LaneError that stopped it (0: none)
     coverage: CodeCoverage | None = None  # what the calls ran of the code (None: not collected)
+    mock_calls: list | None = None  # per call, the mocks' calls the reference takes (retro.routines.world)
 
     @property
     def calls(self) -> int:
@@ -122,6 +123,7 @@ def run_on_machine(runner: RoutineRunner, cases: list[tuple], coverage: bool = T
     the block (the next could run away as well). `coverage`: collect it (from the same recorded path)."""
     read = runner.machine.memory.__getitem__
     answers, cycles, stolen, modelled = [], [], [], []
+    calls = [] if runner.routine.world.recorded else None
     stop, message = None, ""
     covered = CodeCoverage() if coverage else None
     for case in cases:
@@ -134,11 +136,14 @@ def run_on_machine(runner: RoutineRunner, cases: list[tuple], coverage: bool = T
         answers.append(answer)
         cycles.append(spent)
         stolen.append(runner.last_stolen)
-        modelled.append(count_steps(covered, read, steps, runner.routine.cpu) if coverage else
-                        model_cycles(read, steps, runner.routine.cpu))
+        # the timing model times the routine's instructions; a world's traps and interrupt entry are added
+        modelled.append((count_steps(covered, read, steps, runner.routine.cpu) if coverage else
+                         model_cycles(read, steps, runner.routine.cpu)) + runner.last_extra_cycles)
+        if calls is not None:
+            calls.append(runner.last_calls)
     return CallBlock(_output_arrays(runner.routine, answers), np.asarray(cycles, dtype=np.int64),
                      np.asarray(stolen, dtype=np.int64), np.asarray(modelled, dtype=np.int64), len(answers),
-                     stop, message, coverage=covered)
+                     stop, message, coverage=covered, mock_calls=calls)
 
 
 def _output_arrays(routine: Routine, answers: list[tuple]) -> list[np.ndarray]:
@@ -156,7 +161,7 @@ def run_on_batched_core(runner: RoutineRunner, columns: list, confirm_stop: bool
     n = len(outcome.cycles)
     block = CallBlock(outcome.outputs, outcome.cycles, np.zeros(n, dtype=np.int64), None,
                       int(stopped[0]) if len(stopped) else n, lane_errors=outcome.error,
-                      coverage=from_lanes(outcome.coverage) if coverage else None)
+                      coverage=from_lanes(outcome.coverage) if coverage else None, mock_calls=outcome.mock_calls)
     if coverage and len(stopped):  # coverage counts the calls before the first that stopped, as on Machine
         block.coverage = (from_lanes(runner.run_batch([c[:block.returned] for c in columns], True).coverage)
                           if block.returned else CodeCoverage())
@@ -198,7 +203,7 @@ def failure_trace(spec: str, seed: int, case: tuple, start: SceneStart | None = 
     for entry in result.trace[:TRACE_SHOWN]:
         total += entry.cycles
         notes = " ".join(n for n, on in (("taken", entry.branch_taken), ("page+1", entry.page_crossed)) if on)
-        lines.append(f"${entry.address:04X}  {runner.machine.disassemble_at(entry.address):<14} "
+        lines.append(f"${entry.address:04X}  {runner.disassemble_at(entry.address):<14} "
                      f"{entry.cycles}  {total:>6}  {notes}".rstrip())
     if len(result.trace) > TRACE_SHOWN:
         lines.append(f"... {len(result.trace) - TRACE_SHOWN} more instructions")

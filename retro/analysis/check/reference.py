@@ -10,13 +10,15 @@ from retro.errors import InputError
 from retro.routines import cases as case_sets
 from retro.routines.sandbox import UserCodeError, shown
 from retro.routines.spec import Routine
+from retro.routines.world import reference_calls
 
 
-def expected_outputs(routine: Routine, case: tuple, memory: dict) -> tuple:
+def expected_outputs(routine: Routine, case: tuple, memory: dict, calls: dict | None = None) -> tuple:
     """The reference's answer for a case, as a tuple in the outputs' order (a one-line error for a
-    reference that raises or answers in the wrong shape)."""
+    reference that raises or answers in the wrong shape); `calls`: the mocks' calls it takes, by name."""
     arguments = dict(zip(routine.input_names, case))
     arguments.update({name: memory[name] for name in routine.reference_memory})
+    arguments.update(calls or {})
     try:
         value = routine.reference(**arguments)
     except UserCodeError:  # a hang, an exit, a runaway: its own line, never a refusal
@@ -69,28 +71,31 @@ def _output_value(port, item, where: str, routine: Routine, case: tuple):
 
 
 def reference_answers(routine: Routine, columns: list, cases: list[tuple] | None, memory: dict,
-                      inside: np.ndarray | None = None) -> tuple[list[np.ndarray], np.ndarray]:
+                      inside: np.ndarray | None = None, calls: list | None = None) -> tuple[list[np.ndarray], np.ndarray]:
     """The reference's answers for a block of cases, the one way the check gets them: one array per
     output (a table: (n, bytes)), and which cases it answered. The reference is called once on the
     arrays (`arrays = true`) or case by case; outside the domain (`inside` False) it may refuse a case
-    or answer out of range; inside, that is a one-line error."""
+    or answer out of range; inside, that is a one-line error. `calls`: per case, the mocks' calls the
+    reference takes by name (retro.routines.world); with arrays, a list per case."""
     n = len(columns[0])
     inside = np.ones(n, dtype=bool) if inside is None else inside
     if routine.reference_arrays:
+        if calls is not None:
+            memory = {**memory, **{name: [c[name] for c in calls] for name in calls[0]}} if calls else memory
         return _answers_on_arrays(routine, columns, memory, inside)
     return _answers_case_by_case(routine, cases if cases is not None else case_sets.columns_to_cases(columns),
-                                 memory, inside)
+                                 memory, inside, calls)
 
 
 def _answers_case_by_case(routine: Routine, cases: list[tuple], memory: dict,
-                          inside: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
+                          inside: np.ndarray, calls: list | None = None) -> tuple[list[np.ndarray], np.ndarray]:
     n = len(cases)
     answerable = np.ones(n, dtype=bool)
     answers = []
     blank = tuple(tuple(-1 for _ in p.places) if p.table else -1 for p in routine.outputs)
     for i, case in enumerate(cases):
         try:
-            answers.append(expected_outputs(routine, case, memory))
+            answers.append(expected_outputs(routine, case, memory, None if calls is None else calls[i]))
         except UserCodeError:  # a hang, an exit: never a refusal
             raise
         except InputError:
@@ -130,7 +135,8 @@ def _answers_on_arrays(routine: Routine, columns: list, memory: dict,
 def _call_on_arrays(routine: Routine, columns: list, memory: dict, where: str) -> list:
     """The reference called once on the block: its answer per output, in the outputs' order."""
     arguments = dict(zip(routine.input_names, columns))
-    arguments.update({name: memory[name] for name in routine.reference_memory})
+    arguments.update({name: memory[name] for name in (*routine.reference_memory, *reference_calls(routine.world))
+                      if name in memory})
     try:
         with np.errstate(all="ignore"):
             value = routine.reference(**arguments)

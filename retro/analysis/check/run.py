@@ -161,7 +161,11 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     unknown = any(p.count is None for p in parts)
     runner = runner_for(spec, seed, start)  # loads and validates in this process before any worker starts
     on_batch = batched(engine, None if unknown else known, runner.batchable, AUTO_BATCH_CASES)
-    if engine == "batch" and not on_batch:
+    refusal = runner.batch_refusal if runner.vic is None else None
+    engine_note = ""
+    if refusal is not None and batched(engine, None if unknown else known, True, AUTO_BATCH_CASES):
+        engine_note = f"Machine ran the calls: {refusal}"  # the batched core would have: say why not
+    elif engine == "batch" and not on_batch:
         raise InputError("--engine batch: with --scene the calls run on Machine (the batched core models no chips); "
                          "use --engine scalar or auto")
     totals = Tally()
@@ -194,7 +198,7 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     check = RoutineCheck(routine, runner.size(), static, totals, bounds_violations(routine, static, totals),
                          budget_violations(routine, static, totals), _part_runs(parts, totals, unknown, rows),
                          start=runner.start, engine="batch" if on_batch else "scalar", agreement=agreement, rows=rows,
-                         search=searched)
+                         search=searched, engine_note=engine_note)
     if rows is not None and rows.agreement is not None:
         check.agreement = agreement = merged_agreement(agreement, rows)
     if agreement is not None and agreement.failure is not None and totals.failure is None:

@@ -168,7 +168,8 @@ def _calls(routine: Routine, block: CallBlock, columns: list, cases: list[tuple]
     for broken in broken_by:
         inside &= ~broken
     if n:
-        expected, answerable = reference_answers(routine, columns, cases, memory, inside)
+        expected, answerable = reference_answers(routine, columns, cases, memory, inside,
+                                                 None if block.mock_calls is None else block.mock_calls[:n])
     else:
         expected, answerable = [np.zeros((0, *o.shape[1:]), dtype=np.int64) for o in block.outputs], inside
     equal = np.ones(n, dtype=bool)

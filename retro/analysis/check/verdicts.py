@@ -26,8 +26,13 @@ def static_bounds(routine: Routine, runner: RoutineRunner | None = None) -> Boun
     def describe(address: int) -> str:
         return f"${address:04X}" + (f" ({names[address]})" if address in names else "")
     try:
-        return analyse(memory.__getitem__, runner.entry, bounds, name=routine.name,
-                       within=(program.origin, program.end), describe=describe, cpu=routine.cpu)
+        world = routine.world
+        found = analyse(memory.__getitem__, runner.entry, bounds, name=routine.name,
+                        within=(program.origin, program.end), describe=describe, cpu=routine.cpu,
+                        mocks=world.mock_costs(), interrupt=world.enter != "jsr", exits=frozenset(world.exits))
+        if world.entry_cycles:  # the interrupt sequence before the handler's first instruction
+            found = Bounds(found.best + world.entry_cycles, found.worst + world.entry_cycles, found.instructions)
+        return found
     except InputError as exc:
         raise InputError(f"{routine.spec_path}: static analysis: {exc} ([cycles] static = false skips it)") from None
 

@@ -99,6 +99,7 @@ PALETTE_MIRRORED = 0x10
 class PpuDevice:
     """The PPU on the bus, created from a PpuState; `retro.machines.nes.build_nes` maps it on a 2A03's bus."""
 
+    chip_name = "PPU"
     drives_cpu_lines = True
     irq_next = NEVER  # the PPU has no IRQ output
 

@@ -106,6 +106,7 @@ def _time_between(t: int | None, lo: int, hi: int, frame_cycles: int) -> bool:
 class VicDevice:
     """A VIC-II whose frame starts (line 0, cycle 1) at machine cycle `start_cycle`."""
 
+    chip_name = "VIC-II"
     drives_cpu_lines = True
     nmi_next = NEVER  # the VIC-II has no NMI output
 
