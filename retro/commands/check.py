@@ -8,7 +8,8 @@ import math
 from pathlib import Path
 
 from retro.analysis.check import RoutineCheck, SceneStart, inputs_by_name, run_checks
-from retro.analysis.check.results import describe_case, describe_outputs
+from retro.analysis.check.entry_runs import VARIANTS
+from retro.analysis.check.results import describe_case, describe_outputs, entry_needs
 from retro.analysis.junit import junit_xml
 from retro.analysis.raster import format_raster, raster_figures
 from retro.analysis.row_check import rows_lines, rows_record
@@ -17,6 +18,7 @@ from retro.fileio import file_option, write_atomic
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
 from retro.routines import cases as case_sets
+from retro.routines.entry import EntryState
 from retro.workers import MAX_WORKERS
 
 MAX_RANDOM = 10 ** 9
@@ -127,7 +129,8 @@ def check_record(check: RoutineCheck) -> dict:
               "engine_agreement": None if check.agreement is None else {
                   "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
                   "timing_model_mismatches": check.agreement.cycle_mismatches},
-              "notes": list(check.routine.notes), "first_failure": None, "rows": None}
+              "notes": list(check.routine.notes), "first_failure": None, "rows": None,
+              "entry_dependence": entry_record(check)}
     failure = t.failure
     if failure is not None:
         routine = check.routine
@@ -141,6 +144,47 @@ def check_record(check: RoutineCheck) -> dict:
     if check.rows is not None:
         record["rows"] = rows_record(check.routine, check.rows)
     return record
+
+
+def entry_record(check: RoutineCheck) -> dict | None:
+    """The entry-state runs (retro.analysis.check.entry_runs): null when none ran."""
+    if not check.entry_every:
+        return None
+    t = check.totals
+    routine = check.routine
+    state = EntryState.of(routine.entry_state, routine.inputs, vary_interrupt=check.start is None)
+    first = min(t.entry_first.values(), key=lambda finding: finding.index, default=None)
+    return {"cases": t.entry_cases, "every": check.entry_every, "variants": list(VARIANTS),
+            "stated": dict(routine.entry_state),
+            "varied": [n.upper() for n in state.free_registers] + list(state.free_flags) + ["memory"],
+            "changed": t.entry_changed, "needs": entry_needs(check),
+            "first": None if first is None else {
+                "variant": first.variant, "inputs": inputs_by_name(routine, first.case),
+                "outputs": dict(zip(routine.output_names, _plain(first.baseline[0]))), "cycles": first.baseline[1],
+                "varied_outputs": None if first.varied[0] is None else dict(zip(routine.output_names,
+                                                                                _plain(first.varied[0]))),
+                "varied_cycles": first.varied[1] if first.varied[0] is not None else None,
+                "stopped": first.varied[1] if first.varied[0] is None else None}}
+
+
+def entry_lines(check: RoutineCheck) -> list[str]:
+    record = entry_record(check)
+    if record is None:
+        return []
+    varied = ", ".join(record["varied"][:-1]) + (" and " if len(record["varied"]) > 1 else "") + "untouched memory"
+    sample = f"1 case in {record['every']:,}" if record["every"] > 1 else "every case"
+    if not record["changed"]:
+        return [f"  entry state: {record['cases']:,} cases ({sample}) run again with {varied} all ones and random: "
+                "no change"]
+    lines = [f"  ENTRY {record['changed']:,} of {record['cases']:,} cases change with {varied} all ones or random:"]
+    lines += [f"  ENTRY {need}" for need in record["needs"]]
+    first = check.totals.entry_first[record["first"]["variant"]]
+    routine = check.routine
+    varied_text = (f"stopped ({first.varied[1]})" if first.varied[0] is None else
+                   f"{describe_outputs(routine, first.varied[0])} in {first.varied[1]} cycles")
+    lines.append(f"  ENTRY e.g. {describe_case(routine, first.case)}: {describe_outputs(routine, first.baseline[0])} "
+                 f"in {first.baseline[1]} cycles, with the entry state {first.variant}: {varied_text}")
+    return lines
 
 
 def _plain(values: tuple) -> list:
@@ -183,6 +227,7 @@ def format_check(check: RoutineCheck) -> list[str]:
                      + (f", e.g. {t.outside_examples[0]}" if t.outside_examples else ""))
     if check.rows is not None:
         lines += rows_lines(routine, check.rows)
+    lines += entry_lines(check)
     lines += [f"  MISMATCH {example}" for example in t.examples]
     lines += [f"  MISMATCH {violation}" for violation in check.bounds_violations]
     lines += [f"  BUDGET {violation}" for violation in check.budget_violations]

@@ -39,6 +39,7 @@ from retro.routines.places import (
     port_of,
     resolve,
 )
+from retro.routines.entry import parse_entry
 from retro.routines.rows import Row, misplaced_rows, parse_rows
 from retro.routines import sandbox
 from retro.routines.where import Condition, parse_where
@@ -51,7 +52,8 @@ MAX_LOOP_BOUND = 1 << 20
 NUMBER_CHARACTERS = 40  # the longest number a spec may write as text
 CPUS = tuple(VARIANTS)
 
-TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows"}
+TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows",
+            "entry"}
 PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays", "time_limit"}
@@ -110,6 +112,7 @@ class Routine:
     coverage: str = ""  # why the cases cover the input space (an argument the report quotes)
     notes: tuple[str, ...] = ()  # what loading the program left out (a symbol file's skipped lines)
     rows: tuple[Row, ...] = ()  # expected rows written in the spec (retro.routines.rows)
+    entry_state: tuple[tuple[str, int], ...] = ()  # `[entry]`: registers and flags the caller guarantees
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -192,7 +195,8 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     cycles = _cycles_section(r, doc, program.program)
     routine = Routine(name=_text(r, doc, "name", "name") or path.stem, spec_path=path, **program.fields(),
                       inputs=inputs, outputs=outputs, memory=memory, **reference, **cases, **cycles,
-                      summary=_summary(r, doc), rows=rows, notes=program.program.notes)
+                      summary=_summary(r, doc), rows=rows, notes=program.program.notes,
+                      entry_state=parse_entry(r, doc.get("entry", {}), inputs))
     if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep or routine.rows):
         raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary, sweep or [[rows]]")
     if routine.exhaustive_count() > MAX_EXHAUSTIVE:

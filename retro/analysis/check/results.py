@@ -50,6 +50,7 @@ class RoutineCheck:
     agreement: Tally | None = None  # with the batched core: the cases also run on Machine
     rows: RowsCheck | None = None  # the spec's expected rows (retro.analysis.row_check)
     seconds: float = 0.0  # wall time of the check (JUnit reports)
+    entry_every: int = 0  # every how many cases one ran again with the entry state varied (0: none did)
 
     @property
     def mismatches(self) -> int:
@@ -60,7 +61,7 @@ class RoutineCheck:
             found += self.agreement.engine_mismatches + self.agreement.cycle_mismatches
         if self.rows is not None:  # rows whose call returned something else (a stopped call is a run error)
             found += self.rows.wrong
-        return found
+        return found + t.entry_changed  # cases whose outputs or cycles change with the entry state
 
     @property
     def mean(self) -> float:
@@ -80,6 +81,14 @@ class RoutineCheck:
             lines.append(f"  condition {condition.text}: {violating} cases break it, {wrong} of them wrong: {verdict}")
         return lines
 
+
+
+def entry_needs(check: RoutineCheck) -> list[str]:
+    """What the routine depends on, one line each, from every variant's first changed case."""
+    needs: list[str] = []
+    for finding in check.totals.entry_first.values():
+        needs += [line for line in finding.needs or () if line not in needs]
+    return needs
 
 
 def inputs_by_name(routine: Routine, case: tuple) -> dict:
