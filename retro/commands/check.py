@@ -130,7 +130,7 @@ def check_record(check: RoutineCheck) -> dict:
                   "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
                   "timing_model_mismatches": check.agreement.cycle_mismatches},
               "notes": list(check.routine.notes), "first_failure": None, "rows": None,
-              "entry_dependence": entry_record(check)}
+              "entry_dependence": entry_record(check), "random_draw": draw_record(check.random_draw)}
     failure = t.failure
     if failure is not None:
         routine = check.routine
@@ -165,6 +165,27 @@ def entry_record(check: RoutineCheck) -> dict | None:
                                                                                 _plain(first.varied[0]))),
                 "varied_cycles": first.varied[1] if first.varied[0] is not None else None,
                 "stopped": first.varied[1] if first.varied[0] is None else None}}
+
+
+def draw_record(draw) -> dict | None:
+    """How the random part met the `where` domain (retro.routines.cases.DomainDraw); null without one."""
+    if draw is None:
+        return None
+    return {"inside": draw.inside, "share": round(draw.share, 6), "requested": draw.requested, "drawn": draw.drawn,
+            "method": draw.method, "ranges": {name: [lo, hi] for name, lo, hi in draw.ranges},
+            "candidates": draw.candidates}
+
+
+def draw_lines(check: RoutineCheck) -> list[str]:
+    draw = check.random_draw
+    if draw is None or not draw.inside:
+        return []
+    box = ", ".join(f"{name} {lo}..{hi}" for name, lo, hi in draw.ranges)
+    how = (f"sampled from the {draw.candidates:,} combinations of the box {box}" if draw.method == "enumerated" else
+           f"drawn in the box {box}" + (f" ({draw.candidates:,} candidates)" if draw.candidates else ""))
+    short = "" if draw.drawn == draw.requested else f" of {draw.requested:,} asked for (the draw's budget ran out)"
+    return [f"  random cases: {draw.drawn:,}{short} inside the domain (uniform draws keep {100 * draw.share:.2f}%), "
+            f"{how}"]
 
 
 def entry_lines(check: RoutineCheck) -> list[str]:
@@ -215,6 +236,7 @@ def format_check(check: RoutineCheck) -> list[str]:
     lines += [f"  note: {note}" for note in routine.notes]
     if check.parts:
         lines.append(f"  cases: {format_coverage(check)}; input space {format_space(check.routine.input_space())}")
+    lines += draw_lines(check)
     if routine.coverage:
         lines.append(f"  coverage: {routine.coverage}")
     if t.cycles_count:

@@ -18,7 +18,7 @@ import importlib.util
 import inspect
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 
@@ -33,6 +33,7 @@ from retro.routines.places import (
     BYTE_VALUES,
     MAX_TABLE,
     Port,
+    Values,
     no_overlap,
     parse_values,
     places_of,
@@ -57,7 +58,8 @@ TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "refere
 PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays", "time_limit"}
-CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage"}
+CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage",
+              "random_values", "random_inside"}
 CYCLES_KEYS = {"max", "loops", "limit", "static"}
 
 
@@ -113,6 +115,10 @@ class Routine:
     notes: tuple[str, ...] = ()  # what loading the program left out (a symbol file's skipped lines)
     rows: tuple[Row, ...] = ()  # expected rows written in the spec (retro.routines.rows)
     entry_state: tuple[tuple[str, int], ...] = ()  # `[entry]`: registers and flags the caller guarantees
+    # per-part values (`exhaustive = { a = "0..7" }`, `random_values = { a = "0..255" }`): input name -> Values
+    exhaustive_values: tuple[tuple[str, Values], ...] = ()
+    random_values: tuple[tuple[str, Values], ...] = ()
+    random_inside: bool | None = None  # draw the random part inside the domain (None: when it is a small share)
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -134,10 +140,16 @@ class Routine:
 
     def exhaustive_count(self) -> int:
         count = 1
-        for port in self.inputs:
+        for port in self.part_inputs("exhaustive"):
             if port.name in self.exhaustive:
                 count *= port.count
         return count if self.exhaustive else 0
+
+    def part_inputs(self, part: str) -> tuple[Port, ...]:
+        """The inputs with the values a part of the cases takes ("exhaustive" or "random": the spec's
+        per-part values where it gives them, else each input's own)."""
+        given = dict(self.exhaustive_values if part == "exhaustive" else self.random_values if part == "random" else ())
+        return tuple(replace(port, values=given[port.name]) if port.name in given else port for port in self.inputs)
 
 
 # ---- reading a spec --------------------------------------------------------------------------------
@@ -293,8 +305,13 @@ def _cases_section(r: Fields, doc: dict, inputs: tuple[Port, ...], seconds: int,
     cases_doc = r.table(doc.get("cases", {}), "cases", CASES_KEYS)
     names = tuple(p.name for p in inputs)
     exhaustive = cases_doc.get("exhaustive", [])
+    exhaustive_values = ()
+    if isinstance(exhaustive, dict):  # { name = values }: the exhaustive part's own values of each input
+        exhaustive_values = _part_values(r, exhaustive, inputs, "cases.exhaustive")
+        exhaustive = list(exhaustive)
     if not isinstance(exhaustive, list) or not all(isinstance(n, str) for n in exhaustive):
-        raise r.error("cases.exhaustive", "expected a list of input names")
+        raise r.error("cases.exhaustive", "expected a list of input names, or a table of input names and their "
+                                          "values ({ a = \"0..7\" })")
     for n in exhaustive:
         if n not in names:
             raise r.error("cases.exhaustive", f"unknown input {n!r} (inputs: {', '.join(names)})")
@@ -312,8 +329,32 @@ def _cases_section(r: Fields, doc: dict, inputs: tuple[Port, ...], seconds: int,
             "seed": r.integer(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1),
             "coverage": _text(r, cases_doc, "coverage", "cases.coverage") or "",
             "domain": domain,
+            "exhaustive_values": exhaustive_values,
+            "random_values": _part_values(r, r.table(cases_doc.get("random_values", {}), "cases.random_values"),
+                                          inputs, "cases.random_values"),
+            "random_inside": (r.flag(cases_doc["random_inside"], "cases.random_inside")
+                              if "random_inside" in cases_doc else None),
             "boundary": generators.get("boundary"), "sweep": generators.get("sweep"),
             "random_generator": generators.get("random_generator")}
+
+
+def _part_values(r: Fields, doc: dict, inputs: tuple[Port, ...], key: str) -> tuple[tuple[str, Values], ...]:
+    """{ input = values } of one part of the cases: each a range or a list that fits the input's place
+    (it may reach past the input's own `values`: the part's cases take these instead)."""
+    ports = {port.name: port for port in inputs}
+    out = []
+    for name, value in doc.items():
+        field_name = f"{key}.{name}"
+        if name not in ports:
+            raise r.error(field_name, f"unknown input (inputs: {', '.join(ports)})")
+        port = ports[name]
+        values = parse_values(r, value, field_name)
+        limit = 256 if port.table else 1 << port.bits
+        if values.hi >= limit:
+            raise r.error(field_name, f"{values.describe()} does not fit in {port.describe()} "
+                                      f"({'each byte ' if port.table else ''}0..{limit - 1})")
+        out.append((name, values))
+    return tuple(out)
 
 
 def _cycles_section(r: Fields, doc: dict, program: Program) -> dict:

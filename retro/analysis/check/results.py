@@ -51,6 +51,7 @@ class RoutineCheck:
     rows: RowsCheck | None = None  # the spec's expected rows (retro.analysis.row_check)
     seconds: float = 0.0  # wall time of the check (JUnit reports)
     entry_every: int = 0  # every how many cases one ran again with the entry state varied (0: none did)
+    random_draw: object = None  # retro.routines.cases.DomainDraw: how the random part met the domain (or None)
 
     @property
     def mismatches(self) -> int:

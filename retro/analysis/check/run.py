@@ -229,7 +229,7 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     check = RoutineCheck(routine, runner.size(), static, totals, bounds_violations(routine, static, totals),
                          budget_violations(routine, static, totals), _part_runs(parts, totals, unknown, rows),
                          start=runner.start, engine="batch" if on_batch else "scalar", agreement=agreement, rows=rows,
-                         entry_every=every)
+                         entry_every=every, random_draw=next((p.draw for p in parts if p.name == "random"), None))
     if rows is not None and rows.agreement is not None:
         check.agreement = agreement = merged_agreement(agreement, rows)
     if agreement is not None and agreement.failure is not None and totals.failure is None:
