@@ -74,6 +74,9 @@ def coverage(check: RoutineCheck) -> list[dict]:
             item["space"] = part.total
             item["inputs"] = list(check.routine.exhaustive)
             item["complete"] = part.cases == part.total
+            if part.inside is not None:  # only the combinations inside the domain ran
+                item["inside"] = part.inside
+                item["complete"] = part.cases == part.inside
         out.append(item)
     return out
 
@@ -221,6 +224,11 @@ def format_coverage(check: RoutineCheck) -> str:
     for part in check.parts:
         if part.name == "exhaustive":
             scope = ", ".join(check.routine.exhaustive)
+            if part.inside is not None:
+                parts.append(f"exhaustive over {scope}: {part.cases:,} of the {part.inside:,} combinations inside "
+                             f"the domain (of {part.total:,})"
+                             + ("" if part.cases == part.inside else " (sampled; --exhaustive runs all)"))
+                continue
             parts.append(f"exhaustive over {scope}: {part.cases:,} of {part.total:,}"
                          + ("" if part.cases == part.total else " (sampled; --exhaustive runs all)"))
         else:

@@ -15,6 +15,7 @@ widths (one-line error naming the function and the case).
 
 from __future__ import annotations
 
+import ast
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, replace
@@ -55,6 +56,7 @@ class Part:
     total: int  # cases of the full space this part stands for (exhaustive: the whole product)
     blocks: Callable[[], Iterator[Columns]]  # a fresh iterator of column blocks of at most CHUNK cases
     draw: "DomainDraw | None" = None  # the random part: how its cases were drawn (with a `where` domain)
+    inside: int | None = None  # the exhaustive part: its combinations inside the domain, when only those run
 
     @property
     def cases(self) -> Iterator[tuple]:
@@ -100,7 +102,13 @@ def plan(routine: Routine, *, exhaustive: bool, seed: int | None = None, random:
         parts.append(Part("boundary", count, count, lambda: iter(made)))
     if routine.exhaustive:
         total = routine.exhaustive_count()
-        if exhaustive or total <= bounded_product:
+        valid = _valid_sweep(routine, total)
+        if valid is not None:  # only the combinations inside the domain (a small share of them)
+            full = exhaustive or len(valid) <= bounded_product
+            sample = None if full else min(BOUNDED_SAMPLE, bounded_product)
+            parts.append(Part("exhaustive", len(valid) if full else sample, total,
+                              lambda: _product(routine, seed, sample, valid), inside=len(valid)))
+        elif exhaustive or total <= bounded_product:
             parts.append(Part("exhaustive", total, total, lambda: _product(routine, seed, None)))
         else:
             sample = min(BOUNDED_SAMPLE, bounded_product)
@@ -173,17 +181,19 @@ def block_size(block: Columns, size: int) -> int:
 
 # ---- exhaustive product ----------------------------------------------------------------------------
 
-def _product(routine: Routine, seed: int, sample: int | None) -> Iterator[Columns]:
+def _product(routine: Routine, seed: int, sample: int | None, valid: np.ndarray | None = None) -> Iterator[Columns]:
     """Every combination (mixed-radix counting over the swept inputs' values), in blocks; or a seeded
-    sample of `sample` distinct combinations."""
+    sample of `sample` distinct combinations; `valid`: only these combinations (their indices)."""
     ports = routine.part_inputs("exhaustive")
     swept = [i for i, port in enumerate(ports) if port.name in routine.exhaustive]
     radices = [ports[i].count for i in swept]
     total = int(np.prod(radices, dtype=object))
     rng = np.random.default_rng(seed + EXHAUSTIVE_RNG_OFFSET)
-    if sample is None:
-        indices: Iterable[np.ndarray] = (np.arange(start, min(start + CHUNK, total), dtype=np.uint64)
-                                         for start in range(0, total, CHUNK))
+    if valid is not None:
+        chosen = valid if sample is None else valid[np.sort(rng.choice(len(valid), size=sample, replace=False))]
+        indices: Iterable[np.ndarray] = (chosen[i:i + CHUNK] for i in range(0, len(chosen), CHUNK))
+    elif sample is None:
+        indices = (np.arange(start, min(start + CHUNK, total), dtype=np.uint64) for start in range(0, total, CHUNK))
     else:
         picked = np.sort(rng.choice(total, size=sample, replace=False).astype(np.uint64))
         indices = (picked[i:i + CHUNK] for i in range(0, sample, CHUNK))
@@ -199,6 +209,32 @@ def _product(routine: Routine, seed: int, sample: int | None) -> Iterator[Column
             if columns[i] is None:
                 columns[i] = _random_column(port, rng, n)
         yield columns
+
+
+def _valid_sweep(routine: Routine, total: int) -> np.ndarray | None:
+    """The indices of the exhaustive part's combinations that meet the domain's conditions on the swept
+    inputs alone, when those keep fewer than INSIDE_SHARE of at most ENUMERATE_LIMIT combinations
+    (running only them is then cheaper than running every one); else None: every combination runs."""
+    swept = set(routine.exhaustive)
+    own = [c for c in routine.domain if c.term is not None and
+           {n.id for n in ast.walk(c.term) if isinstance(n, ast.Name)} & set(routine.input_names) <= swept]
+    if not own or total > ENUMERATE_LIMIT:
+        return None
+    ports = routine.part_inputs("exhaustive")
+    indices = [i for i, port in enumerate(ports) if port.name in swept]
+    valid = []
+    for start in range(0, total, 1 << 16):
+        block = np.arange(start, min(start + (1 << 16), total), dtype=np.uint64)
+        digits = _combinations([ports[i] for i in indices], block)
+        columns = [np.zeros((len(block), len(p.places)) if p.table else len(block), dtype=np.int64) for p in ports]
+        for i, column in zip(indices, digits):
+            columns[i] = column
+        inside = np.ones(len(block), dtype=bool)
+        for condition in own:
+            inside &= condition.over(columns)
+        valid.append(block[inside])
+    kept = np.concatenate(valid)
+    return kept if 0 < len(kept) < INSIDE_SHARE * total else None
 
 
 def _digit_values(port: Port, digit: np.ndarray) -> np.ndarray:

@@ -168,3 +168,35 @@ def test_random_values_shape_the_random_part_only():
     assert {a for a, _ in _cases(routine, "exhaustive")} == {1, 2}
     assert {a for a, _ in _cases(routine, "random")} <= set(range(200, 211))
     assert routine.exhaustive_count() == 2  # only a is swept; b takes random values in that part
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_an_exhaustive_part_runs_only_its_combinations_inside_a_small_domain(capsys, engine, tmp_path):
+    doc = _pair_spec("a + b == 300", random=0, exhaustive=["a", "b"])
+    routine = spec_from_dict(doc, base=DOMAIN)
+    cases = _cases(routine, "exhaustive")
+    assert sorted(cases) == [(a, 300 - a) for a in range(45, 256)]  # the 211 of 65,536
+    spec = tmp_path / "pairs.toml"
+    spec.write_text(f'''[program]\nfile = "{DOMAIN / "add8.s"}"\nentry = "add8"\n[inputs]\na = "A"\nb = "b_val"\n
+[outputs]\nsum = "sum"\n[reference]\nfunction = "{DOMAIN / "refs.py"}:add8"\n[entry]\nd = 0\n
+[cases]\nexhaustive = ["a", "b"]\nrandom = 0\nwhere = "a + b == 300"\n''')
+    code, record = _check(capsys, spec, "--engine", engine)
+    (part,) = record["coverage"]
+    assert code == 0 and record["cases"] == 211 and record["outside_domain"] == 0
+    assert part == {"part": "exhaustive", "cases": 211, "space": 65536, "inputs": ["a", "b"], "complete": True,
+                    "inside": 211}
+    main(["check", str(spec), "--engine", engine, "--jobs", "1"])
+    assert "exhaustive over a, b: 211 of the 211 combinations inside the domain (of 65,536)" in capsys.readouterr().out
+
+
+def test_an_exhaustive_part_over_a_large_domain_runs_every_combination():
+    routine = spec_from_dict(_pair_spec("a < 128 and b >= 0", random=0, exhaustive=["a", "b"]), base=DOMAIN)
+    (part,) = case_sets.plan(routine, exhaustive=False)
+    assert part.count == 65536 and part.inside is None  # the outside half shows the condition is needed
+
+
+def test_conditions_on_other_inputs_do_not_filter_the_sweep():
+    # b is not swept: whether a case is inside depends on its random b, so every a runs
+    routine = spec_from_dict(_pair_spec("a + b == 300", random=0, exhaustive=["a"]), base=DOMAIN)
+    (part,) = case_sets.plan(routine, exhaustive=False)
+    assert part.count == 256 and part.inside is None

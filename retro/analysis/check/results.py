@@ -33,6 +33,7 @@ class PartRun:
     name: str
     cases: int
     total: int  # cases of the space the part stands for (exhaustive: the whole product)
+    inside: int | None = None  # exhaustive: the combinations inside the domain, when only those run
 
 
 @dataclass

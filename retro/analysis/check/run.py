@@ -170,7 +170,7 @@ def _agreement(spec: str, seed: int, parts: list[case_sets.Part]) -> Tally:
 
 
 def _part_runs(parts: list[case_sets.Part], totals: Tally, unknown: bool, rows: RowsCheck | None) -> list[PartRun]:
-    part_runs = [PartRun(p.name, p.count if p.count is not None else 0, p.total) for p in parts]
+    part_runs = [PartRun(p.name, p.count if p.count is not None else 0, p.total, p.inside) for p in parts]
     if rows is not None:  # the rows ran first, as a part of their own
         part_runs.insert(0, PartRun("rows", sum(o.checked for o in rows.outcomes), len(rows.outcomes)))
     if unknown:  # the sweep's count is whatever was left after the counted parts
