@@ -16,6 +16,7 @@ from retro.routines.registry import get
 from retro.testing import spec_from_dict
 
 DOMAIN = Path(__file__).resolve().parents[1] / "data" / "domain"
+ADD = DOMAIN.parent / "entry" / "add_bcd.s"  # a + b with CLC (and no CLD: the specs state d = 0)
 ENGINES = ("scalar", "batch")
 
 
@@ -55,7 +56,7 @@ def _bcd_doc() -> dict:
 
 
 def _pair_spec(where: str, random: int = 1000, **cases) -> dict:
-    return {"program": {"file": "add8.s", "entry": "add8"}, "inputs": {"a": "A", "b": "b_val"},
+    return {"program": {"file": "../entry/add_bcd.s", "entry": "add_bcd"}, "inputs": {"a": "A", "b": "b_val"},
             "outputs": {"sum": "sum"}, "reference": {"function": "refs.py:add8"},
             "cases": {"random": random, "where": where, **cases}, "entry": {"d": 0}}
 
@@ -132,7 +133,7 @@ def test_per_part_values_on_both_engines(capsys, engine, tmp_path):
     (part,) = [p for p in record["coverage"] if p["part"] == "exhaustive"]
     assert code == 0 and part["cases"] == part["space"] == 64 and part["complete"]
     # a reference right only for a < 8: the exhaustive part passes, the random part (a up to 255) fails
-    text = (DOMAIN / "add8_parts.toml").read_text().replace('file = "add8.s"', f'file = "{DOMAIN / "add8.s"}"')
+    text = (DOMAIN / "add8_parts.toml").read_text().replace('file = "../entry/add_bcd.s"', f'file = "{ADD}"')
     spec = tmp_path / "small.toml"
     spec.write_text(text.replace('"refs.py:add8"', f'"{DOMAIN / "refs.py"}:add8_small_only"'))
     code, record = _check(capsys, spec, "--engine", engine)
@@ -177,7 +178,7 @@ def test_an_exhaustive_part_runs_only_its_combinations_inside_a_small_domain(cap
     cases = _cases(routine, "exhaustive")
     assert sorted(cases) == [(a, 300 - a) for a in range(45, 256)]  # the 211 of 65,536
     spec = tmp_path / "pairs.toml"
-    spec.write_text(f'''[program]\nfile = "{DOMAIN / "add8.s"}"\nentry = "add8"\n[inputs]\na = "A"\nb = "b_val"\n
+    spec.write_text(f'''[program]\nfile = "{ADD}"\nentry = "add_bcd"\n[inputs]\na = "A"\nb = "b_val"\n
 [outputs]\nsum = "sum"\n[reference]\nfunction = "{DOMAIN / "refs.py"}:add8"\n[entry]\nd = 0\n
 [cases]\nexhaustive = ["a", "b"]\nrandom = 0\nwhere = "a + b == 300"\n''')
     code, record = _check(capsys, spec, "--engine", engine)
