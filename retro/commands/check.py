@@ -159,7 +159,7 @@ def entry_record(check: RoutineCheck) -> dict | None:
     first = min(t.entry_first.values(), key=lambda finding: finding.index, default=None)
     return {"cases": t.entry_cases, "every": check.entry_every, "variants": list(VARIANTS),
             "stated": dict(routine.entry_state),
-            "varied": [n.upper() for n in state.free_registers] + list(state.free_flags) + ["memory"],
+            "varied": [n.upper() for n in state.free_registers] + list(state.free_flags) + ["S", "memory"],
             "changed": t.entry_changed, "needs": entry_needs(check),
             "first": None if first is None else {
                 "variant": first.variant, "inputs": inputs_by_name(routine, first.case),

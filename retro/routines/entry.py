@@ -111,6 +111,24 @@ def variant_memory(variant: str, seed: int) -> np.ndarray:
     return np.random.default_rng(seed + ENTRY_RNG_OFFSET).integers(0, 256, size=0x10000, dtype=np.uint8)
 
 
+STACK_TOPS = (0x80, 0xFE)  # the random variant's S before the call's JSR: room for the routine's own stack
+
+
+def variant_stack(variant: str, seed: int) -> int:
+    """S before the call's JSR in a variant (the baseline's is $FF, which "all ones" keeps): one value
+    per check, as a caller's stack depth is."""
+    if variant == "ones":
+        return 0xFF
+    word = int(_mix(np.asarray([(seed + ENTRY_RNG_OFFSET) % 2 ** 64], dtype=np.uint64) ^ np.uint64(0x5EED))[0])
+    return STACK_TOPS[0] + word % (STACK_TOPS[1] - STACK_TOPS[0] + 1)
+
+
+def stack_advice(baseline: int, varied: int) -> str:
+    return (f"depends on the stack pointer (S = ${baseline - 2:02X} at its first instruction in the check, "
+            f"${varied - 2:02X} in a caller with more on the stack): address the stack relative to S (TSX), "
+            "never at fixed addresses in page 1")
+
+
 def _mix(x: np.ndarray) -> np.ndarray:
     """splitmix64's finaliser: a counter -> 64 well-mixed bits (numpy's uint64 arithmetic wraps)."""
     with np.errstate(over="ignore"):

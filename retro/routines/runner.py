@@ -25,7 +25,6 @@ from retro.assembler import requested_tables
 from retro.cpu.batch import BatchCpu
 from retro.cpu.lane_memory import LaneMemoryFull
 from retro.cpu.machine import (
-    CALL_STACK_TOP,
     DEFAULT_BUDGET,
     RETURN_TRAP,
     CallResult,
@@ -38,7 +37,7 @@ from retro.fileio import read_text
 from retro.machines import build_machine
 from retro.machines.c64 import vic_of
 from retro.program import Program
-from retro.routines.entry import EntryState, variant_memory
+from retro.routines.entry import EntryState, variant_memory, variant_stack
 from retro.routines.sandbox import bytes_of
 from retro.routines.spec import Port, Routine, call_with
 from retro.scenes.vic import VicScene
@@ -252,6 +251,8 @@ class RoutineRunner:
         if fill is not None:  # before anything is loaded: what stays untouched keeps the variant's bytes
             memory = np.asarray(self.machine.memory, dtype=np.uint8)
             self.machine.memory[:] = np.where(memory == 0, variant_memory(fill, seed), memory).tolist()
+        if fill is not None:
+            self.machine.stack_top = variant_stack(fill, seed)
         self.machine.load(self.program)
         self.last_stolen = 0  # cycles of the last call in which the VIC-II held the CPU
         self.entry = routine.entry_address
@@ -347,7 +348,7 @@ class RoutineRunner:
 
     def _run_lanes(self, columns: list, n: int, entry: tuple[dict, np.ndarray, int] | None = None) -> "BatchOutcome":
         image = bytearray(self.call_image)
-        stack_pointer = push_return_trap(image)
+        stack_pointer = push_return_trap(image, self.machine.stack_top)
         cpu = BatchCpu(self.routine.cpu, image, n)
         registers, p = self.plan.place(columns, _column_byte, cpu.memory.fill, entry)
         for name, value in registers.items():
@@ -355,7 +356,7 @@ class RoutineRunner:
             lanes |= np.asarray(value).astype(lanes.dtype)
         cpu.p[:] = (p | FLAG_U) & ~FLAG_B  # as Machine sets P
         cpu.sp[:] = stack_pointer
-        cpu.call(self.entry, self.limit, RETURN_TRAP, CALL_STACK_TOP)
+        cpu.call(self.entry, self.limit, RETURN_TRAP, self.machine.stack_top)
         outputs = port_values(self.routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,
                               widen=lambda lanes: np.asarray(lanes, dtype=np.int64),
                               table=lambda columns: np.stack(columns, axis=1).astype(np.int64))

@@ -15,8 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from retro.cpu.batch import LaneError
 from retro.errors import RunError
-from retro.routines.entry import VARIANTS, advice, memory_advice, variant_values
+from retro.routines.entry import VARIANTS, advice, memory_advice, stack_advice, variant_stack, variant_values
 from retro.routines.places import FLAGS
 from retro.routines.runner import RoutineRunner
 
@@ -104,7 +105,7 @@ def entry_block_on_batched_core(variants: dict[str, RoutineRunner], columns: lis
             registers, bits = variant_values(state, variant, seed, positions + first)
             outcome = runner.run_batch(subset, entry=(registers, bits, state.free_mask))
             stopped = outcome.error != 0
-            messages = {int(k): f"the batched core stopped the call (error {int(outcome.error[k])})"
+            messages = {int(k): f"the batched core stopped the call ({LaneError(int(outcome.error[k])).name})"
                         for k in np.flatnonzero(stopped)[:1]}
             runs[variant] = VariantRun(outcome.outputs, outcome.cycles, stopped, messages)
     return EntryBlock(first, positions, runs)
@@ -141,17 +142,21 @@ def name_dependence(base: RoutineRunner, varied_image: bytes, finding: EntryFind
     address is left). The parts that alone change the call are named, each with what to do."""
     state = base.entry_state
     baseline_image = bytes(base.call_image)
+    baseline_top, varied_top = base.machine.stack_top, variant_stack(finding.variant, seed)
     registers, bits = variant_values(state, finding.variant, seed, np.asarray([finding.index]))
     registers = {name: int(v[0]) for name, v in registers.items()}
     bits = int(bits[0])
     case = finding.case
 
-    def outcome(entry, image: bytes) -> tuple:
+    def outcome(entry, image: bytes, stack_top: int | None = None) -> tuple:
         base.reset_memory(image)
+        base.machine.stack_top = baseline_top if stack_top is None else stack_top
         try:
             return base.run(case, entry=entry)
         except RunError:
             return (None, "stopped")
+        finally:
+            base.machine.stack_top = baseline_top
 
     reference = outcome(None, baseline_image)
     needs = []
@@ -163,6 +168,8 @@ def name_dependence(base: RoutineRunner, varied_image: bytes, finding: EntryFind
         bit = FLAGS[name]
         if (bits & bit) != (state.flags & bit) and outcome(({}, bits & bit, bit), baseline_image) != reference:
             needs.append(advice(name, state.baseline_of(name)))
+    if varied_top != baseline_top and outcome(None, baseline_image, varied_top) != reference:
+        needs.append(stack_advice(baseline_top, varied_top))
     address = _memory_dependence(outcome, reference, baseline_image, varied_image)
     if address is not None:
         labels = {a: label for label, a in sorted(base.program.symbols.items(), key=lambda kv: -len(kv[0]))}
@@ -173,7 +180,7 @@ def name_dependence(base: RoutineRunner, varied_image: bytes, finding: EntryFind
                          "declare it (an input, or a [memory] block), or write it before reading it")
     base.reset_memory(baseline_image)
     if not needs:
-        varied = [n.upper() for n in state.free_registers] + list(state.free_flags) + ["memory"]
+        varied = [n.upper() for n in state.free_registers] + list(state.free_flags) + ["S", "memory"]
         needs.append(f"changes only when several of {', '.join(varied)} change together: state what the routine "
                      "needs in [entry], or set it in the routine")
     return tuple(needs)

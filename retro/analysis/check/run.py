@@ -35,7 +35,7 @@ from retro.analysis.check.results import PartRun, RoutineCheck
 from retro.analysis.check.tally import Tally, count_block
 from retro.analysis.check.verdicts import bounds_violations, budget_violations, static_bounds
 from retro.analysis.row_check import RowsCheck, check_rows, merged_agreement, rows_only_static
-from retro.errors import InputError
+from retro.errors import InputError, RunError
 from retro.routines import cases as case_sets
 from retro.routines.registry import select
 from retro.routines.runner import RoutineRunner
@@ -58,8 +58,7 @@ def machine_chunk(spec: str, seed: int, cases: list[tuple], start: SceneStart | 
     block = run_on_machine(runner, cases)
     entry = None
     if every:
-        variants = {variant: runner_for(spec, seed, start, variant) for variant in VARIANTS}
-        entry = entry_block_on_machine(variants, cases[:block.calls], first, every, seed)
+        entry = entry_block_on_machine(_variants(spec, seed, start), cases[:block.calls], first, every, seed)
     return _named(spec, seed, start, count_block(runner.routine, block, columns, cases, runner.memory_values,
                                                  entry=entry))
 
@@ -71,10 +70,22 @@ def batch_chunk(spec: str, seed: int, columns: list, first: int = 0, every: int 
     block = run_on_batched_core(runner, columns)
     entry = None
     if every:
-        variants = {variant: runner_for(spec, seed, None, variant) for variant in VARIANTS}
-        entry = entry_block_on_batched_core(variants, [c[:block.calls] for c in columns], first, every, seed)
+        entry = entry_block_on_batched_core(_variants(spec, seed, None), [c[:block.calls] for c in columns], first,
+                                            every, seed)
     return _named(spec, seed, None, count_block(runner.routine, block, columns, None, runner.memory_values,
                                                 entry=entry))
+
+
+def _variants(spec: str, seed: int, start: SceneStart | None) -> dict[str, RoutineRunner]:
+    """The runners of the entry-state variants; an `init` that stops on their memory is a run error."""
+    runners = {}
+    for variant in VARIANTS:
+        try:
+            runners[variant] = runner_for(spec, seed, start, variant)
+        except RunError as exc:
+            raise RunError(f"{routine_of(spec).spec_path}: init stops when the memory nothing sets is {variant} "
+                           f"instead of 0 (it depends on the entry state): {exc}") from None
+    return runners
 
 
 def _named(spec: str, seed: int, start: SceneStart | None, tally: Tally) -> Tally:
@@ -216,7 +227,7 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         if totals.run_errors:  # a row's call that stopped stops the check
             parts = []
     agreement = _agreement(spec, seed, parts) if on_batch else None
-    every = entry_every(known, exhaustive, bounded_product) if entry_state else 0
+    every = entry_every(known, exhaustive, bounded_product) if entry_state and parts else 0
     work = (((batch_chunk, (spec, seed, block, first, every)) for block, first in _blocks(parts)) if on_batch else
             ((machine_chunk, (spec, seed, chunk, start, first, every)) for chunk, first in _chunks(parts)))
     _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
