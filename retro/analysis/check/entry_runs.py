@@ -34,6 +34,10 @@ class VariantRun:
     stopped: np.ndarray
     messages: dict  # position among the rerun cases -> why the call stopped
 
+    def head(self, count: int) -> "VariantRun":
+        """The first `count` rerun cases."""
+        return VariantRun([o[:count] for o in self.outputs], self.cycles[:count], self.stopped[:count], self.messages)
+
 
 @dataclass(frozen=True)
 class EntryBlock:

@@ -244,9 +244,7 @@ def _entry_figures(out: Tally, calls: _Calls, entry: EntryBlock) -> None:
     out.entry_cases = int(compared.sum())
     any_changed = np.zeros(len(positions), dtype=bool)
     for variant, run in entry.runs.items():
-        count = len(positions)
-        trimmed = type(run)([o[:count] for o in run.outputs], run.cycles[:count], run.stopped[:count], run.messages)
-        changed = changed_calls(calls.block.outputs, calls.block.cycles, compared, positions, trimmed)
+        changed = changed_calls(calls.block.outputs, calls.block.cycles, compared, positions, run.head(len(positions)))
         any_changed |= changed
         if changed.any():
             k = int(np.flatnonzero(changed)[0])
