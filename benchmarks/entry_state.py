@@ -1,8 +1,9 @@
 """What the entry-state runs (issue 23 part 2: a sample of the cases again with the unnamed
 registers, flags and untouched memory all ones and random) cost a check: the same check with and
-without them, side by side in one run, on both engines, one process (jobs = 1), best of `--repeat`.
+without them, side by side in one run, on both engines, one process (jobs = 1), best of `--repeat`
+(the two alternate, so that a machine's changing load weighs on both alike).
 
-    PYTHONPATH=. python benchmarks/entry_state.py [--repeat 3]
+    PYTHONPATH=. python benchmarks/entry_state.py [--repeat 5]
 
 The default check reruns every case up to 2,000 planned cases, then about 2,000 of them (every k-th);
 with --exhaustive every case up to 65,536. Each rerun case costs two more calls on the check's
@@ -16,6 +17,7 @@ import time
 from pathlib import Path
 
 from retro.analysis.check import check_routine
+from retro.routines.registry import spec_path
 
 ROOT = Path(__file__).resolve().parents[1]
 CHECKS = [  # (spec, engine, exhaustive, random)
@@ -29,26 +31,32 @@ CHECKS = [  # (spec, engine, exhaustive, random)
 ]
 
 
-def seconds(spec: str, engine: str, exhaustive: bool, random: int | None, entry: bool, repeat: int) -> tuple[float, object]:
-    best, check = float("inf"), None
+def timed(spec: str, engine: str, exhaustive: bool, random: int | None, entry: bool) -> tuple[float, object]:
+    began = time.perf_counter()
+    check = check_routine(spec, engine=engine, exhaustive=exhaustive, random_count=random, jobs=1, entry_state=entry)
+    return time.perf_counter() - began, check
+
+
+def best_of(spec: str, engine: str, exhaustive: bool, random: int | None, repeat: int) -> tuple[float, float, object]:
+    """Best times without and with the entry-state runs, the two alternating (load drifts alike)."""
+    without = with_runs = float("inf")
+    check = None
     for _ in range(repeat):
-        began = time.perf_counter()
-        check = check_routine(spec, engine=engine, exhaustive=exhaustive, random_count=random, jobs=1,
-                              entry_state=entry)
-        best = min(best, time.perf_counter() - began)
-    return best, check
+        without = min(without, timed(spec, engine, exhaustive, random, False)[0])
+        seconds, check = timed(spec, engine, exhaustive, random, True)
+        with_runs = min(with_runs, seconds)
+    return without, with_runs, check
 
 
 def main() -> None:
     parser = argparse.ArgumentParser()
-    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--repeat", type=int, default=5)
     repeat = parser.parse_args().repeat
     print(f"{'check':<48} {'engine':<7} {'cases':>8} {'rerun':>7} {'without s':>10} {'with s':>8} {'ratio':>6}")
     for spec, engine, exhaustive, random in CHECKS:
-        name = spec if spec.endswith(".toml") is False else str(Path(spec).name)
-        resolved = spec if not spec.endswith(".toml") else str(ROOT / spec)
-        without, _ = seconds(resolved, engine, exhaustive, random, False, repeat)
-        with_runs, check = seconds(resolved, engine, exhaustive, random, True, repeat)
+        name = Path(spec).name
+        resolved = str(ROOT / spec) if spec.endswith(".toml") else str(spec_path(spec))
+        without, with_runs, check = best_of(resolved, engine, exhaustive, random, repeat)
         label = name + (" --exhaustive" if exhaustive else "") + (f" --random {random}" if random else "")
         print(f"{label:<48} {engine:<7} {check.totals.cases:>8,} {check.totals.entry_cases:>7,} "
               f"{without:>10.2f} {with_runs:>8.2f} {with_runs / without:>6.2f}")
