@@ -119,3 +119,20 @@ def test_bad_entry_values_are_one_line_naming_the_key(tmp_path, extra, message):
     with pytest.raises(InputError) as caught:
         get(str(path))
     assert message in str(caught.value) and "\n" not in str(caught.value)
+
+
+def test_which_cases_run_again():
+    from retro.analysis.check.entry_runs import entry_every, rerun_positions
+
+    assert entry_every(2_000, False, 65_536) == 1  # a small check: every case
+    assert entry_every(65_536, True, 65_536) == 1  # an exhaustive check of a small space: every case
+    assert entry_every(67_536, False, 65_536) == 34  # else about 2,000 of them
+    assert entry_every(67_536, True, 65_536) == 34
+    assert entry_every(100, True, 65_536, sweep=True) == 64  # a sweep's count is unknown: 1 in 64 at most
+    # the same cases whatever the blocks: positions by the case's index in the check
+    every = 7
+    whole = rerun_positions(0, 100, every)
+    pieces = [rerun_positions(first, 30, every) + first for first in range(0, 100, 30)]
+    import numpy as np
+
+    assert np.concatenate(pieces)[np.concatenate(pieces) < 100].tolist() == whole.tolist() == list(range(0, 100, 7))

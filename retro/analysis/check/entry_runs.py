@@ -22,6 +22,7 @@ from retro.routines.places import FLAGS
 from retro.routines.runner import RoutineRunner
 
 ENTRY_SAMPLE = 2_000  # cases rerun (in each variant) when a check plans more; fewer: all of them
+SWEEP_EVERY = 64  # with a sweep (its count unknown beforehand), at most one case in this many is rerun
 
 
 @dataclass(frozen=True)
@@ -61,12 +62,12 @@ class EntryFinding:
     needs: tuple[str, ...] | None = None  # one line per thing the routine depends on (None: not yet named)
 
 
-def entry_every(planned: int, exhaustive: bool, everything: int) -> int:
+def entry_every(planned: int, exhaustive: bool, everything: int, sweep: bool = False) -> int:
     """Every how many cases one is rerun: all of a check of at most ENTRY_SAMPLE cases (with
-    --exhaustive: of at most `everything`), else a sample of about ENTRY_SAMPLE."""
-    if planned <= ENTRY_SAMPLE or (exhaustive and planned <= everything):
-        return 1
-    return -(-planned // ENTRY_SAMPLE)
+    --exhaustive: of at most `everything`), else a sample of about ENTRY_SAMPLE; with a sweep, whose
+    cases are not counted beforehand, at most one in SWEEP_EVERY."""
+    every = 1 if planned <= ENTRY_SAMPLE or (exhaustive and planned <= everything) else -(-planned // ENTRY_SAMPLE)
+    return max(every, SWEEP_EVERY) if sweep else every
 
 
 def rerun_positions(first: int, n: int, every: int) -> np.ndarray:

@@ -227,7 +227,7 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         if totals.run_errors:  # a row's call that stopped stops the check
             parts = []
     agreement = _agreement(spec, seed, parts) if on_batch else None
-    every = entry_every(known, exhaustive, bounded_product) if entry_state and parts else 0
+    every = entry_every(known, exhaustive, bounded_product, unknown) if entry_state and parts else 0
     work = (((batch_chunk, (spec, seed, block, first, every)) for block, first in _blocks(parts)) if on_batch else
             ((machine_chunk, (spec, seed, chunk, start, first, every)) for chunk, first in _chunks(parts)))
     _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
