@@ -323,6 +323,11 @@ def _cases_section(r: Fields, doc: dict, inputs: tuple[Port, ...], seconds: int,
     domain = parse_where(where, names, f"{r.source}: cases.where", tables, bounds) if where is not None else ()
     generators = {key: load_function(_text(r, cases_doc, key, f"cases.{key}"), r, f"cases.{key}", seconds)
                   for key in ("boundary", "sweep", "random_generator") if key in cases_doc}
+    for key in ("random_inside", "random_values"):
+        if key in cases_doc and "random_generator" in generators:
+            raise r.error(f"cases.{key}", "the random_generator draws the random cases itself")
+    if cases_doc.get("random_inside") is True and where is None:
+        raise r.error("cases.random_inside", "there is no domain (where) to draw inside")
     return {"exhaustive": tuple(exhaustive),
             "random": r.integer(cases_doc.get("random", DEFAULT_RANDOM if answered else 0), "cases.random", 0,
                                 MAX_RANDOM),

@@ -201,3 +201,22 @@ def test_conditions_on_other_inputs_do_not_filter_the_sweep():
     routine = spec_from_dict(_pair_spec("a + b == 300", random=0, exhaustive=["a"]), base=DOMAIN)
     (part,) = case_sets.plan(routine, exhaustive=False)
     assert part.count == 256 and part.inside is None
+
+
+@pytest.mark.parametrize("cases, message", [
+    ({"random_inside": True, "random_generator": "refs.py:add8"}, "cases.random_inside: the random_generator draws"),
+    ({"random_values": {"a": "0..3"}, "random_generator": "refs.py:add8"}, "cases.random_values: the random_generator"),
+])
+def test_part_keys_that_a_generator_would_ignore_are_refused(cases, message):
+    doc = _pair_spec("a < 128")
+    doc["cases"].update(cases)
+    with pytest.raises(InputError, match=message):
+        spec_from_dict(doc, base=DOMAIN)
+
+
+def test_random_inside_needs_a_domain():
+    doc = _pair_spec("a < 128")
+    del doc["cases"]["where"]
+    doc["cases"]["random_inside"] = True
+    with pytest.raises(InputError, match="cases.random_inside: there is no domain"):
+        spec_from_dict(doc, base=DOMAIN)
