@@ -9,7 +9,8 @@ from pathlib import Path
 
 from retro.analysis.check import RoutineCheck, SceneStart, inputs_by_name, run_checks
 from retro.analysis.check.coverage import coverage_line, coverage_record, summary
-from retro.analysis.check.results import describe_case, describe_outputs
+from retro.analysis.check.entry_runs import VARIANTS
+from retro.analysis.check.results import describe_case, describe_outputs, entry_needs
 from retro.analysis.check.search import CYCLES_PER_CANDIDATE, DEFAULT_SEARCH, STALE_GENERATIONS
 from retro.analysis.junit import junit_xml
 from retro.analysis.raster import format_raster, raster_figures
@@ -24,6 +25,7 @@ from retro.reports.coverage_html import html_pages
 from retro.reports.lcov import lcov_text
 from retro.reports.listing import listing_text
 from retro.routines import cases as case_sets
+from retro.routines.entry import EntryState
 from retro.workers import MAX_WORKERS
 import argparse
 from retro.analysis.check import AGREEMENT_PER_PART, AUTO_BATCH_CASES
@@ -88,6 +90,9 @@ def coverage(check: RoutineCheck) -> list[dict]:
             item["space"] = part.total
             item["inputs"] = list(check.routine.exhaustive)
             item["complete"] = part.cases == part.total
+            if part.inside is not None:  # only the combinations inside the domain ran
+                item["inside"] = part.inside
+                item["complete"] = part.cases == part.inside
         out.append(item)
     return out
 
@@ -147,7 +152,8 @@ def check_record(check: RoutineCheck) -> dict:
               "notes": list(check.routine.notes), "first_failure": None, "rows": None,
               "code_coverage": None if check.code_coverage is None else coverage_record(
                   summary(check.code_coverage, check.routine.program)),
-              "search": search_record(check), "bounds_reached": bounds_reached(check)}
+              "search": search_record(check), "bounds_reached": bounds_reached(check),
+              "entry_dependence": entry_record(check), "random_draw": draw_record(check.random_draw)}
     failure = t.failure
     if failure is not None:
         routine = check.routine
@@ -163,6 +169,68 @@ def check_record(check: RoutineCheck) -> dict:
     return record
 
 
+def entry_record(check: RoutineCheck) -> dict | None:
+    """The entry-state runs (retro.analysis.check.entry_runs): null when none ran."""
+    if not check.entry_every:
+        return None
+    t = check.totals
+    routine = check.routine
+    state = EntryState.of(routine.entry_state, routine.inputs, vary_interrupt=check.start is None)
+    first = min(t.entry_first.values(), key=lambda finding: finding.index, default=None)
+    return {"cases": t.entry_cases, "every": check.entry_every, "variants": list(VARIANTS),
+            "stated": dict(routine.entry_state),
+            "varied": [n.upper() for n in state.free_registers] + list(state.free_flags) + ["S", "memory"],
+            "changed": t.entry_changed, "needs": entry_needs(check),
+            "first": None if first is None else {
+                "variant": first.variant, "inputs": inputs_by_name(routine, first.case),
+                "outputs": dict(zip(routine.output_names, _plain(first.baseline[0]))), "cycles": first.baseline[1],
+                "varied_outputs": None if first.varied[0] is None else dict(zip(routine.output_names,
+                                                                                _plain(first.varied[0]))),
+                "varied_cycles": first.varied[1] if first.varied[0] is not None else None,
+                "stopped": first.varied[1] if first.varied[0] is None else None}}
+
+
+def draw_record(draw) -> dict | None:
+    """How the random part met the `where` domain (retro.routines.cases.DomainDraw); null without one."""
+    if draw is None:
+        return None
+    return {"inside": draw.inside, "share": round(draw.share, 6), "requested": draw.requested, "drawn": draw.drawn,
+            "method": draw.method, "ranges": {name: [lo, hi] for name, lo, hi in draw.ranges},
+            "candidates": draw.candidates}
+
+
+def draw_lines(check: RoutineCheck) -> list[str]:
+    draw = check.random_draw
+    if draw is None or not draw.inside:
+        return []
+    box = ", ".join(f"{name} {lo}..{hi}" for name, lo, hi in draw.ranges)
+    how = (f"sampled from the {draw.candidates:,} combinations of the box {box}" if draw.method == "enumerated" else
+           f"drawn in the box {box}" + (f" ({draw.candidates:,} candidates)" if draw.candidates else ""))
+    short = "" if draw.drawn == draw.requested else f" of {draw.requested:,} asked for (the draw's budget ran out)"
+    return [f"  random cases: {draw.drawn:,}{short} inside the domain (uniform draws keep {100 * draw.share:.2f}%), "
+            f"{how}"]
+
+
+def entry_lines(check: RoutineCheck) -> list[str]:
+    record = entry_record(check)
+    if record is None:
+        return []
+    varied = ", ".join(record["varied"][:-1]) + (" and " if len(record["varied"]) > 1 else "") + "untouched memory"
+    sample = f"1 case in {record['every']:,}" if record["every"] > 1 else "every case"
+    if not record["changed"]:
+        return [f"  entry state: {record['cases']:,} cases ({sample}) run again with {varied} all ones and random: "
+                "no change"]
+    lines = [f"  ENTRY {record['changed']:,} of {record['cases']:,} cases change with {varied} all ones or random:"]
+    lines += [f"  ENTRY {need}" for need in record["needs"]]
+    first = check.totals.entry_first[record["first"]["variant"]]
+    routine = check.routine
+    varied_text = (f"stopped ({first.varied[1]})" if first.varied[0] is None else
+                   f"{describe_outputs(routine, first.varied[0])} in {first.varied[1]} cycles")
+    lines.append(f"  ENTRY e.g. {describe_case(routine, first.case)}: {describe_outputs(routine, first.baseline[0])} "
+                 f"in {first.baseline[1]} cycles, with the entry state {first.variant}: {varied_text}")
+    return lines
+
+
 def _plain(values: tuple) -> list:
     return [list(v) if isinstance(v, tuple) else v for v in values]
 
@@ -176,6 +244,11 @@ def format_coverage(check: RoutineCheck) -> str:
     for part in check.parts:
         if part.name == "exhaustive":
             scope = ", ".join(check.routine.exhaustive)
+            if part.inside is not None:
+                parts.append(f"exhaustive over {scope}: {part.cases:,} of the {part.inside:,} combinations inside "
+                             f"the domain (of {part.total:,})"
+                             + ("" if part.cases == part.inside else " (sampled; --exhaustive runs all)"))
+                continue
             parts.append(f"exhaustive over {scope}: {part.cases:,} of {part.total:,}"
                          + ("" if part.cases == part.total else " (sampled; --exhaustive runs all)"))
         else:
@@ -191,6 +264,7 @@ def format_check(check: RoutineCheck) -> list[str]:
     lines += [f"  note: {note}" for note in routine.notes]
     if check.parts:
         lines.append(f"  cases: {format_coverage(check)}; input space {format_space(check.routine.input_space())}")
+    lines += draw_lines(check)
     if routine.coverage:
         lines.append(f"  coverage: {routine.coverage}")
     if check.code_coverage is not None:
@@ -207,6 +281,7 @@ def format_check(check: RoutineCheck) -> list[str]:
                      + (f", e.g. {t.outside_examples[0]}" if t.outside_examples else ""))
     if check.rows is not None:
         lines += rows_lines(routine, check.rows)
+    lines += entry_lines(check)
     lines += [f"  MISMATCH {example}" for example in t.examples]
     lines += [f"  MISMATCH {violation}" for violation in check.bounds_violations]
     lines += [f"  BUDGET {violation}" for violation in check.budget_violations]

@@ -75,22 +75,23 @@ class CallResult:
     stolen: int = 0  # of `cycles`, those the CPU stood still (only with a chip driving BA)
 
 
-def push_return_trap(memory) -> int:
-    """Put on an empty stack what a JSR from RETURN_TRAP pushes (its return address minus one, high
-    byte first) and return S after it: how every call is entered, on Machine and the batched core."""
+def push_return_trap(memory, stack_top: int = CALL_STACK_TOP) -> int:
+    """Put on the stack, from S = stack_top (an empty stack by default), what a JSR from RETURN_TRAP
+    pushes (its return address minus one, high byte first) and return S after it: how every call is
+    entered, on Machine and the batched core; the call has returned when S is back at stack_top."""
     back = (RETURN_TRAP - 1) & 0xFFFF
-    top = STACK_BASE | CALL_STACK_TOP
+    top = STACK_BASE | stack_top
     memory[top], memory[top - 1] = back >> 8, back & 0xFF
-    return CALL_STACK_TOP - 2
+    return stack_top - 2
 
 
-def push_interrupt_frame(memory, p: int) -> int:
-    """Put on an empty stack what the CPU's interrupt sequence pushes when it interrupts RETURN_TRAP
-    (the address, high byte first, then P with B clear) and return S after it: how an IRQ or NMI
-    handler is entered (its RTI then returns to RETURN_TRAP with S back at the top)."""
-    top = STACK_BASE | CALL_STACK_TOP
+def push_interrupt_frame(memory, p: int, stack_top: int = CALL_STACK_TOP) -> int:
+    """Put on the stack, from S = stack_top, what the CPU's interrupt sequence pushes when it
+    interrupts RETURN_TRAP (the address, high byte first, then P with B clear) and return S after it:
+    how an IRQ or NMI handler is entered (its RTI then returns to RETURN_TRAP with S back at stack_top)."""
+    top = STACK_BASE | stack_top
     memory[top], memory[top - 1], memory[top - 2] = RETURN_TRAP >> 8, RETURN_TRAP & 0xFF, (p | FLAG_U) & ~FLAG_B
-    return CALL_STACK_TOP - 3
+    return stack_top - 3
 
 
 def interrupt_entry_flags(mpu_class, p: int) -> int:
@@ -116,6 +117,7 @@ class Machine:
         self.bus = Bus()
         self.mpu = VARIANTS[variant](memory=self.bus.memory, page_devices=self.bus.page_devices)
         self.mpu.stop_on_brk = True
+        self.stack_top = CALL_STACK_TOP  # S before a call's JSR (the entry-state runs of a check vary it)
         self.symbols: dict[str, int] = {}
         self.ambiguous: dict[str, tuple[str, ...]] = {}
 
@@ -202,7 +204,7 @@ class Machine:
         entries: list[TraceEntry] | None = [] if trace else None
         start = self._enter(address, a, x, y, p, enter)
         stolen_before = self.mpu.stolen
-        count = self._execute(RETURN_TRAP, CALL_STACK_TOP, start + budget,
+        count = self._execute(RETURN_TRAP, self.stack_top, start + budget,
                               None if entries is None else _Tracer(self, entries))
         cycles = self._returned(start, budget, count)
         mpu = self.mpu
@@ -219,9 +221,9 @@ class Machine:
         mpu.pc = address
         mpu.pending_interrupt = None  # a poll before the call does not carry into it
         if enter == "jsr":
-            mpu.sp = push_return_trap(mpu.memory)
+            mpu.sp = push_return_trap(mpu.memory, self.stack_top)
             return mpu.processorCycles
-        mpu.sp = push_interrupt_frame(mpu.memory, mpu.p)
+        mpu.sp = push_interrupt_frame(mpu.memory, mpu.p, self.stack_top)
         mpu.p = interrupt_entry_flags(type(mpu), mpu.p)
         mpu.processorCycles += INTERRUPT_CYCLES  # the sequence's cycles (no stall is modelled in them)
         return mpu.processorCycles - INTERRUPT_CYCLES
@@ -229,7 +231,7 @@ class Machine:
     def _returned(self, start: int, budget: int, count: int) -> int:
         """The routine's cycles, or a RunError if it did not return within the budget."""
         mpu = self.mpu
-        if mpu.pc != RETURN_TRAP or mpu.sp != CALL_STACK_TOP:
+        if mpu.pc != RETURN_TRAP or mpu.sp != self.stack_top:
             self._over_budget(budget, count)
         cycles = mpu.processorCycles - start
         if cycles > budget:  # returned, but its last instruction ran past the budget
@@ -252,7 +254,7 @@ class Machine:
             memory[target] = value
         start = self._enter(address, a, x, y, p, enter)
         observer = None if record is None else _Recorder(record, pointer_pcs)
-        count = self._execute(RETURN_TRAP, CALL_STACK_TOP, start + budget, observer)
+        count = self._execute(RETURN_TRAP, self.stack_top, start + budget, observer)
         cycles = self._returned(start, budget, count)
         mpu = self.mpu
         return cycles, mpu.a, mpu.x, mpu.y, _status(mpu.p)

@@ -15,16 +15,19 @@ widths (one-line error naming the function and the case).
 
 from __future__ import annotations
 
+import ast
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from itertools import chain, islice
 
 import numpy as np
 
 from retro.errors import InputError
 from retro.routines.sandbox import shown
+from retro.routines.places import Values
 from retro.routines.spec import Port, Routine, call_with
+from retro.routines.where import input_ranges
 
 RANDOM_BOUNDED = 2_000  # random cases without --exhaustive
 BOUNDED_PRODUCT = 1 << 16  # an exhaustive set this small runs in full even without --exhaustive
@@ -33,6 +36,14 @@ CHUNK = 4_000
 BLOCK_BYTES = 8 << 20  # a column block for the batched core: 8 MiB (65,536 cases of 16 numbers; fewer of tables)
 RANDOM_BLOCK = 1_000_000  # a random generator is called once per block of this many cases
 EXHAUSTIVE_RNG_OFFSET = 2  # the non-swept inputs of the exhaustive part draw from seed + 2
+PROBE_RNG_OFFSET = 4  # the probe of the domain's share draws from seed + 4 (entry state: seed + 3)
+INSIDE_SHARE = 1 / 20  # random cases are drawn inside the domain when fewer uniform draws than this land there
+PROBE = 4_096  # uniform draws that estimate the domain's share
+ENUMERATE_LIMIT = 1 << 22  # a box of at most this many combinations is enumerated, its valid ones kept
+DRAW_BUDGET = 256  # candidates drawn in the box per random case wanted, at most (then fewer cases) ...
+DRAW_FLOOR, DRAW_CEILING = 1 << 22, 1 << 25  # ... but at least 4 Mi and at most 32 Mi of them
+DRAW_BATCH = 1 << 16  # candidates drawn (and tested against the domain) at once
+EAGER_INSIDE = 1 << 20  # up to this many random cases inside the domain are drawn when the plan is made
 
 
 Columns = list  # one numpy array per input, in input order: (n,) int64, or (n, size) for a table
@@ -44,6 +55,8 @@ class Part:
     count: int | None  # None when a sweep function does not say
     total: int  # cases of the full space this part stands for (exhaustive: the whole product)
     blocks: Callable[[], Iterator[Columns]]  # a fresh iterator of column blocks of at most CHUNK cases
+    draw: "DomainDraw | None" = None  # the random part: how its cases were drawn (with a `where` domain)
+    inside: int | None = None  # the exhaustive part: its combinations inside the domain, when only those run
 
     @property
     def cases(self) -> Iterator[tuple]:
@@ -89,7 +102,13 @@ def plan(routine: Routine, *, exhaustive: bool, seed: int | None = None, random:
         parts.append(Part("boundary", count, count, lambda: iter(made)))
     if routine.exhaustive:
         total = routine.exhaustive_count()
-        if exhaustive or total <= bounded_product:
+        valid = _valid_sweep(routine, total)
+        if valid is not None:  # only the combinations inside the domain (a small share of them)
+            full = exhaustive or len(valid) <= bounded_product
+            sample = None if full else min(BOUNDED_SAMPLE, bounded_product)
+            parts.append(Part("exhaustive", len(valid) if full else sample, total,
+                              lambda: _product(routine, seed, sample, valid), inside=len(valid)))
+        elif exhaustive or total <= bounded_product:
             parts.append(Part("exhaustive", total, total, lambda: _product(routine, seed, None)))
         else:
             sample = min(BOUNDED_SAMPLE, bounded_product)
@@ -98,7 +117,11 @@ def plan(routine: Routine, *, exhaustive: bool, seed: int | None = None, random:
         parts.append(Part("sweep", None, 0, lambda: _lazy_sweep(routine, seed)))
     count = random_count(routine, exhaustive, random)
     if count:
-        parts.append(Part("random", count, count, lambda: _random(routine, seed, count)))
+        draw = domain_draw(routine, seed, count)
+        if draw is not None and draw.inside:
+            parts.append(Part("random", draw.drawn, count, draw.blocks, draw))
+        else:
+            parts.append(Part("random", count, count, lambda: _random(routine, seed, count), draw))
     return parts
 
 
@@ -158,31 +181,60 @@ def block_size(block: Columns, size: int) -> int:
 
 # ---- exhaustive product ----------------------------------------------------------------------------
 
-def _product(routine: Routine, seed: int, sample: int | None) -> Iterator[Columns]:
+def _product(routine: Routine, seed: int, sample: int | None, valid: np.ndarray | None = None) -> Iterator[Columns]:
     """Every combination (mixed-radix counting over the swept inputs' values), in blocks; or a seeded
-    sample of `sample` distinct combinations."""
-    swept = [i for i, port in enumerate(routine.inputs) if port.name in routine.exhaustive]
-    radices = [routine.inputs[i].count for i in swept]
+    sample of `sample` distinct combinations; `valid`: only these combinations (their indices)."""
+    ports = routine.part_inputs("exhaustive")
+    swept = [i for i, port in enumerate(ports) if port.name in routine.exhaustive]
+    radices = [ports[i].count for i in swept]
     total = int(np.prod(radices, dtype=object))
     rng = np.random.default_rng(seed + EXHAUSTIVE_RNG_OFFSET)
-    if sample is None:
-        indices: Iterable[np.ndarray] = (np.arange(start, min(start + CHUNK, total), dtype=np.uint64)
-                                         for start in range(0, total, CHUNK))
+    if valid is not None:
+        chosen = valid if sample is None else valid[np.sort(rng.choice(len(valid), size=sample, replace=False))]
+        indices: Iterable[np.ndarray] = (chosen[i:i + CHUNK] for i in range(0, len(chosen), CHUNK))
+    elif sample is None:
+        indices = (np.arange(start, min(start + CHUNK, total), dtype=np.uint64) for start in range(0, total, CHUNK))
     else:
         picked = np.sort(rng.choice(total, size=sample, replace=False).astype(np.uint64))
         indices = (picked[i:i + CHUNK] for i in range(0, sample, CHUNK))
     for block in indices:
         n = len(block)
-        columns: list = [None] * len(routine.inputs)
+        columns: list = [None] * len(ports)
         rest = block.copy()
         for i, radix in zip(reversed(swept), reversed(radices)):  # the last swept input varies fastest
             digit = rest % np.uint64(radix)
             rest //= np.uint64(radix)
-            columns[i] = _digit_values(routine.inputs[i], digit)
-        for i, port in enumerate(routine.inputs):
+            columns[i] = _digit_values(ports[i], digit)
+        for i, port in enumerate(ports):
             if columns[i] is None:
                 columns[i] = _random_column(port, rng, n)
         yield columns
+
+
+def _valid_sweep(routine: Routine, total: int) -> np.ndarray | None:
+    """The indices of the exhaustive part's combinations that meet the domain's conditions on the swept
+    inputs alone, when those keep fewer than INSIDE_SHARE of at most ENUMERATE_LIMIT combinations
+    (running only them is then cheaper than running every one); else None: every combination runs."""
+    swept = set(routine.exhaustive)
+    own = [c for c in routine.domain if c.term is not None and
+           {n.id for n in ast.walk(c.term) if isinstance(n, ast.Name)} & set(routine.input_names) <= swept]
+    if not own or total > ENUMERATE_LIMIT:
+        return None
+    ports = routine.part_inputs("exhaustive")
+    indices = [i for i, port in enumerate(ports) if port.name in swept]
+    valid = []
+    for start in range(0, total, 1 << 16):
+        block = np.arange(start, min(start + (1 << 16), total), dtype=np.uint64)
+        digits = _combinations([ports[i] for i in indices], block)
+        columns = [np.zeros((len(block), len(p.places)) if p.table else len(block), dtype=np.int64) for p in ports]
+        for i, column in zip(indices, digits):
+            columns[i] = column
+        inside = np.ones(len(block), dtype=bool)
+        for condition in own:
+            inside &= condition.over(columns)
+        valid.append(block[inside])
+    kept = np.concatenate(valid)
+    return kept if 0 < len(kept) < INSIDE_SHARE * total else None
 
 
 def _digit_values(port: Port, digit: np.ndarray) -> np.ndarray:
@@ -212,6 +264,7 @@ def _random_column(port: Port, rng: np.random.Generator, n: int) -> np.ndarray:
 
 def _random(routine: Routine, seed: int, count: int) -> Iterator[Columns]:
     rng = np.random.default_rng(seed)
+    ports = routine.part_inputs("random")
     done = 0
     while done < count:
         n = min(RANDOM_BLOCK, count - done)
@@ -221,8 +274,145 @@ def _random(routine: Routine, seed: int, count: int) -> Iterator[Columns]:
         else:
             for start in range(0, n, CHUNK):
                 m = min(CHUNK, n - start)
-                yield [_random_column(port, rng, m) for port in routine.inputs]
+                yield [_random_column(port, rng, m) for port in ports]
         done += n
+
+
+# ---- random cases inside the domain -------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class DomainDraw:
+    """How the random part meets a `where` domain: the share of uniform draws that land inside it
+    (estimated from PROBE of them), and, when that share is small (or the spec asks), the cases drawn
+    inside it instead: from the combinations of a box narrowed by the domain's comparisons, all
+    enumerated when few, else drawn in the box and kept when inside (at most DRAW_BUDGET candidates
+    per case wanted, within DRAW_FLOOR..DRAW_CEILING: fewer cases when the domain is too rare even
+    there)."""
+
+    inside: bool  # the random cases were drawn inside the domain
+    share: float  # of uniform draws over the inputs' values, those inside the domain (estimated)
+    requested: int
+    drawn: int  # random cases made (requested, unless the budget ran out)
+    method: str | None = None  # "enumerated" or "rejection" (drawn in the box, kept when inside)
+    ranges: tuple[tuple[str, int, int], ...] = ()  # the box: each number input's narrowed range
+    candidates: int = 0  # combinations enumerated, or candidates drawn in the box
+    made: tuple = ()  # the column blocks (drawn when the plan is made)
+    lazy: Callable[[], Iterator[Columns]] | None = None  # a generator of them, for very many cases
+
+    def blocks(self) -> Iterator[Columns]:
+        return self.lazy() if self.lazy is not None else iter(self.made)
+
+
+def domain_draw(routine: Routine, seed: int, count: int) -> DomainDraw | None:
+    """The random part's draw against the domain (None: no domain, or the spec's own generator)."""
+    if not routine.domain or routine.random_generator is not None or not count:
+        return None
+    ports = routine.part_inputs("random")
+    probing = np.random.default_rng(seed + PROBE_RNG_OFFSET)
+    probe = [_random_column(port, probing, PROBE) for port in ports]
+    share = float(_inside(routine, probe).mean())
+    if not (routine.random_inside or (routine.random_inside is None and share < INSIDE_SHARE)):
+        return DomainDraw(False, share, count, count)
+    box = _narrowed(routine, ports)
+    empty = next((p.name for p in box if p.values is None), None)
+    if empty is not None:
+        raise InputError(f"{routine.spec_path}: cases.where: no value of {empty} within its values lies inside the "
+                         f"domain: nothing can be checked")
+    ranges = tuple((p.name, p.values.lo, p.values.hi) for p in box if not p.table)
+    total = 1
+    for port in box:
+        total *= port.count
+    if total <= ENUMERATE_LIMIT:
+        valid = _valid_combinations(routine, box, total)
+        if not len(valid):
+            raise InputError(f"{routine.spec_path}: cases.where: none of the {total:,} combinations of the inputs' "
+                             f"values lies inside the domain: nothing can be checked")
+
+        def enumerated() -> Iterator[Columns]:  # a fresh generator each time: the same cases
+            picks = np.random.default_rng(seed)
+            for start in range(0, count, CHUNK):
+                yield _combinations(box, valid[picks.integers(0, len(valid), size=min(CHUNK, count - start))])
+        return DomainDraw(True, share, count, count, "enumerated", ranges, total,
+                          lazy=enumerated)
+    if count > EAGER_INSIDE:
+        return DomainDraw(True, share, count, count, "rejection", ranges, 0,
+                          lazy=lambda: _draw_inside(routine, box, seed, count, strict=True)[0])
+    blocks, candidates = _draw_inside(routine, box, seed, count, strict=False)
+    made = tuple(blocks)
+    if not made:
+        raise InputError(f"{routine.spec_path}: cases.where: none of {candidates():,} random draws lies inside the "
+                         f"domain: nothing can be checked (narrow the inputs' values, or give cases: boundary)")
+    return DomainDraw(True, share, count, sum(len(b[0]) for b in made), "rejection", ranges, candidates(), made)
+
+
+def _inside(routine: Routine, columns: Columns) -> np.ndarray:
+    inside = np.ones(len(columns[0]), dtype=bool)
+    for condition in routine.domain:
+        inside &= condition.over(columns)
+    return inside
+
+
+def _narrowed(routine: Routine, ports: tuple[Port, ...]) -> list[Port]:
+    """The ports with their values narrowed to the ranges the domain's comparisons allow (a port whose
+    range is empty gets values None)."""
+    ranges = input_ranges(routine.domain, {p.name: (p.values.lo, p.values.hi) for p in ports if not p.table})
+    out = []
+    for port in ports:
+        if port.table or ranges[port.name] == (port.values.lo, port.values.hi):
+            out.append(port)
+            continue
+        lo, hi = ranges[port.name]
+        if port.values.listed is not None:
+            kept = tuple(v for v in port.values.listed if lo <= v <= hi)
+            values = Values(min(kept), max(kept), kept) if kept else None
+        else:
+            values = Values(lo, hi) if lo <= hi else None
+        out.append(replace(port, values=values))
+    return out
+
+
+def _combinations(box: list[Port], indices: np.ndarray) -> Columns:
+    """The combinations at mixed-radix `indices` of the box (the last input varies fastest)."""
+    rest = indices.astype(np.uint64)
+    columns: list = [None] * len(box)
+    for i in reversed(range(len(box))):
+        radix = np.uint64(box[i].count)
+        columns[i] = _digit_values(box[i], rest % radix)
+        rest = rest // radix
+    return columns
+
+
+def _valid_combinations(routine: Routine, box: list[Port], total: int) -> np.ndarray:
+    """The indices of the box's combinations inside the domain."""
+    valid = []
+    for start in range(0, total, 1 << 16):
+        indices = np.arange(start, min(start + (1 << 16), total), dtype=np.uint64)
+        valid.append(indices[_inside(routine, _combinations(box, indices))])
+    return np.concatenate(valid)
+
+
+def _draw_inside(routine: Routine, box: list[Port], seed: int, count: int, strict: bool):
+    """Blocks of cases drawn uniformly in the box and kept when inside the domain, and a function
+    giving the candidates drawn so far; at most DRAW_BUDGET candidates per case wanted (`strict`:
+    running out is an error, for a part whose count was promised)."""
+    rng = np.random.default_rng(seed)
+    drawn = [0]
+
+    def blocks() -> Iterator[Columns]:
+        made = 0
+        budget = min(max(DRAW_BUDGET * count, DRAW_FLOOR), DRAW_CEILING)
+        while made < count and drawn[0] < budget:
+            candidates = [_random_column(port, rng, DRAW_BATCH) for port in box]
+            drawn[0] += DRAW_BATCH
+            kept = [c[_inside(routine, candidates)] for c in candidates]
+            kept = [c[:count - made] for c in kept]
+            made += len(kept[0])
+            for start in range(0, len(kept[0]), CHUNK):
+                yield [c[start:start + CHUNK] for c in kept]
+        if strict and made < count:
+            raise InputError(f"{routine.spec_path}: cases.where: {drawn[0]:,} random draws gave only {made:,} cases "
+                             f"inside the domain of the {count:,} asked for: narrow the inputs' values")
+    return blocks(), lambda: drawn[0]
 
 
 def _lazy_sweep(routine: Routine, seed: int) -> Iterator[Columns]:

@@ -25,10 +25,8 @@ from retro.assembler import requested_tables
 from retro.cpu.batch import BatchCpu, LaneCoverage
 from retro.cpu.lane_memory import LaneMemoryFull
 from retro.cpu.machine import (
-    CALL_STACK_TOP,
     DEFAULT_BUDGET,
     STACK_BASE,
-    DEFAULT_FLAGS,
     RETURN_TRAP,
     CallResult,
     interrupt_entry_flags,
@@ -43,6 +41,7 @@ from retro.fileio import read_text
 from retro.machines import build_machine
 from retro.machines.c64 import vic_of
 from retro.program import Program
+from retro.routines.entry import EntryState, variant_memory, variant_stack
 from retro.routines.sandbox import bytes_of
 from retro.routines.spec import Port, Routine, call_with
 from retro.routines.world import NO_WORLD, WORLD_PLACES, BatchWorld, MachineWorld, World, chip_overlaps
@@ -176,6 +175,7 @@ class InputPlan:
     tables: tuple[tuple[int, tuple[int, ...]], ...]  # (input index, addresses)
     base_flags: int  # P before the flag inputs: the default flags without those the inputs set
     output_addresses: tuple[int, ...]  # output places in memory (restored before each Machine call)
+    base_registers: tuple[tuple[str, int], ...] = (("a", 0), ("x", 0), ("y", 0))  # before the inputs ([entry])
 
     @classmethod
     def of(cls, routine: Routine) -> "InputPlan":
@@ -195,25 +195,36 @@ class InputPlan:
         for _, bit in flags:
             forced |= bit
         outputs = sorted({place.address for port in routine.outputs for place in port.places if place.kind == "memory"})
-        return cls(tuple(registers), tuple(flags), tuple(places), tuple(tables), DEFAULT_FLAGS & ~forced,
-                   tuple(outputs))
+        entry = EntryState.of(routine.entry_state, routine.inputs)
+        return cls(tuple(registers), tuple(flags), tuple(places), tuple(tables),
+                   (entry.flags | FLAG_U) & ~forced, tuple(outputs),
+                   tuple(entry.registers.items()))
 
-    def place(self, values: Sequence, table_byte: Callable, write: Callable) -> tuple[dict[str, object], object]:
+    def place(self, values: Sequence, table_byte: Callable, write: Callable,
+              entry: tuple[dict, object, int] | None = None) -> tuple[dict[str, object], object]:
         """Put `values` (one per input: numbers, or arrays of lanes) in place: `write(address, byte)`
         for every memory byte as it is made (a block's arrays are consumed while in cache), and
-        (register values, P) returned; `table_byte(value, k)` is byte k of a table input's value."""
+        (register values, P) returned; `table_byte(value, k)` is byte k of a table input's value.
+        `entry`: (free registers by name, free P bits, the free bits' mask) of an entry-state run
+        (retro.routines.entry), replacing the baseline's values of the registers and flags no input
+        or `[entry]` sets."""
         for index, address, shift in self.bytes:
             write(address, (values[index] >> shift) & 0xFF)
         for index, addresses in self.tables:
             for k, address in enumerate(addresses):
                 write(address, table_byte(values[index], k))
-        registers = {"a": 0, "x": 0, "y": 0}
+        registers = dict(self.base_registers)
+        p = self.base_flags
+        if entry is not None:
+            free, bits, mask = entry
+            registers.update(free)
+            p = (p & ~mask) | bits
         for index, register, shift in self.registers:
             registers[register] |= (values[index] >> shift) & 0xFF
-        p = self.base_flags
         for index, bit in self.flags:
             p |= (values[index] != 0) * bit
         return registers, p
+
 
 
 @dataclass(frozen=True)
@@ -227,10 +238,16 @@ class RasterStart:
 
 
 class RoutineRunner:
-    def __init__(self, routine: Routine, seed: int = 0, start: RasterStart | None = None) -> None:
+    def __init__(self, routine: Routine, seed: int = 0, start: RasterStart | None = None,
+                 fill: str | None = None) -> None:
+        """`fill`: an entry-state variant ("ones", "random": retro.routines.entry) whose bytes every
+        address holds that the machine, the program, the `[memory]` blocks and `init` leave alone;
+        None: zeros (power-on RAM), the baseline."""
         self.routine = routine
         self.seed = seed
         self.start = start
+        self.fill = fill
+        self.entry_state = EntryState.of(routine.entry_state, routine.inputs, vary_interrupt=start is None)
         self.program = routine.program  # read once, by the spec
         self.vic = None
         if start is None:
@@ -243,6 +260,11 @@ class RoutineRunner:
                 raise InputError(NEEDS_A_VIC_SCENE)
             self.machine = build_machine(start.scene)
             self.vic = vic_of(self.machine)
+        if fill is not None:  # before anything is loaded: what stays untouched keeps the variant's bytes
+            memory = np.asarray(self.machine.memory, dtype=np.uint8)
+            self.machine.memory[:] = np.where(memory == 0, variant_memory(fill, seed), memory).tolist()
+        if fill is not None:
+            self.machine.stack_top = variant_stack(fill, seed)
         self.machine.load(self.program)
         if start is not None:  # before the world's own devices join the bus
             chip_overlaps(routine, self.machine.bus.devices, str(start.scene.source))
@@ -276,19 +298,27 @@ class RoutineRunner:
     def limit(self) -> int:
         return self.routine.limit or DEFAULT_BUDGET
 
-    def inputs_for_call(self, case: Sequence) -> tuple[list[tuple[int, int]], dict[str, int], int]:
+    def inputs_for_call(self, case: Sequence, entry: tuple[dict, int, int] | None = None
+                        ) -> tuple[list[tuple[int, int]], dict[str, int], int]:
         """(memory writes, register values, P) that put the case where the spec says; the output
-        places in memory are restored first (see the module's docstring)."""
+        places in memory are restored first (see the module's docstring). `entry`: an entry-state
+        run's free registers and P bits (InputPlan.place)."""
         image = self.call_image
         writes = [(address, image[address]) for address in self.plan.output_addresses]
-        registers, p = self.plan.place(case, _case_byte, lambda address, byte: writes.append((address, byte)))
+        registers, p = self.plan.place(case, _case_byte, lambda address, byte: writes.append((address, byte)), entry)
         return writes, registers, p
 
-    def run(self, case: Sequence, record: list | None = None) -> tuple[tuple, int]:
-        """(outputs in the spec's order, cycles) of one call. With a world, `record` leaves out the
-        traps (mocks, exits) and `last_extra_cycles` says what the timing model must add for them
-        and for an interrupt entry; `last_calls` holds the recorded mocks' calls."""
-        writes, registers, p = self.inputs_for_call(case)
+    def reset_memory(self, image: bytes) -> None:
+        """Start the following calls from this memory image (entry-state runs, naming a dependence)."""
+        self.machine.memory[:] = list(image)
+        self.call_image = bytearray(image)
+
+    def run(self, case: Sequence, record: list | None = None, entry: tuple[dict, int, int] | None = None
+            ) -> tuple[tuple, int]:
+        """(outputs in the spec's order, cycles) of one call; `entry` as in `inputs_for_call`. With a
+        world, `record` leaves out the traps (mocks, exits) and `last_extra_cycles` says what the timing
+        model must add for them and for an interrupt entry; `last_calls` holds the recorded mocks' calls."""
+        writes, registers, p = self.inputs_for_call(case, entry)
         if self.vic is not None:
             self._restart_beam()
             stolen = self.machine.mpu.stolen
@@ -346,32 +376,41 @@ class RoutineRunner:
         """Why the batched core cannot run this routine's world (None: it can; a scene aside)."""
         return self.routine.world.batch_refusal()
 
-    def run_batch(self, columns: list, coverage: bool = False, first_lanes: bool = False) -> "BatchOutcome":
+    def run_batch(self, columns: list, coverage: bool = False, first_lanes: bool = False,
+                  entry: tuple[dict, np.ndarray, int] | None = None) -> "BatchOutcome":
         """Run every case of a column block (one array per input) on the batched core (`coverage`:
-        count what the lanes ran; `first_lanes`: also which lane first went each way at each branch)."""
+        count what the lanes ran; `first_lanes`: also which lane first went each way at each branch;
+        `entry`: an entry-state run's free registers and P bits per lane, InputPlan.place)."""
         n = len(columns[0])
         try:
-            return self._run_lanes(columns, n, coverage, first_lanes)
+            return self._run_lanes(columns, n, coverage, first_lanes, entry)
         except LaneMemoryFull:
             if n <= 1:
                 raise
             half = n // 2
-            first = self.run_batch([c[:half] for c in columns], coverage, first_lanes)
-            second = self.run_batch([c[half:] for c in columns], coverage, first_lanes)
+            halves = [None, None] if entry is None else [
+                ({k: v[:half] for k, v in entry[0].items()}, entry[1][:half], entry[2]),
+                ({k: v[half:] for k, v in entry[0].items()}, entry[1][half:], entry[2])]
+            first = self.run_batch([c[:half] for c in columns], coverage, first_lanes, halves[0])
+            second = self.run_batch([c[half:] for c in columns], coverage, first_lanes, halves[1])
             if first.coverage is not None:
                 first.coverage.merge(second.coverage, lane_offset=half)
             return BatchOutcome([np.concatenate(pair) for pair in zip(first.outputs, second.outputs)],
                                 np.concatenate([first.cycles, second.cycles]),
-                                np.concatenate([first.error, second.error]), first.coverage)
+                                np.concatenate([first.error, second.error]), coverage=first.coverage,
+                                mock_calls=None if first.mock_calls is None else first.mock_calls + second.mock_calls)
 
-    def _run_lanes(self, columns: list, n: int, coverage: bool = False, first_lanes: bool = False) -> "BatchOutcome":
+    def _run_lanes(self, columns: list, n: int, coverage: bool = False, first_lanes: bool = False,
+                   entry: tuple[dict, np.ndarray, int] | None = None) -> "BatchOutcome":
         image = bytearray(self.call_image)
+        stack_top = self.machine.stack_top
         enter = self.routine.world.enter
-        stack_pointer = push_return_trap(image) if enter == "jsr" else push_interrupt_frame(image, 0)
+        stack_pointer = (push_return_trap(image, stack_top) if enter == "jsr"
+                         else push_interrupt_frame(image, 0, stack_top))
         cpu = BatchCpu(self.routine.cpu, image, n, coverage=coverage, first_lanes=first_lanes)
         world = None if self.routine.world.empty else BatchWorld(self.routine.world, cpu, self.written_kept,
                                                                   str(self.routine.spec_path))
-        registers, p = self.plan.place(columns, _column_byte, cpu.memory.fill)
+        registers, p = self.plan.place(columns, _column_byte, cpu.memory.fill, entry)
         for name, value in registers.items():
             lanes = getattr(cpu, name)
             lanes |= np.asarray(value).astype(lanes.dtype)
@@ -381,7 +420,7 @@ class RoutineRunner:
             cpu.p[:] = interrupt_entry_flags(VARIANTS[self.routine.cpu], cpu.p)
             cpu.cycles[:] = self.routine.world.entry_cycles
         cpu.sp[:] = stack_pointer
-        cpu.call(self.entry, self.limit, RETURN_TRAP, CALL_STACK_TOP)
+        cpu.call(self.entry, self.limit, RETURN_TRAP, stack_top)
         if world is not None:
             world.finish()
         outputs = port_values(self.routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,

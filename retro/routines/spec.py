@@ -18,7 +18,7 @@ import importlib.util
 import inspect
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 
@@ -34,12 +34,14 @@ from retro.routines.places import (
     BYTE_VALUES,
     MAX_TABLE,
     Port,
+    Values,
     no_overlap,
     parse_values,
     places_of,
     port_of,
     resolve,
 )
+from retro.routines.entry import parse_entry
 from retro.routines.rows import Row, misplaced_rows, parse_rows
 from retro.routines import sandbox
 from retro.routines.world import NO_WORLD, World, check_names, is_world_output, parse_world, recorded_mocks, world_output
@@ -54,11 +56,12 @@ NUMBER_CHARACTERS = 40  # the longest number a spec may write as text
 CPUS = tuple(VARIANTS)
 
 TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows",
-            "mocks", "hardware"}
+            "mocks", "hardware", "entry"}
 PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load", "listing", "interrupt", "exit"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays", "time_limit"}
-CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage", "search"}
+CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage", "search",
+              "random_values", "random_inside"}
 MAX_SEARCH = 10_000_000  # candidates of the coverage-guided search (retro.analysis.check.search)
 CYCLES_KEYS = {"max", "loops", "limit", "static"}
 
@@ -117,6 +120,11 @@ class Routine:
     rows: tuple[Row, ...] = ()  # expected rows written in the spec (retro.routines.rows)
     search: int | None = None  # [cases] search: candidates of the coverage-guided search (None: the default)
     world: World = NO_WORLD  # mocks, scripted hardware, interrupt entry, exits (retro.routines.world)
+    entry_state: tuple[tuple[str, int], ...] = ()  # `[entry]`: registers and flags the caller guarantees
+    # per-part values (`exhaustive = { a = "0..7" }`, `random_values = { a = "0..255" }`): input name -> Values
+    exhaustive_values: tuple[tuple[str, Values], ...] = ()
+    random_values: tuple[tuple[str, Values], ...] = ()
+    random_inside: bool | None = None  # draw the random part inside the domain (None: when it is a small share)
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -138,10 +146,16 @@ class Routine:
 
     def exhaustive_count(self) -> int:
         count = 1
-        for port in self.inputs:
+        for port in self.part_inputs("exhaustive"):
             if port.name in self.exhaustive:
                 count *= port.count
         return count if self.exhaustive else 0
+
+    def part_inputs(self, part: str) -> tuple[Port, ...]:
+        """The inputs with the values a part of the cases takes ("exhaustive" or "random": the spec's
+        per-part values where it gives them, else each input's own)."""
+        given = dict(self.exhaustive_values if part == "exhaustive" else self.random_values if part == "random" else ())
+        return tuple(replace(port, values=given[port.name]) if port.name in given else port for port in self.inputs)
 
 
 # ---- reading a spec --------------------------------------------------------------------------------
@@ -202,7 +216,8 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     cycles = _cycles_section(r, doc, program.program)
     routine = Routine(name=_text(r, doc, "name", "name") or path.stem, spec_path=path, **program.fields(),
                       inputs=inputs, outputs=outputs, memory=memory, **reference, **cases, **cycles,
-                      summary=_summary(r, doc), rows=rows, notes=program.program.notes, world=world)
+                      summary=_summary(r, doc), rows=rows, notes=program.program.notes, world=world,
+                      entry_state=parse_entry(r, doc.get("entry", {}), inputs))
     if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep or routine.rows):
         raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary, sweep or [[rows]]")
     if routine.exhaustive_count() > MAX_EXHAUSTIVE:
@@ -311,8 +326,13 @@ def _cases_section(r: Fields, doc: dict, inputs: tuple[Port, ...], seconds: int,
     cases_doc = r.table(doc.get("cases", {}), "cases", CASES_KEYS)
     names = tuple(p.name for p in inputs)
     exhaustive = cases_doc.get("exhaustive", [])
+    exhaustive_values = ()
+    if isinstance(exhaustive, dict):  # { name = values }: the exhaustive part's own values of each input
+        exhaustive_values = _part_values(r, exhaustive, inputs, "cases.exhaustive")
+        exhaustive = list(exhaustive)
     if not isinstance(exhaustive, list) or not all(isinstance(n, str) for n in exhaustive):
-        raise r.error("cases.exhaustive", "expected a list of input names")
+        raise r.error("cases.exhaustive", "expected a list of input names, or a table of input names and their "
+                                          "values ({ a = \"0..7\" })")
     for n in exhaustive:
         if n not in names:
             raise r.error("cases.exhaustive", f"unknown input {n!r} (inputs: {', '.join(names)})")
@@ -324,6 +344,11 @@ def _cases_section(r: Fields, doc: dict, inputs: tuple[Port, ...], seconds: int,
     domain = parse_where(where, names, f"{r.source}: cases.where", tables, bounds) if where is not None else ()
     generators = {key: load_function(_text(r, cases_doc, key, f"cases.{key}"), r, f"cases.{key}", seconds)
                   for key in ("boundary", "sweep", "random_generator") if key in cases_doc}
+    for key in ("random_inside", "random_values"):
+        if key in cases_doc and "random_generator" in generators:
+            raise r.error(f"cases.{key}", "the random_generator draws the random cases itself")
+    if cases_doc.get("random_inside") is True and where is None:
+        raise r.error("cases.random_inside", "there is no domain (where) to draw inside")
     return {"exhaustive": tuple(exhaustive),
             "random": r.integer(cases_doc.get("random", DEFAULT_RANDOM if answered else 0), "cases.random", 0,
                                 MAX_RANDOM),
@@ -331,8 +356,32 @@ def _cases_section(r: Fields, doc: dict, inputs: tuple[Port, ...], seconds: int,
             "search": r.integer(cases_doc["search"], "cases.search", 0, MAX_SEARCH) if "search" in cases_doc else None,
             "coverage": _text(r, cases_doc, "coverage", "cases.coverage") or "",
             "domain": domain,
+            "exhaustive_values": exhaustive_values,
+            "random_values": _part_values(r, r.table(cases_doc.get("random_values", {}), "cases.random_values"),
+                                          inputs, "cases.random_values"),
+            "random_inside": (r.flag(cases_doc["random_inside"], "cases.random_inside")
+                              if "random_inside" in cases_doc else None),
             "boundary": generators.get("boundary"), "sweep": generators.get("sweep"),
             "random_generator": generators.get("random_generator")}
+
+
+def _part_values(r: Fields, doc: dict, inputs: tuple[Port, ...], key: str) -> tuple[tuple[str, Values], ...]:
+    """{ input = values } of one part of the cases: each a range or a list that fits the input's place
+    (it may reach past the input's own `values`: the part's cases take these instead)."""
+    ports = {port.name: port for port in inputs}
+    out = []
+    for name, value in doc.items():
+        field_name = f"{key}.{name}"
+        if name not in ports:
+            raise r.error(field_name, f"unknown input (inputs: {', '.join(ports)})")
+        port = ports[name]
+        values = parse_values(r, value, field_name)
+        limit = 256 if port.table else 1 << port.bits
+        if values.hi >= limit:
+            raise r.error(field_name, f"{values.describe()} does not fit in {port.describe()} "
+                                      f"({'each byte ' if port.table else ''}0..{limit - 1})")
+        out.append((name, values))
+    return tuple(out)
 
 
 def _cycles_section(r: Fields, doc: dict, program: Program) -> dict:

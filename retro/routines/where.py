@@ -22,7 +22,7 @@ from __future__ import annotations
 import ast
 import operator
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -54,6 +54,7 @@ class Condition:
     # The same test over numpy columns (one array per input, in input order) -> a bool array; None when
     # the term takes tables, lists or numbers past int64 (then it runs case by case).
     test_columns: Callable[..., np.ndarray] | None = None
+    term: ast.expr | None = field(default=None, compare=False)  # the parsed term (what `input_ranges` reads)
 
     def over(self, columns: list, cases: list[tuple] | None = None) -> np.ndarray:
         """Which of a chunk's cases (given as columns) meet the condition."""
@@ -92,8 +93,93 @@ def parse_where(text: str, names: tuple[str, ...], field: str, tables: frozenset
         earlier = tuple(conditions)
         test = _compile(term, names, f"{field}: {term_text}", earlier)
         columns = _Columns(term, names, f"{field}: {term_text}", source, earlier) if columnar else None
-        conditions.append(Condition(term_text, test, columns))
+        conditions.append(Condition(term_text, test, columns, term))
     return tuple(conditions)
+
+
+# ---- ranges the domain allows, for drawing cases inside it ----------------------------------------------
+
+RANGE_ROUNDS = 20  # passes over the comparisons (each narrows what the others allow)
+
+
+def input_ranges(domain: tuple[Condition, ...], ranges: dict[str, tuple[int, int]]) -> dict[str, tuple[int, int]]:
+    """The (lo, hi) of each number input (`ranges`: what its values allow) narrowed by the domain's
+    top-level comparisons of sums of inputs and constants (`aw >= 1`, `ax + aw <= 255`,
+    `2 <= n < 9`): every case inside the domain lies within them (a necessary condition only: other
+    terms, `or`, tables, bit operations narrow nothing). lo > hi: no case lies inside."""
+    constraints = []
+    for condition in domain:
+        term = condition.term
+        if not isinstance(term, ast.Compare):
+            continue
+        operands = [term.left, *term.comparators]
+        for op, left, right in zip(term.ops, operands, operands[1:]):
+            a, b = _linear(left, ranges), _linear(right, ranges)
+            if a is None or b is None:
+                continue
+            difference = _combine(a, b, -1)  # left - right
+            if isinstance(op, (ast.LtE, ast.Eq)):
+                constraints.append(difference)
+            if isinstance(op, ast.Lt):
+                constraints.append((difference[0], difference[1] + 1))
+            if isinstance(op, (ast.GtE, ast.Eq)):
+                constraints.append(_scaled(difference, -1))
+            if isinstance(op, ast.Gt):
+                negated = _scaled(difference, -1)
+                constraints.append((negated[0], negated[1] + 1))
+    bounds = dict(ranges)
+    for _ in range(RANGE_ROUNDS):
+        changed = False
+        for coefficients, constant in constraints:  # sum(c * x) + constant <= 0
+            lows = {name: min(c * bounds[name][0], c * bounds[name][1]) for name, c in coefficients.items()}
+            total = sum(lows.values())
+            for name, c in coefficients.items():
+                room = -constant - (total - lows[name])  # c * x <= room
+                lo, hi = bounds[name]
+                if c > 0:
+                    hi = min(hi, room // c)
+                else:
+                    lo = max(lo, -(room // -c))
+                if (lo, hi) != bounds[name]:
+                    bounds[name] = (lo, hi)
+                    changed = True
+                    if lo > hi:
+                        return bounds
+        if not changed:
+            break
+    return bounds
+
+
+def _linear(node: ast.AST, ranges: dict) -> tuple[dict[str, int], int] | None:
+    """node as (coefficients by input, constant), when it is a sum of inputs and constants."""
+    if isinstance(node, ast.Name):
+        return ({node.id: 1}, 0) if node.id in ranges else None
+    if isinstance(node, ast.Constant) and isinstance(node.value, int):
+        return {}, int(node.value)
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
+        inner = _linear(node.operand, ranges)
+        return None if inner is None else _scaled(inner, -1 if isinstance(node.op, ast.USub) else 1)
+    if isinstance(node, ast.BinOp) and isinstance(node.op, (ast.Add, ast.Sub, ast.Mult)):
+        a, b = _linear(node.left, ranges), _linear(node.right, ranges)
+        if a is None or b is None:
+            return None
+        if isinstance(node.op, ast.Mult):
+            if not a[0]:
+                return _scaled(b, a[1])
+            return _scaled(a, b[1]) if not b[0] else None
+        return _combine(a, b, 1 if isinstance(node.op, ast.Add) else -1)
+    return None
+
+
+def _combine(a: tuple[dict, int], b: tuple[dict, int], sign: int) -> tuple[dict, int]:
+    coefficients = dict(a[0])
+    for name, c in b[0].items():
+        coefficients[name] = coefficients.get(name, 0) + sign * c
+    return {k: v for k, v in coefficients.items() if v}, a[1] + sign * b[1]
+
+
+def _scaled(a: tuple[dict, int], factor: int) -> tuple[dict, int]:
+    return {k: v * factor for k, v in a[0].items() if v * factor}, a[1] * factor
 
 
 def require_inside(field: str, domain: tuple[Condition, ...], cases: int, outside: int,

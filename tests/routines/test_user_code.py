@@ -51,6 +51,8 @@ time_limit = 1
 [cases]
 {cases}
 {memory}
+[entry]
+d = 0
 """)
     return path
 

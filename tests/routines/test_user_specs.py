@@ -171,7 +171,8 @@ def test_an_unbounded_loop_is_one_line(tmp_path, capsys):
     for file in ("scan.s", "scan_ref.py"):
         (tmp_path / file).write_text((spec.parent / file).read_text())
     (tmp_path / "scan.toml").write_text(spec.read_text().replace("loops = { _loop = 8, _sum = 8 }", "loops = { _loop = 8 }"))
-    assert main(["check", str(tmp_path / "scan.toml"), "--random", "0", "--jobs", "1"]) == 2
+    # --quiet: a check that takes over a second also prints progress lines to stderr
+    assert main(["check", str(tmp_path / "scan.toml"), "--random", "0", "--jobs", "1", "--quiet"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "the loop at $C029 (_sum) needs a bound" in err, err
 

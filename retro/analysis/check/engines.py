@@ -25,7 +25,7 @@ AUTO_BATCH_CASES = 20_000  # planned cases from which engine="auto" takes the ba
 AGREEMENT_PER_PART = 2_000  # cases of each part also run on Machine when the batched core runs the check
 TRACE_SHOWN = 400  # instructions of the first failing case's trace in the report
 
-_RUNNERS: dict[tuple[str, int], RoutineRunner] = {}
+_RUNNERS: dict[tuple, RoutineRunner] = {}
 _BUILT: dict[str, Routine] = {}  # specs built in Python (retro.testing), by a key standing for their path
 _BUILT_PREFIX = "<built>:"
 
@@ -67,10 +67,11 @@ class SceneStart:
         return RasterStart(scene, line, cycle)
 
 
-def runner_for(spec: str, seed: int, start: SceneStart | None = None) -> RoutineRunner:
-    key = (str(spec), seed, start)
+def runner_for(spec: str, seed: int, start: SceneStart | None = None, fill: str | None = None) -> RoutineRunner:
+    """The cached runner of a spec (`fill`: an entry-state variant's, retro.routines.entry)."""
+    key = (str(spec), seed, start, fill)
     if key not in _RUNNERS:
-        _RUNNERS[key] = RoutineRunner(routine_of(str(spec)), seed, start.raster_start() if start else None)
+        _RUNNERS[key] = RoutineRunner(routine_of(str(spec)), seed, start.raster_start() if start else None, fill)
     return _RUNNERS[key]
 
 

@@ -35,6 +35,7 @@ class PartRun:
     name: str
     cases: int
     total: int  # cases of the space the part stands for (exhaustive: the whole product)
+    inside: int | None = None  # exhaustive: the combinations inside the domain, when only those run
 
 
 @dataclass
@@ -55,6 +56,8 @@ class RoutineCheck:
     seconds: float = 0.0  # wall time of the check (JUnit reports)
     code_coverage: CodeCoverage | None = None  # what the cases ran of the code (retro.analysis.check.coverage)
     search: SearchResult | None = None  # the coverage-guided search (retro.analysis.check.search)
+    entry_every: int = 0  # every how many cases one ran again with the entry state varied (0: none did)
+    random_draw: object = None  # retro.routines.cases.DomainDraw: how the random part met the domain (or None)
 
     @property
     def mismatches(self) -> int:
@@ -65,7 +68,7 @@ class RoutineCheck:
             found += self.agreement.engine_mismatches + self.agreement.cycle_mismatches
         if self.rows is not None:  # rows whose call returned something else (a stopped call is a run error)
             found += self.rows.wrong
-        return found
+        return found + t.entry_changed  # cases whose outputs or cycles change with the entry state
 
     @property
     def mean(self) -> float:
@@ -97,6 +100,14 @@ class RoutineCheck:
             lines.append(f"  condition {condition.text}: {violating} cases break it, {wrong} of them wrong: {verdict}")
         return lines
 
+
+
+def entry_needs(check: RoutineCheck) -> list[str]:
+    """What the routine depends on, one line each, from every variant's first changed case."""
+    needs: list[str] = []
+    for finding in check.totals.entry_first.values():
+        needs += [line for line in finding.needs or () if line not in needs]
+    return needs
 
 
 def inputs_by_name(routine: Routine, case: tuple) -> dict:

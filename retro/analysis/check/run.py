@@ -25,14 +25,22 @@ from retro.analysis.check.engines import (
     runner_for,
 )
 from retro.analysis.check.coverage import completed, worst_path
+from retro.analysis.check.entry_runs import (
+    VARIANTS,
+    entry_block_on_batched_core,
+    entry_block_on_machine,
+    entry_every,
+    name_dependence,
+)
 from retro.analysis.check.results import PartRun, RoutineCheck
 from retro.analysis.check.search import DEFAULT_SEARCH, SearchResult, search
 from retro.analysis.check.tally import Tally, count_block
 from retro.analysis.check.verdicts import bounds_violations, budget_violations, static_bounds
 from retro.analysis.row_check import RowsCheck, check_rows, merged_agreement, rows_only_static
-from retro.errors import InputError
+from retro.errors import InputError, RunError
 from retro.routines import cases as case_sets
 from retro.routines.registry import select
+from retro.routines.runner import RoutineRunner
 from retro.routines.spec import Routine
 from retro.routines.where import require_inside
 from retro.workers import worker_pool
@@ -42,17 +50,54 @@ PROGRESS_SECONDS = 1.0  # at most one progress line a second
 
 # ---- what a worker does: one block of calls, tallied ------------------------------------------------
 
-def machine_chunk(spec: str, seed: int, cases: list[tuple], start: SceneStart | None = None) -> Tally:
-    """Cases on Machine, tallied (a pure function of its arguments, run in worker processes)."""
+def machine_chunk(spec: str, seed: int, cases: list[tuple], start: SceneStart | None = None, first: int = 0,
+                  every: int = 0) -> Tally:
+    """Cases on Machine, tallied (a pure function of its arguments, run in worker processes); `first`
+    is the index of the first case in the check, and every `every`-th case of the check is run again
+    with the entry state varied (0: none)."""
     runner = runner_for(spec, seed, start)
     columns = case_sets.cases_to_columns(runner.routine, cases)
-    return count_block(runner.routine, run_on_machine(runner, cases), columns, cases, runner.memory_values)
+    block = run_on_machine(runner, cases)
+    entry = None
+    if every:
+        entry = entry_block_on_machine(_variants(spec, seed, start), cases[:block.calls], first, every, seed)
+    return _named(spec, seed, start, count_block(runner.routine, block, columns, cases, runner.memory_values,
+                                                 entry=entry))
 
 
-def batch_chunk(spec: str, seed: int, columns: list) -> Tally:
-    """A column block on the batched core, tallied (run in worker processes)."""
+def batch_chunk(spec: str, seed: int, columns: list, first: int = 0, every: int = 0) -> Tally:
+    """A column block on the batched core, tallied (run in worker processes); `first` and `every` as
+    for machine_chunk."""
     runner = runner_for(spec, seed, None)
-    return count_block(runner.routine, run_on_batched_core(runner, columns), columns, None, runner.memory_values)
+    block = run_on_batched_core(runner, columns)
+    entry = None
+    if every:
+        entry = entry_block_on_batched_core(_variants(spec, seed, None), [c[:block.calls] for c in columns], first,
+                                            every, seed)
+    return _named(spec, seed, None, count_block(runner.routine, block, columns, None, runner.memory_values,
+                                                entry=entry))
+
+
+def _variants(spec: str, seed: int, start: SceneStart | None) -> dict[str, RoutineRunner]:
+    """The runners of the entry-state variants; an `init` that stops on their memory is a run error."""
+    runners = {}
+    for variant in VARIANTS:
+        try:
+            runners[variant] = runner_for(spec, seed, start, variant)
+        except RunError as exc:
+            raise RunError(f"{routine_of(spec).spec_path}: init stops when the memory nothing sets is {variant} "
+                           f"instead of 0 (it depends on the entry state): {exc}") from None
+    return runners
+
+
+def _named(spec: str, seed: int, start: SceneStart | None, tally: Tally) -> Tally:
+    """Name what the first changed case of each entry-state variant depends on (on Machine)."""
+    for variant, finding in tally.entry_first.items():
+        if finding.needs is None:
+            base = RoutineRunner(routine_of(spec), seed, start.raster_start() if start else None)
+            varied = bytes(runner_for(spec, seed, start, variant).call_image)
+            finding.needs = name_dependence(base, varied, finding, seed)
+    return tally
 
 
 def agreement_chunk(spec: str, seed: int, cases: list[tuple]) -> Tally:
@@ -92,9 +137,21 @@ def _run_work(work: Iterator[tuple], jobs: int, report: Callable[[Tally], None],
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _chunks(parts: list[case_sets.Part]) -> Iterator[list[tuple]]:
+def _chunks(parts: list[case_sets.Part]) -> Iterator[tuple[list[tuple], int]]:
+    """The parts' cases in chunks, each with the index of its first case in the check."""
+    first = 0
     for part in parts:
-        yield from case_sets.chunks(part.cases)
+        for chunk in case_sets.chunks(part.cases):
+            yield chunk, first
+            first += len(chunk)
+
+
+def _blocks(parts: list[case_sets.Part]) -> Iterator[tuple[list, int]]:
+    """The parts' cases in column blocks for the batched core, each with its first case's index."""
+    first = 0
+    for block in case_sets.batches(parts, BATCH_LANES):
+        yield block, first
+        first += len(block[0])
 
 
 def _reporter(routine: Routine, totals: Tally, known: int, unknown: bool,
@@ -127,7 +184,7 @@ def _agreement(spec: str, seed: int, parts: list[case_sets.Part]) -> Tally:
 
 
 def _part_runs(parts: list[case_sets.Part], totals: Tally, unknown: bool, rows: RowsCheck | None) -> list[PartRun]:
-    part_runs = [PartRun(p.name, p.count if p.count is not None else 0, p.total) for p in parts]
+    part_runs = [PartRun(p.name, p.count if p.count is not None else 0, p.total, p.inside) for p in parts]
     if rows is not None:  # the rows ran first, as a part of their own
         part_runs.insert(0, PartRun("rows", sum(o.checked for o in rows.outcomes), len(rows.outcomes)))
     if unknown:  # the sweep's count is whatever was left after the counted parts
@@ -140,12 +197,13 @@ def _part_runs(parts: list[case_sets.Part], totals: Tally, unknown: bool, rows: 
 def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | None = None,
                   random_count: int | None = None, jobs: int = 1, progress: Callable[[str], None] | None = None,
                   start: SceneStart | None = None, bounded_product: int = case_sets.BOUNDED_PRODUCT,
-                  engine: str = "auto", search_budget: int | None = None) -> RoutineCheck:
+                  engine: str = "auto", search_budget: int | None = None, entry_state: bool = True) -> RoutineCheck:
     """Check one routine: a spec path, or a Routine built in Python (then in this process only).
     `engine`: "scalar" (Machine), "batch" (the batched core, checked against Machine on the first
     AGREEMENT_PER_PART cases of each part) or "auto" (batch from AUTO_BATCH_CASES planned cases).
     `search_budget`: candidates the coverage-guided search may run after the planned cases (None:
-    the spec's `[cases] search`, else DEFAULT_SEARCH; 0: no search)."""
+    the spec's `[cases] search`, else DEFAULT_SEARCH; 0: no search). `entry_state`: also run a sample
+    of the cases with the entry state the spec leaves arbitrary varied (retro.analysis.check.entry_runs)."""
     began = time.monotonic()
     check_engine(engine)
     if isinstance(spec, Routine):
@@ -177,8 +235,9 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         if totals.run_errors:  # a row's call that stopped stops the check
             parts = []
     agreement = _agreement(spec, seed, parts) if on_batch else None
-    work = (((batch_chunk, (spec, seed, block)) for block in case_sets.batches(parts, BATCH_LANES)) if on_batch else
-            ((machine_chunk, (spec, seed, chunk, start)) for chunk in _chunks(parts)))
+    every = entry_every(known, exhaustive, bounded_product, unknown) if entry_state and parts else 0
+    work = (((batch_chunk, (spec, seed, block, first, every)) for block, first in _blocks(parts)) if on_batch else
+            ((machine_chunk, (spec, seed, chunk, start, first, every)) for chunk, first in _chunks(parts)))
     _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
     searched = _search(spec, seed, runner, on_batch, totals, search_budget)
     if searched.found:  # the search's cases, checked like every other case
@@ -187,7 +246,7 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         if on_batch:
             agreement.merge(_agreement(spec, seed, parts[-1:]))
         work = (((batch_chunk, (spec, seed, block)) for block in case_sets.batches(parts[-1:], BATCH_LANES))
-                if on_batch else ((machine_chunk, (spec, seed, chunk, start)) for chunk in _chunks(parts[-1:])))
+                if on_batch else ((machine_chunk, (spec, seed, chunk, start)) for chunk, _ in _chunks(parts[-1:])))
         _run_work(work, 1, report, lambda: totals.run_errors)
     require_inside(f"{routine.spec_path}: cases.where", routine.domain, totals.cases, totals.outside,
                    totals.constraint_cases)
@@ -198,7 +257,8 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     check = RoutineCheck(routine, runner.size(), static, totals, bounds_violations(routine, static, totals),
                          budget_violations(routine, static, totals), _part_runs(parts, totals, unknown, rows),
                          start=runner.start, engine="batch" if on_batch else "scalar", agreement=agreement, rows=rows,
-                         search=searched, engine_note=engine_note)
+                         search=searched, engine_note=engine_note, entry_every=every,
+                         random_draw=next((p.draw for p in parts if p.name == "random"), None))
     if rows is not None and rows.agreement is not None:
         check.agreement = agreement = merged_agreement(agreement, rows)
     if agreement is not None and agreement.failure is not None and totals.failure is None:

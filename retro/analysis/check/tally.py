@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from retro.analysis.check.engines import CallBlock, disagreement
+from retro.analysis.check.entry_runs import EntryBlock, EntryFinding, changed_calls
 from retro.analysis.check.reference import reference_answers
 from retro.analysis.check.results import Failure, describe_case, describe_outputs
 from retro.analysis.coverage_model import CodeCoverage
@@ -60,6 +61,9 @@ class Tally:
     outside_examples: list[str] = field(default_factory=list)
     failure: Failure | None = None
     code_coverage: CodeCoverage = field(default_factory=CodeCoverage)  # what the calls ran of the code
+    entry_cases: int = 0  # cases rerun with the entry state varied (retro.analysis.check.entry_runs)
+    entry_changed: int = 0  # of them, those whose outputs or cycles changed in a variant
+    entry_first: dict[str, EntryFinding] = field(default_factory=dict)  # variant -> its first changed case
 
     def merge(self, other: "Tally") -> None:
         self.cases += other.cases
@@ -89,6 +93,11 @@ class Tally:
         self.outside_examples = (self.outside_examples + other.outside_examples)[:EXAMPLES_KEPT]
         self.failure = self.failure or other.failure
         self.code_coverage = self.code_coverage.merge(other.code_coverage)
+        self.entry_cases += other.entry_cases
+        self.entry_changed += other.entry_changed
+        for variant, finding in other.entry_first.items():
+            if variant not in self.entry_first or finding.index < self.entry_first[variant].index:
+                self.entry_first[variant] = finding
 
 
 @dataclass(frozen=True)
@@ -116,10 +125,11 @@ class _Calls:
 
 
 def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[tuple] | None, memory: dict,
-                against: CallBlock | None = None) -> Tally:
+                against: CallBlock | None = None, entry: EntryBlock | None = None) -> Tally:
     """Tally the calls of one block (either engine) against the reference's answers. `cases`: the
     block's cases as tuples when they are at hand (else made when the reference or a condition needs
-    them); `against`: the batched core's block for the same calls, compared call for call."""
+    them); `against`: the batched core's block for the same calls, compared call for call; `entry`:
+    the entry-state runs of some of its cases, compared with the block's own calls."""
     calls = _calls(routine, block, columns, cases, memory)
     out = Tally()
     n = block.returned
@@ -150,6 +160,8 @@ def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[t
     _cycle_figures(out, calls, cpu)
     _examples(out, calls, wrong_inside, cycle_wrong, cpu, engine_wrong)
     _outside_examples(out, calls, wrong_outside)
+    if entry is not None:
+        _entry_figures(out, calls, entry)
     if block.stop is not None:  # the call that did not return ends the block, as it ends the check
         case = cases[n] if cases is not None else case_sets.case_of(columns, n)
         _stop(out, calls, case, engine_wrong.get(n))
@@ -227,6 +239,27 @@ def _outside_examples(out: Tally, calls: _Calls, wrong_outside: np.ndarray) -> N
         out.outside_examples.append(
             f"{calls.described(i)}: returned {describe_outputs(routine, calls.block.row(i))}, "
             f"reference {describe_outputs(routine, calls.expected_row(i))} (outside: {', '.join(broken)})")
+
+
+def _entry_figures(out: Tally, calls: _Calls, entry: EntryBlock) -> None:
+    """The rerun cases whose outputs or cycles changed with the entry state (inside the domain, among
+    the calls that returned), and each variant's first."""
+    n = calls.block.returned
+    positions = entry.positions[entry.positions < n]
+    compared = calls.inside[positions]
+    out.entry_cases = int(compared.sum())
+    any_changed = np.zeros(len(positions), dtype=bool)
+    for variant, run in entry.runs.items():
+        changed = changed_calls(calls.block.outputs, calls.block.cycles, compared, positions, run.head(len(positions)))
+        any_changed |= changed
+        if changed.any():
+            k = int(np.flatnonzero(changed)[0])
+            i = int(positions[k])
+            varied = ((None, run.messages.get(k, "the call did not return")) if run.stopped[k]
+                      else (row_of(run.outputs, k), int(run.cycles[k])))
+            out.entry_first[variant] = EntryFinding(variant, entry.first + i, calls.case(i),
+                                                    (calls.block.row(i), int(calls.block.cycles[i])), varied)
+    out.entry_changed = int(any_changed.sum())
 
 
 def _stop(out: Tally, calls: _Calls, case: tuple, engine_message: str | None) -> None:

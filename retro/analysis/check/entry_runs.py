@@ -1,0 +1,221 @@
+"""Entry-state runs: a sample of a check's cases run again with everything the spec leaves arbitrary
+on entry (registers and flags no input or `[entry]` sets, untouched memory) set to all ones and to
+random values (retro.routines.entry), on the engine that runs the check; a case whose outputs or
+cycles change (inside the domain) is a failure, and the first such case of each variant is run again
+on Machine with one thing varied at a time to name what the routine depends on.
+
+Which cases are rerun is a function of their index in the check (every `every`-th), and their random
+state a function of (seed, index): both engines, any block size and any number of workers rerun the
+same cases with the same state and reach the same verdict.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from retro.cpu.batch import LaneError
+from retro.errors import RunError
+from retro.routines.entry import VARIANTS, advice, memory_advice, stack_advice, variant_stack, variant_values
+from retro.routines.places import FLAGS
+from retro.routines.runner import RoutineRunner
+
+ENTRY_SAMPLE = 2_000  # cases rerun (in each variant) when a check plans more; fewer: all of them
+SWEEP_EVERY = 64  # with a sweep (its count unknown beforehand), at most one case in this many is rerun
+
+
+@dataclass(frozen=True)
+class VariantRun:
+    """What the rerun cases of a block did in one variant: per output an array, cycles, and which
+    calls did not return (their outputs and cycles mean nothing)."""
+
+    outputs: list
+    cycles: np.ndarray
+    stopped: np.ndarray
+    messages: dict  # position among the rerun cases -> why the call stopped
+
+    def head(self, count: int) -> "VariantRun":
+        """The first `count` rerun cases."""
+        return VariantRun([o[:count] for o in self.outputs], self.cycles[:count], self.stopped[:count], self.messages)
+
+
+@dataclass(frozen=True)
+class EntryBlock:
+    """A block's rerun cases: their positions in the block, the block's first case's index in the
+    check, and per variant what they did."""
+
+    first: int
+    positions: np.ndarray
+    runs: dict  # variant -> VariantRun
+
+
+@dataclass
+class EntryFinding:
+    """The first case of a variant whose outputs or cycles changed, and what it depends on."""
+
+    variant: str
+    index: int  # the case's place in the check
+    case: tuple
+    baseline: tuple  # (outputs, cycles) as the check ran it
+    varied: tuple  # (outputs, cycles), or (None, why the call stopped)
+    needs: tuple[str, ...] | None = None  # one line per thing the routine depends on (None: not yet named)
+
+
+def entry_every(planned: int, exhaustive: bool, everything: int, sweep: bool = False) -> int:
+    """Every how many cases one is rerun: all of a check of at most ENTRY_SAMPLE cases (with
+    --exhaustive: of at most `everything`), else a sample of about ENTRY_SAMPLE; with a sweep, whose
+    cases are not counted beforehand, at most one in SWEEP_EVERY."""
+    every = 1 if planned <= ENTRY_SAMPLE or (exhaustive and planned <= everything) else -(-planned // ENTRY_SAMPLE)
+    return max(every, SWEEP_EVERY) if sweep else every
+
+
+def rerun_positions(first: int, n: int, every: int) -> np.ndarray:
+    """Positions within a block (whose first case has index `first`) of the cases to rerun."""
+    start = (-first) % every
+    return np.arange(start, n, every, dtype=np.int64)
+
+
+def entry_block_on_machine(variants: dict[str, RoutineRunner], cases: list[tuple], first: int, every: int,
+                           seed: int) -> EntryBlock:
+    positions = rerun_positions(first, len(cases), every)
+    runs = {}
+    for variant, runner in variants.items():
+        state = runner.entry_state
+        registers, bits = variant_values(state, variant, seed, positions + first)
+        answers, cycles, stopped, messages = [], [], [], {}
+        for k, position in enumerate(positions.tolist()):
+            entry = ({name: int(v[k]) for name, v in registers.items()}, int(bits[k]), state.free_mask)
+            try:
+                answer, spent = runner.run(cases[position], entry=entry)
+            except RunError as exc:
+                answer, spent = None, -1
+                messages[k] = str(exc)
+            answers.append(answer)
+            cycles.append(spent)
+            stopped.append(answer is None)
+        runs[variant] = VariantRun(_columns(runner, answers), np.asarray(cycles, dtype=np.int64),
+                                   np.asarray(stopped, dtype=bool), messages)
+    return EntryBlock(first, positions, runs)
+
+
+def entry_block_on_batched_core(variants: dict[str, RoutineRunner], columns: list, first: int, every: int,
+                                seed: int) -> EntryBlock:
+    positions = rerun_positions(first, len(columns[0]), every)
+    runs = {}
+    if len(positions):
+        subset = [c[positions] for c in columns]
+        for variant, runner in variants.items():
+            state = runner.entry_state
+            registers, bits = variant_values(state, variant, seed, positions + first)
+            outcome = runner.run_batch(subset, entry=(registers, bits, state.free_mask))
+            stopped = outcome.error != 0
+            messages = {int(k): f"the batched core stopped the call ({LaneError(int(outcome.error[k])).name})"
+                        for k in np.flatnonzero(stopped)[:1]}
+            runs[variant] = VariantRun(outcome.outputs, outcome.cycles, stopped, messages)
+    return EntryBlock(first, positions, runs)
+
+
+def _columns(runner: RoutineRunner, answers: list) -> list[np.ndarray]:
+    outputs = runner.routine.outputs
+    n = len(answers)
+    columns = []
+    for k, port in enumerate(outputs):
+        width = len(port.places) if port.table else None
+        filler = (0,) * width if width else 0
+        column = np.asarray([a[k] if a is not None else filler for a in answers], dtype=np.int64)
+        columns.append(column.reshape((n, width) if width else (n,)))
+    return columns
+
+
+def changed_calls(block_outputs: list, block_cycles: np.ndarray, compared: np.ndarray, positions: np.ndarray,
+                  run: VariantRun) -> np.ndarray:
+    """Which rerun cases (of those `compared`: returned in the check, inside the domain) changed."""
+    changed = run.stopped.copy()
+    for baseline, varied in zip(block_outputs, run.outputs):
+        differ = baseline[positions] != varied
+        changed |= differ.any(axis=1) if differ.ndim == 2 else differ
+    changed |= block_cycles[positions] != run.cycles
+    return changed & compared
+
+
+# ---- naming what a changed case depends on ----------------------------------------------------------
+
+def name_dependence(base: RoutineRunner, varied_image: bytes, finding: EntryFinding, seed: int) -> tuple[str, ...]:
+    """Run the finding's case on Machine (`base`: a fresh runner of the baseline) with one part of
+    the variant's entry state at a time: each register, each flag, then memory (halved until one
+    address is left). The parts that alone change the call are named, each with what to do."""
+    state = base.entry_state
+    baseline_image = bytes(base.call_image)
+    baseline_top, varied_top = base.machine.stack_top, variant_stack(finding.variant, seed)
+    registers, bits = variant_values(state, finding.variant, seed, np.asarray([finding.index]))
+    registers = {name: int(v[0]) for name, v in registers.items()}
+    bits = int(bits[0])
+    case = finding.case
+
+    def outcome(entry, image: bytes, stack_top: int | None = None) -> tuple:
+        base.reset_memory(image)
+        base.machine.stack_top = baseline_top if stack_top is None else stack_top
+        try:
+            return base.run(case, entry=entry)
+        except RunError:
+            return (None, "stopped")
+        finally:
+            base.machine.stack_top = baseline_top
+
+    reference = outcome(None, baseline_image)
+    needs = []
+    for name in state.free_registers:
+        if registers[name] != state.registers[name] and outcome(({name: registers[name]}, 0, 0),
+                                                               baseline_image) != reference:
+            needs.append(advice(name.upper(), state.registers[name]))
+    for name in state.free_flags:
+        bit = FLAGS[name]
+        if (bits & bit) != (state.flags & bit) and outcome(({}, bits & bit, bit), baseline_image) != reference:
+            needs.append(advice(name, state.baseline_of(name)))
+    if varied_top != baseline_top and outcome(None, baseline_image, varied_top) != reference:
+        needs.append(stack_advice(baseline_top, varied_top))
+    address = _memory_dependence(outcome, reference, baseline_image, varied_image)
+    if address is not None:
+        labels = {a: label for label, a in sorted(base.program.symbols.items(), key=lambda kv: -len(kv[0]))}
+        if isinstance(address, int):
+            needs.append(memory_advice(address, baseline_image[address], labels.get(address)))
+        else:
+            needs.append(f"reads memory in ${address[0]:04X}-${address[1]:04X} that nothing sets before the call: "
+                         "declare it (an input, or a [memory] block), or write it before reading it")
+    base.reset_memory(baseline_image)
+    if not needs:
+        varied = [n.upper() for n in state.free_registers] + list(state.free_flags) + ["S", "memory"]
+        needs.append(f"changes only when several of {', '.join(varied)} change together: state what the routine "
+                     "needs in [entry], or set it in the routine")
+    return tuple(needs)
+
+
+def _memory_dependence(outcome, reference, baseline_image: bytes, varied_image: bytes):
+    """The address (or the range) of untouched memory whose variant byte alone changes the call."""
+    base = np.frombuffer(baseline_image, dtype=np.uint8)
+    varied = np.frombuffer(varied_image, dtype=np.uint8)
+    candidates = np.flatnonzero(base != varied)
+
+    def changes(addresses: np.ndarray) -> bool:
+        image = base.copy()
+        image[addresses] = varied[addresses]
+        return outcome(None, image.tobytes()) != reference
+
+    if not len(candidates) or not changes(candidates):
+        return None
+    while len(candidates) > 1:
+        half = len(candidates) // 2
+        low, high = candidates[:half], candidates[half:]
+        if changes(low):
+            candidates = low
+        elif changes(high):
+            candidates = high
+        else:  # only bytes of both halves together change it
+            return int(candidates[0]), int(candidates[-1])
+    return int(candidates[0])
+
+
+__all__ = ["ENTRY_SAMPLE", "VARIANTS", "EntryBlock", "EntryFinding", "VariantRun", "changed_calls",
+           "entry_block_on_batched_core", "entry_block_on_machine", "entry_every", "name_dependence",
+           "rerun_positions"]

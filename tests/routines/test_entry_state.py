@@ -1,0 +1,138 @@
+"""Entry state as part of a spec's contract (issue 23 part 2): `[entry]` states what the caller
+guarantees; everything else is arbitrary, and a case whose outputs or cycles change when it is all
+ones or random is a failure naming what the routine depends on. The fixtures (tests/data/entry) are
+routines with one hidden assumption each, their references written from what they are meant to do."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from retro.cli import main
+from retro.errors import InputError
+from retro.routines.registry import get
+from retro.routines.runner import RoutineRunner
+
+ENTRY = Path(__file__).resolve().parents[1] / "data" / "entry"
+ENGINES = ("scalar", "batch")
+
+
+def _check(capsys, spec, *args) -> tuple[int, dict]:
+    code = main(["check", str(spec), "--json", "--jobs", "1", *args])
+    (record,) = json.loads(capsys.readouterr().out)
+    return code, record
+
+
+def _spec_with(tmp_path: Path, name: str, extra: str) -> Path:
+    """A copy of a fixture's spec beside its files' absolute paths, with `extra` TOML appended."""
+    text = (ENTRY / f"{name}.toml").read_text()
+    text = text.replace(f'file = "{name.split("_stated")[0]}.s"', f'file = "{ENTRY / name.split("_stated")[0]}.s"')
+    text = text.replace('"refs.py:', f'"{ENTRY / "refs.py"}:')
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text + extra)
+    return path
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_the_superoptimisers_overlap_test_needs_the_carry_clear(capsys, engine):
+    code, record = _check(capsys, ENTRY / "overlap8.toml", "--exhaustive", "--engine", engine)
+    entry = record["entry_dependence"]
+    assert code == 1 and record["result_mismatches"] == 0  # with C = 0 on entry every answer is right
+    assert entry["every"] == 1 and entry["cases"] == 65_536  # a small exhaustive space: every case again
+    assert "needs C = 0 on entry: add it to the spec ([entry] c = 0), or clear it (CLC)" in entry["needs"]
+    assert "needs D = 0 on entry: add it to the spec ([entry] d = 0), or clear it (CLD)" in entry["needs"]
+    assert entry["changed"] > 0 and record["mismatches"] >= entry["changed"]
+    assert "C" in entry["varied"] and "D" in entry["varied"] and "A" not in entry["varied"]  # A is input a
+
+
+def test_the_overlap_tests_failure_is_real_at_207_215_with_the_carry_set():
+    runner = RoutineRunner(get(str(ENTRY / "overlap8.toml")))
+    assert runner.run((207, 215))[0] == (0,)  # 8 apart: no overlap, as |a - b| < 8 says
+    carry = ({}, 1, 1)  # the carry set on entry, nothing else changed
+    assert runner.run((207, 215), entry=carry)[0] == (1,)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_stated_entry_conditions_are_kept_and_not_varied(capsys, engine, tmp_path):
+    code, record = _check(capsys, ENTRY / "overlap8_stated.toml", "--engine", engine)
+    entry = record["entry_dependence"]
+    assert code == 0 and entry["changed"] == 0 and entry["needs"] == []
+    assert entry["stated"] == {"C": 0, "D": 0} and "C" not in entry["varied"] and "D" not in entry["varied"]
+    # a stated value is what every call starts with: C = 1 on entry makes the routine wrong
+    code, record = _check(capsys, _spec_with(tmp_path, "overlap8", "\n[entry]\nc = 1\nd = 0\n"), "--engine", engine)
+    assert code == 1 and record["result_mismatches"] > 0
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("name, need", [
+    ("add_bcd", "needs D = 0 on entry: add it to the spec ([entry] d = 0), or clear it (CLD)"),
+    ("index_x", "needs X = 0 on entry: add it to the spec ([entry] x = 0), or set it (LDX #0)"),
+    ("scratch", "reads $00FB, which nothing sets before the call (baseline $00): declare it (an input, or a "
+                "[memory] block), or write it before reading it"),
+    ("room", None),  # the stack pointer: its value in the random variant depends on the seed
+])
+def test_each_hidden_assumption_is_named(capsys, engine, name, need):
+    code, record = _check(capsys, ENTRY / f"{name}.toml", "--engine", engine)
+    entry = record["entry_dependence"]
+    assert code == 1 and record["result_mismatches"] == 0
+    if need is None:
+        (need,) = entry["needs"]
+        assert need.startswith("depends on the stack pointer (S = $FD at its first instruction in the check, $")
+        assert need.endswith("address the stack relative to S (TSX), never at fixed addresses in page 1")
+    assert entry["needs"] == [need]
+    assert entry["changed"] > 0
+
+
+@pytest.mark.parametrize("name", ["overlap8", "add_bcd", "index_x", "scratch", "room"])
+def test_both_engines_give_the_same_verdict(capsys, name):
+    records = [_check(capsys, ENTRY / f"{name}.toml", "--engine", engine)[1] for engine in ENGINES]
+    assert records[0]["entry_dependence"] == records[1]["entry_dependence"]
+    assert records[0]["mismatches"] == records[1]["mismatches"]
+
+
+def test_the_text_report_names_the_dependence(capsys):
+    main(["check", str(ENTRY / "index_x.toml"), "--jobs", "1"])
+    text = capsys.readouterr().out
+    assert "ENTRY 16 of 16 cases change" in text
+    assert "ENTRY needs X = 0 on entry" in text and "ENTRY e.g. i=" in text
+
+
+def test_a_routine_without_hidden_assumptions_says_so(capsys, tmp_path):
+    code, record = _check(capsys, _spec_with(tmp_path, "index_x", "\n[entry]\nx = 0\n"))
+    assert code == 0 and record["entry_dependence"]["changed"] == 0
+    main(["check", str(tmp_path / "index_x.toml"), "--jobs", "1"])
+    assert "entry state: 16 cases (every case) run again with A, Y, C, Z, I, D, V, N, S and untouched memory" in \
+        capsys.readouterr().out
+
+
+@pytest.mark.parametrize("extra, message", [
+    ("c = 2", "entry.c: 2 is out of range 0..1"),
+    ("x = 256", "entry.x: 256 is out of range 0..255"),
+    ("q = 0", "entry.q: unknown register or flag"),
+    ("A = 1", "entry.A: A is input a: every case sets it"),
+    ("x = \"lots\"", "entry.x"),
+])
+def test_bad_entry_values_are_one_line_naming_the_key(tmp_path, extra, message):
+    path = _spec_with(tmp_path, "overlap8", f"\n[entry]\n{extra}\n")
+    with pytest.raises(InputError) as caught:
+        get(str(path))
+    assert message in str(caught.value) and "\n" not in str(caught.value)
+
+
+def test_which_cases_run_again():
+    from retro.analysis.check.entry_runs import entry_every, rerun_positions
+
+    assert entry_every(2_000, False, 65_536) == 1  # a small check: every case
+    assert entry_every(65_536, True, 65_536) == 1  # an exhaustive check of a small space: every case
+    assert entry_every(67_536, False, 65_536) == 34  # else about 2,000 of them
+    assert entry_every(67_536, True, 65_536) == 34
+    assert entry_every(100, True, 65_536, sweep=True) == 64  # a sweep's count is unknown: 1 in 64 at most
+    # the same cases whatever the blocks: positions by the case's index in the check
+    every = 7
+    whole = rerun_positions(0, 100, every)
+    pieces = [rerun_positions(first, 30, every) + first for first in range(0, 100, 30)]
+    import numpy as np
+
+    assert np.concatenate(pieces)[np.concatenate(pieces) < 100].tolist() == whole.tolist() == list(range(0, 100, 7))
