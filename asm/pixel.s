@@ -12,7 +12,7 @@
 ;      first mask's byte; the first non-zero AND ends the test (early exit on the first hit).
 ; Loop bounds (for the static analysis): _row runs at most 21 times, _byte at most 3 per row.
 ; Domain: every dx, dy; |dx| >= 24 or |dy| >= 21 return "no overlap" at once.
-        .org $c000
+        .org $8000              ; below $A000: the tables and masks end at $92FF, clear of the I/O area at $D000
         .alias pdx   $10
         .alias pdy   $11
         .alias pa    $12        ; first mask, row of the first overlapping row, plus k bytes
