@@ -124,6 +124,8 @@ def check_record(check: RoutineCheck) -> dict:
               "input_space": space if (space := check.routine.input_space()) < JSON_EXACT else None,
               "input_space_log2": round(math.log2(space), 3), "coverage_argument": check.routine.coverage or None,
               "examples": t.examples, "outside_examples": t.outside_examples, "engine": check.engine,
+              "engine_reason": check.engine_reason, "compile_seconds": None if check.compile_seconds is None else
+              round(check.compile_seconds, 3), "compiled_fallbacks": fallback_counts(t),
               "engine_agreement": None if check.agreement is None else {
                   "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
                   "timing_model_mismatches": check.agreement.cycle_mismatches},
@@ -141,6 +143,26 @@ def check_record(check: RoutineCheck) -> dict:
     if check.rows is not None:
         record["rows"] = rows_record(check.routine, check.rows)
     return record
+
+
+def fallback_counts(t) -> dict[str, int]:
+    """The compiled engine's calls that ran on the batched core, by reason (the reason's text)."""
+    from retro.cpu.compiled import FALLBACK_REASON
+
+    return {FALLBACK_REASON.get(code, str(code)): count for code, count in sorted(t.fallbacks.items())}
+
+
+def engine_lines(check: RoutineCheck) -> list[str]:
+    """Which engine ran and why, when the compiled engine was asked for or considered."""
+    if check.engine != "compiled" and "compiled" not in check.engine_reason:
+        return []
+    line = f"  engine: {check.engine} ({check.engine_reason})"
+    if check.compile_seconds is not None:
+        line += f"; code compiled or loaded from the cache in {check.compile_seconds:.2f} s"
+    lines = [line]
+    for reason, count in fallback_counts(check.totals).items():
+        lines.append(f"  engine: {count:,} calls ran on the batched core: {reason}")
+    return lines
 
 
 def _plain(values: tuple) -> list:
@@ -168,6 +190,7 @@ def format_check(check: RoutineCheck) -> list[str]:
     t = check.totals
     routine = check.routine
     lines = [_headline(check)]
+    lines += engine_lines(check)
     lines += [f"  note: {note}" for note in routine.notes]
     if check.parts:
         lines.append(f"  cases: {format_coverage(check)}; input space {format_space(check.routine.input_space())}")
@@ -203,7 +226,8 @@ def _headline(check: RoutineCheck) -> str:
         checked = f"timing model equal on {t.cases - t.cycle_mismatches - t.run_errors} of {t.cases} calls"
     else:
         a = check.agreement
-        checked = (f"batched core; on {a.engine_cases} of the calls Machine agrees on "
+        checked = (f"{'compiled engine' if check.engine == 'compiled' else 'batched core'}; on {a.engine_cases} of "
+                   f"the calls Machine agrees on "
                    f"{a.engine_cases - a.engine_mismatches} and the timing model on "
                    f"{a.cases - a.cycle_mismatches - a.run_errors}")
     return f"{check.routine.name}: {t.cases} cases, {verdict}; {cost}, {static}; {checked}"

@@ -15,8 +15,10 @@ from retro.analysis.check.engines import (
     AUTO_BATCH_CASES,
     BATCH_LANES,
     SceneStart,
+    array_engine,
     batched,
     check_engine,
+    compiled_or_why,
     failure_trace,
     routine_key,
     routine_of,
@@ -47,18 +49,19 @@ def machine_chunk(spec: str, seed: int, cases: list[tuple], start: SceneStart | 
     return count_block(runner.routine, run_on_machine(runner, cases), columns, cases, runner.memory_values)
 
 
-def batch_chunk(spec: str, seed: int, columns: list) -> Tally:
-    """A column block on the batched core, tallied (run in worker processes)."""
+def batch_chunk(spec: str, seed: int, columns: list, engine: str = "batch") -> Tally:
+    """A column block on an array engine ("batch" or "compiled"), tallied (run in worker processes)."""
     runner = runner_for(spec, seed, None)
-    return count_block(runner.routine, run_on_batched_core(runner, columns), columns, None, runner.memory_values)
+    return count_block(runner.routine, run_on_batched_core(runner, columns, engine=engine), columns, None,
+                       runner.memory_values)
 
 
-def agreement_chunk(spec: str, seed: int, cases: list[tuple]) -> Tally:
+def agreement_chunk(spec: str, seed: int, cases: list[tuple], engine: str = "batch") -> Tally:
     """Cases on both engines: Machine's tally (timing model included), its block compared with the
-    batched core's call for call."""
+    array engine's call for call."""
     runner = runner_for(spec, seed, None)
     columns = case_sets.cases_to_columns(runner.routine, cases)
-    against = run_on_batched_core(runner, columns, confirm_stop=False)
+    against = run_on_batched_core(runner, columns, confirm_stop=False, engine=engine)
     return count_block(runner.routine, run_on_machine(runner, cases), columns, cases, runner.memory_values, against)
 
 
@@ -112,12 +115,12 @@ def _reporter(routine: Routine, totals: Tally, known: int, unknown: bool,
     return report
 
 
-def _agreement(spec: str, seed: int, parts: list[case_sets.Part]) -> Tally:
+def _agreement(spec: str, seed: int, parts: list[case_sets.Part], engine: str) -> Tally:
     """Machine first: the reference engine's verdict on a prefix of every part, both engines compared."""
     agreement = Tally()
     for part in parts:
         for chunk in case_sets.chunks(islice(part.cases, AGREEMENT_PER_PART)):
-            agreement.merge(agreement_chunk(spec, seed, chunk))
+            agreement.merge(agreement_chunk(spec, seed, chunk, engine))
             if agreement.run_errors:
                 break
     return agreement
@@ -156,9 +159,20 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     unknown = any(p.count is None for p in parts)
     runner = runner_for(spec, seed, start)  # loads and validates in this process before any worker starts
     on_batch = batched(engine, None if unknown else known, runner.batchable, AUTO_BATCH_CASES)
-    if engine == "batch" and not on_batch:
-        raise InputError("--engine batch: with --scene the calls run on Machine (the batched core models no chips); "
-                         "use --engine scalar or auto")
+    if engine in ("batch", "compiled") and not on_batch:
+        raise InputError(f"--engine {engine}: with --scene the calls run on Machine (the batched core and the "
+                         f"compiled engine model no chips); use --engine scalar or auto")
+    used, reason = ("scalar", "with --scene the calls run on Machine" if start is not None else
+                    f"{engine}: {known:,} planned calls" if engine == "auto" else f"--engine {engine}")
+    compile_seconds = None
+    if on_batch:
+        used, reason = array_engine(engine, None if unknown else known)
+        if used == "compiled":
+            refused = compiled_or_why(runner)
+            if refused is not None:
+                used, reason = "batch", f"the compiled engine does not take it: {refused}"
+            else:
+                compile_seconds = runner.compiled().compile_seconds
     totals = Tally()
     report = _reporter(routine, totals, known, unknown, progress)
     rows = None
@@ -167,8 +181,8 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         report(rows_totals)
         if totals.run_errors:  # a row's call that stopped stops the check
             parts = []
-    agreement = _agreement(spec, seed, parts) if on_batch else None
-    work = (((batch_chunk, (spec, seed, block)) for block in case_sets.batches(parts, BATCH_LANES)) if on_batch else
+    agreement = _agreement(spec, seed, parts, used) if on_batch else None
+    work = (((batch_chunk, (spec, seed, block, used)) for block in case_sets.batches(parts, BATCH_LANES)) if on_batch else
             ((machine_chunk, (spec, seed, chunk, start)) for chunk in _chunks(parts)))
     _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
     require_inside(f"{routine.spec_path}: cases.where", routine.domain, totals.cases, totals.outside,
@@ -179,7 +193,8 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         static = static_bounds(routine, runner)
     check = RoutineCheck(routine, runner.size(), static, totals, bounds_violations(routine, static, totals),
                          budget_violations(routine, static, totals), _part_runs(parts, totals, unknown, rows),
-                         start=runner.start, engine="batch" if on_batch else "scalar", agreement=agreement, rows=rows)
+                         start=runner.start, engine=used, agreement=agreement, rows=rows, engine_reason=reason,
+                         compile_seconds=compile_seconds)
     if rows is not None and rows.agreement is not None:
         check.agreement = agreement = merged_agreement(agreement, rows)
     if agreement is not None and agreement.failure is not None and totals.failure is None:
