@@ -47,7 +47,7 @@ FALLBACK_REASON = {translate.FALLBACK_STOP: "an instruction the compiled engine 
                                             "address no block starts at)",
                    translate.FALLBACK_WRITE: "a write into the routine's own code"}
 SIGNATURE = ("void(int64[::1], int64[::1], int32[::1], uint8[::1], int32[::1], int64[::1], "
-             "uint8[:, ::1], int64[::1], int64[::1], int64[::1], int64[::1], int64, int64, int64, int64, int64[::1], "
+             "uint8[:, ::1], int64[::1], int64[::1], int64[::1], int64[::1], int64, int64, int64, int64, "
              "int64[::1], int64[::1], int64[::1], int64[::1], int64[::1], int64[::1], int64[::1], uint8[:, ::1])")
 MEMORY = 0x10000
 
@@ -74,20 +74,31 @@ class CompiledRoutine:
     from_cache: bool
     code_map: np.ndarray
     addr_block: np.ndarray
-    restore: np.ndarray
+    _scratch: tuple | None = None  # (image bytes, the image as int64, memory as the calls leave it, the write log)
 
-    def run(self, image: np.ndarray, in_addr: np.ndarray, in_bytes: np.ndarray, a: np.ndarray, x: np.ndarray,
+    def memory_for(self, image: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(image, working memory, log) for this image, kept between runs: every call restores what it
+        wrote, so the working memory is the image again after a run (inputs put back by `run`)."""
+        if self._scratch is None or self._scratch[0] != image:
+            wide = np.frombuffer(image, dtype=np.uint8).astype(np.int64)
+            self._scratch = (image, wide, wide.copy(), np.zeros(MEMORY, dtype=np.int32))
+        return self._scratch[1:]
+
+    def run(self, image: bytes, in_addr: np.ndarray, in_bytes: np.ndarray, a: np.ndarray, x: np.ndarray,
             y: np.ndarray, p: np.ndarray, sp: int, budget: int, return_pc: int, return_sp: int,
             out_addr: np.ndarray) -> dict:
-        """Every call of the block (one per element of a): its results as arrays (see the module docstring)."""
+        """Every call of the block (one per element of a; `in_bytes` one row per address of `in_addr`):
+        its results as arrays, the bytes at `out_addr` one row per address (see the module docstring)."""
         n = len(a)
-        mem = image.copy()
-        results = {name: np.zeros(n, dtype=np.int64) for name in ("a", "x", "y", "p", "cycles", "status")}
-        out_bytes = np.zeros((n, len(out_addr)), dtype=np.uint8)
-        self.function(mem, image, np.zeros(MEMORY, dtype=np.int32), self.code_map,
-                      self.addr_block, in_addr, in_bytes, a, x, y, p, sp, budget, return_pc, return_sp, self.restore,
-                      out_addr, results["a"], results["x"], results["y"], results["p"], results["cycles"],
-                      results["status"], out_bytes)
+        wide, mem, log = self.memory_for(image)
+        results = {name: np.empty(n, dtype=np.int64) for name in ("a", "x", "y", "p", "cycles", "status")}
+        out_bytes = np.empty((len(out_addr), n), dtype=np.uint8)
+        try:
+            self.function(mem, wide, log, self.code_map, self.addr_block, in_addr, in_bytes, a, x, y, p, sp, budget,
+                          return_pc, return_sp, out_addr, results["a"], results["x"], results["y"], results["p"],
+                          results["cycles"], results["status"], out_bytes)
+        finally:
+            mem[in_addr] = wide[in_addr]
         results["bytes"] = out_bytes
         return results
 
@@ -214,8 +225,7 @@ def compile_routine(image: bytes, entry: int, cpu: str, return_pc: int, inputs_a
     addr_block = np.full(MEMORY, translate.NO_BLOCK, dtype=np.int32)
     for address, number in translation.blocks.items():
         addr_block[address] = number
-    restore = np.asarray(translation.fixed_writes, dtype=np.int64)
-    return CompiledRoutine(translation, function, seconds, from_cache, code_map, addr_block, restore)
+    return CompiledRoutine(translation, function, seconds, from_cache, code_map, addr_block)
 
 
 __all__ = ["CompiledRoutine", "FALLBACK", "FALLBACK_REASON", "Untranslatable", "cache_root", "compile_routine",

@@ -141,6 +141,9 @@ class _Emitter:
         self.lines: list[str] = []
         self.fixed_writes: set[int] = set()
         self.indent = ""
+        self.inlined: set[int] = set()
+        self.chained: set[int] = set()  # blocks some code reaches through the dispatch
+        self.emit_block: Callable[[int], None] = lambda start: None
 
     def put(self, line: str) -> None:
         self.lines.append(self.indent + line)
@@ -374,6 +377,10 @@ def _go(e: _Emitter, address: int, blocks: dict[int, int], return_pc: int) -> No
         e.put(f"t = {address}")
         _jump_to(e, "t", blocks)
         return
+    if address in e.inlined and len(e.indent) < MAX_INDENT:  # its only way in is from here: its code
+        e.emit_block(address)  # follows, no trip through the dispatch
+        return
+    e.chained.add(address)
     e.put(f"blk = {blocks[address]}")
     e.put("continue")
 
@@ -390,6 +397,7 @@ def _branch(e: _Emitter, condition: str, pc: int, length: int, offset: int, bloc
     _go(e, following, blocks, return_pc)
 
 
+MAX_INDENT = 160  # spaces: nested inlined blocks stop here (Python's tokenizer allows 100 levels)
 _Z_BIT = "(((zv - 1) >> 8) & 2)"  # P's Z bit from zv (0..255): 2 when zv == 0, without a branch
 BRANCH_TESTS = {0x80: ("nv >= 128", "nv < 128"), 0x40: ("fv", "fv == 0"), 0x01: ("fc", "fc == 0"),
                 0x02: ("zv == 0", "zv != 0")}
@@ -539,6 +547,35 @@ def _instruction(e: _Emitter, pc: int, op: Op | None, blocks: dict[int, int], re
     return False
 
 
+def _exits(start: int, instructions: dict, leaders: set[int], return_pc: int, read) -> tuple[list[int], list[int]]:
+    """(blocks a block goes to by its code, blocks reached later by an RTS: the addresses after its JSRs)."""
+    pc = start
+    while True:
+        op = instructions[pc]
+        targets, falls = _successors(pc, op, read)
+        if op is not None and op.mnemonic == "JSR":
+            return targets[:1], targets[1:]
+        following = (pc + MODE_LENGTH[op.mode]) & WORD if op is not None else pc
+        if op is None or not falls or op.mode in ("rel", "zpr") or following in leaders or following == return_pc:
+            return [t for t in targets + ([following] if falls else []) if t != return_pc], []
+        pc = following
+
+
+def _inlined(starts: list[int], instructions: dict, entry: int, return_pc: int, read) -> set[int]:
+    """Blocks whose code goes inside their one predecessor's: a block reached by one jump (or fall) from
+    a block before it, never by a return or as the entry. Forward only, so no loop is unrolled."""
+    leaders = set(starts)
+    into: dict[int, list[int]] = {start: [] for start in starts}
+    returned_to = set()
+    for start in starts:
+        goes, comes_back = _exits(start, instructions, leaders, return_pc, read)
+        for target in goes:
+            into[target].append(start)
+        returned_to.update(comes_back)
+    return {start for start, sources in into.items()
+            if start != entry and start not in returned_to and len(sources) == 1 and sources[0] < start}
+
+
 def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
               inputs_at: Iterable[int] = ()) -> Translation:
     """The routine at entry (its bytes as `read` gives them: the memory every call starts from) as
@@ -551,26 +588,39 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
         if address in code_bytes:
             raise Untranslatable(f"self-modifying code: an input is placed at ${address:04X}, a byte of the "
                                  f"routine's code")
-    blocks = {start: number for number, start in enumerate(starts)}
+    inlined = _inlined(starts, instructions, entry, return_pc, read)
+    dispatched = [start for start in starts if start not in inlined]
+    blocks = {start: number for number, start in enumerate(dispatched + sorted(inlined))}
+    leaders = set(starts)
     e = _Emitter(cpu, code_bytes, read)
-    e.indent = " " * 12
-    for start in starts:
-        e.put(f"{'if' if blocks[start] == 0 else 'elif'} blk == {blocks[start]}:  # ${start:04X}")
-        e.indent = " " * 16
+    e.inlined = inlined
+
+    def emit_block(start: int) -> None:
         pc = start
+        e.put(f"# block ${start:04X}")
         while True:
             op = instructions[pc]
             e.put(f"# ${pc:04X} {op.mnemonic if op is not None else 'not translated'}")
             if _instruction(e, pc, op, blocks, return_pc):
                 break
             pc = (pc + MODE_LENGTH[op.mode]) & WORD
-            if pc in blocks or pc == return_pc:  # falls into the next block
+            if pc in leaders or pc == return_pc:  # falls into the next block
                 _go(e, pc, blocks, return_pc)
                 break
+    e.emit_block = emit_block
+    pending, done = list(dispatched), set()
+    while pending:  # the dispatched blocks, then any block nested too deep to be inlined where it was met
+        start = pending.pop(0)
+        done.add(start)
         e.indent = " " * 12
+        e.put(f"{'if' if not e.lines else 'elif'} blk == {blocks[start]}:  # ${start:04X}")
+        e.indent = " " * 16
+        emit_block(start)
+        pending += sorted(e.chained - done - set(pending))
     name = "run_calls"
+    restore = "\n".join(f"        mem[{address}] = image[{address}]" for address in sorted(e.fixed_writes))
     source = _FUNCTION.format(name=name, entry_block=blocks[entry], body="\n".join(e.lines), budget_status=BUDGET,
-                              fallback_write=FALLBACK_WRITE, z_bit=_Z_BIT)
+                              fallback_write=FALLBACK_WRITE, z_bit=_Z_BIT, restore=restore)
     return Translation(source, name, blocks, code_bytes, tuple(sorted(e.fixed_writes)), len(instructions))
 
 
@@ -580,11 +630,11 @@ LOG_MASK = 65535
 
 
 def {name}(mem, image, log, code_map, addr_block, in_addr, in_bytes, reg_a, reg_x, reg_y, reg_p,
-           start_sp, budget, return_pc, return_sp, restore, out_addr, out_a, out_x, out_y, out_p, out_cycles,
+           start_sp, budget, return_pc, return_sp, out_addr, out_a, out_x, out_y, out_p, out_cycles,
            out_status, out_bytes):
     for lane in range(reg_a.shape[0]):
         for k in range(in_addr.shape[0]):
-            mem[in_addr[k]] = in_bytes[lane, k]
+            mem[in_addr[k]] = in_bytes[k, lane]
         a = np.int64(reg_a[lane])
         x = np.int64(reg_x[lane])
         y = np.int64(reg_y[lane])
@@ -623,13 +673,13 @@ def {name}(mem, image, log, code_map, addr_block, in_addr, in_bytes, reg_a, reg_
         out_cycles[lane] = cycles
         out_status[lane] = status
         for k in range(out_addr.shape[0]):
-            out_bytes[lane, k] = mem[out_addr[k]]
+            out_bytes[k, lane] = mem[out_addr[k]]
         if nlog > LOG_MASK + 1:  # more writes than the log holds: the whole memory
             mem[:] = image
         else:
             for k in range(nlog):
                 t = log[k]
                 mem[t] = image[t]
-        for k in range(restore.shape[0]):
-            mem[restore[k]] = image[restore[k]]
+{restore}
 '''
+

@@ -320,14 +320,14 @@ class RoutineRunner:
 
         image = bytes(self.call_image)
         held = getattr(self, "_compiled", None)
-        if held is not None and all(image[a] == b for a, b in held[1]):
+        if held is not None and (held[2] == image or all(image[a] == b for a, b in held[1])):
             return held[0]
         inputs_at = [address for _, address, _ in self.plan.bytes] + [a for _, addresses in self.plan.tables
                                                                       for a in addresses]
         trapped = bytearray(image)
         push_return_trap(trapped)
         routine = compile_routine(bytes(trapped), self.entry, self.routine.cpu, RETURN_TRAP, inputs_at)
-        self._compiled = (routine, [(a, image[a]) for a in sorted(routine.translation.code_bytes)])
+        self._compiled = (routine, [(a, image[a]) for a in sorted(routine.translation.code_bytes)], image)
         return routine
 
     def run_compiled(self, columns: list) -> "BatchOutcome":
@@ -340,22 +340,22 @@ class RoutineRunner:
         placed: list[tuple[int, np.ndarray]] = []
         registers, p = self.plan.place(columns, _column_byte, lambda address, lanes: placed.append((address, lanes)))
         in_addr = np.asarray([address for address, _ in placed], dtype=np.int64)
-        in_bytes = np.empty((n, len(placed)), dtype=np.uint8)
+        in_bytes = np.empty((len(placed), n), dtype=np.uint8)
         for k, (_, lanes) in enumerate(placed):
-            in_bytes[:, k] = lanes
+            in_bytes[k] = lanes
         image = bytearray(self.call_image)
         stack_pointer = push_return_trap(image)
         lanes = {name: np.broadcast_to(np.asarray(value, dtype=np.int64), (n,)).copy() for name, value in registers.items()}
         flags = np.broadcast_to(np.asarray((p | FLAG_U) & ~FLAG_B, dtype=np.int64), (n,)).copy()
         out_addr = np.asarray(sorted({place.address for port in self.routine.outputs for place in port.places
                                       if place.kind == "memory"}), dtype=np.int64)
-        done = compiled.run(np.frombuffer(bytes(image), dtype=np.uint8).astype(np.int64), in_addr, in_bytes, lanes["a"],
+        done = compiled.run(bytes(image), in_addr, in_bytes, lanes["a"],
                             lanes["x"], lanes["y"], flags, stack_pointer, self.limit, RETURN_TRAP, CALL_STACK_TOP,
                             out_addr)
         column_of = {int(address): k for k, address in enumerate(out_addr)}
         out_bytes = done["bytes"]
         outputs = port_values(self.routine.outputs, {"a": done["a"], "x": done["x"], "y": done["y"]}, done["p"],
-                              lambda address: out_bytes[:, column_of[address]].astype(np.int64),
+                              lambda address: out_bytes[column_of[address]].astype(np.int64),
                               widen=lambda values: np.asarray(values, dtype=np.int64),
                               table=lambda columns: np.stack(columns, axis=1).astype(np.int64))
         status = done["status"]

@@ -171,8 +171,7 @@ def on_compiled(cpu: str, code: bytes, registers, memory, watched=WATCHED) -> tu
     sp = push_return_trap(image)
     routine = compile_routine(bytes(image), CODE, cpu, RETURN_TRAP)
     flags = ((registers[:, 3] | 0x20) & ~0x10).astype(np.int64)
-    done = routine.run(np.frombuffer(bytes(image), dtype=np.uint8).astype(np.int64), PLACED,
-                       memory.astype(np.uint8).copy(), registers[:, 0].astype(np.int64),
+    done = routine.run(bytes(image), PLACED, np.ascontiguousarray(memory.T.astype(np.uint8)), registers[:, 0].astype(np.int64),
                        registers[:, 1].astype(np.int64), registers[:, 2].astype(np.int64), flags, sp, BUDGET,
                        RETURN_TRAP, CALL_STACK_TOP, np.asarray(watched, dtype=np.int64))
     results, left = [], 0
@@ -185,7 +184,7 @@ def on_compiled(cpu: str, code: bytes, registers, memory, watched=WATCHED) -> tu
             results.append(None)
         else:
             results.append((int(done["a"][i]), int(done["x"][i]), int(done["y"][i]), int(done["p"][i]) & 0xCF,
-                            int(done["cycles"][i]), tuple(done["bytes"][i].tolist())))
+                            int(done["cycles"][i]), tuple(done["bytes"][:, i].tolist())))
     return results, left
 
 
