@@ -20,6 +20,7 @@ from retro.routines import cases as case_sets
 from retro.workers import MAX_WORKERS
 import argparse
 from retro.analysis.check import AGREEMENT_PER_PART, AUTO_BATCH_CASES
+from retro.analysis.check.engines import AUTO_COMPILED_CASES
 from retro.commands import options
 from retro.progress import progress_printer
 from retro.routines.registry import builtin_names
@@ -315,9 +316,9 @@ def routine_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--at-line", metavar="L", help="with --scene: the raster line each call starts at "
                    "(default: the scene's [cpu] start_line)")
     p.add_argument("--at-cycle", metavar="C", help="with --scene: the cycle in that line (default: the scene's)")
-    options.engine(p, f"; scalar is the reference and the timing model checks every call, batch is checked against "
-                      f"Machine on the first {AGREEMENT_PER_PART:,} cases of each part, auto takes batch from "
-                      f"{AUTO_BATCH_CASES:,} cases")
+    options.engine(p, f"; scalar is the reference and the timing model checks every call, batch and compiled are "
+                      f"checked against Machine on the first {AGREEMENT_PER_PART:,} cases of each part, auto takes "
+                      f"batch from {AUTO_BATCH_CASES:,} cases and compiled from {AUTO_COMPILED_CASES:,}")
     p.add_argument("--json", action="store_true", help="print a JSON list, one object per routine")
     options.quiet(p)
 

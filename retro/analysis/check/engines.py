@@ -21,9 +21,9 @@ ARRAY_ENGINES = ("batch", "compiled")  # engines that run a column block at once
 BATCH_LANES = 65_536  # cases the batched core runs at once (memory stays bounded: see LaneMemory)
 AUTO_BATCH_CASES = 20_000  # planned cases from which engine="auto" takes the batched core for a check
 # (it then also runs AGREEMENT_PER_PART cases of each part on Machine: below this it would not pay)
-AUTO_COMPILED_CASES = 2_000_000  # planned cases from which "auto" takes the compiled engine (numba importable):
-# a routine's first compile costs 1.5-19 s of CPU (benchmarks/compiled_speed.py), which the compiled
-# engine's speed (3-20x the batched core's) wins back only over millions of calls
+AUTO_COMPILED_CASES = 16_000_000  # planned cases from which "auto" takes the compiled engine (numba importable):
+# a routine's first compile costs 0.9-19 s of CPU, won back against the batched core after 0.6-63 million
+# calls (benchmarks/compiled_speed.py, "pays from": 12-19 million for mul8, tile and circle)
 AGREEMENT_PER_PART = 2_000  # cases of each part also run on Machine when the batched core runs the check
 TRACE_SHOWN = 400  # instructions of the first failing case's trace in the report
 
