@@ -280,3 +280,20 @@ def test_a_runaway_call_stops_at_the_budget(compiled_cache):
     code = bytes([0xE8, 0x4C, 0xA0, 0xC0])  # INX; JMP $C0A0
     compiled, left = on_compiled("6510", code, np.array([[0, 0, 0, 0x20]]), np.zeros((1, len(PLACED)), dtype=np.int64))
     assert compiled == [None] and left == 0
+
+
+def test_a_taken_branch_into_the_next_page_costs_two_cycles_more(compiled_cache):
+    """NOP x4 at $C0F8; BCS $C102 at $C0FC (the next instruction at $C0FE, the target in page $C1);
+    LDA #1; TAX; NOP; RTS. By hand: not taken 8 + 2 + 2 + 2 + 2 + 6 = 22 cycles; taken 8 + 2 + 1 + 1
+    + 6 = 18."""
+    start = 0xC0F8
+    code = bytes([0xEA] * 4 + [0xB0, 0x04, 0xA9, 0x01, 0xAA, 0xEA, 0x60])
+    image = bytearray(0x10000)
+    image[start:start + len(code)] = code
+    sp = push_return_trap(image)
+    routine = compile_routine(bytes(image), start, "6510", RETURN_TRAP)
+    flags = np.array([0x20, 0x21], dtype=np.int64)  # carry clear, carry set
+    zeros = np.zeros(2, dtype=np.int64)
+    done = routine.run(bytes(image), np.zeros(0, dtype=np.int64), np.zeros((0, 2), dtype=np.uint8), zeros, zeros,
+                       zeros, flags, sp, BUDGET, RETURN_TRAP, CALL_STACK_TOP, np.zeros(0, dtype=np.int64))
+    assert done["cycles"].tolist() == [22, 18] and done["status"].tolist() == [0, 0]
