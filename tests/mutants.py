@@ -46,6 +46,7 @@ BUDGET_TESTS = ("tests/vic", "tests/test_machines.py", "tests/test_commands.py")
 STABILITY_TESTS = ("tests/study/test_stability_pinned.py", "tests/study/test_stability_report_pinned.py",
                    "tests/study/test_study_cli.py")
 FIELD_TESTS = ("tests/test_fields.py",)
+COMPILED_TESTS = ("tests/cpu/test_compiled.py",)
 COMMAND_TESTS = ("tests/test_commands.py", "tests/test_cli_foundation.py", "tests/routines/test_routines_cli.py")
 
 MUTANTS = [
@@ -296,6 +297,17 @@ MUTANTS = [
            "return any(c.mismatches for c in checks)", "return False", COMMAND_TESTS),
     Mutant("run-json-drops-p", "retro/commands/run.py",
            "\"y\": r.y, \"s\": r.s, \"p\": r.p,", "\"y\": r.y, \"s\": r.s,", COMMAND_TESTS),
+    # ---- the compiled engine's translator (retro/cpu/translate.py, compiled_ops.py) -----------------
+    Mutant("compiled-page-penalty-dropped", "retro/cpu/translate.py",
+           'self.put(f"cycles += {base} + {crossed} * {PAGE_CROSS_CYCLES}")', 'self.put(f"cycles += {base}")',
+           COMPILED_TESTS),
+    Mutant("compiled-branch-page-cycle-dropped", "retro/cpu/translate.py",
+           "extra = BRANCH_TAKEN_CYCLES + (BRANCH_PAGE_CYCLES if", "extra = BRANCH_TAKEN_CYCLES + (0 if",
+           COMPILED_TESTS),
+    Mutant("compiled-nmos-decimal-high-adjust-off-by-one", "retro/cpu/compiled_ops.py",
+           "    if high >= 0xA0:", "    if high > 0xA0:", COMPILED_TESTS),
+    Mutant("compiled-store-into-code-trusted", "retro/cpu/translate.py",
+           'self.put("bad |= code_map[t]")', 'self.put("bad |= 0")', COMPILED_TESTS),
 ]
 
 

@@ -29,6 +29,7 @@ from retro.routines.entry import EntryState
 from retro.workers import MAX_WORKERS
 import argparse
 from retro.analysis.check import AGREEMENT_PER_PART, AUTO_BATCH_CASES
+from retro.analysis.check.engines import AUTO_COMPILED_CASES
 from retro.commands import options
 from retro.progress import progress_printer
 from retro.routines.registry import builtin_names
@@ -146,6 +147,8 @@ def check_record(check: RoutineCheck) -> dict:
               "input_space_log2": round(math.log2(space), 3), "coverage_argument": check.routine.coverage or None,
               "examples": t.examples, "outside_examples": t.outside_examples, "engine": check.engine,
               "engine_note": check.engine_note or None,
+              "engine_reason": check.engine_reason, "compile_seconds": None if check.compile_seconds is None else
+              round(check.compile_seconds, 3), "compiled_fallbacks": fallback_counts(t),
               "engine_agreement": None if check.agreement is None else {
                   "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
                   "timing_model_mismatches": check.agreement.cycle_mismatches},
@@ -169,6 +172,23 @@ def check_record(check: RoutineCheck) -> dict:
     return record
 
 
+def fallback_counts(t) -> dict[str, int]:
+    """The compiled engine's calls that ran on the batched core, by reason (the reason's text)."""
+    from retro.cpu.compiled import FALLBACK_REASON
+
+    return {FALLBACK_REASON.get(code, str(code)): count for code, count in sorted(t.fallbacks.items())}
+
+
+def engine_lines(check: RoutineCheck) -> list[str]:
+    """Which engine ran and why, when the compiled engine was asked for or considered."""
+    if check.engine != "compiled" and "compiled" not in check.engine_reason:
+        return []
+    line = f"  engine: {check.engine} ({check.engine_reason})"
+    if check.compile_seconds is not None:
+        line += f"; code compiled or loaded from the cache in {check.compile_seconds:.2f} s"
+    lines = [line]
+    for reason, count in fallback_counts(check.totals).items():
+        lines.append(f"  engine: {count:,} calls ran on the batched core: {reason}")
 def entry_record(check: RoutineCheck) -> dict | None:
     """The entry-state runs (retro.analysis.check.entry_runs): null when none ran."""
     if not check.entry_every:
@@ -261,6 +281,7 @@ def format_check(check: RoutineCheck) -> list[str]:
     t = check.totals
     routine = check.routine
     lines = [_headline(check)]
+    lines += engine_lines(check)
     lines += [f"  note: {note}" for note in routine.notes]
     if check.parts:
         lines.append(f"  cases: {format_coverage(check)}; input space {format_space(check.routine.input_space())}")
@@ -269,6 +290,8 @@ def format_check(check: RoutineCheck) -> list[str]:
         lines.append(f"  coverage: {routine.coverage}")
     if check.code_coverage is not None:
         lines.append(f"  {coverage_line(summary(check.code_coverage, routine.program))}")
+    elif check.engine == "compiled":
+        lines.append("  code: not counted on the compiled engine (--engine batch counts what the cases ran)")
     if _search_line(check):
         lines.append(_search_line(check))
     if t.cycles_count:
@@ -302,7 +325,8 @@ def _headline(check: RoutineCheck) -> str:
         checked = f"timing model equal on {t.cases - t.cycle_mismatches - t.run_errors} of {t.cases} calls"
     else:
         a = check.agreement
-        checked = (f"batched core; on {a.engine_cases} of the calls Machine agrees on "
+        checked = (f"{'compiled engine' if check.engine == 'compiled' else 'batched core'}; on {a.engine_cases} of "
+                   f"the calls Machine agrees on "
                    f"{a.engine_cases - a.engine_mismatches} and the timing model on "
                    f"{a.cases - a.cycle_mismatches - a.run_errors}")
     note = f" ({check.engine_note})" if check.engine_note else ""
@@ -436,8 +460,8 @@ def annotated_checks(checks: list[RoutineCheck]) -> list[Annotated]:
     """Each check's code coverage on its routine's code; a check without it is an error naming it."""
     missing = [c.routine.name for c in checks if getattr(c, "code_coverage", None) is None]
     if missing:
-        raise InputError(f"no code coverage was recorded for {', '.join(missing)} (the engine ran without it), "
-                         f"so --listing, --lcov and --html cannot be written")
+        raise InputError(f"no code coverage was recorded for {', '.join(missing)} (the compiled engine counts "
+                         f"none: use --engine batch), so --listing, --lcov and --html cannot be written")
     return [annotate(routine_code(c), c.code_coverage) for c in checks]
 
 
@@ -500,9 +524,9 @@ def routine_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--at-line", metavar="L", help="with --scene: the raster line each call starts at "
                    "(default: the scene's [cpu] start_line)")
     p.add_argument("--at-cycle", metavar="C", help="with --scene: the cycle in that line (default: the scene's)")
-    options.engine(p, f"; scalar is the reference and the timing model checks every call, batch is checked against "
-                      f"Machine on the first {AGREEMENT_PER_PART:,} cases of each part, auto takes batch from "
-                      f"{AUTO_BATCH_CASES:,} cases")
+    options.engine(p, f"; scalar is the reference and the timing model checks every call, batch and compiled are "
+                      f"checked against Machine on the first {AGREEMENT_PER_PART:,} cases of each part, auto takes "
+                      f"batch from {AUTO_BATCH_CASES:,} cases and compiled from {AUTO_COMPILED_CASES:,}")
     searching = p.add_mutually_exclusive_group()
     searching.add_argument("--search", metavar="N", help="candidate cases the coverage-guided search may run after "
                            f"the planned cases (default: the spec's [cases] search, else {DEFAULT_SEARCH:,}; the "

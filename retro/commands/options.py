@@ -43,8 +43,9 @@ def methods(p: argparse.ArgumentParser) -> None:
 
 def engine(p: argparse.ArgumentParser, detail: str = "") -> None:
     p.add_argument("--engine", choices=ENGINES, default="auto",
-                   help="which engine runs the 6502 calls: scalar (Machine), batch (the numpy batched core) or auto "
-                        f"(batch for many calls; default){detail}")
+                   help="which engine runs the 6502 calls: scalar (Machine), batch (the numpy batched core), compiled "
+                        "(native code through numba, docs/compiled.md; retro check only, the other commands run the "
+                        f"batched core for it) or auto (batch for many calls, compiled for millions; default){detail}")
 
 
 def scale(p: argparse.ArgumentParser, what: str, top: int) -> None:

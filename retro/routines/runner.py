@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from retro.assembler import requested_tables
-from retro.cpu.batch import BatchCpu, LaneCoverage
+from retro.cpu.batch import BatchCpu, LaneCoverage, LaneError
 from retro.cpu.lane_memory import LaneMemoryFull
 from retro.cpu.machine import (
     DEFAULT_BUDGET,
@@ -293,6 +293,7 @@ class RoutineRunner:
             for place in port.places:
                 if place.kind == "written":
                     self.written_kept[place.register] = max(self.written_kept.get(place.register, 0), place.bit + 1)
+        self.fallbacks: dict[int, int] = {}  # compiled engine: calls it left to the batched core, by status
 
     @property
     def limit(self) -> int:
@@ -399,6 +400,65 @@ class RoutineRunner:
                                 np.concatenate([first.cycles, second.cycles]),
                                 np.concatenate([first.error, second.error]), coverage=first.coverage,
                                 mock_calls=None if first.mock_calls is None else first.mock_calls + second.mock_calls)
+
+    def compiled(self):
+        """The routine compiled (`retro.cpu.compiled`), made on first use and again when the code bytes
+        changed (set_memory); Untranslatable when the compiled engine does not take it."""
+        from retro.cpu.compiled import compile_routine
+
+        image = bytes(self.call_image)
+        held = getattr(self, "_compiled", None)
+        if held is not None and (held[2] == image or all(image[a] == b for a, b in held[1])):
+            return held[0]
+        inputs_at = [address for _, address, _ in self.plan.bytes] + [a for _, addresses in self.plan.tables
+                                                                      for a in addresses]
+        trapped = bytearray(image)
+        push_return_trap(trapped)
+        routine = compile_routine(bytes(trapped), self.entry, self.routine.cpu, RETURN_TRAP, inputs_at)
+        self._compiled = (routine, [(a, image[a]) for a in sorted(routine.translation.code_bytes)], image)
+        return routine
+
+    def run_compiled(self, columns: list) -> "BatchOutcome":
+        """Run every case of a column block on the compiled engine; calls it leaves (`fallbacks`, by
+        reason) run on the batched core."""
+        from retro.cpu.compiled import FALLBACK
+
+        compiled = self.compiled()
+        n = len(columns[0])
+        placed: list[tuple[int, np.ndarray]] = []
+        registers, p = self.plan.place(columns, _column_byte, lambda address, lanes: placed.append((address, lanes)))
+        in_addr = np.asarray([address for address, _ in placed], dtype=np.int64)
+        in_bytes = np.empty((len(placed), n), dtype=np.uint8)
+        for k, (_, lanes) in enumerate(placed):
+            in_bytes[k] = lanes
+        image = bytearray(self.call_image)
+        stack_pointer = push_return_trap(image, self.machine.stack_top)
+        lanes = {name: np.broadcast_to(np.asarray(value, dtype=np.int64), (n,)).copy() for name, value in registers.items()}
+        flags = np.broadcast_to(np.asarray((p | FLAG_U) & ~FLAG_B, dtype=np.int64), (n,)).copy()
+        out_addr = np.asarray(sorted({place.address for port in self.routine.outputs for place in port.places
+                                      if place.kind == "memory"}), dtype=np.int64)
+        done = compiled.run(bytes(image), in_addr, in_bytes, lanes["a"],
+                            lanes["x"], lanes["y"], flags, stack_pointer, self.limit, RETURN_TRAP, self.machine.stack_top,
+                            out_addr)
+        column_of = {int(address): k for k, address in enumerate(out_addr)}
+        out_bytes = done["bytes"]
+        outputs = port_values(self.routine.outputs, {"a": done["a"], "x": done["x"], "y": done["y"]}, done["p"],
+                              lambda address: out_bytes[column_of[address]].astype(np.int64),
+                              widen=lambda values: np.asarray(values, dtype=np.int64),
+                              table=lambda columns: np.stack(columns, axis=1).astype(np.int64))
+        status = done["status"]
+        error = np.where(status == LaneError.BUDGET, LaneError.BUDGET, 0).astype(np.int8)
+        cycles = done["cycles"]
+        left = np.flatnonzero(status >= FALLBACK)
+        if len(left):
+            for code, count in zip(*np.unique(status[left], return_counts=True)):
+                self.fallbacks[int(code)] = self.fallbacks.get(int(code), 0) + int(count)
+            batch = self.run_batch([c[left] for c in columns])
+            for output, redone in zip(outputs, batch.outputs):
+                output[left] = redone
+            cycles[left] = batch.cycles
+            error[left] = batch.error
+        return BatchOutcome(outputs, cycles, error)
 
     def _run_lanes(self, columns: list, n: int, coverage: bool = False, first_lanes: bool = False,
                    entry: tuple[dict, np.ndarray, int] | None = None) -> "BatchOutcome":

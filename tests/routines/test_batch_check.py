@@ -22,7 +22,7 @@ from retro.routines.runner import RoutineRunner
 
 SPECS = Path(__file__).resolve().parents[1] / "data" / "specs"
 USER_SPECS = sorted(str(p) for p in SPECS.glob("boxhit_*.toml")) + [str(SPECS / "scan" / "scan.toml")]
-ENGINE_FIELDS = {"engine", "engine_agreement"}
+ENGINE_FIELDS = {"engine", "engine_agreement", "engine_reason", "compile_seconds", "compiled_fallbacks"}
 
 
 def check_json(capsys, *args) -> tuple[int, list[dict]]:

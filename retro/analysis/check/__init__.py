@@ -15,7 +15,9 @@ Two engines run the calls: `Machine` (scalar, the reference, with the timing mod
 and the batched core (retro.cpu.batch: 65,536 cases at a time with numpy). `engine="auto"` takes the
 batched core from AUTO_BATCH_CASES planned cases on; then the first AGREEMENT_PER_PART cases of every
 part also run on `Machine` with the timing model, and the two engines must agree call for call
-(outputs and cycles): a disagreement is a mismatch of kind "engine".
+(outputs and cycles): a disagreement is a mismatch of kind "engine". The compiled engine
+(retro.cpu.compiled, `engine="compiled"`, or "auto" from AUTO_COMPILED_CASES) is an array engine like
+the batched core, held to Machine the same way; `engines.array_engine` says which one runs and why.
 
 The check by job (docs/architecture.md draws its path): `engines` (either engine -> the same
 `CallBlock`; the one engine rule `batched`; runners cached per worker), `reference` (the reference's

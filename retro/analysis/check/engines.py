@@ -18,10 +18,14 @@ from retro.routines import cases as case_sets
 from retro.routines.runner import NEEDS_A_VIC_SCENE, RasterStart, RoutineRunner, row_of
 from retro.routines.spec import Routine, load_spec
 
-ENGINES = ("auto", "scalar", "batch")
+ENGINES = ("auto", "scalar", "batch", "compiled")
+ARRAY_ENGINES = ("batch", "compiled")  # engines that run a column block at once (never with chips on the bus)
 BATCH_LANES = 65_536  # cases the batched core runs at once (memory stays bounded: see LaneMemory)
 AUTO_BATCH_CASES = 20_000  # planned cases from which engine="auto" takes the batched core for a check
 # (it then also runs AGREEMENT_PER_PART cases of each part on Machine: below this it would not pay)
+AUTO_COMPILED_CASES = 16_000_000  # planned cases from which "auto" takes the compiled engine (numba importable):
+# a routine's first compile costs 0.9-19 s of CPU, won back against the batched core after 0.6-63 million
+# calls (benchmarks/compiled_speed.py, "pays from": 12-19 million for mul8, tile and circle)
 AGREEMENT_PER_PART = 2_000  # cases of each part also run on Machine when the batched core runs the check
 TRACE_SHOWN = 400  # instructions of the first failing case's trace in the report
 
@@ -92,6 +96,7 @@ class CallBlock:
     lane_errors: np.ndarray | None = None  # the batched core: per call, the LaneError that stopped it (0: none)
     coverage: CodeCoverage | None = None  # what the calls ran of the code (None: not collected)
     mock_calls: list | None = None  # per call, the mocks' calls the reference takes (retro.routines.world)
+    fallbacks: dict | None = None  # the compiled engine: calls it left to the batched core, by reason
 
     @property
     def calls(self) -> int:
@@ -113,10 +118,54 @@ def check_engine(engine: str) -> None:
 
 
 def batched(engine: str, calls: int | None, batchable: bool, threshold: int) -> bool:
-    """The one rule choosing the engine: "batch" and "scalar" as said; "auto" takes the batched core
-    for `threshold` calls or more (None: an unknown count, a sweep). Never with chips on the bus."""
+    """The one rule choosing between Machine and an array engine: "batch", "compiled" and "scalar" as
+    said; "auto" takes an array engine for `threshold` calls or more (None: an unknown count, a sweep).
+    Never with chips on the bus."""
     check_engine(engine)
-    return batchable and (engine == "batch" or (engine == "auto" and (calls is None or calls >= threshold)))
+    return batchable and (engine in ARRAY_ENGINES or (engine == "auto" and (calls is None or calls >= threshold)))
+
+
+def array_engine(engine: str, calls: int | None) -> tuple[str, str]:
+    """Which array engine runs a check that `batched` sent to one, and why: ("compiled" or "batch",
+    the reason the report gives). "auto" takes the compiled engine from AUTO_COMPILED_CASES planned
+    calls (or a sweep) when numba can be imported; its routine may still be refused (`compiled_or_why`)."""
+    from retro.cpu.compiled import numba_problem
+
+    if engine == "batch":
+        return "batch", "--engine batch"
+    if engine == "auto" and calls is not None and calls < AUTO_COMPILED_CASES:
+        return "batch", f"auto: {calls:,} planned calls (the compiled engine from {AUTO_COMPILED_CASES:,})"
+    problem = numba_problem()
+    if problem is not None:
+        _say_once(f"the compiled engine is off: {problem}; the batched core runs instead")
+        return "batch", problem
+    return "compiled", "--engine compiled" if engine == "compiled" else (
+        "auto: a sweep" if calls is None else f"auto: {calls:,} planned calls")
+
+
+_SAID: set[str] = set()
+
+
+def _say_once(message: str) -> None:
+    import sys
+
+    if message not in _SAID:
+        _SAID.add(message)
+        print(f"retro: {message}", file=sys.stderr)
+
+
+def compiled_or_why(runner: RoutineRunner) -> str | None:
+    """None when the compiled engine takes the runner's routine (compiling it, or loading it from the
+    cache, in this process), else why not (the report's reason)."""
+    from retro.cpu.compiled import Untranslatable
+
+    if not runner.routine.world.empty:  # traps, scripted reads and interrupt entry live in the other engines
+        return "the routine has a world ([mocks], [hardware], an interrupt entry or an exit), which it does not model"
+    try:
+        runner.compiled()
+    except Untranslatable as exc:
+        return str(exc)
+    return None
 
 
 def run_on_machine(runner: RoutineRunner, cases: list[tuple], coverage: bool = True) -> CallBlock:
@@ -154,15 +203,26 @@ def _output_arrays(routine: Routine, answers: list[tuple]) -> list[np.ndarray]:
 
 
 def run_on_batched_core(runner: RoutineRunner, columns: list, confirm_stop: bool = True,
-                        coverage: bool = True) -> CallBlock:
-    """Calls on the batched core; the first call it stops is run again on Machine (`confirm_stop`),
-    whose error names it (or which returns: then the engines disagree). `coverage`: collect it."""
-    outcome = runner.run_batch(columns, coverage)
+                        coverage: bool = True, engine: str = "batch") -> CallBlock:
+    """Calls on an array engine (the batched core, or the compiled engine with the calls it leaves run
+    on the batched core); the first call it stops is run again on Machine (`confirm_stop`), whose error
+    names it (or which returns: then the engines disagree). `coverage`: collect it (the batched core
+    only: the compiled engine counts none)."""
+    fallbacks = None
+    if engine == "compiled":
+        before = dict(runner.fallbacks)
+        outcome = runner.run_compiled(columns)
+        fallbacks = {code: count - before.get(code, 0) for code, count in runner.fallbacks.items()
+                     if count != before.get(code, 0)}
+        coverage = False
+    else:
+        outcome = runner.run_batch(columns, coverage)
     stopped = np.flatnonzero(outcome.error)
     n = len(outcome.cycles)
     block = CallBlock(outcome.outputs, outcome.cycles, np.zeros(n, dtype=np.int64), None,
                       int(stopped[0]) if len(stopped) else n, lane_errors=outcome.error,
-                      coverage=from_lanes(outcome.coverage) if coverage else None, mock_calls=outcome.mock_calls)
+                      coverage=from_lanes(outcome.coverage) if coverage else None, mock_calls=outcome.mock_calls,
+                      fallbacks=fallbacks)
     if coverage and len(stopped):  # coverage counts the calls before the first that stopped, as on Machine
         block.coverage = (from_lanes(runner.run_batch([c[:block.returned] for c in columns], True).coverage)
                           if block.returned else CodeCoverage())

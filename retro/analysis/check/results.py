@@ -49,8 +49,10 @@ class RoutineCheck:
     parts: list[PartRun] = field(default_factory=list)
     trace: list[str] = field(default_factory=list)  # the first failing case's instructions
     start: RasterStart | None = None  # with --scene: the beam position every call started at
-    engine: str = "scalar"  # which engine ran the cases: "scalar" (Machine) or "batch"
+    engine: str = "scalar"  # which engine ran the cases: "scalar" (Machine), "batch" or "compiled"
     engine_note: str = ""  # why Machine ran a check the batched core was asked for or would have run
+    engine_reason: str = ""  # why that engine (the rule, the option, or why the compiled engine was refused)
+    compile_seconds: float | None = None  # the compiled engine: building or loading the routine's code
     agreement: Tally | None = None  # with the batched core: the cases also run on Machine
     rows: RowsCheck | None = None  # the spec's expected rows (retro.analysis.row_check)
     seconds: float = 0.0  # wall time of the check (JUnit reports)

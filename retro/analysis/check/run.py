@@ -15,8 +15,10 @@ from retro.analysis.check.engines import (
     AUTO_BATCH_CASES,
     BATCH_LANES,
     SceneStart,
+    array_engine,
     batched,
     check_engine,
+    compiled_or_why,
     failure_trace,
     routine_key,
     routine_of,
@@ -65,11 +67,11 @@ def machine_chunk(spec: str, seed: int, cases: list[tuple], start: SceneStart | 
                                                  entry=entry))
 
 
-def batch_chunk(spec: str, seed: int, columns: list, first: int = 0, every: int = 0) -> Tally:
-    """A column block on the batched core, tallied (run in worker processes); `first` and `every` as
-    for machine_chunk."""
+def batch_chunk(spec: str, seed: int, columns: list, first: int = 0, every: int = 0, engine: str = "batch") -> Tally:
+    """A column block on an array engine ("batch" or "compiled"), tallied (run in worker processes);
+    `first` and `every` as for machine_chunk (the entry-state runs are the batched core's)."""
     runner = runner_for(spec, seed, None)
-    block = run_on_batched_core(runner, columns)
+    block = run_on_batched_core(runner, columns, engine=engine)
     entry = None
     if every:
         entry = entry_block_on_batched_core(_variants(spec, seed, None), [c[:block.calls] for c in columns], first,
@@ -100,14 +102,14 @@ def _named(spec: str, seed: int, start: SceneStart | None, tally: Tally) -> Tall
     return tally
 
 
-def agreement_chunk(spec: str, seed: int, cases: list[tuple]) -> Tally:
+def agreement_chunk(spec: str, seed: int, cases: list[tuple], engine: str = "batch") -> Tally:
     """Cases on both engines: Machine's tally (timing model included), its block compared with the
-    batched core's call for call."""
+    array engine's call for call."""
     runner = runner_for(spec, seed, None)
     columns = case_sets.cases_to_columns(runner.routine, cases)
-    against = run_on_batched_core(runner, columns, confirm_stop=False, coverage=False)
+    against = run_on_batched_core(runner, columns, confirm_stop=False, coverage=False, engine=engine)
     return count_block(runner.routine, run_on_machine(runner, cases, coverage=False), columns, cases,
-                       runner.memory_values, against)  # (the batched core counts these cases' coverage)
+                       runner.memory_values, against)  # (the array engine counts these cases' coverage)
 
 
 # ---- a whole check ------------------------------------------------------------------------------------
@@ -172,12 +174,12 @@ def _reporter(routine: Routine, totals: Tally, known: int, unknown: bool,
     return report
 
 
-def _agreement(spec: str, seed: int, parts: list[case_sets.Part]) -> Tally:
+def _agreement(spec: str, seed: int, parts: list[case_sets.Part], engine: str) -> Tally:
     """Machine first: the reference engine's verdict on a prefix of every part, both engines compared."""
     agreement = Tally()
     for part in parts:
         for chunk in case_sets.chunks(islice(part.cases, AGREEMENT_PER_PART)):
-            agreement.merge(agreement_chunk(spec, seed, chunk))
+            agreement.merge(agreement_chunk(spec, seed, chunk, engine))
             if agreement.run_errors:
                 break
     return agreement
@@ -223,9 +225,20 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     engine_note = ""
     if refusal is not None and batched(engine, None if unknown else known, True, AUTO_BATCH_CASES):
         engine_note = f"Machine ran the calls: {refusal}"  # the batched core would have: say why not
-    elif engine == "batch" and not on_batch:
-        raise InputError("--engine batch: with --scene the calls run on Machine (the batched core models no chips); "
-                         "use --engine scalar or auto")
+    elif engine in ("batch", "compiled") and not on_batch:
+        raise InputError(f"--engine {engine}: with --scene the calls run on Machine (the batched core and the "
+                         f"compiled engine model no chips); use --engine scalar or auto")
+    used, reason = ("scalar", "with --scene the calls run on Machine" if start is not None else
+                    engine_note or (f"{engine}: {known:,} planned calls" if engine == "auto" else f"--engine {engine}"))
+    compile_seconds = None
+    if on_batch:
+        used, reason = array_engine(engine, None if unknown else known)
+        if used == "compiled":
+            refused = compiled_or_why(runner)
+            if refused is not None:
+                used, reason = "batch", f"the compiled engine does not take it: {refused}"
+            else:
+                compile_seconds = runner.compiled().compile_seconds
     totals = Tally()
     report = _reporter(routine, totals, known, unknown, progress)
     rows = None
@@ -234,17 +247,17 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         report(rows_totals)
         if totals.run_errors:  # a row's call that stopped stops the check
             parts = []
-    agreement = _agreement(spec, seed, parts) if on_batch else None
+    agreement = _agreement(spec, seed, parts, used) if on_batch else None
     every = entry_every(known, exhaustive, bounded_product, unknown) if entry_state and parts else 0
-    work = (((batch_chunk, (spec, seed, block, first, every)) for block, first in _blocks(parts)) if on_batch else
-            ((machine_chunk, (spec, seed, chunk, start, first, every)) for chunk, first in _chunks(parts)))
+    work = (((batch_chunk, (spec, seed, block, first, every, used)) for block, first in _blocks(parts)) if on_batch
+            else ((machine_chunk, (spec, seed, chunk, start, first, every)) for chunk, first in _chunks(parts)))
     _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
     searched = _search(spec, seed, runner, on_batch, totals, search_budget)
     if searched.found:  # the search's cases, checked like every other case
         found = case_sets.cases_to_columns(routine, searched.found)
         parts.append(case_sets.Part("search", len(searched.found), len(searched.found), lambda: iter([found])))
         if on_batch:
-            agreement.merge(_agreement(spec, seed, parts[-1:]))
+            agreement.merge(_agreement(spec, seed, parts[-1:], "batch"))
         work = (((batch_chunk, (spec, seed, block)) for block in case_sets.batches(parts[-1:], BATCH_LANES))
                 if on_batch else ((machine_chunk, (spec, seed, chunk, start)) for chunk, _ in _chunks(parts[-1:])))
         _run_work(work, 1, report, lambda: totals.run_errors)
@@ -256,8 +269,8 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         static = static_bounds(routine, runner)
     check = RoutineCheck(routine, runner.size(), static, totals, bounds_violations(routine, static, totals),
                          budget_violations(routine, static, totals), _part_runs(parts, totals, unknown, rows),
-                         start=runner.start, engine="batch" if on_batch else "scalar", agreement=agreement, rows=rows,
-                         search=searched, engine_note=engine_note, entry_every=every,
+                         start=runner.start, engine=used, agreement=agreement, rows=rows, engine_reason=reason,
+                         compile_seconds=compile_seconds, search=searched, engine_note=engine_note, entry_every=every,
                          random_draw=next((p.draw for p in parts if p.name == "random"), None))
     if rows is not None and rows.agreement is not None:
         check.agreement = agreement = merged_agreement(agreement, rows)
@@ -265,10 +278,16 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         totals.failure = agreement.failure  # the timing model or the engines disagreed on a call
     if totals.failure is not None:
         check.trace = failure_trace(spec, seed, totals.failure.case, start)
+    if used == "compiled":  # the compiled engine counts no coverage: say so rather than show what it did not count
+        return _finished(check, began)
     check.code_coverage = completed(totals.code_coverage, runner)
     if totals.max_case is not None and not totals.run_errors:
         check.code_coverage.worst_path = worst_path(runner, totals.max_case)
         check.code_coverage.worst_cycles = totals.cycles_max
+    return _finished(check, began)
+
+
+def _finished(check: RoutineCheck, began: float) -> RoutineCheck:
     check.seconds = time.monotonic() - began
     return check
 

@@ -57,6 +57,7 @@ class Tally:
     stolen_max: int = 0  # with a scene: the most cycles one call lost to Bad Lines and sprite DMA
     engine_cases: int = 0  # calls run on both engines and compared
     engine_mismatches: int = 0
+    fallbacks: dict[int, int] = field(default_factory=dict)  # compiled engine: calls run on the batched core, by reason
     examples: list[str] = field(default_factory=list)
     outside_examples: list[str] = field(default_factory=list)
     failure: Failure | None = None
@@ -89,6 +90,8 @@ class Tally:
         self.stolen_max = max(self.stolen_max, other.stolen_max)
         self.engine_cases += other.engine_cases
         self.engine_mismatches += other.engine_mismatches
+        for code, count in other.fallbacks.items():
+            self.fallbacks[code] = self.fallbacks.get(code, 0) + count
         self.examples = (self.examples + other.examples)[:EXAMPLES_KEPT]
         self.outside_examples = (self.outside_examples + other.outside_examples)[:EXAMPLES_KEPT]
         self.failure = self.failure or other.failure
@@ -139,6 +142,7 @@ def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[t
     out.cases = n
     if block.coverage is not None:
         out.code_coverage = block.coverage
+    out.fallbacks = dict(block.fallbacks or {})
     out.result_mismatches = len(wrong_inside)
     out.outside = int((~inside).sum())
     out.outside_wrong = int(wrong_outside.sum())

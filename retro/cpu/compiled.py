@@ -1,0 +1,232 @@
+"""The compiled engine: a routine translated by `retro.cpu.translate` and compiled with numba, cached on
+disk per routine and content, run on many calls at native speed (docs/compiled.md).
+
+`compile_routine(...)` gives a `CompiledRoutine` (the function, how long it took, whether it came from
+the cache); `CompiledRoutine.run(...)` runs a block of calls and returns per call the registers, P,
+cycles, a status (returned, over the budget, or why it must run on the batched core instead) and the
+bytes at the output addresses.
+
+The cache: one folder per key under `$RETRO_CACHE/compiled` (default `~/.cache/retro/compiled`). The
+key is a hash of the generated source, the translator's and helpers' code, and the versions of
+Python, numba, llvmlite and numpy and the host CPU, so a routine whose bytes change, or another
+machine's entry, never matches. An entry holds the generated module, numba's cache files beside it
+and a manifest of their SHA-256 sums written after the compile; an entry whose manifest is missing,
+unreadable, for another key, or whose files do not match it is deleted and built again (numba's index
+is a pickle: nothing in an entry is loaded before its sums are checked). A lock file serialises
+workers building the same entry.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import hashlib
+import importlib.util
+import inspect
+import json
+import os
+import platform
+import shutil
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from retro.cpu import compiled_ops, translate
+from retro.cpu.translate import FALLBACK, Translation, Untranslatable
+
+CACHE_ENV = "RETRO_CACHE"
+MODULE_FILE = "routine.py"
+MANIFEST_FILE = "manifest.json"
+LOCK_FILE = ".lock"
+FALLBACK_REASON = {translate.FALLBACK_STOP: "an instruction the compiled engine leaves to the batched core "
+                                            "(BRK, RTI, JAM, an unstable opcode, STP or WAI)",
+                   translate.FALLBACK_JUMP: "a jump to code not found before the run (RTS or JMP (ind) to an "
+                                            "address no block starts at)",
+                   translate.FALLBACK_WRITE: "a write into the routine's own code"}
+SIGNATURE = ("void(int64[::1], int64[::1], int32[::1], uint8[::1], int32[::1], int64[::1], "
+             "uint8[:, ::1], int64[::1], int64[::1], int64[::1], int64[::1], int64, int64, int64, int64, "
+             "int64[::1], int64[::1], int64[::1], int64[::1], int64[::1], int64[::1], int64[::1], uint8[:, ::1])")
+MEMORY = 0x10000
+
+
+def numba_problem() -> str | None:
+    """Why numba cannot be used here (None: it can)."""
+    try:
+        import numba  # noqa: F401
+    except Exception as exc:  # an unsupported Python or numpy raises ImportError or worse at import
+        return f"numba cannot be imported ({type(exc).__name__}: {exc})"
+    return None
+
+
+def cache_root() -> Path:
+    base = os.environ.get(CACHE_ENV)
+    return (Path(base) if base else Path.home() / ".cache" / "retro") / "compiled"
+
+
+@dataclass
+class CompiledRoutine:
+    translation: Translation
+    function: object
+    compile_seconds: float  # building (or loading) the function: numba's compile, or reading the cache
+    from_cache: bool
+    code_map: np.ndarray
+    addr_block: np.ndarray
+    _scratch: tuple | None = None  # (image bytes, the image as int64, memory as the calls leave it, the write log)
+
+    def memory_for(self, image: bytes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(image, working memory, log) for this image, kept between runs: every call restores what it
+        wrote, so the working memory is the image again after a run (inputs put back by `run`)."""
+        if self._scratch is None or self._scratch[0] != image:
+            wide = np.frombuffer(image, dtype=np.uint8).astype(np.int64)
+            self._scratch = (image, wide, wide.copy(), np.zeros(MEMORY, dtype=np.int32))
+        return self._scratch[1:]
+
+    def run(self, image: bytes, in_addr: np.ndarray, in_bytes: np.ndarray, a: np.ndarray, x: np.ndarray,
+            y: np.ndarray, p: np.ndarray, sp: int, budget: int, return_pc: int, return_sp: int,
+            out_addr: np.ndarray) -> dict:
+        """Every call of the block (one per element of a; `in_bytes` one row per address of `in_addr`):
+        its results as arrays, the bytes at `out_addr` one row per address (see the module docstring)."""
+        n = len(a)
+        wide, mem, log = self.memory_for(image)
+        results = {name: np.empty(n, dtype=np.int64) for name in ("a", "x", "y", "p", "cycles", "status")}
+        out_bytes = np.empty((len(out_addr), n), dtype=np.uint8)
+        try:
+            self.function(mem, wide, log, self.code_map, self.addr_block, in_addr, in_bytes, a, x, y, p, sp, budget,
+                          return_pc, return_sp, out_addr, results["a"], results["x"], results["y"], results["p"],
+                          results["cycles"], results["status"], out_bytes)
+        finally:
+            mem[in_addr] = wide[in_addr]
+        results["bytes"] = out_bytes
+        return results
+
+
+def _versions() -> dict[str, str]:
+    import llvmlite
+    import llvmlite.binding
+    import numba
+
+    return {"python": sys.version, "numba": numba.__version__, "llvmlite": llvmlite.__version__,
+            "numpy": np.__version__, "machine": platform.machine(), "cpu": llvmlite.binding.get_host_cpu_name(),
+            "translator": str(translate.TRANSLATOR_VERSION)}
+
+
+def _module_source(translation: Translation) -> str:
+    helpers = "\n".join(f"{name} = njit(_ops.{name})" for name in compiled_ops.HELPERS)
+    return (f'"""Generated by retro.cpu.compiled: do not edit (the cache rebuilds it)."""\n'
+            f"import numpy as np\nfrom numba import njit\nfrom retro.cpu import compiled_ops as _ops\n\n{helpers}\n"
+            f"{translation.source}\n{translation.function_name} = njit({SIGNATURE!r}, cache=True)"
+            f"({translation.function_name})\n")
+
+
+def cache_key(module: str) -> str:
+    own = inspect.getsource(compiled_ops) + inspect.getsource(translate)
+    text = json.dumps([module, hashlib.sha256(own.encode()).hexdigest(), _versions()], sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _sha(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _entry_files(entry: Path) -> list[Path]:
+    return sorted(p for p in entry.rglob("*") if p.is_file() and p.name not in (MANIFEST_FILE, LOCK_FILE)
+                  and p.suffix != ".pyc")
+
+
+def _valid(entry: Path, key: str, module: str) -> bool:
+    """Whether the entry is whole and ours: the manifest for this key, every file's sum as written."""
+    try:
+        manifest = json.loads((entry / MANIFEST_FILE).read_text())
+        if manifest.get("key") != key or (entry / MODULE_FILE).read_text() != module:
+            return False
+        files = {str(p.relative_to(entry)): _sha(p) for p in _entry_files(entry)}
+        return files == manifest.get("files") and any(name.endswith(".nbc") for name in files)
+    except (OSError, ValueError, UnicodeDecodeError, AttributeError):
+        return False
+
+
+def _write_manifest(entry: Path, key: str) -> None:
+    files = {str(p.relative_to(entry)): _sha(p) for p in _entry_files(entry)}
+    handle, temporary = tempfile.mkstemp(dir=entry, suffix=".tmp")
+    with os.fdopen(handle, "w") as out:
+        json.dump({"key": key, "files": files}, out)
+    os.replace(temporary, entry / MANIFEST_FILE)
+
+
+def _clear(entry: Path) -> None:
+    for path in entry.iterdir():
+        if path.name == LOCK_FILE:
+            continue
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path)
+        else:
+            path.unlink()
+
+
+def _load(entry: Path, key: str, name: str):
+    module_name = f"retro_compiled_{key[:24]}"
+    spec = importlib.util.spec_from_file_location(module_name, entry / MODULE_FILE)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[module_name] = module  # numba finds the module by name when it loads the cached code
+    try:
+        spec.loader.exec_module(module)
+    except BaseException:
+        del sys.modules[module_name]
+        raise
+    return getattr(module, name)
+
+
+_LOADED: dict[str, tuple[object, float, bool]] = {}  # key -> (function, seconds, from the cache), this process
+
+
+def _function(translation: Translation) -> tuple[object, float, bool]:
+    module = _module_source(translation)
+    key = cache_key(module)  # imports numba: not part of the compile time
+    if key in _LOADED:
+        return _LOADED[key]
+    began = time.perf_counter()
+    entry = cache_root() / key[:40]
+    entry.mkdir(parents=True, exist_ok=True)
+    with open(entry / LOCK_FILE, "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        cached = _valid(entry, key, module)
+        if not cached:
+            _clear(entry)
+            (entry / MODULE_FILE).write_text(module)
+        try:
+            function = _load(entry, key, translation.function_name)
+        except Exception:
+            if not cached:
+                raise
+            _clear(entry)  # the sums matched but numba refused what it wrote: build it again
+            (entry / MODULE_FILE).write_text(module)
+            function, cached = _load(entry, key, translation.function_name), False
+        hits = sum(function.stats.cache_hits.values())
+        if not cached or not hits:
+            _write_manifest(entry, key)
+        loaded = (function, time.perf_counter() - began, bool(cached and hits))
+    _LOADED[key] = loaded
+    return loaded
+
+
+def compile_routine(image: bytes, entry: int, cpu: str, return_pc: int, inputs_at=()) -> CompiledRoutine:
+    """The routine at entry in this memory image, compiled (or loaded from the cache); Untranslatable
+    when the compiled engine does not take it (the message says why)."""
+    problem = numba_problem()
+    if problem is not None:
+        raise Untranslatable(problem)
+    translation = translate.translate(image.__getitem__, entry, cpu, return_pc, inputs_at)
+    function, seconds, from_cache = _function(translation)
+    code_map = np.zeros(MEMORY, dtype=np.uint8)
+    code_map[list(translation.code_bytes)] = 1
+    addr_block = np.full(MEMORY, translate.NO_BLOCK, dtype=np.int32)
+    for address, number in translation.blocks.items():
+        addr_block[address] = number
+    return CompiledRoutine(translation, function, seconds, from_cache, code_map, addr_block)
+
+
+__all__ = ["CompiledRoutine", "FALLBACK", "FALLBACK_REASON", "Untranslatable", "cache_root", "compile_routine",
+           "numba_problem"]

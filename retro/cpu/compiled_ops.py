@@ -1,0 +1,87 @@
+"""The rare paths of the compiled engine's generated code, as plain Python functions of ints that the
+generated module compiles with numba (`retro.cpu.compiled`): decimal-mode ADC and SBC, and ARR.
+
+Each returns (A, nv, zv, V, C): N is bit 7 of nv, Z is set when zv == 0 (the generated code's lazy
+flags, `retro.cpu.translate`). The rules are those of the batched core (`retro.cpu.batch`,
+`retro.cpu.batch65c02`) for one call: Bruce Clark, "Decimal Mode", appendix A (the NMOS 6502's A, C,
+N, V and Z; the 65C02's valid N and Z), and "NMOS 6510 Unintended Opcodes - No More Secrets" for ARR.
+"""
+
+from __future__ import annotations
+
+
+def adc_decimal_nmos(a, value, carry):
+    """NMOS ADC with D set: Clark's sequences 1 and 2; Z from the binary sum."""
+    total = a + value + carry
+    low = (a & 0x0F) + (value & 0x0F) + carry
+    if low >= 0x0A:
+        low = ((low + 0x06) & 0x0F) + 0x10
+    high = (a & 0xF0) + (value & 0xF0) + low
+    signed = (a & 0xF0) - ((a & 0x80) << 1) + (value & 0xF0) - ((value & 0x80) << 1) + low  # N and V before the high adjust
+    overflow = 1 if (signed < -128 or signed > 127) else 0
+    if high >= 0xA0:
+        high += 0x60
+    return high & 0xFF, signed & 0x80, total & 0xFF, overflow, 1 if high > 0xFF else 0
+
+
+def sbc_decimal_nmos(a, value, carry):
+    """NMOS SBC with D set: flags from the binary difference, A by Clark's sequence 3."""
+    binary = a + (value ^ 0xFF) + carry
+    result = binary & 0xFF
+    overflow = ((a ^ binary) & ((value ^ 0xFF) ^ binary) & 0x80) >> 7
+    low = (a & 0x0F) - (value & 0x0F) - (1 - carry)
+    if low < 0:
+        low = ((low - 0x06) & 0x0F) - 0x10
+    high = (a & 0xF0) - (value & 0xF0) + low
+    if high < 0:
+        high -= 0x60
+    return high & 0xFF, result, result, overflow, binary >> 8
+
+
+def adc_decimal_cmos(a, value, carry):
+    """65C02 ADC with D set: A and C by Clark's sequence 1, V by sequence 2, N and Z from A."""
+    low = (a & 0x0F) + (value & 0x0F) + carry
+    if low >= 0x0A:
+        low = ((low + 0x06) & 0x0F) + 0x10
+    total = (a & 0xF0) + (value & 0xF0) + low
+    signed = (a & 0xF0) - ((a & 0x80) << 1) + (value & 0xF0) - ((value & 0x80) << 1) + low
+    overflow = 1 if (signed < -128 or signed > 127) else 0
+    if total >= 0xA0:
+        total += 0x60
+    result = total & 0xFF
+    return result, result, result, overflow, 1 if total > 0xFF else 0
+
+
+def sbc_decimal_cmos(a, value, carry):
+    """65C02 SBC with D set: C and V from the binary difference, A by Clark's sequence 4, N and Z from A."""
+    binary = a + (value ^ 0xFF) + carry
+    overflow = ((a ^ binary) & ((value ^ 0xFF) ^ binary) & 0x80) >> 7
+    borrow = 1 - carry
+    low = (a & 0x0F) - (value & 0x0F) - borrow
+    total = a - value - borrow
+    if total < 0:
+        total -= 0x60
+    if low < 0:
+        total -= 0x06
+    result = total & 0xFF
+    return result, result, result, overflow, binary >> 8
+
+
+def arr(value, carry, decimal):
+    """ARR on A AND the operand (`value`): ROR with its own flags; in decimal mode (NMOS) as 64doc."""
+    result = (value >> 1) | (carry << 7)
+    if not decimal:
+        return result, result, result, ((result >> 6) ^ (result >> 5)) & 1, (result >> 6) & 1
+    low = value & 0x0F
+    high = value >> 4
+    overflow = 1 if (value ^ result) & 0x40 else 0
+    adjusted = result
+    if low + (low & 1) > 5:
+        adjusted = (result & 0xF0) | ((result + 6) & 0x0F)
+    high_carry = 1 if high + (high & 1) > 5 else 0
+    if high_carry:
+        adjusted = (adjusted + 0x60) & 0xFF
+    return adjusted, carry << 7, result, overflow, high_carry
+
+
+HELPERS = ("adc_decimal_nmos", "sbc_decimal_nmos", "adc_decimal_cmos", "sbc_decimal_cmos", "arr")

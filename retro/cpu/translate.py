@@ -1,0 +1,685 @@
+"""A routine's code translated, basic block by basic block, into the Python source of one function that
+numba compiles (`retro.cpu.compiled`): the compiled engine's front half, pure (bytes in, text out).
+
+The code is found from the entry as the static analysis finds it (branches both ways, JMP and JSR
+targets, the address after every JSR, where its RTS returns). Every instruction becomes a few lines
+with its operands, addresses and base cycles folded in; page-crossing penalties, taken branches and
+decimal mode are tested at run time. A block starts at every address control can reach other than by
+falling through; the function runs the calls one after another, each a loop over block numbers
+(`blk`) whose body is a chain of `if blk == k:` (LLVM turns it into one jump table), so the code grows
+with the instructions, not with the blocks squared.
+
+Semantics and cycles are those of `retro.cpu.batch` (and so of `Machine`): the cycle table of
+`retro.cpu.opcodes`, the branch rules of `retro.cpu.timing`, NMOS decimal mode on the 6510 (Bruce
+Clark, "Decimal Mode", appendix A), binary ADC/SBC on the 2A03, the stable undocumented opcodes
+("NMOS 6510 Unintended Opcodes - No More Secrets"), the WDC 65C02's table and decimal mode. The helpers
+the generated code calls for the rare paths (decimal arithmetic, ARR) are in `retro.cpu.compiled_ops`.
+
+What is not translated stops the call with FALLBACK, and the caller runs that call on the batched
+core: BRK, RTI, JAM and unstable opcodes, STP/WAI, a jump (RTS, JMP (ind)) to an address that starts
+no block, a write into the routine's own code bytes (self-modifying code). Code that certainly modifies
+itself (a store to a fixed address inside the code, an input placed in it) is refused as a whole
+(`Untranslatable`, with the reason the report gives).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+
+from retro.cpu.opcodes import DOCUMENTED, MODE_LENGTH, OPCODE_TABLE, OPCODE_TABLE_65C02, RESERVED, STABLE, Op
+from retro.cpu.timing import (
+    BRANCH_CONDITIONS,
+    BRANCH_PAGE_CYCLES,
+    BRANCH_TAKEN_CYCLES,
+    PAGE_CROSS_CYCLES,
+    PAGE_MASK,
+    WDC_65C02,
+    branch_target,
+)
+
+TRANSLATOR_VERSION = 1  # part of every cache key: a change of the generated code's meaning bumps it
+# A call's status (the compiled function's per-call result): 0 returned, else why it stopped.
+RETURNED = 0
+BUDGET = 4  # the cycle budget was spent (retro.cpu.batch.LaneError.BUDGET)
+FALLBACK = 100  # from here up: the call left the translated code and runs again on the batched core
+FALLBACK_STOP = 101  # an instruction not translated (BRK, RTI, JAM, unstable, STP, WAI)
+FALLBACK_JUMP = 102  # RTS or JMP (ind) to an address no block starts at
+FALLBACK_WRITE = 103  # a write into the routine's own code bytes
+NO_BLOCK = -1
+WORD = 0xFFFF
+BYTE = 0xFF
+STACK_PAGE = 0x100
+
+
+class Untranslatable(Exception):
+    """A routine the compiled engine does not take (the message says why: it goes in the report)."""
+
+
+@dataclass(frozen=True)
+class Translation:
+    """The generated source and what the compiled function needs beside it."""
+
+    source: str
+    function_name: str
+    blocks: dict[int, int]  # block start address -> block number
+    code_bytes: frozenset[int]  # every byte of a translated instruction (writes there fall back)
+    fixed_writes: tuple[int, ...]  # addresses written at a fixed address (restored after every call)
+    instructions: int
+
+
+def tables_for(cpu: str) -> dict[int, Op]:
+    return OPCODE_TABLE_65C02 if cpu == WDC_65C02 else OPCODE_TABLE
+
+
+# ---- finding the code -------------------------------------------------------------------------------
+
+def _op(table: dict[int, Op], opcode: int) -> Op | None:
+    op = table[opcode]
+    return op if op.kind in (DOCUMENTED, STABLE, RESERVED) else None
+
+
+STOPS = {"BRK", "RTI", "STP", "WAI"}  # not translated: the call runs on the batched core from here
+
+
+def _successors(pc: int, op: Op | None, read: Callable[[int], int]) -> tuple[list[int], bool]:
+    """(addresses control may go to next that start a block, whether it may fall through to pc + length)."""
+    if op is None or op.mnemonic in STOPS or op.mnemonic == "RTS":
+        return [], False
+    length = MODE_LENGTH[op.mode]
+    if op.mode == "rel":
+        target = branch_target(pc, read((pc + 1) & WORD))
+        return [target], op.mnemonic != "BRA"
+    if op.mode == "zpr":
+        return [branch_target(pc, read((pc + 2) & WORD), 3)], True
+    if op.mnemonic == "JMP":
+        return ([read((pc + 1) & WORD) | read((pc + 2) & WORD) << 8] if op.mode == "abs" else []), False
+    if op.mnemonic == "JSR":
+        return [read((pc + 1) & WORD) | read((pc + 2) & WORD) << 8, (pc + length) & WORD], False
+    return [], True
+
+
+def find_blocks(read: Callable[[int], int], entry: int, cpu: str, return_pc: int) -> tuple[list[int], dict]:
+    """(block starts in address order, {pc: Op or None} of every reachable instruction)."""
+    table = tables_for(cpu)
+    leaders = {entry}
+    instructions: dict[int, Op | None] = {}
+    pending = [entry]
+    while pending:
+        pc = pending.pop()
+        while pc not in instructions and pc != return_pc:
+            op = _op(table, read(pc))
+            instructions[pc] = op
+            targets, falls = _successors(pc, op, read)
+            for target in targets:
+                if target != return_pc:
+                    leaders.add(target)
+                    pending.append(target)
+            if not falls:
+                break
+            pc = (pc + MODE_LENGTH[op.mode]) & WORD
+            if op.mode in ("rel", "zpr") and pc != return_pc:  # a branch ends its block: what follows starts one
+                leaders.add(pc)
+    return sorted(leaders), instructions
+
+
+# ---- code generation ------------------------------------------------------------------------------------
+# State: a x y sp (ints), cycles; flags as fc fv fd fi (0/1) and N, Z lazily: N is bit 7 of `nv`, Z is
+# set when `zv` == 0 (most instructions set both from one value: one assignment each).
+
+def _read(address: str) -> str:
+    return f"mem[{address}]"
+
+
+class _Emitter:
+    def __init__(self, cpu: str, code_bytes: frozenset[int], read: Callable[[int], int]) -> None:
+        self.cpu = cpu
+        self.decimal = cpu == "6510"  # NMOS decimal mode; the 2A03 has none; the 65C02's own below
+        self.cmos = cpu == WDC_65C02
+        self.code_bytes = code_bytes
+        self.read = read
+        self.lines: list[str] = []
+        self.fixed_writes: set[int] = set()
+        self.indent = ""
+        self.inlined: set[int] = set()
+        self.chained: set[int] = set()  # blocks some code reaches through the dispatch
+        self.emit_block: Callable[[int], None] = lambda start: None
+
+    def put(self, line: str) -> None:
+        self.lines.append(self.indent + line)
+
+    # memory
+    def write_fixed(self, pc: int, address: int, value: str) -> None:
+        if address in self.code_bytes:
+            raise Untranslatable(f"self-modifying code: the instruction at ${pc:04X} writes ${address:04X}, "
+                                 f"a byte of the routine's code")
+        self.fixed_writes.add(address)
+        self.put(f"mem[{address}] = {value}")
+
+    def write_at(self, address: str, value: str) -> None:
+        """A write to a computed address: into the code -> the call falls back; logged for the restore."""
+        self.put(f"t = {address}")
+        self.put("bad |= code_map[t]")  # looked at when the block ends: the call then runs again elsewhere
+        self.put("log[nlog & LOG_MASK] = t")
+        self.put("nlog += 1")
+        self.put(f"mem[t] = {value}")
+
+    def push(self, value: str) -> None:
+        self.write_at(f"{STACK_PAGE} + sp", value)
+        self.put("sp = (sp - 1) & 255")
+
+    def pull(self, into: str) -> None:
+        self.put("sp = (sp + 1) & 255")
+        self.put(f"{into} = {_read(f'{STACK_PAGE} + sp')}")
+
+    # operands: (address expression or int, page-crossing expression or None)
+    def address(self, pc: int, op: Op) -> tuple[str | int, str | None]:
+        lo = self.read((pc + 1) & WORD)
+        hi = self.read((pc + 2) & WORD)
+        word = lo | hi << 8
+        mode = op.mode
+        if mode == "zpg":
+            return lo, None
+        if mode == "zpx":
+            return f"({lo} + x) & 255", None
+        if mode == "zpy":
+            return f"({lo} + y) & 255", None
+        if mode == "abs":
+            return word, None
+        if mode in ("abx", "aby"):
+            index = "x" if mode == "abx" else "y"
+            self.put(f"ea = ({word} + {index}) & 65535")
+            self.put(f"pg = ({lo} + {index}) >> 8")
+            return "ea", "pg"
+        if mode == "inx":
+            self.put(f"t = ({lo} + x) & 255")
+            self.put(f"ea = {_read('t')} | ({_read('(t + 1) & 255')} << 8)")
+            return "ea", None
+        if mode == "iny":
+            self.put(f"t = {_read(lo)} | ({_read((lo + 1) & BYTE)} << 8)")
+            self.put("ea = (t + y) & 65535")
+            self.put("pg = ((t & 255) + y) >> 8")
+            return "ea", "pg"
+        if mode == "zpi":
+            self.put(f"ea = {_read(lo)} | ({_read((lo + 1) & BYTE)} << 8)")
+            return "ea", None
+        raise AssertionError(mode)  # pragma: no cover
+
+    def operand(self, pc: int, op: Op) -> tuple[str, str | None]:
+        """The value an instruction reads (an expression) and its page-crossing test."""
+        if op.mode == "imm":
+            return str(self.read((pc + 1) & WORD)), None
+        address, crossed = self.address(pc, op)
+        self.put(f"v = {_read(address)}")
+        return "v", crossed
+
+    def cycles(self, base: int, crossed: str | None, penalised: bool) -> None:
+        if penalised and crossed is not None:
+            self.put(f"cycles += {base} + {crossed} * {PAGE_CROSS_CYCLES}")
+        else:
+            self.put(f"cycles += {base}")
+
+    # ALU
+    def nz(self, value: str) -> None:
+        self.put(f"nv = {value}")
+        self.put(f"zv = {value}")
+
+    def adc(self, value: str) -> None:
+        if self.cmos:
+            self.put("if fd:")
+            self.put(f"    a, nv, zv, fv, fc = adc_decimal_cmos(a, {value}, fc)")
+            self.put("    cycles += 1")
+            self.put("else:")
+        elif self.decimal:
+            self.put("if fd:")
+            self.put(f"    a, nv, zv, fv, fc = adc_decimal_nmos(a, {value}, fc)")
+            self.put("else:")
+        else:
+            self.put("if True:")
+        self.put(f"    t = a + {value} + fc")
+        self.put(f"    fv = (((a ^ t) & ({value} ^ t)) >> 7) & 1")
+        self.put("    fc = t >> 8")
+        self.put("    a = t & 255")
+        self.put("    nv = a")
+        self.put("    zv = a")
+
+    def sbc(self, value: str) -> None:
+        if self.cmos:
+            self.put("if fd:")
+            self.put(f"    a, nv, zv, fv, fc = sbc_decimal_cmos(a, {value}, fc)")
+            self.put("    cycles += 1")
+            self.put("else:")
+        elif self.decimal:
+            self.put("if fd:")
+            self.put(f"    a, nv, zv, fv, fc = sbc_decimal_nmos(a, {value}, fc)")
+            self.put("else:")
+        else:
+            self.put("if True:")
+        self.put(f"    u = {value} ^ 255")
+        self.put("    t = a + u + fc")
+        self.put("    fv = (((a ^ t) & (u ^ t)) >> 7) & 1")
+        self.put("    fc = t >> 8")
+        self.put("    a = t & 255")
+        self.put("    nv = a")
+        self.put("    zv = a")
+
+    def compare(self, register: str, value: str) -> None:
+        self.put(f"t = {register} - {value}")
+        self.put("fc = ((t >> 8) & 1) ^ 1")  # both are bytes: a negative difference has bit 8 set
+        self.put("t = t & 255")
+        self.nz("t")
+
+    def shift(self, name: str, value: str, into: str) -> None:
+        """into = the shift or step of value (an expression of other variables), flags set."""
+        if name == "ASL":
+            self.put(f"fc = {value} >> 7")
+            self.put(f"{into} = ({value} << 1) & 255")
+        elif name == "LSR":
+            self.put(f"fc = {value} & 1")
+            self.put(f"{into} = {value} >> 1")
+        elif name == "ROL":
+            self.put(f"t = ({value} << 1) | fc")
+            self.put(f"fc = {value} >> 7")
+            self.put(f"{into} = t & 255")
+        elif name == "ROR":
+            self.put(f"t = ({value} >> 1) | (fc << 7)")
+            self.put(f"fc = {value} & 1")
+            self.put(f"{into} = t")
+        elif name == "INC":
+            self.put(f"{into} = ({value} + 1) & 255")
+        elif name == "DEC":
+            self.put(f"{into} = ({value} - 1) & 255")
+        else:  # pragma: no cover
+            raise AssertionError(name)
+        self.nz(into)
+
+    def operate(self, name: str, value: str) -> None:
+        """What a reading instruction does with its operand value."""
+        if name in ("LDA", "LDX", "LDY", "LAX"):
+            targets = {"LDA": "a", "LDX": "x", "LDY": "y", "LAX": "a"}[name]
+            self.put(f"{targets} = {value}")
+            if name == "LAX":
+                self.put("x = a")
+            self.nz(targets)
+        elif name in ("ORA", "AND", "EOR"):
+            symbol = {"ORA": "|", "AND": "&", "EOR": "^"}[name]
+            self.put(f"a = a {symbol} {value}")
+            self.nz("a")
+        elif name == "ADC":
+            self.adc(value)
+        elif name in ("SBC", "USBC"):
+            self.sbc(value)
+        elif name in ("CMP", "CPX", "CPY"):
+            self.compare({"CMP": "a", "CPX": "x", "CPY": "y"}[name], value)
+        elif name == "BIT":
+            self.put(f"nv = {value}")
+            self.put(f"fv = ({value} >> 6) & 1")
+            self.put(f"zv = a & {value}")
+        elif name == "ANC":
+            self.put(f"a = a & {value}")
+            self.nz("a")
+            self.put("fc = a >> 7")
+        elif name == "ALR":
+            self.put(f"t = a & {value}")
+            self.shift("LSR", "t", "a")
+        elif name == "ARR":
+            if self.decimal:
+                self.put(f"a, nv, zv, fv, fc = arr(a & {value}, fc, fd)")
+            else:
+                self.put(f"a, nv, zv, fv, fc = arr(a & {value}, fc, 0)")
+        elif name == "SBX":
+            self.put("w = a & x")
+            self.compare("w", value)
+            self.put("x = t")
+        elif name == "NOP":
+            pass
+        else:  # pragma: no cover
+            raise AssertionError(name)
+
+    def pack_p(self) -> str:
+        return f"((nv & 128) | (fv << 6) | 48 | (fd << 3) | (fi << 2) | {_Z_BIT} | fc)"
+
+    def unpack_p(self, value: str) -> None:
+        self.put(f"nv = {value} & 128")
+        self.put(f"fv = ({value} >> 6) & 1")
+        self.put(f"fd = ({value} >> 3) & 1")
+        self.put(f"fi = ({value} >> 2) & 1")
+        self.put(f"zv = ({value} & 2) ^ 2")
+        self.put(f"fc = {value} & 1")
+
+
+READS = {"LDA", "LDX", "LDY", "LAX", "ORA", "AND", "EOR", "ADC", "SBC", "USBC", "CMP", "CPX", "CPY", "BIT",
+         "ANC", "ALR", "ARR", "SBX", "NOP"}
+STORES = {"STA": "a", "STX": "x", "STY": "y", "SAX": "(a & x)", "STZ": "0"}
+SHIFTS = ("ASL", "LSR", "ROL", "ROR", "INC", "DEC")
+COMBINED = {"SLO": ("ASL", "ORA"), "RLA": ("ROL", "AND"), "SRE": ("LSR", "EOR"), "RRA": ("ROR", "ADC"),
+            "DCP": ("DEC", "CMP"), "ISC": ("INC", "SBC")}
+FLAG_SETTERS = {"CLC": ("fc", 0), "SEC": ("fc", 1), "CLI": ("fi", 0), "SEI": ("fi", 1), "CLV": ("fv", 0),
+                "CLD": ("fd", 0), "SED": ("fd", 1)}
+TRANSFERS = {"TAX": ("x", "a"), "TAY": ("y", "a"), "TXA": ("a", "x"), "TYA": ("a", "y"), "TSX": ("x", "sp")}
+STEPS = {"INX": ("x", 1), "INY": ("y", 1), "DEX": ("x", -1), "DEY": ("y", -1)}
+SHIFTS_ABX_65C02 = {"ASL", "LSR", "ROL", "ROR"}
+
+
+def _jump_to(e: _Emitter, target: str, blocks: dict[int, int]) -> None:
+    """Control goes to a computed address: the caller's return, a known block, or the batched core."""
+    e.put(f"if {target} == return_pc and sp == return_sp:")
+    e.put("    break")
+    e.put(f"blk = addr_block[{target}]")
+    e.put("if blk < 0:")
+    e.put(f"    status = {FALLBACK_JUMP}")
+    e.put("    break")
+    e.put("continue")
+
+
+def _go(e: _Emitter, address: int, blocks: dict[int, int], return_pc: int) -> None:
+    if address == return_pc:
+        e.put(f"t = {address}")
+        _jump_to(e, "t", blocks)
+        return
+    if address in e.inlined and len(e.indent) < MAX_INDENT:  # its only way in is from here: its code
+        e.emit_block(address)  # follows, no trip through the dispatch
+        return
+    e.chained.add(address)
+    e.put(f"blk = {blocks[address]}")
+    e.put("continue")
+
+
+def _branch(e: _Emitter, condition: str, pc: int, length: int, offset: int, blocks, return_pc: int) -> None:
+    following = (pc + length) & WORD
+    target = branch_target(pc, offset, length)
+    extra = BRANCH_TAKEN_CYCLES + (BRANCH_PAGE_CYCLES if (following & PAGE_MASK) != (target & PAGE_MASK) else 0)
+    e.put(f"if {condition}:")
+    e.indent += "    "
+    e.put(f"cycles += {extra}")
+    _go(e, target, blocks, return_pc)
+    e.indent = e.indent[:-4]
+    _go(e, following, blocks, return_pc)
+
+
+MAX_INDENT = 160  # spaces: nested inlined blocks stop here (Python's tokenizer allows 100 levels)
+_Z_BIT = "(((zv - 1) >> 8) & 2)"  # P's Z bit from zv (0..255): 2 when zv == 0, without a branch
+BRANCH_TESTS = {0x80: ("nv >= 128", "nv < 128"), 0x40: ("fv", "fv == 0"), 0x01: ("fc", "fc == 0"),
+                0x02: ("zv == 0", "zv != 0")}
+
+
+def _instruction(e: _Emitter, pc: int, op: Op | None, blocks: dict[int, int], return_pc: int) -> bool:
+    """Emit one instruction; True when it ends the block (control went elsewhere)."""
+    read = e.read
+    if op is None or op.mnemonic in STOPS:
+        e.put(f"status = {FALLBACK_STOP}")
+        e.put("break")
+        return True
+    name, mode, base = op.mnemonic, op.mode, op.cycles
+    length = MODE_LENGTH[mode]
+    lo = read((pc + 1) & WORD)
+    if e.cmos and op.kind == RESERVED:
+        e.put(f"cycles += {base}")
+        return False
+    if mode == "rel":
+        e.put(f"cycles += {base}")
+        if name == "BRA":
+            _branch(e, "True", pc, 2, lo, blocks, return_pc)
+        else:
+            flag, wanted = BRANCH_CONDITIONS[read(pc)]
+            _branch(e, BRANCH_TESTS[flag][0 if wanted else 1], pc, 2, lo, blocks, return_pc)
+        return True
+    if mode == "zpr":  # BBRn / BBSn zp, offset
+        bit = int(name[3])
+        e.put(f"cycles += {base}")
+        test = f"({_read(lo)} >> {bit}) & 1"
+        _branch(e, f"{test} == {1 if name[2] == 'S' else 0}", pc, 3, read((pc + 2) & WORD), blocks, return_pc)
+        return True
+    if name == "JMP":
+        e.put(f"cycles += {base}")
+        pointer = lo | read((pc + 2) & WORD) << 8
+        if mode == "abs":
+            _go(e, pointer, blocks, return_pc)
+            return True
+        if mode == "iax":
+            e.put(f"t = ({pointer} + x) & 65535")
+            e.put(f"t = {_read('t')} | ({_read('(t + 1) & 65535')} << 8)")
+        elif e.cmos:
+            e.put(f"t = {_read(pointer)} | ({_read((pointer + 1) & WORD)} << 8)")
+        else:  # NMOS: the high byte from the start of the pointer's page when the pointer ends one
+            e.put(f"t = {_read(pointer)} | ({_read((pointer & PAGE_MASK) | ((pointer + 1) & BYTE))} << 8)")
+        _jump_to(e, "t", blocks)
+        return True
+    if name == "JSR":
+        back = (pc + 2) & WORD
+        e.push(str(back >> 8))
+        e.push(str(back & BYTE))
+        e.put(f"cycles += {base}")
+        _go(e, lo | read((pc + 2) & WORD) << 8, blocks, return_pc)
+        return True
+    if name == "RTS":
+        e.pull("t")
+        e.pull("u")
+        e.put(f"cycles += {base}")
+        e.put("t = ((u << 8 | t) + 1) & 65535")
+        _jump_to(e, "t", blocks)
+        return True
+    if name in STORES:
+        address, _ = e.address(pc, op)
+        if isinstance(address, int):
+            e.write_fixed(pc, address, STORES[name])
+        else:
+            e.write_at(address, STORES[name])
+        e.put(f"cycles += {base}")
+        return False
+    if name in READS and not (e.cmos and name == "BIT" and mode == "imm"):
+        if mode == "imp":  # the undocumented one-byte NOPs
+            e.put(f"cycles += {base}")
+            return False
+        value, crossed = e.operand(pc, op)
+        e.operate(name, value)
+        e.cycles(base, crossed, op.page_penalty)
+        return False
+    if name == "BIT":  # 65C02 BIT #imm: Z only
+        e.put(f"zv = a & {lo}")
+        e.put(f"cycles += {base}")
+        return False
+    shift, then = COMBINED.get(name, (name, None))
+    if shift in SHIFTS:
+        if mode == "acc":
+            e.shift(shift, "a", "a")
+            e.put(f"cycles += {base}")
+            return False
+        address, crossed = e.address(pc, op)
+        fixed = isinstance(address, int)
+        if not fixed and address != "ea":
+            e.put(f"ea = {address}")
+            address = "ea"
+        e.put(f"v = {_read(address)}")
+        e.shift(shift, "v", "v")
+        if fixed:
+            e.write_fixed(pc, address, "v")
+        else:
+            e.write_at(address, "v")
+        if then is not None:
+            e.operate(then, "v")
+        e.cycles(base, crossed, op.page_penalty)  # the 65C02's shifts abs,X: +1 across a page
+        return False
+    if name in ("TSB", "TRB") or name[:3] in ("RMB", "SMB"):
+        address, _ = e.address(pc, op)
+        e.put(f"v = {_read(address)}")
+        if name == "TSB":
+            e.put("zv = a & v")
+            result = "(v | a)"
+        elif name == "TRB":
+            e.put("zv = a & v")
+            result = "(v & (a ^ 255))"
+        else:
+            mask = 1 << int(name[3])
+            result = f"(v | {mask})" if name[0] == "S" else f"(v & {BYTE ^ mask})"
+        e.write_fixed(pc, address, result) if isinstance(address, int) else e.write_at(address, result)
+        e.put(f"cycles += {base}")
+        return False
+    if name in FLAG_SETTERS:
+        flag, value = FLAG_SETTERS[name]
+        e.put(f"{flag} = {value}")
+    elif name in TRANSFERS:
+        target, source = TRANSFERS[name]
+        e.put(f"{target} = {source}")
+        e.nz(target)
+    elif name == "TXS":
+        e.put("sp = x")
+    elif name in STEPS:
+        register, step = STEPS[name]
+        e.put(f"{register} = ({register} + {step}) & 255")
+        e.nz(register)
+    elif name in ("PHA", "PHX", "PHY"):
+        e.push(name[2].lower())
+    elif name == "PHP":
+        e.push(e.pack_p())
+    elif name in ("PLA", "PLX", "PLY"):
+        register = name[2].lower()
+        e.pull(register)
+        e.nz(register)
+    elif name == "PLP":
+        e.pull("t")
+        e.unpack_p("t")
+    elif name == "NOP":
+        pass
+    else:  # pragma: no cover - a new table row needs its translation here
+        raise AssertionError(f"no translation for {name} ({mode})")
+    e.put(f"cycles += {base}")
+    return False
+
+
+def _exits(start: int, instructions: dict, leaders: set[int], return_pc: int, read) -> tuple[list[int], list[int]]:
+    """(blocks a block goes to by its code, blocks reached later by an RTS: the addresses after its JSRs)."""
+    pc = start
+    while True:
+        op = instructions[pc]
+        targets, falls = _successors(pc, op, read)
+        if op is not None and op.mnemonic == "JSR":
+            return targets[:1], targets[1:]
+        following = (pc + MODE_LENGTH[op.mode]) & WORD if op is not None else pc
+        if op is None or not falls or op.mode in ("rel", "zpr") or following in leaders or following == return_pc:
+            return [t for t in targets + ([following] if falls else []) if t != return_pc], []
+        pc = following
+
+
+def _inlined(starts: list[int], instructions: dict, entry: int, return_pc: int, read) -> set[int]:
+    """Blocks whose code goes inside their one predecessor's: a block reached by one jump (or fall) from
+    a block before it, never by a return or as the entry. Forward only, so no loop is unrolled."""
+    leaders = set(starts)
+    into: dict[int, list[int]] = {start: [] for start in starts}
+    returned_to = set()
+    for start in starts:
+        goes, comes_back = _exits(start, instructions, leaders, return_pc, read)
+        for target in goes:
+            into[target].append(start)
+        returned_to.update(comes_back)
+    return {start for start, sources in into.items()
+            if start != entry and start not in returned_to and len(sources) == 1 and sources[0] < start}
+
+
+def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
+              inputs_at: Iterable[int] = ()) -> Translation:
+    """The routine at entry (its bytes as `read` gives them: the memory every call starts from) as
+    the source of one function (see the module docstring); Untranslatable when it certainly modifies
+    its own code."""
+    starts, instructions = find_blocks(read, entry, cpu, return_pc)
+    code_bytes = frozenset((pc + k) & WORD for pc, op in instructions.items()
+                           for k in range(MODE_LENGTH[op.mode] if op is not None else 1))
+    for address in inputs_at:
+        if address in code_bytes:
+            raise Untranslatable(f"self-modifying code: an input is placed at ${address:04X}, a byte of the "
+                                 f"routine's code")
+    inlined = _inlined(starts, instructions, entry, return_pc, read)
+    dispatched = [start for start in starts if start not in inlined]
+    blocks = {start: number for number, start in enumerate(dispatched + sorted(inlined))}
+    leaders = set(starts)
+    e = _Emitter(cpu, code_bytes, read)
+    e.inlined = inlined
+
+    def emit_block(start: int) -> None:
+        pc = start
+        e.put(f"# block ${start:04X}")
+        while True:
+            op = instructions[pc]
+            e.put(f"# ${pc:04X} {op.mnemonic if op is not None else 'not translated'}")
+            if _instruction(e, pc, op, blocks, return_pc):
+                break
+            pc = (pc + MODE_LENGTH[op.mode]) & WORD
+            if pc in leaders or pc == return_pc:  # falls into the next block
+                _go(e, pc, blocks, return_pc)
+                break
+    e.emit_block = emit_block
+    pending, done = list(dispatched), set()
+    while pending:  # the dispatched blocks, then any block nested too deep to be inlined where it was met
+        start = pending.pop(0)
+        done.add(start)
+        e.indent = " " * 12
+        e.put(f"{'if' if not e.lines else 'elif'} blk == {blocks[start]}:  # ${start:04X}")
+        e.indent = " " * 16
+        emit_block(start)
+        pending += sorted(e.chained - done - set(pending))
+    name = "run_calls"
+    restore = "\n".join(f"        mem[{address}] = image[{address}]" for address in sorted(e.fixed_writes))
+    source = _FUNCTION.format(name=name, entry_block=blocks[entry], body="\n".join(e.lines), budget_status=BUDGET,
+                              fallback_write=FALLBACK_WRITE, z_bit=_Z_BIT, restore=restore)
+    return Translation(source, name, blocks, code_bytes, tuple(sorted(e.fixed_writes)), len(instructions))
+
+
+# The function around the blocks: one call per lane, inputs placed, outputs read, memory restored.
+_FUNCTION = '''
+LOG_MASK = 65535
+
+
+def {name}(mem, image, log, code_map, addr_block, in_addr, in_bytes, reg_a, reg_x, reg_y, reg_p,
+           start_sp, budget, return_pc, return_sp, out_addr, out_a, out_x, out_y, out_p, out_cycles,
+           out_status, out_bytes):
+    for lane in range(reg_a.shape[0]):
+        for k in range(in_addr.shape[0]):
+            mem[in_addr[k]] = in_bytes[k, lane]
+        a = np.int64(reg_a[lane])
+        x = np.int64(reg_x[lane])
+        y = np.int64(reg_y[lane])
+        p = np.int64(reg_p[lane])
+        nv = p & 128
+        fv = (p >> 6) & 1
+        fd = (p >> 3) & 1
+        fi = (p >> 2) & 1
+        zv = (p & 2) ^ 2
+        fc = p & 1
+        bad = 0
+        sp = np.int64(start_sp)
+        cycles = np.int64(0)
+        status = 0
+        nlog = 0
+        blk = {entry_block}
+        t = np.int64(0)
+        u = np.int64(0)
+        v = np.int64(0)
+        ea = np.int64(0)
+        w = np.int64(0)
+        pg = np.int64(0)
+        while True:
+            if cycles >= budget or bad:
+                status = {fallback_write} if bad else {budget_status}
+                break
+{body}
+        if status == 0 and bad:
+            status = {fallback_write}
+        if status == 0 and cycles > budget:
+            status = {budget_status}
+        out_a[lane] = a
+        out_x[lane] = x
+        out_y[lane] = y
+        out_p[lane] = (nv & 128) | (fv << 6) | 32 | (fd << 3) | (fi << 2) | {z_bit} | fc
+        out_cycles[lane] = cycles
+        out_status[lane] = status
+        for k in range(out_addr.shape[0]):
+            out_bytes[k, lane] = mem[out_addr[k]]
+        if nlog > LOG_MASK + 1:  # more writes than the log holds: the whole memory
+            mem[:] = image
+        else:
+            for k in range(nlog):
+                t = log[k]
+                mem[t] = image[t]
+{restore}
+'''
+

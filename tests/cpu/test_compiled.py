@@ -1,0 +1,299 @@
+"""The compiled engine (retro.cpu.translate + retro.cpu.compiled) against the batched core and Machine on
+randomly generated routines: straight-line code over every opcode the engines run, forward and
+backward branches, a subroutine, decimal mode (P set from the data by PHA/PLP, and SED), page
+crossings; every call's registers, flags, cycles and memory compared on all three engines. And the
+cache: a second build loads instead of compiling, a corrupt or foreign entry is rebuilt."""
+
+from __future__ import annotations
+
+import json
+import random
+
+import numpy as np
+import pytest
+
+from retro.cpu import compiled as compiled_module
+from retro.cpu.batch import BatchCpu, LaneError
+from retro.cpu.compiled import compile_routine, numba_problem
+from retro.cpu.machine import CALL_STACK_TOP, RETURN_TRAP, push_return_trap
+from retro.cpu.opcodes import DOCUMENTED, MODE_LENGTH, RESERVED, STABLE
+from retro.cpu.translate import FALLBACK, Untranslatable, tables_for
+from retro.errors import RunError
+from retro.machines import build_machine
+
+pytestmark = pytest.mark.skipif(numba_problem() is not None, reason=f"{numba_problem()}")
+
+CODE = 0xC0A0  # the routines cross into the next page: branches across it cost their extra cycle
+ZERO_PAGE = range(0x00, 0x100)
+DATA = range(0x0300, 0x0500)  # absolute operands and (zp),Y pointers land here (page crossings included)
+STACK = range(0x0100, 0x0200)
+LANES = 160
+BUDGET = 4_000
+CONTROL = {"JMP", "JSR", "RTS", "RTI", "BRK", "TXS", "STP", "WAI", "PHA", "PHP", "PLA", "PLP", "PHX", "PHY",
+           "PLX", "PLY"}
+
+
+def _pool(cpu: str) -> list[int]:
+    kinds = (DOCUMENTED, STABLE, RESERVED)
+    return [op for op, row in tables_for(cpu).items()
+            if row.kind in kinds and row.mnemonic not in CONTROL and row.mode not in ("rel", "zpr", "ind", "iax")]
+
+
+def _operand(rng: random.Random, mode: str) -> list[int]:
+    if mode in ("zpg", "zpx", "zpy", "inx", "iny", "zpi"):
+        return [rng.randrange(0x20, 0x40)]
+    if mode in ("abs", "abx", "aby"):
+        return list((rng.randrange(0x0300, 0x0400)).to_bytes(2, "little"))
+    if mode == "imm":
+        return [rng.randrange(256)]
+    return []
+
+
+def random_program(cpu: str, seed: int, length: int = 70) -> bytes:
+    """Random instructions with branches (forward, and backward in counted loops), a JSR, P from the
+    data (LDA zp; PHA; PLP: D and the other flags vary per call) and SED; ends with RTS."""
+    rng = random.Random(seed)
+    pool = _pool(cpu)
+    table = tables_for(cpu)
+    branches = [op for op, row in table.items() if row.mode == "rel" and row.mnemonic != "BRA"]
+    items: list = []  # bytes, or ("branch", opcode, label) / ("label", name)
+    labels = 0
+    for _ in range(length):
+        roll = rng.random()
+        if roll < 0.08:  # a forward branch over a few instructions
+            labels += 1
+            items.append(("branch", rng.choice(branches), labels))
+            for _ in range(rng.randrange(1, 4)):
+                op = rng.choice(pool)
+                items.append(bytes([op, *_operand(rng, table[op].mode)]))
+            items.append(("label", labels))
+        elif roll < 0.12:  # flags from the data, decimal mode included
+            items.append(bytes([0xA5, rng.randrange(0x20, 0x40), 0x48, 0x28]))  # LDA zp; PHA; PLP
+        elif roll < 0.14:
+            items.append(bytes([0xF8]))  # SED
+        elif roll < 0.16:  # a counted loop: LDY #n; body (Y untouched); DEY; BNE back
+            labels += 1
+            items.append(bytes([0xA0, rng.randrange(1, 5)]))
+            items.append(("label", labels))
+            for _ in range(rng.randrange(1, 3)):
+                op = rng.choice([o for o in pool if "Y" not in table[o].mnemonic and table[o].mode not in ("aby", "zpy", "iny")])
+                items.append(bytes([op, *_operand(rng, table[op].mode)]))
+            items.append(bytes([0x88]))
+            items.append(("branch", 0xD0, labels))
+        elif roll < 0.18:
+            items.append(("jsr",))
+        else:
+            op = rng.choice(pool)
+            items.append(bytes([op, *_operand(rng, table[op].mode)]))
+    items.append(bytes([0x60]))
+    subroutine = bytes([0xE8, 0x69, rng.randrange(256), 0x60])  # INX; ADC #imm; RTS
+    # layout: two passes (branches are 2 bytes, JSR 3)
+    address, where = CODE, {}
+    for item in items:
+        if isinstance(item, bytes):
+            address += len(item)
+        elif item[0] == "label":
+            where[item[1]] = address
+        else:
+            address += 2 if item[0] == "branch" else 3
+    sub_at = address
+    code = bytearray()
+    for item in items:
+        if isinstance(item, bytes):
+            code += item
+        elif item[0] == "branch":
+            offset = where[item[2]] - (CODE + len(code) + 2)
+            assert -128 <= offset <= 127
+            code += bytes([item[1], offset & 0xFF])
+        elif item[0] == "jsr":
+            code += bytes([0x20, sub_at & 0xFF, sub_at >> 8])
+    return bytes(code + subroutine)
+
+
+def random_states(seed: int, n: int):
+    """Per call: A, X, Y, P and the bytes of zero page and the data pages ((zp) pointers into DATA)."""
+    rng = np.random.default_rng(seed)
+    registers = rng.integers(0, 256, size=(n, 4))
+    zero_page = rng.integers(0, 256, size=(n, 256))
+    zero_page[:, 1::2] = rng.integers(0x03, 0x05, size=(n, 128))  # every pointer's high byte: $03 or $04
+    data = rng.integers(0, 256, size=(n, len(DATA)))
+    return registers, np.concatenate([zero_page, data], axis=1)
+
+
+PLACED = np.asarray(list(ZERO_PAGE) + list(DATA), dtype=np.int64)
+WATCHED = np.asarray(list(ZERO_PAGE) + list(STACK) + list(DATA), dtype=np.int64)
+
+
+def image_with(code: bytes) -> bytearray:
+    image = bytearray(0x10000)
+    image[CODE:CODE + len(code)] = code
+    return image
+
+
+def on_machine(cpu: str, code: bytes, registers, memory) -> list:
+    machine = build_machine(cpu=cpu)
+    image = image_with(code)
+    results = []
+    for (a, x, y, p), values in zip(registers.tolist(), memory.tolist()):
+        machine.memory[:] = list(image)
+        for address, value in zip(PLACED.tolist(), values):
+            machine.memory[address] = value
+        try:
+            call = machine.call(CODE, a=a, x=x, y=y, p=p, budget=BUDGET)
+        except RunError:
+            results.append(None)
+            continue
+        results.append((call.a, call.x, call.y, call.p & 0xCF, call.cycles,
+                        tuple(machine.memory[address] for address in WATCHED.tolist())))
+    return results
+
+
+def on_batch(cpu: str, code: bytes, registers, memory, watched=WATCHED) -> list:
+    image = image_with(code)
+    sp = push_return_trap(image)
+    n = len(registers)
+    batch = BatchCpu(cpu, bytes(image), n)
+    lanes = np.repeat(np.arange(n), len(PLACED))
+    batch.memory.write(lanes, np.tile(PLACED, n), memory.ravel())
+    batch.a[:], batch.x[:], batch.y[:] = registers[:, 0], registers[:, 1], registers[:, 2]
+    batch.p[:] = (registers[:, 3] | 0x20) & ~0x10
+    batch.sp[:] = sp
+    batch.call(CODE, BUDGET, RETURN_TRAP, CALL_STACK_TOP)
+    watched = np.stack([batch.read(int(address)) for address in watched], axis=1)
+    return [None if batch.error[i] else
+            (int(batch.a[i]), int(batch.x[i]), int(batch.y[i]), int(batch.p[i]) & 0xCF, int(batch.cycles[i]),
+             tuple(watched[i].tolist())) for i in range(n)]
+
+
+def on_compiled(cpu: str, code: bytes, registers, memory, watched=WATCHED) -> tuple[list, int]:
+    """(results, calls left to the batched core); a call stopped by the budget is None."""
+    image = image_with(code)
+    sp = push_return_trap(image)
+    routine = compile_routine(bytes(image), CODE, cpu, RETURN_TRAP)
+    flags = ((registers[:, 3] | 0x20) & ~0x10).astype(np.int64)
+    done = routine.run(bytes(image), PLACED, np.ascontiguousarray(memory.T.astype(np.uint8)), registers[:, 0].astype(np.int64),
+                       registers[:, 1].astype(np.int64), registers[:, 2].astype(np.int64), flags, sp, BUDGET,
+                       RETURN_TRAP, CALL_STACK_TOP, np.asarray(watched, dtype=np.int64))
+    results, left = [], 0
+    for i in range(len(registers)):
+        status = int(done["status"][i])
+        if status >= FALLBACK:
+            left += 1
+            results.append("fallback")
+        elif status == LaneError.BUDGET:
+            results.append(None)
+        else:
+            results.append((int(done["a"][i]), int(done["x"][i]), int(done["y"][i]), int(done["p"][i]) & 0xCF,
+                            int(done["cycles"][i]), tuple(done["bytes"][:, i].tolist())))
+    return results, left
+
+
+def _differences(name: str, one: list, other: list) -> list[str]:
+    found = []
+    for i, (a, b) in enumerate(zip(one, other)):
+        if a != "fallback" and b != "fallback" and a != b:
+            found.append(f"call {i}: {name}: {a if a is None else a[:5]} != {b if b is None else b[:5]}"
+                         + ("" if a is None or b is None or a[5] == b[5] else " (memory differs)"))
+    return found
+
+
+@pytest.mark.parametrize("cpu,seed", [(cpu, seed) for cpu in ("6510", "2a03", "65c02") for seed in range(2)])
+def test_random_routines_agree_on_all_three_engines(cpu, seed, compiled_cache):
+    code = random_program(cpu, seed * 3 + ("6510", "2a03", "65c02").index(cpu))
+    registers, memory = random_states(seed, LANES)
+    compiled, left = on_compiled(cpu, code, registers, memory)
+    batch = on_batch(cpu, code, registers, memory)
+    machine = on_machine(cpu, code, registers, memory)
+    problems = _differences("compiled vs batch", compiled, batch) + _differences("batch vs Machine", batch, machine)
+    assert not problems, "\n".join(problems[:10])
+    assert left < LANES // 4  # nearly every call ran compiled (a (zp),Y store may land in the code: batched)
+    assert sum(r is not None for r in machine) > LANES // 2
+
+
+def test_decimal_mode_on_every_operand_pair(compiled_cache):
+    """SED; ADC, SBC (and ARR on the NMOS) of every A, every third operand and both carries, results and
+    flags stored, against the batched core: the 6510's NMOS decimal mode, the 2A03's binary, the 65C02's
+    (one cycle more)."""
+    pairs = np.array([(a, v, c) for a in range(256) for v in range(0, 256, 3) for c in (0, 1)])
+    zeros = np.zeros(len(pairs), dtype=np.int64)
+    registers = np.stack([pairs[:, 0], zeros, zeros, pairs[:, 2]], axis=1)  # A, X, Y, P (the carry)
+    memory = np.zeros((len(pairs), len(PLACED)), dtype=np.int64)
+    memory[:, 0x21] = pairs[:, 1]
+    for cpu in ("6510", "2a03", "65c02"):
+        code = bytes([0xF8, 0x08, 0x85, 0x40,  # SED; PHP (the input P); STA $40
+                      0x65, 0x21, 0x85, 0x41, 0x08, 0x68, 0x85, 0x42, 0x28,  # ADC $21; A, P -> $41, $42; PLP
+                      0x08, 0xA5, 0x40, 0xE5, 0x21, 0x85, 0x43, 0x08, 0x68, 0x85, 0x44, 0x28])  # SBC $21 -> $43, $44
+        if cpu == "6510":
+            code += bytes([0xA5, 0x40, 0x6B, 0xFF, 0x85, 0x45, 0x08, 0x68, 0x85, 0x46])  # ARR #$FF -> $45, $46
+        code += bytes([0x60])
+        results = list(range(0x40, 0x47))
+        compiled, left = on_compiled(cpu, code, registers, memory, results)
+        batch = on_batch(cpu, code, registers, memory, results)
+        assert left == 0
+        problems = _differences(cpu, compiled, batch)
+        assert not problems, "\n".join(problems[:10])
+
+
+def test_a_store_into_the_code_leaves_the_call_to_the_batched_core(compiled_cache):
+    # STA ($20),Y with the pointer at the code: the write lands in the routine's own bytes
+    code = bytes([0x91, 0x20, 0xA9, 0x01, 0x60])
+    registers = np.array([[7, 0, 0, 0x20], [7, 0, 0, 0x20]])
+    memory = np.zeros((2, len(PLACED)), dtype=np.int64)
+    memory[0, 0x20:0x22] = (0x03, 0x03)  # call 0 writes data
+    memory[1, 0x20:0x22] = (0xA2, 0xC0)  # call 1 writes $C0A2: LDA's opcode
+    compiled, left = on_compiled("6510", code, registers, memory)
+    assert left == 1 and compiled[1] == "fallback" and compiled[0][0] == 1
+
+
+def test_a_fixed_store_into_the_code_is_refused_with_its_reason():
+    image = image_with(bytes([0x8D, 0xA4, 0xC0, 0xA9, 0x00, 0x60]))  # STA $C0A4: LDA's operand
+    with pytest.raises(Untranslatable, match=r"self-modifying code: the instruction at \$C0A0 writes \$C0A4"):
+        compile_routine(bytes(image), CODE, "6510", RETURN_TRAP)
+
+
+def test_the_cache_loads_the_second_time_and_rebuilds_a_corrupt_or_foreign_entry(tmp_path, monkeypatch):
+    monkeypatch.setenv("RETRO_CACHE", str(tmp_path))
+    monkeypatch.setattr(compiled_module, "_LOADED", {})
+    code = bytes([0xA9, 0x05, 0x69, 0x03, 0x60])  # LDA #5; ADC #3; RTS
+    image = bytes(image_with(code))
+    first = compile_routine(image, CODE, "2a03", RETURN_TRAP)
+    assert not first.from_cache
+    monkeypatch.setattr(compiled_module, "_LOADED", {})
+    second = compile_routine(image, CODE, "2a03", RETURN_TRAP)
+    assert second.from_cache
+    (entry,) = (tmp_path / "compiled").iterdir()
+    data = next(entry.rglob("*.nbc"))
+    data.write_bytes(b"not numba's" + data.read_bytes()[11:])  # corrupt: the sums no longer match
+    monkeypatch.setattr(compiled_module, "_LOADED", {})
+    third = compile_routine(image, CODE, "2a03", RETURN_TRAP)
+    assert not third.from_cache
+    manifest = entry / "manifest.json"
+    record = json.loads(manifest.read_text())
+    manifest.write_text(json.dumps({**record, "key": "0" * 64}))  # another key's manifest: foreign
+    monkeypatch.setattr(compiled_module, "_LOADED", {})
+    assert not compile_routine(image, CODE, "2a03", RETURN_TRAP).from_cache
+    monkeypatch.setattr(compiled_module, "_LOADED", {})
+    assert compile_routine(image, CODE, "2a03", RETURN_TRAP).from_cache
+
+
+def test_a_runaway_call_stops_at_the_budget(compiled_cache):
+    code = bytes([0xE8, 0x4C, 0xA0, 0xC0])  # INX; JMP $C0A0
+    compiled, left = on_compiled("6510", code, np.array([[0, 0, 0, 0x20]]), np.zeros((1, len(PLACED)), dtype=np.int64))
+    assert compiled == [None] and left == 0
+
+
+def test_a_taken_branch_into_the_next_page_costs_two_cycles_more(compiled_cache):
+    """NOP x4 at $C0F8; BCS $C102 at $C0FC (the next instruction at $C0FE, the target in page $C1);
+    LDA #1; TAX; NOP; RTS. By hand: not taken 8 + 2 + 2 + 2 + 2 + 6 = 22 cycles; taken 8 + 2 + 1 + 1
+    + 6 = 18."""
+    start = 0xC0F8
+    code = bytes([0xEA] * 4 + [0xB0, 0x04, 0xA9, 0x01, 0xAA, 0xEA, 0x60])
+    image = bytearray(0x10000)
+    image[start:start + len(code)] = code
+    sp = push_return_trap(image)
+    routine = compile_routine(bytes(image), start, "6510", RETURN_TRAP)
+    flags = np.array([0x20, 0x21], dtype=np.int64)  # carry clear, carry set
+    zeros = np.zeros(2, dtype=np.int64)
+    done = routine.run(bytes(image), np.zeros(0, dtype=np.int64), np.zeros((0, 2), dtype=np.uint8), zeros, zeros,
+                       zeros, flags, sp, BUDGET, RETURN_TRAP, CALL_STACK_TOP, np.zeros(0, dtype=np.int64))
+    assert done["cycles"].tolist() == [22, 18] and done["status"].tolist() == [0, 0]

@@ -1,0 +1,73 @@
+"""`retro check --engine compiled`: the same JSON record as the batched core (and so as Machine, which
+tests/routines/test_batch_check.py holds the batched core to) on every built-in and user fixture spec,
+the engine and its reason in the report; a routine the compiled engine refuses runs on the batched core
+and the report says why; a scene keeps Machine."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from retro.analysis.check import engines
+from retro.cli import main
+from retro.cpu import compiled
+from retro.cpu.compiled import numba_problem
+from retro.routines.registry import builtin_names
+
+from test_batch_check import USER_SPECS  # noqa: E402 (pytest puts this folder on sys.path)
+
+needs_numba = pytest.mark.skipif(numba_problem() is not None, reason=f"{numba_problem()}")
+ENGINE_FIELDS = {"engine", "engine_agreement", "engine_reason", "compile_seconds", "compiled_fallbacks"}
+
+
+def check_json(capsys, *args) -> tuple[int, list[dict]]:
+    code = main(["check", *args, "--json", "--jobs", "1"])
+    return code, json.loads(capsys.readouterr().out)
+
+
+def without_engine(record: dict) -> dict:
+    return {k: v for k, v in record.items() if k not in ENGINE_FIELDS}
+
+
+@needs_numba
+@pytest.mark.parametrize("spec", builtin_names() + USER_SPECS)
+def test_the_compiled_engine_gives_the_batched_cores_check(spec, capsys):
+    code_b, (batched,) = check_json(capsys, spec, "--engine", "batch", "--random", "400")
+    code_c, (compiled,) = check_json(capsys, spec, "--engine", "compiled", "--random", "400")
+    assert code_b == code_c
+    assert without_engine(batched) == without_engine(compiled)
+    if compiled["engine"] == "compiled":
+        assert compiled["engine_reason"] == "--engine compiled" and compiled["compile_seconds"] >= 0
+        agreement = compiled["engine_agreement"]
+        assert agreement["cases"] > 0 and agreement["mismatches"] == 0
+    else:  # refused: the batched core ran, and the report says why
+        assert compiled["engine"] == "batch" and compiled["engine_reason"].startswith(
+            "the compiled engine does not take it: ")
+
+
+@needs_numba
+def test_self_modifying_code_runs_on_the_batched_core_and_says_why(capsys):
+    code, (record,) = check_json(capsys, "pixel", "--engine", "compiled", "--random", "50")
+    assert code == 0 and record["engine"] == "batch"
+    assert "self-modifying code" in record["engine_reason"]
+    main(["check", "pixel", "--engine", "compiled", "--random", "50", "--jobs", "1"])
+    assert "engine: batch (the compiled engine does not take it: self-modifying code" in capsys.readouterr().out
+
+
+def test_without_numba_auto_runs_the_batched_core_and_says_so_once(monkeypatch, capsys):
+    monkeypatch.setattr(compiled, "numba_problem", lambda: "numba cannot be imported (ImportError: no numba)")
+    monkeypatch.setattr(engines, "_SAID", set())
+    assert engines.array_engine("auto", None) == ("batch", "numba cannot be imported (ImportError: no numba)")
+    assert engines.array_engine("auto", 10 ** 9)[0] == "batch"
+    assert engines.array_engine("compiled", 5)[0] == "batch"
+    assert capsys.readouterr().err.count("the compiled engine is off: numba cannot be imported") == 1
+    assert engines.array_engine("auto", 30_000) == ("batch", "auto: 30,000 planned calls (the compiled engine "
+                                                             "from 16,000,000)")
+
+
+@needs_numba
+def test_auto_takes_the_compiled_engine_for_a_sweep_or_millions_of_calls():
+    assert engines.array_engine("auto", None) == ("compiled", "auto: a sweep")
+    assert engines.array_engine("auto", 20_000_000) == ("compiled", "auto: 20,000,000 planned calls")
+    assert engines.array_engine("batch", None) == ("batch", "--engine batch")
