@@ -145,12 +145,9 @@ def _inside(values, value: int) -> int:
     """The value itself when the input takes it, else the nearest value it takes."""
     if values.listed is None:
         return min(max(value, values.lo), values.hi)
-    listed = values.listed
-    at = int(np.searchsorted(listed, value))
-    if at < len(listed) and listed[at] == value:
+    if value in values.listed:
         return value
-    below, above = listed[max(at - 1, 0)], listed[min(at, len(listed) - 1)]
-    return below if abs(value - below) <= abs(above - value) else above
+    return min(values.listed, key=lambda v: (abs(v - value), v))
 
 
 def _inside_domain(routine: Routine, cases: list[tuple]) -> list[tuple]:
