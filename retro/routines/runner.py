@@ -469,7 +469,7 @@ class RoutineRunner:
                          else push_interrupt_frame(image, 0, stack_top))
         cpu = BatchCpu(self.routine.cpu, image, n, coverage=coverage, first_lanes=first_lanes)
         world = None if self.routine.world.empty else BatchWorld(self.routine.world, cpu, self.written_kept,
-                                                                  str(self.routine.spec_path))
+                                                                  str(self.routine.spec_path), stack_top)
         registers, p = self.plan.place(columns, _column_byte, cpu.memory.fill, entry)
         for name, value in registers.items():
             lanes = getattr(cpu, name)

@@ -392,7 +392,7 @@ class MachineWorld:
             self.written[name] = []
 
     def _exit(self, mpu) -> int:
-        mpu.pc, mpu.sp = RETURN_TRAP, CALL_STACK_TOP  # the run loop's stop: the call has ended here
+        mpu.pc, mpu.sp = RETURN_TRAP, self.machine.stack_top  # the run loop's stop: the call has ended here
         return 0
 
     def _mock_action(self, mock: Mock) -> Callable:
@@ -538,12 +538,14 @@ class BatchWorld:
     """The world on one BatchCpu (mocks with stated effects, exits): per-lane call counts and, for
     the mocks the reference takes, every call's arguments."""
 
-    def __init__(self, world: World, cpu, written_kept: dict[str, int] | None = None, spec: str = "") -> None:
+    def __init__(self, world: World, cpu, written_kept: dict[str, int] | None = None, spec: str = "",
+                 stack_top: int = CALL_STACK_TOP) -> None:
         from retro.cpu.batch import LaneError
 
         self.world = world
         self.cpu = cpu
         self.spec = spec
+        self.stack_top = stack_top  # S the call started from (the entry-state runs vary it): an exit ends there
         self.counts = {m.name: np.zeros(cpu.lanes, dtype=np.int64) for m in world.mocks}
         self.records: dict[str, list[tuple[np.ndarray, dict]]] = {m.name: [] for m in world.mocks}
         actions: dict[int, Callable] = {m.address: self._mock_action(m) for m in world.mocks}
@@ -597,9 +599,8 @@ class BatchWorld:
         if self.hardware:
             self._unhook()
 
-    @staticmethod
-    def _exit(g):
-        g.sp = np.full(len(g), CALL_STACK_TOP, dtype=np.int32)
+    def _exit(self, g):
+        g.sp = np.full(len(g), self.stack_top, dtype=np.int32)
         return RETURN_TRAP
 
     def _mock_action(self, mock: Mock) -> Callable:

@@ -66,7 +66,9 @@ def test_a_handler_is_entered_with_seven_cycles_and_i_set_and_ends_at_its_rti(tm
 def test_the_static_bounds_of_a_handler_count_the_entry_and_end_at_rti(tmp_path):
     (tmp_path / "ref.py").write_text("def f(c): return {'inside': 0x34 | c}  # PHP: I, bit 5 and B (pushed copies) set\n")
     routine = build(tmp_path, HANDLER, {"program": {"interrupt": "irq"}, "inputs": {"c": "C"},
-                                         "outputs": {"inside": "$fb"}, "reference": {"function": "ref.py:f"}})
+                                         "outputs": {"inside": "$fb"}, "reference": {"function": "ref.py:f"},
+                                         # P is pushed whole: the other flags are the caller's (stated)
+                                         "entry": {"z": 0, "d": 0, "v": 0, "n": 0}})
     for engine in ENGINES:
         report = check(routine, engine=engine)
         assert (report.static.best, report.static.worst) == (23, 23)
@@ -105,8 +107,9 @@ def test_a_jmp_to_an_exit_ends_the_call_with_the_jmp_counted(tmp_path, value, cy
 
 
 def test_exits_bound_the_static_analysis_and_the_check_holds(tmp_path):
-    (tmp_path / "ref.py").write_text("def f(v): return v\n")
-    routine = build(tmp_path, EXIT, {"program": {"exit": ["done", "$EA31"]}, "inputs": {"v": "$fb"},
+    # v = 0 leaves by the second exit before the store: $fc keeps what it held (an input, so stated)
+    (tmp_path / "ref.py").write_text("def f(v, held): return v if v else held\n")
+    routine = build(tmp_path, EXIT, {"program": {"exit": ["done", "$EA31"]}, "inputs": {"v": "$fb", "held": "$fc"},
                                       "outputs": {"w": "$fc"}, "reference": {"function": "ref.py:f"}})
     report = check(routine, engine="batch")
     assert (report.static.best, report.static.worst) == (9, 11)
