@@ -32,6 +32,7 @@ MAX_BUDGET = 100_000_000  # cycles; about 100 s of C64 time, a minute or two on 
 MAX_TRACE = 200_000  # instructions a trace keeps (about 30 MB); a longer traced run is stopped
 RETURN_TRAP = 0x0000  # the routine "returns" here: RTS to $0000 with the stack back where it started
 CALL_STACK_TOP = 0xFF
+ENTRY_S = CALL_STACK_TOP - 2  # S on a routine's entry by default: an empty stack after the caller's JSR
 STACK_BASE = 0x100  # the 6502's stack is page 1
 DEFAULT_FLAGS = FLAG_U | FLAG_I
 RECENT_SHOWN = 8  # instructions listed in a failure message
@@ -70,13 +71,18 @@ class CallResult:
     stolen: int = 0  # of `cycles`, those the CPU stood still (only with a chip driving BA)
 
 
-def push_return_trap(memory) -> int:
-    """Put on an empty stack what a JSR from RETURN_TRAP pushes (its return address minus one, high
-    byte first) and return S after it: how every call is entered, on Machine and the batched core."""
+def push_return_trap(memory, s: int = ENTRY_S) -> int:
+    """Put on the stack what a JSR from RETURN_TRAP pushes (its return address minus one, high byte
+    first) so that S is `s` after it, and return S: how every call is entered, on Machine and the
+    batched core. The call has returned when the PC is RETURN_TRAP and S is `return_s(s)`."""
     back = (RETURN_TRAP - 1) & 0xFFFF
-    top = STACK_BASE | CALL_STACK_TOP
-    memory[top], memory[top - 1] = back >> 8, back & 0xFF
-    return CALL_STACK_TOP - 2
+    memory[STACK_BASE | return_s(s)], memory[STACK_BASE | ((s + 1) & 0xFF)] = back >> 8, back & 0xFF
+    return s
+
+
+def return_s(s):
+    """S after the RTS of a routine entered with S = s (an int, or a numpy array of lanes)."""
+    return (s + 2) & 0xFF
 
 
 def _status(p: int) -> int:
@@ -162,14 +168,15 @@ class Machine:
     # ---- running ---------------------------------------------------------------------------
 
     def call(self, entry: str | int, *, a: int = 0, x: int = 0, y: int = 0, p: int = DEFAULT_FLAGS,
-             memory: dict | None = None, budget: int = DEFAULT_BUDGET, trace: bool = False) -> CallResult:
+             memory: dict | None = None, budget: int = DEFAULT_BUDGET, trace: bool = False,
+             s: int = ENTRY_S) -> CallResult:
         """Run the routine at entry as if called by JSR; stop at its RTS.
 
         Fails (RunError) on BRK, JAM or an unstable opcode, and when the routine needs more than
         `budget` cycles (a runaway routine is stopped as soon as it has used them).
         """
         address = self.resolve(entry, "entry")
-        for name, value in (("a", a), ("x", x), ("y", y), ("p", p)):
+        for name, value in (("a", a), ("x", x), ("y", y), ("p", p), ("s", s)):
             if not 0 <= value <= 0xFF:
                 raise InputError(f"{name}: {value} is not a byte (0-255)")
         if not 1 <= budget <= MAX_BUDGET:
@@ -177,30 +184,30 @@ class Machine:
         for target, values in (memory or {}).items():
             self.poke(target, values)
         entries: list[TraceEntry] | None = [] if trace else None
-        start = self._enter(address, a, x, y, p)
+        start = self._enter(address, a, x, y, p, s)
         stolen_before = self.mpu.stolen
-        count = self._execute(RETURN_TRAP, CALL_STACK_TOP, start + budget,
+        count = self._execute(RETURN_TRAP, return_s(s), start + budget,
                               None if entries is None else _Tracer(self, entries))
-        cycles = self._returned(start, budget, count)
+        cycles = self._returned(start, budget, count, return_s(s))
         mpu = self.mpu
         status = _status(mpu.p)
         return CallResult(a=mpu.a, x=mpu.x, y=mpu.y, s=mpu.sp, p=status, cycles=cycles,
                           instructions=count, trace=entries, flags=_flags(status),
                           stolen=mpu.stolen - stolen_before)
 
-    def _enter(self, address: int, a: int, x: int, y: int, p: int) -> int:
+    def _enter(self, address: int, a: int, x: int, y: int, p: int, s: int = ENTRY_S) -> int:
         """Set registers and the stack as a JSR from the return trap would; return the start cycle."""
         mpu = self.mpu
         mpu.a, mpu.x, mpu.y, mpu.p = a, x, y, _status(p)
-        mpu.sp = push_return_trap(mpu.memory)
+        mpu.sp = push_return_trap(mpu.memory, s)
         mpu.pc = address
         mpu.pending_interrupt = None  # a poll before the call does not carry into it
         return mpu.processorCycles
 
-    def _returned(self, start: int, budget: int, count: int) -> int:
+    def _returned(self, start: int, budget: int, count: int, stop_s: int = CALL_STACK_TOP) -> int:
         """The routine's cycles, or a RunError if it did not return within the budget."""
         mpu = self.mpu
-        if mpu.pc != RETURN_TRAP or mpu.sp != CALL_STACK_TOP:
+        if mpu.pc != RETURN_TRAP or mpu.sp != stop_s:
             self._over_budget(budget, count)
         cycles = mpu.processorCycles - start
         if cycles > budget:  # returned, but its last instruction ran past the budget
@@ -209,7 +216,7 @@ class Machine:
 
     def call_fast(self, address: int, writes=(), *, a: int = 0, x: int = 0, y: int = 0, p: int = DEFAULT_FLAGS,
                   budget: int = DEFAULT_BUDGET, record: list | None = None,
-                  pointer_pcs: frozenset[int] = frozenset()) -> tuple[int, int, int, int, int]:
+                  pointer_pcs: frozenset[int] = frozenset(), s: int = ENTRY_S) -> tuple[int, int, int, int, int]:
         """`call` for sweeps of many thousands of calls: the same run without its conveniences.
 
         `address` is the entry as a number, `writes` are raw (address, byte) pairs stored into RAM,
@@ -221,10 +228,10 @@ class Machine:
         memory = self.bus.memory
         for target, value in writes:
             memory[target] = value
-        start = self._enter(address, a, x, y, p)
+        start = self._enter(address, a, x, y, p, s)
         observer = None if record is None else _Recorder(record, pointer_pcs)
-        count = self._execute(RETURN_TRAP, CALL_STACK_TOP, start + budget, observer)
-        cycles = self._returned(start, budget, count)
+        count = self._execute(RETURN_TRAP, return_s(s), start + budget, observer)
+        cycles = self._returned(start, budget, count, return_s(s))
         mpu = self.mpu
         return cycles, mpu.a, mpu.x, mpu.y, _status(mpu.p)
 

@@ -25,12 +25,14 @@ from retro.assembler import requested_tables
 from retro.cpu.batch import BatchCpu
 from retro.cpu.lane_memory import LaneMemoryFull
 from retro.cpu.machine import (
-    CALL_STACK_TOP,
     DEFAULT_BUDGET,
     DEFAULT_FLAGS,
+    ENTRY_S,
     RETURN_TRAP,
+    STACK_BASE,
     CallResult,
     push_return_trap,
+    return_s,
 )
 from retro.cpu.mpu import FLAG_B, FLAG_U
 from retro.cpu.timing import timing_table
@@ -164,11 +166,20 @@ class InputPlan:
     tables: tuple[tuple[int, tuple[int, ...]], ...]  # (input index, addresses)
     base_flags: int  # P before the flag inputs: the default flags without those the inputs set
     output_addresses: tuple[int, ...]  # output places in memory (restored before each Machine call)
+    vias: "ViaPlan | None" = None  # inputs and outputs placed by the case (stack, table slot, pointer)
+    entry_s: int = ENTRY_S  # S at entry when no input sets it
+
+    @property
+    def s_varies(self) -> bool:
+        """An input sets S (each call, or each lane, has its own)."""
+        return any(register == "s" for _, register, _ in self.registers)
 
     @classmethod
-    def of(cls, routine: Routine) -> "InputPlan":
+    def of(cls, routine: Routine, image: Sequence[int] | None = None, salt: int = 0) -> "InputPlan":
         registers, flags, places, tables = [], [], [], []
         for index, port in enumerate(routine.inputs):
+            if port.via is not None:
+                continue  # placed by ViaPlan
             if port.flag:
                 flags.append((index, port.places[0].bit))
             elif port.table:
@@ -183,25 +194,132 @@ class InputPlan:
         for _, bit in flags:
             forced |= bit
         outputs = sorted({place.address for port in routine.outputs for place in port.places if place.kind == "memory"})
+        vias = ViaPlan.of(routine, image, salt) if any(p.via for p in routine.inputs + routine.outputs) else None
         return cls(tuple(registers), tuple(flags), tuple(places), tuple(tables), DEFAULT_FLAGS & ~forced,
-                   tuple(outputs))
+                   tuple(outputs), vias, routine.entry_s)
 
-    def place(self, values: Sequence, table_byte: Callable, write: Callable) -> tuple[dict[str, object], object]:
+    def place(self, values: Sequence, table_byte: Callable, write: Callable, scatter: Callable | None = None,
+              select: Callable | None = None) -> tuple[dict[str, object], object]:
         """Put `values` (one per input: numbers, or arrays of lanes) in place: `write(address, byte)`
         for every memory byte as it is made (a block's arrays are consumed while in cache), and
-        (register values, P) returned; `table_byte(value, k)` is byte k of a table input's value."""
+        (register values, P) returned; `table_byte(value, k)` is byte k of a table input's value.
+        Inputs placed by the case go through `scatter(address, byte)` (the address: a number, or
+        one per lane) and `select(condition, a, b)` (a where b otherwise: per case or per lane)."""
         for index, address, shift in self.bytes:
             write(address, (values[index] >> shift) & 0xFF)
         for index, addresses in self.tables:
             for k, address in enumerate(addresses):
                 write(address, table_byte(values[index], k))
-        registers = {"a": 0, "x": 0, "y": 0}
+        if self.vias is not None:
+            self.vias.place(values, table_byte, scatter or write, select or _case_select)
+        registers = {"a": 0, "x": 0, "y": 0, "s": self.entry_s}
         for index, register, shift in self.registers:
+            if register == "s":
+                registers["s"] = values[index]
+                continue
             registers[register] |= (values[index] >> shift) & 0xFF
         p = self.base_flags
         for index, bit in self.flags:
             p |= (values[index] != 0) * bit
         return registers, p
+
+
+def _slots(routine: Routine, port: Port) -> dict[int, list[tuple[int, int]]]:
+    """A table slot port: every address its index may pick -> the (slot, byte) pairs placed there."""
+    via = port.via
+    wrap = 0xFF if via.base < 0x100 else 0xFFFF
+    index = routine.inputs[via.index_input].values
+    at: dict[int, list[tuple[int, int]]] = {}
+    for slot in (index.listed if index.listed is not None else range(index.lo, index.hi + 1)):
+        for i in range(len(port.places)):
+            at.setdefault((via.base + slot + i) & wrap, []).append((slot, i))
+    return at
+
+
+def _case_select(condition, a, b):
+    return a if condition else b
+
+
+def _byte(port: Port, value, i: int, table_byte: Callable):
+    """Byte i of an input's value: of a table, or of a little-endian number."""
+    return table_byte(value, i) if port.table else (value >> (8 * i)) & 0xFF
+
+
+FILLER_MIX = (0x2D, 0x65, 0x1F, 0x9D)  # small odd multipliers: every term stays far below 2^63 (ints and int64 alike)
+
+
+@dataclass(frozen=True)
+class ViaPlan:
+    """Where the inputs and outputs placed by the case go (retro.routines.places.Via), worked out once:
+    the same arithmetic places one case (ints) or a column block (arrays: one address per lane). An
+    input in a slot of a table fills every other slot its index may pick with a value other than its
+    own (from the case and the seed), so that a routine reading the wrong slot reads a wrong value."""
+
+    routine: Routine
+    pointers: dict  # the address of a pointer no input sets -> its value in memory after `init`
+    salt: int
+    slot_maps: dict  # (section, port index) of a table slot port -> {address: [(slot, byte), ...]}
+
+    @classmethod
+    def of(cls, routine: Routine, image: Sequence[int] | None, salt: int) -> "ViaPlan":
+        pointers = {}
+        for port in routine.inputs + routine.outputs:
+            via = port.via
+            if via is not None and via.mode == "pointer" and via.pointer_input < 0:
+                high = (via.base + 1) & (0xFF if via.base < 0x100 else 0xFFFF)
+                pointers[via.base] = (image[via.base] | image[high] << 8) if image is not None else 0
+        slot_maps = {(section, k): _slots(routine, port) for section, ports in (("in", routine.inputs),
+                                                                                ("out", routine.outputs))
+                     for k, port in enumerate(ports) if port.via is not None and port.via.mode == "indexed"}
+        return cls(routine, pointers, salt & 0xFFFF, slot_maps)
+
+    def address(self, via, values: Sequence, i: int):
+        """The address of byte i of a port placed by `via`, for a case (or per lane of a block)."""
+        if via.mode == "stack":
+            s = values[via.s_input] if via.s_input >= 0 else self.routine.entry_s
+            return STACK_BASE | ((s + via.base + i) & 0xFF)
+        index = values[via.index_input] if via.index_input >= 0 else 0
+        if via.mode == "indexed":
+            return (via.base + index + i) & (0xFF if via.base < 0x100 else 0xFFFF)
+        pointer = values[via.pointer_input] if via.pointer_input >= 0 else self.pointers[via.base]
+        return (pointer + via.offset + index + i) & 0xFFFF
+
+    def place(self, values: Sequence, table_byte: Callable, scatter: Callable, select: Callable) -> None:
+        for k, port in enumerate(self.routine.inputs):
+            via = port.via
+            if via is None:
+                continue
+            value = values[k]
+            if via.mode != "indexed":
+                for i in range(len(port.places)):
+                    scatter(self.address(via, values, i), _byte(port, value, i, table_byte))
+                continue
+            index = values[via.index_input]
+            for address, placed in self.slot_maps["in", k].items():
+                slot, i = placed[0]
+                byte = _byte(port, value, i, table_byte)
+                mixed = (byte * FILLER_MIX[0] + slot * FILLER_MIX[1] + i * FILLER_MIX[2] + (index & 0xFF) * FILLER_MIX[3]
+                         + (value & 0xFFFF if not port.table else 0) + self.salt + k)
+                chosen = byte ^ (1 + (mixed ^ (mixed >> 5)) % 255)  # never the slot's own byte
+                for slot, i in placed:
+                    chosen = select(index == slot, _byte(port, value, i, table_byte), chosen)
+                scatter(address, chosen)
+
+    def touched(self, values: Sequence) -> list[int]:
+        """Every address the case's ports placed by the case take (a table slot port: every slot):
+        what Machine restores before the next call, so that each call starts as a batch lane does."""
+        found = []
+        for section, ports in (("in", self.routine.inputs), ("out", self.routine.outputs)):
+            for k, port in enumerate(ports):
+                if port.via is not None:
+                    found += (list(self.slot_maps[section, k]) if port.via.mode == "indexed" else
+                              [self.address(port.via, values, i) for i in range(len(port.places))])
+        return found
+
+    def outputs(self, values: Sequence) -> dict[int, list]:
+        """Output index -> the addresses of its bytes for this case (or per lane)."""
+        return {k: [self.address(port.via, values, i) for i in range(len(port.places))]
+                for k, port in enumerate(self.routine.outputs) if port.via is not None}
 
 
 @dataclass(frozen=True)
@@ -248,7 +366,8 @@ class RoutineRunner:
         # a data byte in the set only costs a lookup.
         indirect_y = {opcode for opcode, op in timing_table(routine.cpu).items() if op.mode in ("iny", "zpr")}
         self.pointer_pcs = frozenset(self.program.origin + i for i, b in enumerate(self.program.code) if b in indirect_y)
-        self.plan = InputPlan.of(routine)
+        self.plan = InputPlan.of(routine, self.call_image, seed)
+        self._dirty: list[int] = []  # addresses the last call's ports placed by the case took (restored)
 
     @property
     def limit(self) -> int:
@@ -259,6 +378,10 @@ class RoutineRunner:
         places in memory are restored first (see the module's docstring)."""
         image = self.call_image
         writes = [(address, image[address]) for address in self.plan.output_addresses]
+        if self.plan.vias is not None:
+            touched = self.plan.vias.touched(case)
+            writes += [(address, image[address]) for address in self._dirty + touched]
+            self._dirty = touched
         registers, p = self.plan.place(case, _case_byte, lambda address, byte: writes.append((address, byte)))
         return writes, registers, p
 
@@ -268,11 +391,12 @@ class RoutineRunner:
         if self.vic is not None:
             self._restart_beam()
             stolen = self.machine.mpu.stolen
+        located = self.plan.vias.outputs(case) if self.plan.vias is not None else None
         cycles, a, x, y, p = self.machine.call_fast(self.entry, writes, **registers, p=p, budget=self.limit,
                                                     record=record, pointer_pcs=self.pointer_pcs)
         if self.vic is not None:
             self.last_stolen = self.machine.mpu.stolen - stolen
-        return self.outputs(a, x, y, p), cycles
+        return self.outputs(a, x, y, p, located), cycles
 
     def _restart_beam(self) -> None:
         self.vic.restart(self.machine.cycle, self.start.line, self.start.cycle)
@@ -314,23 +438,34 @@ class RoutineRunner:
 
     def _run_lanes(self, columns: list, n: int) -> "BatchOutcome":
         image = bytearray(self.call_image)
-        stack_pointer = push_return_trap(image)
+        if not self.plan.s_varies:
+            push_return_trap(image, self.routine.entry_s)
         cpu = BatchCpu(self.routine.cpu, image, n)
-        registers, p = self.plan.place(columns, _column_byte, cpu.memory.fill)
+        memory = cpu.memory
+        registers, p = self.plan.place(columns, _column_byte, memory.fill,
+                                       scatter=lambda address, byte: memory.write(slice(None), address, byte),
+                                       select=np.where)
+        s = registers.pop("s")
         for name, value in registers.items():
             lanes = getattr(cpu, name)
             lanes |= np.asarray(value).astype(lanes.dtype)
         cpu.p[:] = (p | FLAG_U) & ~FLAG_B  # as Machine sets P
-        cpu.sp[:] = stack_pointer
-        cpu.call(self.entry, self.limit, RETURN_TRAP, CALL_STACK_TOP)
+        cpu.sp[:] = s
+        if self.plan.s_varies:  # each lane's return address where its own JSR put it, as Machine does
+            push_return_trap(_LaneStores(memory), cpu.sp.copy())
+        cpu.call(self.entry, self.limit, RETURN_TRAP, return_s(cpu.sp.copy()) if self.plan.s_varies
+                 else return_s(self.routine.entry_s))
+        located = self.plan.vias.outputs(columns) if self.plan.vias is not None else None
         outputs = port_values(self.routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,
                               widen=lambda lanes: np.asarray(lanes, dtype=np.int64),
-                              table=lambda columns: np.stack(columns, axis=1).astype(np.int64))
+                              table=lambda columns: np.stack(columns, axis=1).astype(np.int64),
+                              located=located, read_at=lambda address: _every_lane(memory.read(slice(None), address), n))
         return BatchOutcome(outputs, cpu.cycles, cpu.error)
 
-    def outputs(self, a: int, x: int, y: int, p: int) -> tuple:
-        return tuple(port_values(self.routine.outputs, {"a": a, "x": x, "y": y}, p, self.machine.memory.__getitem__,
-                                 widen=int, table=tuple))
+    def outputs(self, a: int, x: int, y: int, p: int, located: dict | None = None) -> tuple:
+        read = self.machine.memory.__getitem__
+        return tuple(port_values(self.routine.outputs, {"a": a, "x": x, "y": y}, p, read, widen=int, table=tuple,
+                                 located=located, read_at=read))
 
     def traced(self, case: Sequence) -> CallResult:
         """The same call with the instruction trace (for the report of a failing case)."""
@@ -348,14 +483,20 @@ class RoutineRunner:
         return program_size(self.program, text, entries, self.code_image.__getitem__, self.routine.cpu)
 
 
-def port_values(ports: Sequence[Port], registers: dict, p, read: Callable, widen: Callable, table: Callable) -> list:
+def port_values(ports: Sequence[Port], registers: dict, p, read: Callable, widen: Callable, table: Callable,
+                located: dict | None = None, read_at: Callable | None = None) -> list:
     """The outputs of a call, one value per port in the spec's order, read from the registers, P and
     memory (`read(address)`): the same code for one call (ints) and for lanes of the batched core
     (arrays), which differ only in `widen` (a byte or a flag as the output's number type) and
-    `table` (bytes of a table output together)."""
+    `table` (bytes of a table output together). An output placed by the case is read from the
+    addresses `located` gives it (output index -> addresses of its bytes) with `read_at`."""
     values = []
-    for port in ports:
-        if port.flag:
+    for k, port in enumerate(ports):
+        if port.via is not None:
+            data = [read_at(address) for address in located[k]]
+            values.append(table(data) if port.table else
+                          sum((widen(byte) << (8 * i) for i, byte in enumerate(data)), widen(0)))
+        elif port.flag:
             values.append(widen((p & port.places[0].bit) != 0))
         elif port.table:
             values.append(table([read(place.address) for place in port.places]))
@@ -371,4 +512,20 @@ def port_values(ports: Sequence[Port], registers: dict, p, read: Callable, widen
 def describe_value(port: Port, value) -> str:
     if port.table:
         return "[" + " ".join(f"{v:02x}" for v in value) + "]"
+    if port.address:  # a pointer or S: an address, as a 6502 programmer writes it
+        return f"${value:0{2 if port.bits == 8 else 4}X}"
     return str(value)
+
+
+class _LaneStores:
+    """`memory[address] = byte` on every lane of a batch (an address per lane): push_return_trap's view."""
+
+    def __init__(self, memory) -> None:
+        self.memory = memory
+
+    def __setitem__(self, address, byte) -> None:
+        self.memory.write(slice(None), address, byte)
+
+
+def _every_lane(value, lanes: int) -> np.ndarray:
+    return np.full(lanes, value, dtype=np.int64) if isinstance(value, (int, np.integer)) else value

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 
+from retro.cpu.machine import ENTRY_S
 from retro.cpu.mpu import VARIANTS
 from retro.machines import BARE, MACHINE_CPUS, MACHINES, machine_for
 from retro.errors import InputError
@@ -33,6 +34,7 @@ from retro.routines.places import (
     BYTE_VALUES,
     MAX_TABLE,
     Port,
+    bind_vias,
     no_overlap,
     parse_values,
     places_of,
@@ -52,7 +54,7 @@ NUMBER_CHARACTERS = 40  # the longest number a spec may write as text
 CPUS = tuple(VARIANTS)
 
 TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows"}
-PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load"}
+PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load", "s"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays", "time_limit"}
 CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage"}
@@ -94,6 +96,7 @@ class Routine:
     program: Program | None = None  # the program, read once when the spec is loaded
     entry_address: int = 0  # entry, init and the loop labels resolved against its symbols
     init_address: int | None = None
+    entry_s: int = ENTRY_S  # S at entry when no input sets it ([program] s)
     loop_addresses: dict[int, int] = field(default_factory=dict)  # loop header address -> bound
     exhaustive: tuple[str, ...] = ()
     random: int = 0
@@ -185,7 +188,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     misplaced_rows(r, doc)
     seconds = sandbox.time_limit(r, r.table(doc.get("reference", {}), "reference"), "reference")
     program = _program_section(r, doc)
-    inputs, outputs, memory = _places_sections(r, doc, program.program, seconds)
+    inputs, outputs, memory = _places_sections(r, doc, program.program, seconds, program.entry_s)
     rows = parse_rows(r, doc["rows"], inputs, outputs) if "rows" in doc else ()
     reference = _reference_section(r, doc, inputs, memory, rows, seconds)
     cases = _cases_section(r, doc, inputs, seconds, answered=reference["reference"] is not None)
@@ -213,6 +216,7 @@ class _ProgramSection:
     program: Program
     entry_address: int
     init_address: int | None
+    entry_s: int
 
     def fields(self) -> dict:
         return dict(self.__dict__)
@@ -243,12 +247,13 @@ def _program_section(r: Fields, doc: dict) -> _ProgramSection:
     entry_address = _in_program(r, program, resolve(r, program, entry, "program.entry"), "program.entry")
     init_address = (_in_program(r, program, resolve(r, program, init, "program.init"), "program.init")
                     if init is not None else None)
+    entry_s = r.integer(program_doc["s"], "program.s", 0, 0xFF) if "s" in program_doc else ENTRY_S
     return _ProgramSection(program_file, symbols_file, load, cpu, machine, entry, init, program,
-                           entry_address, init_address)
+                           entry_address, init_address, entry_s)
 
 
-def _places_sections(r: Fields, doc: dict, program: Program, seconds: int) -> tuple[tuple[Port, ...], tuple[Port, ...],
-                                                                     tuple[MemoryBlock, ...]]:
+def _places_sections(r: Fields, doc: dict, program: Program, seconds: int, entry_s: int = ENTRY_S
+                     ) -> tuple[tuple[Port, ...], tuple[Port, ...], tuple[MemoryBlock, ...]]:
     """[inputs], [outputs] and [memory]: where every value lives, none overlapping."""
     inputs = tuple(port_of(r, program, name, value, "inputs", is_input=True)
                    for name, value in r.table(r.required(doc, "inputs", hint="the [inputs] table"), "inputs").items())
@@ -261,6 +266,8 @@ def _places_sections(r: Fields, doc: dict, program: Program, seconds: int) -> tu
     memory = tuple(_memory_block(r, program, name, value, seconds)
                    for name, value in r.table(doc.get("memory", {}), "memory").items())
     _no_overlap_memory(r, memory, inputs)
+    inputs, outputs = bind_vias(r, program, inputs, outputs, [(m.address, m.address + m.size, m.name)
+                                                              for m in memory if m.size], entry_s)
     return inputs, outputs, memory
 
 
