@@ -16,7 +16,7 @@ only on some paths reads the same on both engines); the `[memory]` blocks once a
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,7 +36,7 @@ from retro.cpu.machine import (
 )
 from retro.cpu.mpu import FLAG_B, FLAG_U
 from retro.cpu.timing import timing_table
-from retro.errors import InputError
+from retro.errors import InputError, RunError
 from retro.fileio import read_text
 from retro.machines import build_machine
 from retro.machines.c64 import vic_of
@@ -53,8 +53,40 @@ MEMORY_RNG_OFFSET = 1  # memory blocks draw from seed + 1, cases from seed: chan
 @dataclass(frozen=True)
 class Size:
     code_bytes: int  # from the origin up to the first generated table (the program's length without them)
-    table_bytes: int  # lookup tables (storage the caller fills is not counted)
+    table_bytes: int  # lookup tables and the `[memory]` blocks the routine read (storage the caller fills: not)
     storage_bytes: int
+    table_blocks: tuple[tuple[str, int], ...] = ()  # (name, bytes) of the `[memory]` blocks among the tables
+
+
+PROBE_CASES = 2_000  # cases of each part run to see which `[memory]` blocks a routine reads
+STORES = frozenset({"STA", "STX", "STY", "STZ", "SAX", "SHA", "SHX", "SHY", "TAS"})  # write, never read
+NO_DATA = frozenset({"JMP", "JSR", "BRK", "RTS", "RTI"})
+
+
+def data_address(read, pc: int, x: int, y: int, pointer: int, cpu: str) -> int | None:
+    """The address the instruction at pc reads its operand from (registers before it, `pointer`: the
+    word of an (indirect),Y instruction as recorded), or None when it reads none."""
+    from retro.cpu.timing import TimingError, timing_of
+
+    try:
+        op = timing_of(read(pc), cpu)
+    except TimingError:
+        return None
+    if op.mnemonic in STORES or op.mnemonic in NO_DATA:
+        return None
+    mode, lo = op.mode, read((pc + 1) & 0xFFFF)
+    if mode == "zpg":
+        return lo
+    if mode in ("zpx", "zpy"):
+        return (lo + (x if mode == "zpx" else y)) & 0xFF
+    if mode in ("abs", "abx", "aby"):
+        return ((lo | read((pc + 2) & 0xFFFF) << 8) + (x if mode == "abx" else y if mode == "aby" else 0)) & 0xFFFF
+    if mode == "iny":
+        return (pointer + y) & 0xFFFF
+    if mode in ("inx", "zpi"):  # the pointer as memory holds it after the call (not recorded)
+        at = (lo + (x if mode == "inx" else 0)) & 0xFF
+        return read(at) | read((at + 1) & 0xFF) << 8
+    return None
 
 
 def routine_code(read, entries: list[int], within: tuple[int, int], cpu: str = "6510") -> dict[int, int]:
@@ -85,7 +117,8 @@ def routine_code(read, entries: list[int], within: tuple[int, int], cpu: str = "
     return found
 
 
-def program_size(program: Program, source_text: str | None, entries: list[int], read, cpu: str = "6510") -> Size:
+def program_size(program: Program, source_text: str | None, entries: list[int], read, cpu: str = "6510",
+                 blocks: Sequence[tuple[str, int, int]] = ()) -> Size:
     """The routine's bytes: its reachable instructions (the entry's and init's, with their subroutines)
     and the generated tables they name (by address, or by `#>table` for pointers set up at init)."""
     within = (program.origin, program.end)
@@ -102,7 +135,11 @@ def program_size(program: Program, source_text: str | None, entries: list[int], 
                 used.add(name)  # lda #>table: a pointer's high byte, as set up by an init routine
     lookup = sum(len(GENERATORS[n]()) for n in used if n not in STORAGE_TABLES)
     storage = sum(len(GENERATORS[n]()) for n in used if n in STORAGE_TABLES)
-    return Size(code_bytes=sum(code.values()), table_bytes=lookup, storage_bytes=storage)
+    counted = [spans[n] for n in used]  # a `[memory]` block inside a generated table is that table
+    read_blocks = [(name, start, size) for name, start, size in blocks
+                   if not any(first <= start < end for first, end in counted)]
+    return Size(code_bytes=sum(code.values()), table_bytes=lookup + sum(size for _, _, size in read_blocks),
+                storage_bytes=storage, table_blocks=tuple((name, size) for name, _, size in read_blocks))
 
 
 IMMEDIATE_LOAD_A = 0xA9
@@ -475,12 +512,36 @@ class RoutineRunner:
         return self.machine.call(self.entry, **registers, p=p, memory={address: [v] for address, v in writes},
                                  budget=self.limit, trace=True)
 
-    def size(self) -> Size:
-        """Bytes of code, lookup tables and caller-filled storage of the routine's program."""
+    def size(self, read_blocks: Sequence[str] = ()) -> Size:
+        """Bytes of code, lookup tables and caller-filled storage of the routine's program; the
+        `[memory]` blocks named in `read_blocks` (those the routine read: `blocks_read`) count as tables."""
         source = self.routine.program_file
         text = read_text(source, "source file") if source.suffix.lower() in (".s", ".asm", ".oph") else None
         entries = [self.entry] + ([self.routine.init_address] if self.routine.init is not None else [])
-        return program_size(self.program, text, entries, self.code_image.__getitem__, self.routine.cpu)
+        blocks = [(b.name, b.address, len(self.memory_values[b.name])) for b in self.routine.memory
+                  if b.name in read_blocks]
+        return program_size(self.program, text, entries, self.code_image.__getitem__, self.routine.cpu, blocks)
+
+    def blocks_read(self, cases: Iterable[tuple]) -> tuple[str, ...]:
+        """The `[memory]` blocks the routine reads on these cases (run on Machine, each instruction's
+        operand address from the recorded path), in the spec's order; it stops once every block was
+        read, or at the first call that does not return."""
+        spans = [(b.address, b.address + len(self.memory_values[b.name]), b.name) for b in self.routine.memory]
+        found: set[str] = set()
+        read = self.machine.memory.__getitem__
+        for case in cases:
+            if len(found) == len(spans):
+                break
+            steps: list = []
+            try:
+                self.run(case, steps)
+            except RunError:
+                break
+            for pc, x, y, _, pointer in steps:
+                address = data_address(read, pc, x, y, pointer, self.routine.cpu)
+                if address is not None:
+                    found.update(name for start, end, name in spans if start <= address < end)
+        return tuple(b.name for b in self.routine.memory if b.name in found)
 
 
 def port_values(ports: Sequence[Port], registers: dict, p, read: Callable, widen: Callable, table: Callable,

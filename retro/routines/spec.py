@@ -113,6 +113,7 @@ class Routine:
     coverage: str = ""  # why the cases cover the input space (an argument the report quotes)
     notes: tuple[str, ...] = ()  # what loading the program left out (a symbol file's skipped lines)
     rows: tuple[Row, ...] = ()  # expected rows written in the spec (retro.routines.rows)
+    shown_path: str = ""  # the spec's path as the user gave it (reports print it; spec_path is resolved)
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -195,7 +196,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     cycles = _cycles_section(r, doc, program.program)
     routine = Routine(name=_text(r, doc, "name", "name") or path.stem, spec_path=path, **program.fields(),
                       inputs=inputs, outputs=outputs, memory=memory, **reference, **cases, **cycles,
-                      summary=_summary(r, doc), rows=rows, notes=program.program.notes)
+                      summary=_summary(r, doc), rows=rows, notes=program.program.notes, shown_path=shown or str(path))
     if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep or routine.rows):
         raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary, sweep or [[rows]]")
     if routine.exhaustive_count() > MAX_EXHAUSTIVE:
