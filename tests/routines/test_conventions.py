@@ -140,7 +140,19 @@ push_back:              ; 3,S = 3,S + 1: a result handed back in the caller's st
         tsx
         inc $0103,x
         rts
+sum3:   ldy #0          ; A = the sum of the three bytes behind the pointer (modulo 256)
+        lda (ptr),y
+        iny
+        clc
+        adc (ptr),y
+        iny
+        clc
+        adc (ptr),y
+        rts
+word:   lda words,x     ; A = the high byte of the 16-bit word in slot X (X = 0, 2, 4, ...)
+        rts
 hits:   .byte 0, 0, 0, 0, 0, 0, 0, 0
+words:  .byte 0, 0, 0, 0, 0, 0, 0, 0
 """
 
 REFS = """\
@@ -152,6 +164,12 @@ def one(**kw):
 
 def plus_one(**kw):
     return (kw["value"] + 1) & 0xFF
+
+def total(**kw):
+    return sum(kw["t"]) & 0xFF
+
+def high(**kw):
+    return kw["w"] >> 8
 """
 
 
@@ -275,6 +293,51 @@ exhaustive = ["value"]
 random = 500
 """
     assert both(spec_file(tmp_path, stack, "stack")).mismatches == 0
+
+
+def test_a_table_behind_a_pointer_and_a_word_in_a_slot(tmp_path):
+    sum3 = """\
+[program]
+file = "routines.s"
+entry = "sum3"
+
+[inputs]
+ptr = { at = "ptr", size = 2, values = "$5000..$50FF" }
+t = { at = "(ptr)", size = 3, values = "0..255" }
+
+[outputs]
+a = "A"
+
+[reference]
+function = "refs.py:total"
+
+[cases]
+random = 2000
+"""
+    assert both(spec_file(tmp_path, sum3, "sum3")).mismatches == 0
+    # a word in slots 0, 2, 4, 6; the routine reads its high byte with `lda words+1,x` only if right
+    word = """\
+[program]
+file = "routines.s"
+entry = "word"
+
+[inputs]
+slot = { at = "X", values = [0, 2, 4, 6] }
+w = { at = "words,X", size = 2, values = "0..65535" }
+
+[outputs]
+a = "A"
+
+[reference]
+function = "refs.py:high"
+
+[cases]
+random = 2000
+"""
+    assert both(spec_file(tmp_path, word, "word")).totals.result_mismatches > 0  # it reads the low byte
+    right = spec_file(tmp_path, word, "word_right")
+    (tmp_path / "routines.s").write_text(ROUTINES.replace("word:   lda words,x", "word:   lda words+1,x"))
+    assert both(right).mismatches == 0
 
 
 # ---- bad values of every new key: one line naming the file and the key, exit 2 --------------------
