@@ -8,6 +8,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, replace
 
+from retro.cpu.machine import STACK_BASE
 from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z
 from retro.fields import Fields, describe
 from retro.program import Program
@@ -23,7 +24,6 @@ PORT_KEYS = {"at", "size", "values", "table"}
 _STACK = re.compile(r"^(?P<offset>[^,()]+?)\s*,\s*S$", re.IGNORECASE)
 _POINTER = re.compile(r"^\(\s*(?P<pointer>[^(),]+?)\s*\)\s*(?:,\s*(?P<index>Y)|\+\s*(?P<offset>\S+))?$", re.IGNORECASE)
 _INDEXED = re.compile(r"^(?P<base>[^,()]+?)\s*,\s*(?P<index>[XY])$", re.IGNORECASE)
-STACK_PAGE = 0x100
 FIRST_ARGUMENT = 3  # 1,S and 2,S hold the return address the JSR pushed: the caller's bytes start at 3,S
 _LABEL = re.compile(r"^(?P<name>[A-Za-z_@.][\w.:@]*)\s*(?:(?P<sign>[+-])\s*(?P<offset>\S+))?$")
 
@@ -249,8 +249,8 @@ def port_of(r: Fields, program: Program, name: str, value, section: str, is_inpu
     table_flag = r.flag(doc["table"], f"{key}.table") if "table" in doc else None
     if is_input and size is not None and size > 1 and values is None and table_flag is None:
         raise r.error(f"{key}.size", f"size = {size} without values is ambiguous: a {8 * size}-bit number, or a table "
-                                     f"of {size} bytes? Say which: values = \"0..{(1 << 8 * size) - 1}\" (a number) or "
-                                     f"values = \"0..255\" (a table; or table = true / false)")
+                                     f"of {size} bytes? Say which: table = false (a number; or values = \"LO..HI\"), "
+                                     f"or values = \"0..255\" (a table, each byte from those values; or table = true)")
     # `size` N with byte values is a table of N bytes; otherwise an N-byte little-endian number
     table = table_flag if table_flag is not None else (
         size is not None and size > 1 and values is not None and values.hi < BYTE_VALUES)
@@ -343,7 +343,7 @@ def via_span(via: Via, size: int, inputs: tuple[Port, ...], entry_s: int):
     indexes = listed(inputs[via.index_input]) if via.index_input >= 0 else [0]
     if via.mode == "stack":
         esses = listed(inputs[via.s_input]) if via.s_input >= 0 else [entry_s]
-        return {STACK_PAGE | ((s + via.base + i) & 0xFF) for s in esses for i in range(size)}
+        return {STACK_BASE | ((s + via.base + i) & 0xFF) for s in esses for i in range(size)}
     if via.mode == "indexed":
         wrap = 0xFF if via.base < 0x100 else 0xFFFF
         return {(via.base + j + i) & wrap for j in indexes for i in range(size)}

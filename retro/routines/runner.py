@@ -35,7 +35,7 @@ from retro.cpu.machine import (
     return_s,
 )
 from retro.cpu.mpu import FLAG_B, FLAG_U
-from retro.cpu.timing import timing_table
+from retro.cpu.timing import TimingError, timing_of, timing_table
 from retro.errors import InputError, RunError
 from retro.fileio import read_text
 from retro.machines import build_machine
@@ -66,8 +66,6 @@ NO_DATA = frozenset({"JMP", "JSR", "BRK", "RTS", "RTI"})
 def data_address(read, pc: int, x: int, y: int, pointer: int, cpu: str) -> int | None:
     """The address the instruction at pc reads its operand from (registers before it, `pointer`: the
     word of an (indirect),Y instruction as recorded), or None when it reads none."""
-    from retro.cpu.timing import TimingError, timing_of
-
     try:
         op = timing_of(read(pc), cpu)
     except TimingError:
