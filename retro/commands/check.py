@@ -133,7 +133,7 @@ def scene_raster(check: RoutineCheck) -> dict:
 def check_record(check: RoutineCheck) -> dict:
     """One routine's check as plain data (what `retro check --json` prints)."""
     t = check.totals
-    record = {"routine": check.routine.name, "spec": str(check.routine.spec_path), "cpu": check.routine.cpu,
+    record = {"routine": check.routine.name, "spec": check.routine.shown_path or str(check.routine.spec_path), "cpu": check.routine.cpu,
               "machine": check.routine.machine, "cases": t.cases, "mismatches": check.mismatches,
               "result_mismatches": t.result_mismatches,
               "cycle_mismatches": t.cycle_mismatches + (check.agreement.cycle_mismatches if check.agreement else 0),

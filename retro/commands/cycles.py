@@ -27,7 +27,7 @@ def lines(checks: list[RoutineCheck]) -> list[str]:
 
 # ---- the cost table: bytes, measured and static cycles, cases and mismatches ------------------------
 
-COST_FIELDS = ("routine", "code_bytes", "table_bytes", "min", "mean", "max", "static_min", "static_max",
+COST_FIELDS = ("routine", "code_bytes", "table_bytes", "table_blocks", "min", "mean", "max", "static_min", "static_max",
                "cases", "mismatches", "min_inputs", "max_inputs", "budget", "raster")
 
 # Issue 5's targets: (statistic, cycles). The statistic is "max" (worst case) or "mean".
@@ -38,6 +38,7 @@ TARGETS: dict[str, tuple[str, int]] = {"aabb8": ("max", 30), "aabb_sprite": ("ma
 def cost_row(check: RoutineCheck) -> dict:
     figures = cycle_figures(check)
     row = {"routine": check.routine.name, "code_bytes": check.size.code_bytes, "table_bytes": check.size.table_bytes,
+           "table_blocks": dict(check.size.table_blocks),
            **figures, "cases": check.totals.cases, "mismatches": check.mismatches}
     return {key: row[key] for key in COST_FIELDS}
 
@@ -78,6 +79,10 @@ def format_cost_table(checks: list[RoutineCheck]) -> list[str]:
                  "else on a C64 PAL (6510 routines) or an NTSC NES (2A03) with the CPU never stalled")
     lines.append("cycles: from the routine's first instruction through its RTS (the caller's JSR, 6, not included); "
                  "bytes of tables exclude storage the caller fills")
+    for check in checks:
+        if check.size.table_blocks:
+            lines.append(f"tables of {check.routine.name}: the [memory] blocks it read: " + ", ".join(
+                f"{name} ({size:,} bytes)" for name, size in check.size.table_blocks))
     return lines
 
 

@@ -256,7 +256,7 @@ class BatchCpu:
 
     # ---- running -------------------------------------------------------------------------------
 
-    def call(self, entry: int, budget: int, return_pc: int, return_sp: int) -> None:
+    def call(self, entry: int, budget: int, return_pc: int, return_sp) -> None:
         """Run every lane from entry until it stands at return_pc with S = return_sp (the caller has
         pushed the return address and set S), or stops with an error. Cycles count from entry."""
         pending: dict[int, list[Lanes]] = {entry: [self._everyone()]}
@@ -265,8 +265,8 @@ class BatchCpu:
         while pending:
             pc = min(pending)
             group = Lanes.join(pending.pop(pc))
-            if pc == return_pc:
-                home = group.sp == return_sp
+            if pc == return_pc:  # return_sp: one S for every lane, or an array of one per lane
+                home = group.sp == (return_sp if isinstance(return_sp, int) else return_sp[group.ids])
                 if home.any():
                     done = group.take(np.flatnonzero(home))
                     done.store()

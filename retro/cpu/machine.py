@@ -35,6 +35,7 @@ MAX_BUDGET = 100_000_000  # cycles; about 100 s of C64 time, a minute or two on 
 MAX_TRACE = 200_000  # instructions a trace keeps (about 30 MB); a longer traced run is stopped
 RETURN_TRAP = 0x0000  # the routine "returns" here: RTS to $0000 with the stack back where it started
 CALL_STACK_TOP = 0xFF
+ENTRY_S = CALL_STACK_TOP - 2  # S on a routine's entry by default: an empty stack after the caller's JSR
 STACK_BASE = 0x100  # the 6502's stack is page 1
 DEFAULT_FLAGS = FLAG_U | FLAG_I
 RECENT_SHOWN = 8  # instructions listed in a failure message
@@ -75,23 +76,28 @@ class CallResult:
     stolen: int = 0  # of `cycles`, those the CPU stood still (only with a chip driving BA)
 
 
-def push_return_trap(memory, stack_top: int = CALL_STACK_TOP) -> int:
-    """Put on the stack, from S = stack_top (an empty stack by default), what a JSR from RETURN_TRAP
-    pushes (its return address minus one, high byte first) and return S after it: how every call is
-    entered, on Machine and the batched core; the call has returned when S is back at stack_top."""
+def push_return_trap(memory, s: int = ENTRY_S) -> int:
+    """Put on the stack what a JSR from RETURN_TRAP pushes (its return address minus one, high byte
+    first) so that S is `s` after it, and return S: how every call is entered, on Machine and the
+    batched core. The call has returned when the PC is RETURN_TRAP and S is `return_s(s)`."""
     back = (RETURN_TRAP - 1) & 0xFFFF
-    top = STACK_BASE | stack_top
-    memory[top], memory[top - 1] = back >> 8, back & 0xFF
-    return stack_top - 2
+    memory[STACK_BASE | return_s(s)], memory[STACK_BASE | ((s + 1) & 0xFF)] = back >> 8, back & 0xFF
+    return s
 
 
-def push_interrupt_frame(memory, p: int, stack_top: int = CALL_STACK_TOP) -> int:
-    """Put on the stack, from S = stack_top, what the CPU's interrupt sequence pushes when it
-    interrupts RETURN_TRAP (the address, high byte first, then P with B clear) and return S after it:
-    how an IRQ or NMI handler is entered (its RTI then returns to RETURN_TRAP with S back at stack_top)."""
-    top = STACK_BASE | stack_top
-    memory[top], memory[top - 1], memory[top - 2] = RETURN_TRAP >> 8, RETURN_TRAP & 0xFF, (p | FLAG_U) & ~FLAG_B
-    return stack_top - 3
+def return_s(s):
+    """S after the RTS of a routine entered with S = s (an int, or a numpy array of lanes): the stack
+    top before the call's JSR, where an interrupt handler's RTI (or an exit) ends the call too."""
+    return (s + 2) & 0xFF
+
+
+def push_interrupt_frame(memory, p: int, top: int = CALL_STACK_TOP) -> int:
+    """Put on the stack, from S = top, what the CPU's interrupt sequence pushes when it interrupts
+    RETURN_TRAP (the address, high byte first, then P with B clear) and return S after it: how an IRQ
+    or NMI handler is entered (its RTI then returns to RETURN_TRAP with S back at top)."""
+    base = STACK_BASE | top
+    memory[base], memory[base - 1], memory[base - 2] = RETURN_TRAP >> 8, RETURN_TRAP & 0xFF, (p | FLAG_U) & ~FLAG_B
+    return top - 3
 
 
 def interrupt_entry_flags(mpu_class, p: int) -> int:
@@ -118,8 +124,15 @@ class Machine:
         self.mpu = VARIANTS[variant](memory=self.bus.memory, page_devices=self.bus.page_devices)
         self.mpu.stop_on_brk = True
         self.stack_top = CALL_STACK_TOP  # S before a call's JSR (the entry-state runs of a check vary it)
+        self.stop_s = CALL_STACK_TOP  # S at which the call running now ends
         self.symbols: dict[str, int] = {}
         self.ambiguous: dict[str, tuple[str, ...]] = {}
+
+    @property
+    def entry_s(self) -> int:
+        """S at a called routine's first instruction when the caller does not say: an empty stack
+        from `stack_top` after the JSR."""
+        return (self.stack_top - 2) & 0xFF
 
     # ---- set-up ----------------------------------------------------------------------------
 
@@ -184,15 +197,17 @@ class Machine:
 
     def call(self, entry: str | int, *, a: int = 0, x: int = 0, y: int = 0, p: int = DEFAULT_FLAGS,
              memory: dict | None = None, budget: int = DEFAULT_BUDGET, trace: bool = False,
-             enter: str = "jsr") -> CallResult:
+             enter: str = "jsr", s: int | None = None) -> CallResult:
         """Run the routine at entry as if called by JSR; stop at its RTS (`enter` "irq" or "nmi": as
         the CPU enters an interrupt handler, the 7 cycles of its sequence counted; stop at its RTI).
+        `s`: S at the routine's first instruction (default: `stack_top` - 2, an empty stack after the JSR).
 
         Fails (RunError) on BRK, JAM or an unstable opcode, and when the routine needs more than
         `budget` cycles (a runaway routine is stopped as soon as it has used them).
         """
         address = self.resolve(entry, "entry")
-        for name, value in (("a", a), ("x", x), ("y", y), ("p", p)):
+        s = self.entry_s if s is None else s
+        for name, value in (("a", a), ("x", x), ("y", y), ("p", p), ("s", s)):
             if not 0 <= value <= 0xFF:
                 raise InputError(f"{name}: {value} is not a byte (0-255)")
         if not 1 <= budget <= MAX_BUDGET:
@@ -202,36 +217,37 @@ class Machine:
         for target, values in (memory or {}).items():
             self.poke(target, values)
         entries: list[TraceEntry] | None = [] if trace else None
-        start = self._enter(address, a, x, y, p, enter)
+        start = self._enter(address, a, x, y, p, enter, s)
         stolen_before = self.mpu.stolen
-        count = self._execute(RETURN_TRAP, self.stack_top, start + budget,
+        count = self._execute(RETURN_TRAP, return_s(s), start + budget,
                               None if entries is None else _Tracer(self, entries))
-        cycles = self._returned(start, budget, count)
+        cycles = self._returned(start, budget, count, return_s(s))
         mpu = self.mpu
         status = _status(mpu.p)
         return CallResult(a=mpu.a, x=mpu.x, y=mpu.y, s=mpu.sp, p=status, cycles=cycles,
                           instructions=count, trace=entries, flags=_flags(status),
                           stolen=mpu.stolen - stolen_before)
 
-    def _enter(self, address: int, a: int, x: int, y: int, p: int, enter: str = "jsr") -> int:
+    def _enter(self, address: int, a: int, x: int, y: int, p: int, enter: str, s: int) -> int:
         """Set registers and the stack as a JSR from the return trap would (or, `enter` "irq"/"nmi",
         as the interrupt sequence would, interrupting the return trap); return the start cycle."""
         mpu = self.mpu
         mpu.a, mpu.x, mpu.y, mpu.p = a, x, y, _status(p)
         mpu.pc = address
         mpu.pending_interrupt = None  # a poll before the call does not carry into it
+        self.stop_s = return_s(s)  # where this call ends (a world's exit sets S to it)
         if enter == "jsr":
-            mpu.sp = push_return_trap(mpu.memory, self.stack_top)
+            mpu.sp = push_return_trap(mpu.memory, s)
             return mpu.processorCycles
-        mpu.sp = push_interrupt_frame(mpu.memory, mpu.p, self.stack_top)
+        mpu.sp = push_interrupt_frame(mpu.memory, mpu.p, return_s(s))
         mpu.p = interrupt_entry_flags(type(mpu), mpu.p)
         mpu.processorCycles += INTERRUPT_CYCLES  # the sequence's cycles (no stall is modelled in them)
         return mpu.processorCycles - INTERRUPT_CYCLES
 
-    def _returned(self, start: int, budget: int, count: int) -> int:
+    def _returned(self, start: int, budget: int, count: int, stop_s: int = CALL_STACK_TOP) -> int:
         """The routine's cycles, or a RunError if it did not return within the budget."""
         mpu = self.mpu
-        if mpu.pc != RETURN_TRAP or mpu.sp != self.stack_top:
+        if mpu.pc != RETURN_TRAP or mpu.sp != stop_s:
             self._over_budget(budget, count)
         cycles = mpu.processorCycles - start
         if cycles > budget:  # returned, but its last instruction ran past the budget
@@ -240,7 +256,8 @@ class Machine:
 
     def call_fast(self, address: int, writes=(), *, a: int = 0, x: int = 0, y: int = 0, p: int = DEFAULT_FLAGS,
                   budget: int = DEFAULT_BUDGET, record: list | None = None,
-                  pointer_pcs: frozenset[int] = frozenset(), enter: str = "jsr") -> tuple[int, int, int, int, int]:
+                  pointer_pcs: frozenset[int] = frozenset(), enter: str = "jsr",
+                  s: int | None = None) -> tuple[int, int, int, int, int]:
         """`call` for sweeps of many thousands of calls: the same run without its conveniences.
 
         `address` is the entry as a number, `writes` are raw (address, byte) pairs stored into RAM,
@@ -252,10 +269,11 @@ class Machine:
         memory = self.bus.memory
         for target, value in writes:
             memory[target] = value
-        start = self._enter(address, a, x, y, p, enter)
+        s = self.entry_s if s is None else s
+        start = self._enter(address, a, x, y, p, enter, s)
         observer = None if record is None else _Recorder(record, pointer_pcs)
-        count = self._execute(RETURN_TRAP, self.stack_top, start + budget, observer)
-        cycles = self._returned(start, budget, count)
+        count = self._execute(RETURN_TRAP, return_s(s), start + budget, observer)
+        cycles = self._returned(start, budget, count, return_s(s))
         mpu = self.mpu
         return cycles, mpu.a, mpu.x, mpu.y, _status(mpu.p)
 

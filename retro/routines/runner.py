@@ -16,7 +16,7 @@ only on some paths reads the same on both engines); the `[memory]` blocks once a
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,17 +26,19 @@ from retro.cpu.batch import BatchCpu, LaneCoverage, LaneError
 from retro.cpu.lane_memory import LaneMemoryFull
 from retro.cpu.machine import (
     DEFAULT_BUDGET,
-    STACK_BASE,
+    ENTRY_S,
     RETURN_TRAP,
+    STACK_BASE,
     CallResult,
     interrupt_entry_flags,
     push_interrupt_frame,
     push_return_trap,
+    return_s,
 )
 from retro.cpu.mpu import FLAG_B, FLAG_I, FLAG_U
 from retro.cpu.variants import VARIANTS
-from retro.cpu.timing import timing_table
-from retro.errors import InputError
+from retro.cpu.timing import TimingError, timing_of, timing_table
+from retro.errors import InputError, RunError
 from retro.fileio import read_text
 from retro.machines import build_machine
 from retro.machines.c64 import vic_of
@@ -55,8 +57,38 @@ MEMORY_RNG_OFFSET = 1  # memory blocks draw from seed + 1, cases from seed: chan
 @dataclass(frozen=True)
 class Size:
     code_bytes: int  # from the origin up to the first generated table (the program's length without them)
-    table_bytes: int  # lookup tables (storage the caller fills is not counted)
+    table_bytes: int  # lookup tables and the `[memory]` blocks the routine read (storage the caller fills: not)
     storage_bytes: int
+    table_blocks: tuple[tuple[str, int], ...] = ()  # (name, bytes) of the `[memory]` blocks among the tables
+
+
+PROBE_CASES = 2_000  # cases of each part run to see which `[memory]` blocks a routine reads
+STORES = frozenset({"STA", "STX", "STY", "STZ", "SAX", "SHA", "SHX", "SHY", "TAS"})  # write, never read
+NO_DATA = frozenset({"JMP", "JSR", "BRK", "RTS", "RTI"})
+
+
+def data_address(read, pc: int, x: int, y: int, pointer: int, cpu: str) -> int | None:
+    """The address the instruction at pc reads its operand from (registers before it, `pointer`: the
+    word of an (indirect),Y instruction as recorded), or None when it reads none."""
+    try:
+        op = timing_of(read(pc), cpu)
+    except TimingError:
+        return None
+    if op.mnemonic in STORES or op.mnemonic in NO_DATA:
+        return None
+    mode, lo = op.mode, read((pc + 1) & 0xFFFF)
+    if mode == "zpg":
+        return lo
+    if mode in ("zpx", "zpy"):
+        return (lo + (x if mode == "zpx" else y)) & 0xFF
+    if mode in ("abs", "abx", "aby"):
+        return ((lo | read((pc + 2) & 0xFFFF) << 8) + (x if mode == "abx" else y if mode == "aby" else 0)) & 0xFFFF
+    if mode == "iny":
+        return (pointer + y) & 0xFFFF
+    if mode in ("inx", "zpi"):  # the pointer as memory holds it after the call (not recorded)
+        at = (lo + (x if mode == "inx" else 0)) & 0xFF
+        return read(at) | read((at + 1) & 0xFF) << 8
+    return None
 
 
 def routine_code(read, entries: list[int], within: tuple[int, int], cpu: str = "6510",
@@ -92,7 +124,7 @@ def routine_code(read, entries: list[int], within: tuple[int, int], cpu: str = "
 
 
 def program_size(program: Program, source_text: str | None, entries: list[int], read, cpu: str = "6510",
-                 world: World = NO_WORLD) -> Size:
+                 world: World = NO_WORLD, blocks: Sequence[tuple[str, int, int]] = ()) -> Size:
     """The routine's bytes: its reachable instructions (the entry's and init's, with their subroutines)
     and the generated tables they name (by address, or by `#>table` for pointers set up at init)."""
     within = (program.origin, program.end)
@@ -109,7 +141,11 @@ def program_size(program: Program, source_text: str | None, entries: list[int], 
                 used.add(name)  # lda #>table: a pointer's high byte, as set up by an init routine
     lookup = sum(len(GENERATORS[n]()) for n in used if n not in STORAGE_TABLES)
     storage = sum(len(GENERATORS[n]()) for n in used if n in STORAGE_TABLES)
-    return Size(code_bytes=sum(code.values()), table_bytes=lookup, storage_bytes=storage)
+    counted = [spans[n] for n in used]  # a `[memory]` block inside a generated table is that table
+    read_blocks = [(name, start, size) for name, start, size in blocks
+                   if not any(first <= start < end for first, end in counted)]
+    return Size(code_bytes=sum(code.values()), table_bytes=lookup + sum(size for _, _, size in read_blocks),
+                storage_bytes=storage, table_blocks=tuple((name, size) for name, _, size in read_blocks))
 
 
 IMMEDIATE_LOAD_A = 0xA9
@@ -176,11 +212,20 @@ class InputPlan:
     base_flags: int  # P before the flag inputs: the default flags without those the inputs set
     output_addresses: tuple[int, ...]  # output places in memory (restored before each Machine call)
     base_registers: tuple[tuple[str, int], ...] = (("a", 0), ("x", 0), ("y", 0))  # before the inputs ([entry])
+    vias: "ViaPlan | None" = None  # inputs and outputs placed by the case (stack, table slot, pointer)
+    entry_s: int = ENTRY_S  # S at entry when no input sets it
+
+    @property
+    def s_varies(self) -> bool:
+        """An input sets S (each call, or each lane, has its own)."""
+        return any(register == "s" for _, register, _ in self.registers)
 
     @classmethod
-    def of(cls, routine: Routine) -> "InputPlan":
+    def of(cls, routine: Routine, image: Sequence[int] | None = None, salt: int = 0) -> "InputPlan":
         registers, flags, places, tables = [], [], [], []
         for index, port in enumerate(routine.inputs):
+            if port.via is not None:
+                continue  # placed by ViaPlan
             if port.flag:
                 flags.append((index, port.places[0].bit))
             elif port.table:
@@ -195,36 +240,141 @@ class InputPlan:
         for _, bit in flags:
             forced |= bit
         outputs = sorted({place.address for port in routine.outputs for place in port.places if place.kind == "memory"})
+        vias = ViaPlan.of(routine, image, salt) if any(p.via for p in routine.inputs + routine.outputs) else None
         entry = EntryState.of(routine.entry_state, routine.inputs)
         return cls(tuple(registers), tuple(flags), tuple(places), tuple(tables),
                    (entry.flags | FLAG_U) & ~forced, tuple(outputs),
-                   tuple(entry.registers.items()))
+                   tuple(entry.registers.items()), vias, routine.entry_s)
 
     def place(self, values: Sequence, table_byte: Callable, write: Callable,
-              entry: tuple[dict, object, int] | None = None) -> tuple[dict[str, object], object]:
+              entry: tuple[dict, object, int] | None = None, scatter: Callable | None = None,
+              select: Callable | None = None) -> tuple[dict[str, object], object]:
         """Put `values` (one per input: numbers, or arrays of lanes) in place: `write(address, byte)`
         for every memory byte as it is made (a block's arrays are consumed while in cache), and
         (register values, P) returned; `table_byte(value, k)` is byte k of a table input's value.
         `entry`: (free registers by name, free P bits, the free bits' mask) of an entry-state run
         (retro.routines.entry), replacing the baseline's values of the registers and flags no input
-        or `[entry]` sets."""
+        or `[entry]` sets. Inputs placed by the case go through `scatter(address, byte)` (the
+        address: a number, or one per lane) and `select(condition, a, b)` (a where b otherwise)."""
         for index, address, shift in self.bytes:
             write(address, (values[index] >> shift) & 0xFF)
         for index, addresses in self.tables:
             for k, address in enumerate(addresses):
                 write(address, table_byte(values[index], k))
-        registers = dict(self.base_registers)
+        if self.vias is not None:
+            self.vias.place(values, table_byte, scatter or write, select or _case_select)
+        registers = {**dict(self.base_registers), "s": self.entry_s}
         p = self.base_flags
         if entry is not None:
             free, bits, mask = entry
             registers.update(free)
             p = (p & ~mask) | bits
         for index, register, shift in self.registers:
+            if register == "s":
+                registers["s"] = values[index]
+                continue
             registers[register] |= (values[index] >> shift) & 0xFF
         for index, bit in self.flags:
             p |= (values[index] != 0) * bit
         return registers, p
 
+
+def _slots(routine: Routine, port: Port) -> dict[int, list[tuple[int, int]]]:
+    """A table slot port: every address its index may pick -> the (slot, byte) pairs placed there."""
+    via = port.via
+    wrap = 0xFF if via.base < 0x100 else 0xFFFF
+    index = routine.inputs[via.index_input].values
+    at: dict[int, list[tuple[int, int]]] = {}
+    for slot in (index.listed if index.listed is not None else range(index.lo, index.hi + 1)):
+        for i in range(len(port.places)):
+            at.setdefault((via.base + slot + i) & wrap, []).append((slot, i))
+    return at
+
+
+def _case_select(condition, a, b):
+    return a if condition else b
+
+
+def _byte(port: Port, value, i: int, table_byte: Callable):
+    """Byte i of an input's value: of a table, or of a little-endian number."""
+    return table_byte(value, i) if port.table else (value >> (8 * i)) & 0xFF
+
+
+FILLER_MIX = (0x2D, 0x65, 0x1F, 0x9D)  # small odd multipliers: every term stays far below 2^63 (ints and int64 alike)
+
+
+@dataclass(frozen=True)
+class ViaPlan:
+    """Where the inputs and outputs placed by the case go (retro.routines.places.Via), worked out once:
+    the same arithmetic places one case (ints) or a column block (arrays: one address per lane). An
+    input in a slot of a table fills every other slot its index may pick with a value other than its
+    own (from the case and the seed), so that a routine reading the wrong slot reads a wrong value."""
+
+    routine: Routine
+    pointers: dict  # the address of a pointer no input sets -> its value in memory after `init`
+    salt: int
+    slot_maps: dict  # (section, port index) of a table slot port -> {address: [(slot, byte), ...]}
+
+    @classmethod
+    def of(cls, routine: Routine, image: Sequence[int] | None, salt: int) -> "ViaPlan":
+        pointers = {}
+        for port in routine.inputs + routine.outputs:
+            via = port.via
+            if via is not None and via.mode == "pointer" and via.pointer_input < 0:
+                high = (via.base + 1) & (0xFF if via.base < 0x100 else 0xFFFF)
+                pointers[via.base] = (image[via.base] | image[high] << 8) if image is not None else 0
+        slot_maps = {(section, k): _slots(routine, port) for section, ports in (("in", routine.inputs),
+                                                                                ("out", routine.outputs))
+                     for k, port in enumerate(ports) if port.via is not None and port.via.mode == "indexed"}
+        return cls(routine, pointers, salt & 0xFFFF, slot_maps)
+
+    def address(self, via, values: Sequence, i: int):
+        """The address of byte i of a port placed by `via`, for a case (or per lane of a block)."""
+        if via.mode == "stack":
+            s = values[via.s_input] if via.s_input >= 0 else self.routine.entry_s
+            return STACK_BASE | ((s + via.base + i) & 0xFF)
+        index = values[via.index_input] if via.index_input >= 0 else 0
+        if via.mode == "indexed":
+            return (via.base + index + i) & (0xFF if via.base < 0x100 else 0xFFFF)
+        pointer = values[via.pointer_input] if via.pointer_input >= 0 else self.pointers[via.base]
+        return (pointer + via.offset + index + i) & 0xFFFF
+
+    def place(self, values: Sequence, table_byte: Callable, scatter: Callable, select: Callable) -> None:
+        for k, port in enumerate(self.routine.inputs):
+            via = port.via
+            if via is None:
+                continue
+            value = values[k]
+            if via.mode != "indexed":
+                for i in range(len(port.places)):
+                    scatter(self.address(via, values, i), _byte(port, value, i, table_byte))
+                continue
+            index = values[via.index_input]
+            for address, placed in self.slot_maps["in", k].items():
+                slot, i = placed[0]
+                byte = _byte(port, value, i, table_byte)
+                mixed = (byte * FILLER_MIX[0] + slot * FILLER_MIX[1] + i * FILLER_MIX[2] + (index & 0xFF) * FILLER_MIX[3]
+                         + (value & 0xFFFF if not port.table else 0) + self.salt + k)
+                chosen = byte ^ (1 + (mixed ^ (mixed >> 5)) % 255)  # never the slot's own byte
+                for slot, i in placed:
+                    chosen = select(index == slot, _byte(port, value, i, table_byte), chosen)
+                scatter(address, chosen)
+
+    def touched(self, values: Sequence) -> list[int]:
+        """Every address the case's ports placed by the case take (a table slot port: every slot):
+        what Machine restores before the next call, so that each call starts as a batch lane does."""
+        found = []
+        for section, ports in (("in", self.routine.inputs), ("out", self.routine.outputs)):
+            for k, port in enumerate(ports):
+                if port.via is not None:
+                    found += (list(self.slot_maps[section, k]) if port.via.mode == "indexed" else
+                              [self.address(port.via, values, i) for i in range(len(port.places))])
+        return found
+
+    def outputs(self, values: Sequence) -> dict[int, list]:
+        """Output index -> the addresses of its bytes for this case (or per lane)."""
+        return {k: [self.address(port.via, values, i) for i in range(len(port.places))]
+                for k, port in enumerate(self.routine.outputs) if port.via is not None}
 
 
 @dataclass(frozen=True)
@@ -287,7 +437,8 @@ class RoutineRunner:
         # a data byte in the set only costs a lookup.
         indirect_y = {opcode for opcode, op in timing_table(routine.cpu).items() if op.mode in ("iny", "zpr")}
         self.pointer_pcs = frozenset(self.program.origin + i for i, b in enumerate(self.program.code) if b in indirect_y)
-        self.plan = InputPlan.of(routine)
+        self.plan = InputPlan.of(routine, self.call_image, seed)
+        self._dirty: list[int] = []  # addresses the last call's ports placed by the case took (restored)
         self.written_kept: dict[str, int] = {}  # per hardware entry, the values written that outputs show
         for port in routine.outputs:
             for place in port.places:
@@ -306,7 +457,13 @@ class RoutineRunner:
         run's free registers and P bits (InputPlan.place)."""
         image = self.call_image
         writes = [(address, image[address]) for address in self.plan.output_addresses]
+        if self.plan.vias is not None:
+            touched = self.plan.vias.touched(case)
+            writes += [(address, image[address]) for address in self._dirty + touched]
+            self._dirty = touched
         registers, p = self.plan.place(case, _case_byte, lambda address, byte: writes.append((address, byte)), entry)
+        if not self.plan.s_varies and self.routine.entry_s == ENTRY_S:
+            registers["s"] = self.machine.entry_s  # the machine's stack top (the entry-state runs vary it)
         return writes, registers, p
 
     def reset_memory(self, image: bytes) -> None:
@@ -323,6 +480,7 @@ class RoutineRunner:
         if self.vic is not None:
             self._restart_beam()
             stolen = self.machine.mpu.stolen
+        located = self.plan.vias.outputs(case) if self.plan.vias is not None else None
         world = self.world
         if world is None:
             cycles, a, x, y, p = self.machine.call_fast(self.entry, writes, **registers, p=p, budget=self.limit,
@@ -340,7 +498,7 @@ class RoutineRunner:
                 record[:] = [step for step in record if step[0] not in traps]
             self.last_extra_cycles = world.trap_cycles + self.routine.world.entry_cycles
             self.last_calls = world.recorded_calls()
-        return self.outputs(a, x, y, p), cycles
+        return self.outputs(a, x, y, p, located), cycles
 
     last_extra_cycles = 0
     last_calls: dict | None = None
@@ -432,13 +590,15 @@ class RoutineRunner:
         for k, (_, lanes) in enumerate(placed):
             in_bytes[k] = lanes
         image = bytearray(self.call_image)
-        stack_pointer = push_return_trap(image, self.machine.stack_top)
+        s = self.machine.entry_s if self.routine.entry_s == ENTRY_S else self.routine.entry_s
+        stack_pointer = push_return_trap(image, s)
+        registers.pop("s", None)
         lanes = {name: np.broadcast_to(np.asarray(value, dtype=np.int64), (n,)).copy() for name, value in registers.items()}
         flags = np.broadcast_to(np.asarray((p | FLAG_U) & ~FLAG_B, dtype=np.int64), (n,)).copy()
         out_addr = np.asarray(sorted({place.address for port in self.routine.outputs for place in port.places
                                       if place.kind == "memory"}), dtype=np.int64)
         done = compiled.run(bytes(image), in_addr, in_bytes, lanes["a"],
-                            lanes["x"], lanes["y"], flags, stack_pointer, self.limit, RETURN_TRAP, self.machine.stack_top,
+                            lanes["x"], lanes["y"], flags, stack_pointer, self.limit, RETURN_TRAP, return_s(s),
                             out_addr)
         column_of = {int(address): k for k, address in enumerate(out_addr)}
         out_bytes = done["bytes"]
@@ -463,36 +623,54 @@ class RoutineRunner:
     def _run_lanes(self, columns: list, n: int, coverage: bool = False, first_lanes: bool = False,
                    entry: tuple[dict, np.ndarray, int] | None = None) -> "BatchOutcome":
         image = bytearray(self.call_image)
-        stack_top = self.machine.stack_top
         enter = self.routine.world.enter
-        stack_pointer = (push_return_trap(image, stack_top) if enter == "jsr"
-                         else push_interrupt_frame(image, 0, stack_top))
+        fixed_s = None
+        if not self.plan.s_varies:
+            fixed_s = self.machine.entry_s if self.routine.entry_s == ENTRY_S else self.routine.entry_s
+            stack_pointer = (push_return_trap(image, fixed_s) if enter == "jsr"
+                             else push_interrupt_frame(image, 0, return_s(fixed_s)))
         cpu = BatchCpu(self.routine.cpu, image, n, coverage=coverage, first_lanes=first_lanes)
+        memory = cpu.memory
         world = None if self.routine.world.empty else BatchWorld(self.routine.world, cpu, self.written_kept,
-                                                                  str(self.routine.spec_path), stack_top)
-        registers, p = self.plan.place(columns, _column_byte, cpu.memory.fill, entry)
+                                                                  str(self.routine.spec_path))
+        registers, p = self.plan.place(columns, _column_byte, memory.fill, entry,
+                                       scatter=lambda address, byte: memory.write(slice(None), address, byte),
+                                       select=np.where)
+        s = registers.pop("s")
         for name, value in registers.items():
             lanes = getattr(cpu, name)
             lanes |= np.asarray(value).astype(lanes.dtype)
         cpu.p[:] = (self._entry_p(p) | FLAG_U) & ~FLAG_B  # as Machine sets P
-        if enter != "jsr":  # the interrupt sequence: P pushed (per lane), I set, its 7 cycles counted
-            cpu.memory.fill(STACK_BASE | (stack_pointer + 1), cpu.p.copy())
-            cpu.p[:] = interrupt_entry_flags(VARIANTS[self.routine.cpu], cpu.p)
-            cpu.cycles[:] = self.routine.world.entry_cycles
-        cpu.sp[:] = stack_pointer
-        cpu.call(self.entry, self.limit, RETURN_TRAP, stack_top)
+        if fixed_s is None:  # each lane's return address where its own JSR put it, as Machine does
+            cpu.sp[:] = s
+            push_return_trap(_LaneStores(memory), cpu.sp.copy())
+            stop = return_s(cpu.sp.copy())
+        else:
+            if enter != "jsr":  # the interrupt sequence: P pushed (per lane), I set, its 7 cycles counted
+                memory.fill(STACK_BASE | (stack_pointer + 1), cpu.p.copy())
+                cpu.p[:] = interrupt_entry_flags(VARIANTS[self.routine.cpu], cpu.p)
+                cpu.cycles[:] = self.routine.world.entry_cycles
+            cpu.sp[:] = stack_pointer
+            stop = return_s(fixed_s)
+        if world is not None:
+            world.stack_top = stop  # where an exit ends the call
+        cpu.call(self.entry, self.limit, RETURN_TRAP, stop)
         if world is not None:
             world.finish()
+        located = self.plan.vias.outputs(columns) if self.plan.vias is not None else None
         outputs = port_values(self.routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,
                               widen=lambda lanes: np.asarray(lanes, dtype=np.int64),
                               table=lambda columns: np.stack(columns, axis=1).astype(np.int64),
-                              world=None if world is None else world.value)
+                              world=None if world is None else world.value, located=located,
+                              read_at=lambda address: _every_lane(memory.read(slice(None), address), n))
         calls = world.recorded_calls() if world is not None and self.routine.world.recorded else None
         return BatchOutcome(outputs, cpu.cycles, cpu.error, coverage=cpu.coverage, mock_calls=calls)
 
-    def outputs(self, a: int, x: int, y: int, p: int) -> tuple:
-        return tuple(port_values(self.routine.outputs, {"a": a, "x": x, "y": y}, p, self.machine.memory.__getitem__,
-                                 widen=int, table=tuple, world=None if self.world is None else self.world.value))
+    def outputs(self, a: int, x: int, y: int, p: int, located: dict | None = None) -> tuple:
+        read = self.machine.memory.__getitem__
+        return tuple(port_values(self.routine.outputs, {"a": a, "x": x, "y": y}, p, read, widen=int, table=tuple,
+                                 world=None if self.world is None else self.world.value, located=located,
+                                 read_at=read))
 
     def traced(self, case: Sequence) -> CallResult:
         """The same call with the instruction trace (for the report of a failing case)."""
@@ -511,28 +689,55 @@ class RoutineRunner:
             return self.world.describe_trap(address)
         return self.machine.disassemble_at(address)
 
-    def size(self) -> Size:
-        """Bytes of code, lookup tables and caller-filled storage of the routine's program."""
+    def size(self, read_blocks: Sequence[str] = ()) -> Size:
+        """Bytes of code, lookup tables and caller-filled storage of the routine's program; the
+        `[memory]` blocks named in `read_blocks` (those the routine read: `blocks_read`) count as tables."""
         source = self.routine.program_file
         text = read_text(source, "source file") if source.suffix.lower() in (".s", ".asm", ".oph") else None
         entries = [self.entry] + ([self.routine.init_address] if self.routine.init is not None else [])
+        blocks = [(b.name, b.address, len(self.memory_values[b.name])) for b in self.routine.memory
+                  if b.name in read_blocks]
         return program_size(self.program, text, entries, self.code_image.__getitem__, self.routine.cpu,
-                            self.routine.world)
+                            self.routine.world, blocks)
+
+    def blocks_read(self, cases: Iterable[tuple]) -> tuple[str, ...]:
+        """The `[memory]` blocks the routine reads on these cases (run on Machine, each instruction's
+        operand address from the recorded path), in the spec's order; it stops once every block was
+        read, or at the first call that does not return."""
+        spans = [(b.address, b.address + len(self.memory_values[b.name]), b.name) for b in self.routine.memory]
+        found: set[str] = set()
+        read = self.machine.memory.__getitem__
+        for case in cases:
+            if len(found) == len(spans):
+                break
+            steps: list = []
+            try:
+                self.run(case, steps)
+            except RunError:
+                break
+            for pc, x, y, _, pointer in steps:
+                address = data_address(read, pc, x, y, pointer, self.routine.cpu)
+                if address is not None:
+                    found.update(name for start, end, name in spans if start <= address < end)
+        return tuple(b.name for b in self.routine.memory if b.name in found)
 
 
 def port_values(ports: Sequence[Port], registers: dict, p, read: Callable, widen: Callable, table: Callable,
-                world: Callable | None = None) -> list:
+                world: Callable | None = None, located: dict | None = None, read_at: Callable | None = None) -> list:
     """The outputs of a call, one value per port in the spec's order, read from the registers, P and
     memory (`read(address)`): the same code for one call (ints) and for lanes of the batched core
     (arrays), which differ only in `widen` (a byte or a flag as the output's number type) and
-    `table` (bytes of a table output together); `world(place)`: a world output's byte (retro.routines.world)."""
+    `table` (bytes of a table output together). An output placed by the case is read from the
+    addresses `located` gives it (output index -> addresses of its bytes) with `read_at`; `world(place)`:
+    a world output's byte (retro.routines.world)."""
     values = []
-    for port in ports:
-        if port.places[0].kind in WORLD_PLACES:
-            read_place = world
-        else:
-            read_place = None
-        if port.flag:
+    for k, port in enumerate(ports):
+        read_place = world if port.places[0].kind in WORLD_PLACES else None
+        if port.via is not None:
+            data = [read_at(address) for address in located[k]]
+            values.append(table(data) if port.table else
+                          sum((widen(byte) << (8 * i) for i, byte in enumerate(data)), widen(0)))
+        elif port.flag:
             values.append(widen((p & port.places[0].bit) != 0))
         elif port.table:
             values.append(table([read(place.address) if read_place is None else read_place(place)
@@ -550,4 +755,20 @@ def port_values(ports: Sequence[Port], registers: dict, p, read: Callable, widen
 def describe_value(port: Port, value) -> str:
     if port.table:
         return "[" + " ".join(f"{v:02x}" for v in value) + "]"
+    if port.address:  # a pointer or S: an address, as a 6502 programmer writes it
+        return f"${value:0{2 if port.bits == 8 else 4}X}"
     return str(value)
+
+
+class _LaneStores:
+    """`memory[address] = byte` on every lane of a batch (an address per lane): push_return_trap's view."""
+
+    def __init__(self, memory) -> None:
+        self.memory = memory
+
+    def __setitem__(self, address, byte) -> None:
+        self.memory.write(slice(None), address, byte)
+
+
+def _every_lane(value, lanes: int) -> np.ndarray:
+    return np.full(lanes, value, dtype=np.int64) if isinstance(value, (int, np.integer)) else value

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 
+from retro.cpu.machine import ENTRY_S
 from retro.cpu.variants import VARIANTS
 from retro.machines import BARE, MACHINE_CPUS, MACHINES, machine_for
 from retro.errors import InputError
@@ -35,6 +36,7 @@ from retro.routines.places import (
     MAX_TABLE,
     Port,
     Values,
+    bind_vias,
     no_overlap,
     parse_values,
     places_of,
@@ -57,7 +59,7 @@ CPUS = tuple(VARIANTS)
 
 TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows",
             "mocks", "hardware", "entry"}
-PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load", "listing", "interrupt", "exit"}
+PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load", "listing", "interrupt", "exit", "s"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays", "time_limit"}
 CASES_KEYS = {"exhaustive", "random", "seed", "where", "boundary", "sweep", "random_generator", "coverage", "search",
@@ -102,6 +104,7 @@ class Routine:
     source_map: SourceMap | None = None  # [program] listing: which source line each byte came from
     entry_address: int = 0  # entry, init and the loop labels resolved against its symbols
     init_address: int | None = None
+    entry_s: int = ENTRY_S  # S at entry when no input sets it ([program] s)
     loop_addresses: dict[int, int] = field(default_factory=dict)  # loop header address -> bound
     exhaustive: tuple[str, ...] = ()
     random: int = 0
@@ -125,6 +128,7 @@ class Routine:
     exhaustive_values: tuple[tuple[str, Values], ...] = ()
     random_values: tuple[tuple[str, Values], ...] = ()
     random_inside: bool | None = None  # draw the random part inside the domain (None: when it is a small share)
+    shown_path: str = ""  # the spec's path as the user gave it (reports print it; spec_path is resolved)
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -207,7 +211,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     seconds = sandbox.time_limit(r, r.table(doc.get("reference", {}), "reference"), "reference")
     program = _program_section(r, doc)
     world = parse_world(r, doc, program.program, seconds, load_function, program.cpu)
-    inputs, outputs, memory = _places_sections(r, doc, program.program, seconds, world)
+    inputs, outputs, memory = _places_sections(r, doc, program.program, seconds, world, program.entry_s)
     check_names(r, world, inputs, memory)
     rows = parse_rows(r, doc["rows"], inputs, outputs) if "rows" in doc else ()
     reference = _reference_section(r, doc, inputs, memory, rows, seconds, world)
@@ -217,7 +221,7 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     routine = Routine(name=_text(r, doc, "name", "name") or path.stem, spec_path=path, **program.fields(),
                       inputs=inputs, outputs=outputs, memory=memory, **reference, **cases, **cycles,
                       summary=_summary(r, doc), rows=rows, notes=program.program.notes, world=world,
-                      entry_state=parse_entry(r, doc.get("entry", {}), inputs))
+                      entry_state=parse_entry(r, doc.get("entry", {}), inputs), shown_path=shown or str(path))
     if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep or routine.rows):
         raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary, sweep or [[rows]]")
     if routine.exhaustive_count() > MAX_EXHAUSTIVE:
@@ -239,6 +243,7 @@ class _ProgramSection:
     entry_address: int
     init_address: int | None
     source_map: SourceMap | None
+    entry_s: int
 
     def fields(self) -> dict:
         return dict(self.__dict__)
@@ -277,11 +282,13 @@ def _program_section(r: Fields, doc: dict) -> _ProgramSection:
             source_map = read_source_map(listing_file)
         except InputError as exc:
             raise r.error("program.listing", str(exc)) from None
+    entry_s = r.integer(program_doc["s"], "program.s", 0, 0xFF) if "s" in program_doc else ENTRY_S
     return _ProgramSection(program_file, symbols_file, load, cpu, machine, entry, init, program,
-                           entry_address, init_address, source_map)
+                           entry_address, init_address, source_map, entry_s)
 
 
-def _places_sections(r: Fields, doc: dict, program: Program, seconds: int, world: World = NO_WORLD
+def _places_sections(r: Fields, doc: dict, program: Program, seconds: int, world: World = NO_WORLD,
+                     entry_s: int = ENTRY_S
                      ) -> tuple[tuple[Port, ...], tuple[Port, ...], tuple[MemoryBlock, ...]]:
     """[inputs], [outputs] and [memory]: where every value lives, none overlapping."""
     inputs = tuple(port_of(r, program, name, value, "inputs", is_input=True)
@@ -296,6 +303,8 @@ def _places_sections(r: Fields, doc: dict, program: Program, seconds: int, world
     memory = tuple(_memory_block(r, program, name, value, seconds)
                    for name, value in r.table(doc.get("memory", {}), "memory").items())
     _no_overlap_memory(r, memory, inputs)
+    inputs, outputs = bind_vias(r, program, inputs, outputs, [(m.address, m.address + m.size, m.name)
+                                                              for m in memory if m.size], entry_s)
     return inputs, outputs, memory
 
 

@@ -392,7 +392,7 @@ class MachineWorld:
             self.written[name] = []
 
     def _exit(self, mpu) -> int:
-        mpu.pc, mpu.sp = RETURN_TRAP, self.machine.stack_top  # the run loop's stop: the call has ended here
+        mpu.pc, mpu.sp = RETURN_TRAP, self.machine.stop_s  # the run loop's stop: the call has ended here
         return 0
 
     def _mock_action(self, mock: Mock) -> Callable:
@@ -600,7 +600,8 @@ class BatchWorld:
             self._unhook()
 
     def _exit(self, g):
-        g.sp = np.full(len(g), self.stack_top, dtype=np.int32)
+        stop = self.stack_top  # one S for every lane, or each lane's own (an input S)
+        g.sp = (np.asarray(stop)[g.ids] if np.ndim(stop) else np.full(len(g), stop)).astype(np.int32)
         return RETURN_TRAP
 
     def _mock_action(self, mock: Mock) -> Callable:

@@ -6,7 +6,7 @@ import pytest
 
 from retro.assembler import assemble_text
 from retro.cpu.flow import analyse
-from retro.cpu.machine import Machine
+from retro.cpu.machine import ENTRY_S, Machine
 from retro.cpu.mpu import MPU6510
 from retro.cpu.timing import OPCODES, model_cycles
 from retro.errors import InputError
@@ -47,7 +47,7 @@ def test_call_fast_equals_call(runners):
     machine = runner.machine
     for case in ((10, 20, 5, 14, 23, 1), (0, 0, 0, 255, 255, 255), (200, 3, 40, 190, 60, 30)):
         writes, registers, _ = runner.inputs_for_call(case)
-        assert registers == {"a": case[0], "x": case[2], "y": 0}  # x1 in A, r1 in X (asm/circle.toml)
+        assert registers == {"a": case[0], "x": case[2], "y": 0, "s": ENTRY_S}  # x1 in A, r1 in X (asm/circle.toml)
         assert writes == [(0x11, case[1]), (0x13, case[3]), (0x14, case[4]), (0x15, case[5])]
         fast = machine.call_fast(runner.entry, writes, **registers)
         slow = machine.call(runner.entry, memory={address: [value] for address, value in writes}, **registers)

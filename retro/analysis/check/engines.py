@@ -161,6 +161,8 @@ def compiled_or_why(runner: RoutineRunner) -> str | None:
 
     if not runner.routine.world.empty:  # traps, scripted reads and interrupt entry live in the other engines
         return "the routine has a world ([mocks], [hardware], an interrupt entry or an exit), which it does not model"
+    if runner.plan.vias is not None or runner.plan.s_varies:
+        return "inputs placed by the case (on the stack, in a table slot or behind a pointer), which it does not place"
     try:
         runner.compiled()
     except Untranslatable as exc:

@@ -8,7 +8,7 @@ import time
 from collections import deque
 from collections.abc import Callable, Iterator
 from concurrent.futures import Future
-from itertools import islice
+from itertools import chain, islice
 
 from retro.analysis.check.engines import (
     AGREEMENT_PER_PART,
@@ -42,7 +42,7 @@ from retro.analysis.row_check import RowsCheck, check_rows, merged_agreement, ro
 from retro.errors import InputError, RunError
 from retro.routines import cases as case_sets
 from retro.routines.registry import select
-from retro.routines.runner import RoutineRunner
+from retro.routines.runner import PROBE_CASES, RoutineRunner
 from retro.routines.spec import Routine
 from retro.routines.where import require_inside
 from retro.workers import worker_pool
@@ -267,7 +267,8 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         static, rows.static_note = rows_only_static(routine, runner)
     else:
         static = static_bounds(routine, runner)
-    check = RoutineCheck(routine, runner.size(), static, totals, bounds_violations(routine, static, totals),
+    probe = chain((row.case for row in routine.rows), *(islice(p.cases, PROBE_CASES) for p in parts))
+    check = RoutineCheck(routine, runner.size(runner.blocks_read(probe)), static, totals, bounds_violations(routine, static, totals),
                          budget_violations(routine, static, totals), _part_runs(parts, totals, unknown, rows),
                          start=runner.start, engine=used, agreement=agreement, rows=rows, engine_reason=reason,
                          compile_seconds=compile_seconds, search=searched, engine_note=engine_note, entry_every=every,
