@@ -97,12 +97,12 @@ def _cmd_asm(args: argparse.Namespace) -> int:
 
 def _cmd_run(args: argparse.Namespace) -> int:
     console = {"frames": args.frames, "until": args.until, "until_value": args.until_value, "result": args.result}
-    if args.entry is None:
+    if args.entry is None or run.wants_program_run(args.program, console):
         report = run.run_console_or_refuse(args.program, labels=args.labels, peeks=args.peeks, load=args.load,
-                                           scene=args.scene, trace=args.trace, cpu=args.cpu,
+                                           scene=args.scene, trace=args.trace, cpu=args.cpu, entry=args.entry,
                                            **{k: v for k, v in console.items() if v is not None})
         _print(run, report, args.json)
-        return 1 if report.verdict is not None and report.verdict.passed is False else 0
+        return 1 if getattr(report, "verdict", None) is not None and report.verdict.passed is False else 0
     run.refuse_console_options(console)
     flags = {flag: getattr(args, flag) for flag in run.SETTABLE_FLAGS if getattr(args, flag) is not None}
     report = run.run(args.program, args.entry, labels=args.labels, load=args.load, a=args.a, x=args.x, y=args.y,

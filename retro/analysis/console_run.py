@@ -25,6 +25,7 @@ $6000", and the sources of the 2005 ROMs, runtime/validation.a):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from retro.chips.cartridge import NromCartridge
@@ -102,12 +103,14 @@ class _Stop(Exception):
 
 
 class _Watch:
-    """Observer of the run loop: raises _Stop after the instruction that meets a condition."""
+    """Observer of the run loop: raises _Stop after the instruction that meets a condition. `quiet()`
+    says whether no interrupt can come any more (then an instruction jumping to itself halts)."""
 
-    def __init__(self, machine: Machine, until: int | None, until_value: tuple[int, int] | None) -> None:
+    def __init__(self, machine: Machine, until: int | None, until_value: tuple[int, int] | None,
+                 quiet: Callable[[], bool]) -> None:
         self.memory = machine.bus.memory
         self.peek = machine.bus.peek
-        self.ppu = ppu_of(machine)
+        self.quiet = quiet
         self.until = until
         self.until_value = until_value
         self.pc = -1
@@ -118,7 +121,7 @@ class _Watch:
 
     def after(self, mpu) -> None:
         pc = mpu.pc
-        if pc == self.pc and not self.ppu.ctrl & CTRL_NMI:
+        if pc == self.pc and self.quiet():
             op = self.memory[pc]
             if op == JMP_ABSOLUTE or op in BRANCH_OPCODES:
                 self.halt_pc = pc
@@ -127,6 +130,26 @@ class _Watch:
             raise _Stop(REACHED)
         if self.until_value is not None and self.peek(self.until_value[0]) == self.until_value[1]:
             raise _Stop(VALUE_SEEN)
+
+
+def run_frames(machine: Machine, end: int, frame_cycles: int, watch, after_frame=None) -> tuple[str, int]:
+    """Run `machine` on from its state to machine cycle `end`, a frame at a time, with `watch` (an
+    observer raising _Stop) told of every step; `after_frame()` True ends the run (REPORTED).
+    Returns (why it stopped, instructions run); Ctrl-C ends it as INTERRUPTED with the state so far."""
+    instructions = 0
+    frame_end = machine.cycle
+    try:
+        while machine.cycle < end:
+            frame_end = min(end, frame_end + frame_cycles)
+            try:
+                instructions += machine.run_on(frame_end - machine.cycle, observer=watch)
+            except _Stop as stop:
+                return stop.reason, instructions + machine.mpu.executed
+            if after_frame is not None and after_frame():
+                return REPORTED, instructions
+    except KeyboardInterrupt:
+        return INTERRUPTED, instructions + machine.mpu.executed
+    return FRAMES_DONE, instructions
 
 
 def blargg_verdict(memory: list[int]) -> Verdict | None:
@@ -161,27 +184,18 @@ def run_cartridge(cartridge: NromCartridge, *, frames: int, until: int | None = 
         raise InputError(f"--frames: {frames:,} is not a frame count in 1..{MAX_FRAMES:,}")
     machine = build_nes(cartridge=cartridge)
     entry = reset(machine)
-    watch = _Watch(machine, until, until_value)
+    ppu = ppu_of(machine)
+    watch = _Watch(machine, until, until_value, lambda: not ppu.ctrl & CTRL_NMI)
     start = machine.cycle
-    end = start + math.ceil(frames * CPU_CYCLES_PER_FRAME)
-    stopped, instructions, verdict = FRAMES_DONE, 0, None
-    frame_end = start
-    try:
-        while machine.cycle < end:
-            frame_end = min(end, frame_end + math.ceil(CPU_CYCLES_PER_FRAME))
-            try:
-                instructions += machine.run_on(frame_end - machine.cycle, observer=watch)
-            except _Stop as stop:
-                instructions += machine.mpu.executed
-                stopped = stop.reason
-                break
-            verdict = blargg_verdict(machine.memory)
-            if verdict is not None and verdict.passed is not None:
-                stopped = REPORTED
-                break
-    except KeyboardInterrupt:
-        instructions += machine.mpu.executed
-        stopped = INTERRUPTED
+    verdicts: list[Verdict | None] = [None]
+
+    def reported() -> bool:
+        verdicts[0] = blargg_verdict(machine.memory)
+        return verdicts[0] is not None and verdicts[0].passed is not None
+
+    stopped, instructions = run_frames(machine, start + math.ceil(frames * CPU_CYCLES_PER_FRAME),
+                                       math.ceil(CPU_CYCLES_PER_FRAME), watch, reported)
+    verdict = verdicts[0]
     if verdict is None or verdict.passed is None:
         verdict = blargg_verdict(machine.memory) or verdict
     if result_at is not None and (verdict is None or verdict.protocol != "$6000"):

@@ -1,14 +1,17 @@
 """`retro run`: load a program (source, PRG, raw binary or iNES image) into a machine, with a chip
 scene if one is given, call a routine and report registers, cycles, memory and raster position.
-Or, for an iNES image without `--entry`, run the cartridge on a console from its reset vector for
-N frames or until a condition, and report the state after the run and a test ROM's verdict
-(`retro.analysis.console_run`; docs/nes.md "Running a cartridge")."""
+Or run a whole program as the machine would, for N frames or until a condition, and report the
+state after the run: an iNES image without `--entry` on a console from its reset vector, with a test
+ROM's verdict (`retro.analysis.console_run`; docs/nes.md "Running a cartridge"); any other program
+on a C64 from its BASIC SYS line, or from `--entry` when --frames, --until or --until-value is given
+(`retro.analysis.c64_run`; docs/vic.md "Running a C64 program")."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
 
+from retro.analysis.c64_run import RETURNED, C64Run, run_c64, vic_registers
 from retro.analysis.console_run import MAX_FRAMES, ConsoleRun, ppu_registers, run_cartridge
 from retro.chips.cartridge import read_nrom
 from retro.chips.ines import INES_MAGIC
@@ -17,11 +20,13 @@ from retro.cpu.mpu import FLAG_B, FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_U, FLAG_V
 from retro.errors import InputError
 from retro.fileio import file_option, read_bytes
 from retro.loaders import load_program
+from retro.loaders.basic_stub import sys_line
 from retro.numbers import parse_int
 from retro.machines import build_machine
 from retro.machines.c64 import RasterBudget, call_budget
 from retro.program import Program
 from retro.scenes import load_scene
+from retro.scenes.vic import VicScene
 
 # the status flags a caller may set for the call (B and bit 5 are not flags the CPU keeps)
 SETTABLE_FLAGS = {"n": FLAG_N, "v": FLAG_V, "d": FLAG_D, "i": FLAG_I, "z": FLAG_Z, "c": FLAG_C}
@@ -95,6 +100,25 @@ def is_cartridge(path: str | Path) -> bool:
     return read_bytes(path, "program file")[:len(INES_MAGIC)] == INES_MAGIC
 
 
+def _stop_conditions(resolver: Machine, until, until_value) -> tuple[int | None, tuple[int, int] | None]:
+    """--until and --until-value resolved against the program's symbols."""
+    stop_pc = None if until is None else resolver.resolve(until, "--until")
+    value = None
+    if until_value is not None:
+        target, values = parse_assignment(until_value)
+        if len(values) != 1:
+            raise InputError(f"--until-value {until_value!r}: one byte value, not {len(values)}")
+        value = (resolver.resolve(target, f"--until-value {target}"), values[0])
+    return stop_pc, value
+
+
+def _checked_peeks(resolver: Machine, peeks: list[str]) -> dict[str, int]:
+    peek_counts = _peek_counts(peeks)
+    for target in peek_counts:
+        resolver.resolve(target, f"--peek {target}")
+    return peek_counts
+
+
 def run_console(path: str | Path, *, frames: int | str = DEFAULT_FRAMES, until: str | int | None = None,
                 until_value: str | None = None, result: str | int | None = None, labels: str | Path | None = None,
                 peeks: list[str] = ()) -> ConsoleRun:
@@ -107,39 +131,78 @@ def run_console(path: str | Path, *, frames: int | str = DEFAULT_FRAMES, until: 
     program = load_program(path, symbols=labels)
     resolver = Machine("2a03")
     resolver.load(program)
-    stop_pc = None if until is None else resolver.resolve(until, "--until")
-    value = None
-    if until_value is not None:
-        target, values = parse_assignment(until_value)
-        if len(values) != 1:
-            raise InputError(f"--until-value {until_value!r}: one byte value, not {len(values)}")
-        value = (resolver.resolve(target, f"--until-value {target}"), values[0])
+    stop_pc, value = _stop_conditions(resolver, until, until_value)
     result_at = None if result is None else resolver.resolve(result, "--result")
-    peek_counts = _peek_counts(peeks)
-    for target in peek_counts:
-        resolver.resolve(target, f"--peek {target}")
+    peek_counts = _checked_peeks(resolver, peeks)
     report = run_cartridge(cartridge, frames=frames, until=stop_pc, until_value=value, result_at=result_at)
     report.machine.symbols.update(program.symbols)
     report.peeks = {target: report.machine.peek(target, count) for target, count in peek_counts.items()}
     return report
 
 
+DEFAULT_C64_FRAMES = 50  # one second of PAL time
+
+
+def run_c64_program(path: str | Path, *, entry: str | int | None = None, frames: int | str = DEFAULT_C64_FRAMES,
+                    until: str | int | None = None, until_value: str | None = None,
+                    labels: str | Path | None = None, load: int | str | None = None, scene: str | Path | None = None,
+                    peeks: list[str] = (), cpu: str | None = None) -> C64Run:
+    """Run the program at `path` on a C64 from its BASIC SYS line (or `entry`) for `frames` frames or
+    until a condition (as `run_console`), with `scene`'s VIC-II if given."""
+    frames = parse_int(frames, field="--frames", lo=1, hi=MAX_FRAMES)
+    if cpu is not None and variant_named(cpu, "--cpu") != "6510":
+        raise InputError(f"--cpu {cpu}: a C64 program runs on the 6510")
+    program = load_program(path, symbols=file_option(labels, "--labels"), load=load)
+    if program.cpu and program.cpu != "6510":
+        raise InputError(f"{path}: a program for the {program.cpu.upper()}, not a C64 program")
+    loaded_scene = None if scene is None else load_scene(scene)
+    if loaded_scene is not None and not isinstance(loaded_scene, VicScene):
+        raise InputError(f"--scene {scene}: a C64 program runs with a VIC-II scene (chip = \"vic-ii\")")
+    resolver = Machine("6510")
+    resolver.load(program)
+    stop_pc, value = _stop_conditions(resolver, until, until_value)
+    peek_counts = _checked_peeks(resolver, peeks)
+    if entry is None:
+        basic = sys_line(program)
+        start, line, notes = basic.address, basic.line_number, basic.notes
+    else:
+        start, line, notes = resolver.resolve(entry, "--entry"), None, ()
+    report = run_c64(program, start, frames=frames, scene=loaded_scene, until=stop_pc, until_value=value,
+                     sys_line=line, notes=notes + tuple(program.notes))
+    report.peeks = {target: report.machine.peek(target, count) for target, count in peek_counts.items()}
+    return report
+
+
 CONSOLE_OPTIONS = {"frames": "--frames", "until": "--until", "until_value": "--until-value", "result": "--result"}
+PROGRAM_RUN_OPTIONS = ("frames", "until", "until_value")  # with --entry: a C64 program run from there
+
+
+def wants_program_run(path: str | Path, given: dict) -> bool:
+    """Whether `retro run FILE --entry E` with these options runs a program from E rather than
+    calling E: a program that is not an iNES image, with --frames, --until or --until-value."""
+    return any(given.get(name) is not None for name in PROGRAM_RUN_OPTIONS) and not is_cartridge(path)
 
 
 def refuse_console_options(given: dict) -> None:
-    """--frames, --until, --until-value and --result belong to a cartridge run from reset, not to a call."""
+    """--frames, --until, --until-value and --result belong to a program run, not to a call."""
     used = [CONSOLE_OPTIONS[name] for name, value in given.items() if value is not None]
     if used:
-        raise InputError(f"{', '.join(used)}: only for an iNES image run from its reset vector (without --entry)")
+        raise InputError(f"{', '.join(used)}: only for a program run (an iNES image from its reset vector, "
+                         f"a C64 program from its SYS line or --entry), not for a call")
 
 
 def run_console_or_refuse(path: str | Path, *, load=None, scene=None, trace: bool = False, cpu: str | None = None,
-                          **options) -> ConsoleRun:
-    """`retro run FILE` without --entry: a cartridge from reset, or a one-line error saying what is missing."""
+                          entry: str | int | None = None, **options) -> ConsoleRun | C64Run:
+    """`retro run FILE` as a program run: a cartridge from reset, or a C64 program from its SYS line
+    or `entry`; or a one-line error saying what does not fit."""
+    if trace:
+        raise InputError(f"--trace: not for a program run ({path} runs from its start, not as a call)")
     if not is_cartridge(path):
-        raise InputError(f"--entry: required for {path} (only an iNES image runs from its reset vector)")
-    for name, value in (("--load", load), ("--scene", scene), ("--trace", trace or None)):
+        if options.get("result") is not None:
+            raise InputError("--result: only for an iNES image (a test ROM's result byte)")
+        options.pop("result", None)
+        return run_c64_program(path, entry=entry, load=load, scene=scene, cpu=cpu, **options)
+    for name, value in (("--load", load), ("--scene", scene), ("--entry", entry)):
         if value is not None:
             raise InputError(f"{name}: not for a cartridge run from reset ({path} is an iNES image run without --entry)")
     if cpu is not None and variant_named(cpu, "--cpu") != "2a03":
@@ -197,8 +260,9 @@ STOP_REASONS = {
     "frames": "the frame count ran out",
     "until": "the PC reached --until",
     "until-value": "the --until-value byte took its value",
-    "halted": "the program halted (an instruction jumping to itself with the NMI off)",
+    "halted": "the program halted (an instruction jumping to itself with no interrupt to come)",
     "verdict": "the test ROM reported its result",
+    RETURNED: "the program returned (the RTS from the code SYS called)",
     "interrupted": "interrupted (Ctrl-C)",
 }
 
@@ -209,10 +273,39 @@ def console_json(report: ConsoleRun) -> dict:
     memory = report.machine.memory
     return {"entry": report.entry, "stopped": report.stopped, "frames": round(report.frames_run, 3),
             "cycles": report.cycles, "instructions": report.instructions, "halt_pc": report.halt_pc,
-            "cpu": {"pc": mpu.pc, "a": mpu.a, "x": mpu.x, "y": mpu.y, "s": mpu.sp, "p": (mpu.p | FLAG_U) & ~FLAG_B},
-            "ppu": ppu_registers(report.ppu),
+            "cpu": _cpu_state(mpu), "ppu": ppu_registers(report.ppu),
             "ram": bytes(memory[:RAM_END]).hex(), "prg_ram": bytes(memory[PRG_RAM_START:PRG_RAM_END]).hex(),
             "peek": report.peeks, "verdict": report.verdict.as_dict() if report.verdict else None}
+
+
+def _cpu_state(mpu) -> dict:
+    return {"pc": mpu.pc, "a": mpu.a, "x": mpu.x, "y": mpu.y, "s": mpu.sp, "p": (mpu.p | FLAG_U) & ~FLAG_B}
+
+
+def c64_json(report: C64Run) -> dict:
+    """The object `retro run PROG.prg --json` prints: the state after the run (all 64 KiB of RAM as hex)."""
+    return {"entry": report.entry, "sys_line": report.sys_line, "stopped": report.stopped,
+            "frames": round(report.frames_run, 3), "cycles": report.cycles, "instructions": report.instructions,
+            "halt_pc": report.halt_pc, "cpu": _cpu_state(report.machine.mpu), "vic": vic_registers(report.vic),
+            "ram": bytes(report.machine.memory).hex(), "peek": report.peeks, "notes": list(report.notes)}
+
+
+def c64_lines(report: C64Run) -> list[str]:
+    r = _cpu_state(report.machine.mpu)
+    vic = vic_registers(report.vic)
+    start = (f"the SYS of BASIC line {report.sys_line}, ${report.entry:04X}" if report.sys_line is not None
+             else f"${report.entry:04X}")
+    out = [f"ran {report.frames_run:.2f} of {report.frames_asked} frames ({report.cycles} cycles, "
+           f"{report.instructions} instructions, {report.machine.mpu.stolen} stolen by the VIC-II) from {start}",
+           f"stopped: {STOP_REASONS[report.stopped]}"
+           + (f" at ${report.halt_pc:04X}" if report.halt_pc is not None else ""),
+           f"PC=${r['pc']:04X} A=${r['a']:02X} X=${r['x']:02X} Y=${r['y']:02X} S=${r['s']:02X} P=${r['p']:02X}",
+           f"VIC-II: frame {vic['frame']} line {vic['line']} cycle {vic['cycle']}, $D011=${report.vic.peek(0xD011):02X} "
+           f"$D019=${vic['d019']:02X} $D01A=${report.vic.peek(0xD01A):02X} $D01E=${vic['d01e']:02X} "
+           f"$D01F=${vic['d01f']:02X}"]
+    out += [f"{target}: " + " ".join(f"${v:02X}" for v in values) for target, values in report.peeks.items()]
+    out += [f"note: {note}" for note in report.notes]
+    return out
 
 
 def console_lines(report: ConsoleRun) -> list[str]:
@@ -234,10 +327,12 @@ def console_lines(report: ConsoleRun) -> list[str]:
     return out
 
 
-def as_json(report: RunReport | ConsoleRun) -> dict:
+def as_json(report: RunReport | ConsoleRun | C64Run) -> dict:
     """The object `retro run --json` prints (its keys are a contract: no trace in it)."""
     if isinstance(report, ConsoleRun):
         return console_json(report)
+    if isinstance(report, C64Run):
+        return c64_json(report)
     r = report.result
     return {"cycles": r.cycles, "instructions": r.instructions, "a": r.a, "x": r.x, "y": r.y, "s": r.s, "p": r.p,
             "peek": report.peeks, **({"raster": report.raster.as_dict()} if report.raster else {}),
@@ -259,9 +354,11 @@ def trace_lines(report: RunReport) -> list[str]:
     return out
 
 
-def lines(report: RunReport | ConsoleRun) -> list[str]:
+def lines(report: RunReport | ConsoleRun | C64Run) -> list[str]:
     if isinstance(report, ConsoleRun):
         return console_lines(report)
+    if isinstance(report, C64Run):
+        return c64_lines(report)
     r = report.result
     out = trace_lines(report) if r.trace else []
     out += [f"A=${r.a:02X} X=${r.x:02X} Y=${r.y:02X} S=${r.s:02X} P=${r.p:02X}",

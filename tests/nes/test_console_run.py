@@ -117,7 +117,7 @@ def test_the_console_around_the_cpu(tmp_path, capsys):
     (["--frames", "0"], "--frames"),
     (["--until", "nowhere"], "unknown label"),
     (["--until-value", "$10=1,2"], "one byte"),
-    (["--entry", "$C000", "--frames", "3"], "only for an iNES image run from its reset vector"),
+    (["--entry", "$C000", "--frames", "3"], "only for a program run"),
     (["--scene", "x.toml"], "--scene"),
 ])
 def test_bad_options_are_one_line_exit_2(tmp_path, capsys, args, message):
@@ -129,7 +129,7 @@ def test_without_entry_a_non_cartridge_is_refused(tmp_path, capsys):
     path = tmp_path / "p.prg"
     path.write_bytes(bytes([0x00, 0xC0, 0x60]))
     code, _, err = cli(path, capsys=capsys)
-    assert code == 2 and "--entry: required" in err
+    assert code == 2 and "loads at $C000, not at BASIC's $0801" in err and "--entry" in err
 
 
 def test_other_mappers_are_refused_naming_the_file(tmp_path, capsys):

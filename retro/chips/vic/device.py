@@ -200,6 +200,10 @@ class VicDevice:
         found = [c for c in candidates if c is not None]
         self.irq_next = self.start_cycle + min(found) if found else NEVER
 
+    def catch_up(self, cycle: int) -> None:
+        """Apply everything the beam draws before machine cycle `cycle` (the state a report shows)."""
+        self._advance(self.time(cycle))
+
     def irq_low(self, cycle: int) -> bool:
         self._advance(self.time(cycle) + 1)
         return bool(self.irq_latch & self.registers[REG_IRQ_ENABLE] & IRQ_SOURCES)
