@@ -207,7 +207,8 @@ class InputPlan:
 @dataclass(frozen=True)
 class RasterStart:
     """Run every call with a VIC-II scene on the bus and the beam at this line and cycle (the CPU
-    then stalls on Bad Lines and sprite DMA as on a real C64)."""
+    then stalls on Bad Lines and sprite DMA as on a real C64), the frame drawn so far in the
+    collision latches and $D019 (unread, unacknowledged)."""
 
     scene: VicScene
     line: int
@@ -275,7 +276,7 @@ class RoutineRunner:
         return self.outputs(a, x, y, p), cycles
 
     def _restart_beam(self) -> None:
-        self.vic.restart(self.machine.cycle, self.start.line, self.start.cycle)
+        self.vic.restart(self.machine.cycle, self.start.line, self.start.cycle, drawn=True)
         self.machine.mpu.ba_high_until = -1  # the CPU's note of how long BA stays high was for the old beam
 
     def answer(self, case: Sequence) -> int:
