@@ -17,6 +17,7 @@ from retro.fileio import file_option, write_atomic
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
 from retro.routines import cases as case_sets
+from retro.routines.chip_access import FREE_REASON
 from retro.workers import MAX_WORKERS
 
 MAX_RANDOM = 10 ** 9
@@ -124,6 +125,7 @@ def check_record(check: RoutineCheck) -> dict:
               "input_space": space if (space := check.routine.input_space()) < JSON_EXACT else None,
               "input_space_log2": round(math.log2(space), 3), "coverage_argument": check.routine.coverage or None,
               "examples": t.examples, "outside_examples": t.outside_examples, "engine": check.engine,
+              "engine_reason": check.engine_reason,
               "engine_agreement": None if check.agreement is None else {
                   "cases": check.agreement.engine_cases, "mismatches": check.agreement.engine_mismatches,
                   "timing_model_mismatches": check.agreement.cycle_mismatches},
@@ -173,6 +175,14 @@ def format_check(check: RoutineCheck) -> list[str]:
         lines.append(f"  cases: {format_coverage(check)}; input space {format_space(check.routine.input_space())}")
     if routine.coverage:
         lines.append(f"  coverage: {routine.coverage}")
+    if check.engine_reason:
+        if check.engine == "batch":
+            engine = "the batched core, each lane stalled as on the scene"
+        elif check.engine_reason.startswith(FREE_REASON):
+            engine = "Machine (--engine scalar, or too few cases for the batched core to pay)"
+        else:
+            engine = "Machine"
+        lines.append(f"  engine with the scene: {engine}: {check.engine_reason}")
     if t.cycles_count:
         lines += _cycle_lines(check)
     if routine.budget is not None:

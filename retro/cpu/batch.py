@@ -173,6 +173,11 @@ class BatchCpu:
         self.error = np.zeros(lanes, dtype=np.int8)
         self.error_pc = zeros.copy()
         self.instructions = 0  # group executions (one instruction run by a group of lanes)
+        # A chip's bus stalls (retro.routines.chip_access.BusStalls), or None: bus_stall(opcode, began,
+        # spent) -> cycles each lane waits in that instruction, added to its cycles and to `stolen`
+        self.bus_stall = None
+        self.stolen = np.zeros(lanes, dtype=np.int64)
+        self._began = np.zeros(lanes, dtype=np.int64)
 
     def _everyone(self) -> Lanes:
         return Lanes(self, slice(None), self.a.copy(), self.x.copy(), self.y.copy(), self.p.copy(), self.sp.copy(),
@@ -246,11 +251,18 @@ class BatchCpu:
         if handler is None:
             group.stop(pc, LaneError.JAM if opcode in JAM_OPCODES else LaneError.UNSTABLE)
             return
+        stall = self.bus_stall
+        if stall is not None:
+            self._began[group.ids] = group.cycles
         result = handler(group, pc, lo, hi)
-        if isinstance(result, list):
-            yield from result
-        else:
-            yield result, group
+        parts = result if isinstance(result, list) else [(result, group)]
+        if stall is not None:
+            for _, lanes in parts:
+                began = self._began[lanes.ids]
+                delay = stall(opcode, began, lanes.cycles - began)
+                lanes.cycles += delay
+                self.stolen[lanes.ids] += delay
+        yield from parts
 
     def read(self, address: int) -> np.ndarray:
         """Every lane's byte at address."""

@@ -16,6 +16,7 @@ only on some paths reads the same on both engines); the `[memory]` blocks once a
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -32,13 +33,15 @@ from retro.cpu.machine import (
     CallResult,
     push_return_trap,
 )
-from retro.cpu.mpu import FLAG_B, FLAG_U
+from retro.chips.vic.constants import IRQ_SOURCES, REG_IRQ_ENABLE
+from retro.cpu.mpu import FLAG_B, FLAG_I, FLAG_U
 from retro.cpu.timing import timing_table
 from retro.errors import InputError
 from retro.fileio import read_text
 from retro.machines import build_machine
 from retro.machines.c64 import vic_of
 from retro.program import Program
+from retro.routines.chip_access import BusStalls, chip_free
 from retro.routines.sandbox import bytes_of
 from retro.routines.spec import Port, Routine, call_with
 from retro.scenes.vic import VicScene
@@ -138,6 +141,7 @@ class BatchOutcome:
     outputs: list
     cycles: np.ndarray
     error: np.ndarray
+    stolen: np.ndarray  # per case, the cycles a scene's chip held the CPU (zeros without one)
 
 
 def row_of(arrays: list, i: int) -> tuple:
@@ -295,8 +299,26 @@ class RoutineRunner:
 
     @property
     def batchable(self) -> bool:
-        """Whether the batched core can run this routine (it has no chips: not with a scene)."""
-        return self.vic is None
+        """Whether the batched core can run this routine: without a scene, or with one when no call
+        can touch a chip register or be interrupted (`engine_reason` says why or why not)."""
+        return self.chip_verdict[0]
+
+    @property
+    def engine_reason(self) -> str | None:
+        """Why the batched core may or may not run the calls with the scene (None without a scene)."""
+        return None if self.vic is None else self.chip_verdict[1]
+
+    @functools.cached_property
+    def chip_verdict(self) -> tuple[bool, str]:
+        if self.vic is None:
+            return True, ""
+        memory = self.machine.memory
+        pages = frozenset(page for page, device in enumerate(self.machine.bus.page_devices) if device is not None)
+        interrupts = bool(self.vic.registers[REG_IRQ_ENABLE] & IRQ_SOURCES)
+        if interrupts and (not self.plan.base_flags & FLAG_I or any(bit == FLAG_I for _, bit in self.plan.flags)):
+            return False, "the scene enables VIC-II interrupts and I may be clear on entry"
+        return chip_free(memory.__getitem__, self.entry, (self.program.origin, self.program.end), pages,
+                         self.routine.cpu, interrupts)
 
     def run_batch(self, columns: list) -> "BatchOutcome":
         """Run every case of a column block (one array per input) on the batched core."""
@@ -311,7 +333,8 @@ class RoutineRunner:
             second = self.run_batch([c[half:] for c in columns])
             return BatchOutcome([np.concatenate(pair) for pair in zip(first.outputs, second.outputs)],
                                 np.concatenate([first.cycles, second.cycles]),
-                                np.concatenate([first.error, second.error]))
+                                np.concatenate([first.error, second.error]),
+                                np.concatenate([first.stolen, second.stolen]))
 
     def _run_lanes(self, columns: list, n: int) -> "BatchOutcome":
         image = bytearray(self.call_image)
@@ -323,11 +346,15 @@ class RoutineRunner:
             lanes |= np.asarray(value).astype(lanes.dtype)
         cpu.p[:] = (p | FLAG_U) & ~FLAG_B  # as Machine sets P
         cpu.sp[:] = stack_pointer
+        if self.vic is not None:  # the scene's timeline: each lane stalls as Machine would from the start
+            video = self.vic.video
+            start = self.start.line * video.cycles_per_line + self.start.cycle - 1
+            cpu.bus_stall = BusStalls(self.vic._bus.wait, start, self.machine.mpu.write_masks)
         cpu.call(self.entry, self.limit, RETURN_TRAP, CALL_STACK_TOP)
         outputs = port_values(self.routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,
                               widen=lambda lanes: np.asarray(lanes, dtype=np.int64),
                               table=lambda columns: np.stack(columns, axis=1).astype(np.int64))
-        return BatchOutcome(outputs, cpu.cycles, cpu.error)
+        return BatchOutcome(outputs, cpu.cycles, cpu.error, cpu.stolen)
 
     def outputs(self, a: int, x: int, y: int, p: int) -> tuple:
         return tuple(port_values(self.routine.outputs, {"a": a, "x": x, "y": y}, p, self.machine.memory.__getitem__,

@@ -148,7 +148,7 @@ def run_on_batched_core(runner: RoutineRunner, columns: list, confirm_stop: bool
     outcome = runner.run_batch(columns)
     stopped = np.flatnonzero(outcome.error)
     n = len(outcome.cycles)
-    block = CallBlock(outcome.outputs, outcome.cycles, np.zeros(n, dtype=np.int64), None,
+    block = CallBlock(outcome.outputs, outcome.cycles, outcome.stolen, None,
                       int(stopped[0]) if len(stopped) else n, lane_errors=outcome.error)
     if len(stopped) and confirm_stop:
         machine = run_on_machine(runner, [case_sets.case_of(columns, block.returned)])

@@ -47,6 +47,7 @@ class RoutineCheck:
     trace: list[str] = field(default_factory=list)  # the first failing case's instructions
     start: RasterStart | None = None  # with --scene: the beam position every call started at
     engine: str = "scalar"  # which engine ran the cases: "scalar" (Machine) or "batch"
+    engine_reason: str | None = None  # with --scene: why the batched core may (not) run the calls
     agreement: Tally | None = None  # with the batched core: the cases also run on Machine
     rows: RowsCheck | None = None  # the spec's expected rows (retro.analysis.row_check)
     seconds: float = 0.0  # wall time of the check (JUnit reports)

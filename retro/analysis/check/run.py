@@ -47,16 +47,16 @@ def machine_chunk(spec: str, seed: int, cases: list[tuple], start: SceneStart | 
     return count_block(runner.routine, run_on_machine(runner, cases), columns, cases, runner.memory_values)
 
 
-def batch_chunk(spec: str, seed: int, columns: list) -> Tally:
+def batch_chunk(spec: str, seed: int, columns: list, start: SceneStart | None = None) -> Tally:
     """A column block on the batched core, tallied (run in worker processes)."""
-    runner = runner_for(spec, seed, None)
+    runner = runner_for(spec, seed, start)
     return count_block(runner.routine, run_on_batched_core(runner, columns), columns, None, runner.memory_values)
 
 
-def agreement_chunk(spec: str, seed: int, cases: list[tuple]) -> Tally:
+def agreement_chunk(spec: str, seed: int, cases: list[tuple], start: SceneStart | None = None) -> Tally:
     """Cases on both engines: Machine's tally (timing model included), its block compared with the
     batched core's call for call."""
-    runner = runner_for(spec, seed, None)
+    runner = runner_for(spec, seed, start)
     columns = case_sets.cases_to_columns(runner.routine, cases)
     against = run_on_batched_core(runner, columns, confirm_stop=False)
     return count_block(runner.routine, run_on_machine(runner, cases), columns, cases, runner.memory_values, against)
@@ -112,12 +112,12 @@ def _reporter(routine: Routine, totals: Tally, known: int, unknown: bool,
     return report
 
 
-def _agreement(spec: str, seed: int, parts: list[case_sets.Part]) -> Tally:
+def _agreement(spec: str, seed: int, parts: list[case_sets.Part], start: SceneStart | None = None) -> Tally:
     """Machine first: the reference engine's verdict on a prefix of every part, both engines compared."""
     agreement = Tally()
     for part in parts:
         for chunk in case_sets.chunks(islice(part.cases, AGREEMENT_PER_PART)):
-            agreement.merge(agreement_chunk(spec, seed, chunk))
+            agreement.merge(agreement_chunk(spec, seed, chunk, start))
             if agreement.run_errors:
                 break
     return agreement
@@ -157,8 +157,8 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     runner = runner_for(spec, seed, start)  # loads and validates in this process before any worker starts
     on_batch = batched(engine, None if unknown else known, runner.batchable, AUTO_BATCH_CASES)
     if engine == "batch" and not on_batch:
-        raise InputError("--engine batch: with --scene the calls run on Machine (the batched core models no chips); "
-                         "use --engine scalar or auto")
+        raise InputError(f"--engine batch: with --scene the calls of {routine.name} run on Machine "
+                         f"({runner.engine_reason}); use --engine scalar or auto")
     totals = Tally()
     report = _reporter(routine, totals, known, unknown, progress)
     rows = None
@@ -167,8 +167,8 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         report(rows_totals)
         if totals.run_errors:  # a row's call that stopped stops the check
             parts = []
-    agreement = _agreement(spec, seed, parts) if on_batch else None
-    work = (((batch_chunk, (spec, seed, block)) for block in case_sets.batches(parts, BATCH_LANES)) if on_batch else
+    agreement = _agreement(spec, seed, parts, start) if on_batch else None
+    work = (((batch_chunk, (spec, seed, block, start)) for block in case_sets.batches(parts, BATCH_LANES)) if on_batch else
             ((machine_chunk, (spec, seed, chunk, start)) for chunk in _chunks(parts)))
     _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
     require_inside(f"{routine.spec_path}: cases.where", routine.domain, totals.cases, totals.outside,
@@ -179,7 +179,8 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         static = static_bounds(routine, runner)
     check = RoutineCheck(routine, runner.size(), static, totals, bounds_violations(routine, static, totals),
                          budget_violations(routine, static, totals), _part_runs(parts, totals, unknown, rows),
-                         start=runner.start, engine="batch" if on_batch else "scalar", agreement=agreement, rows=rows)
+                         start=runner.start, engine="batch" if on_batch else "scalar", agreement=agreement, rows=rows,
+                         engine_reason=runner.engine_reason)
     if rows is not None and rows.agreement is not None:
         check.agreement = agreement = merged_agreement(agreement, rows)
     if agreement is not None and agreement.failure is not None and totals.failure is None:
