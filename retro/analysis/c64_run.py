@@ -184,8 +184,10 @@ def c64_for(program: Program, scene: VicScene | None) -> Machine:
 
 def run_c64(program: Program, entry: int, *, frames: int, scene: VicScene | None = None,
             until: int | None = None, until_value: tuple[int, int] | None = None,
-            sys_line: int | None = None, notes: tuple[str, ...] = ()) -> C64Run:
-    """Run `program` on a C64 from `entry` (module docstring) for up to `frames` frames."""
+            sys_line: int | None = None, notes: tuple[str, ...] = (), wrap=None) -> C64Run:
+    """Run `program` on a C64 from `entry` (module docstring) for up to `frames` frames. `wrap(machine,
+    watch)`, if given, returns the observer to run with instead of the stop conditions' own (a
+    profiler that tells them in turn)."""
     if not 1 <= frames <= MAX_C64_FRAMES:
         raise InputError(f"--frames: {frames:,} is not a frame count in 1..{MAX_C64_FRAMES:,}")
     machine = c64_for(program, scene)
@@ -197,9 +199,10 @@ def run_c64(program: Program, entry: int, *, frames: int, scene: VicScene | None
     mpu.pc = entry
     mpu.pending_interrupt = None
     watch = _C64Watch(machine, until, until_value)
+    observer = watch if wrap is None else wrap(machine, watch)
     frame_cycles = vic_of(machine).video.frame_cycles
     start = machine.cycle
-    stopped, instructions = run_frames(machine, start + math.ceil(frames * frame_cycles), frame_cycles, watch)
+    stopped, instructions = run_frames(machine, start + math.ceil(frames * frame_cycles), frame_cycles, observer)
     vic_of(machine).catch_up(machine.cycle)  # the latches and $D019 as they stand at the end of the run
     return C64Run(machine=machine, entry=entry, frames_asked=frames, cycles=machine.cycle - start,
                   instructions=instructions, stopped=stopped, halt_pc=watch.halt_pc, sys_line=sys_line,

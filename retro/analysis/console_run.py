@@ -178,14 +178,16 @@ def result_byte_verdict(value: int, address: int, halted: bool) -> Verdict:
 
 
 def run_cartridge(cartridge: NromCartridge, *, frames: int, until: int | None = None,
-                  until_value: tuple[int, int] | None = None, result_at: int | None = None) -> ConsoleRun:
-    """Power on a console with `cartridge`, reset, and run up to `frames` frames (module docstring)."""
+                  until_value: tuple[int, int] | None = None, result_at: int | None = None, wrap=None) -> ConsoleRun:
+    """Power on a console with `cartridge`, reset, and run up to `frames` frames (module docstring).
+    `wrap(machine, watch)`: the observer to run with instead of the stop conditions' (a profiler)."""
     if not 1 <= frames <= MAX_FRAMES:
         raise InputError(f"--frames: {frames:,} is not a frame count in 1..{MAX_FRAMES:,}")
     machine = build_nes(cartridge=cartridge)
     entry = reset(machine)
     ppu = ppu_of(machine)
     watch = _Watch(machine, until, until_value, lambda: not ppu.ctrl & CTRL_NMI)
+    observer = watch if wrap is None else wrap(machine, watch)
     start = machine.cycle
     verdicts: list[Verdict | None] = [None]
 
@@ -194,7 +196,7 @@ def run_cartridge(cartridge: NromCartridge, *, frames: int, until: int | None = 
         return verdicts[0] is not None and verdicts[0].passed is not None
 
     stopped, instructions = run_frames(machine, start + math.ceil(frames * CPU_CYCLES_PER_FRAME),
-                                       math.ceil(CPU_CYCLES_PER_FRAME), watch, reported)
+                                       math.ceil(CPU_CYCLES_PER_FRAME), observer, reported)
     verdict = verdicts[0]
     if verdict is None or verdict.passed is None:
         verdict = blargg_verdict(machine.memory) or verdict

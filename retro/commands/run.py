@@ -124,7 +124,7 @@ def _checked_peeks(resolver: Machine, peeks: list[str]) -> dict[str, int]:
 
 def run_console(path: str | Path, *, frames: int | str = DEFAULT_FRAMES, until: str | int | None = None,
                 until_value: str | None = None, result: str | int | None = None, labels: str | Path | None = None,
-                peeks: list[str] = ()) -> ConsoleRun:
+                peeks: list[str] = (), wrap=None) -> ConsoleRun:
     """Run the cartridge at `path` from its reset vector for `frames` frames, or until the PC reaches
     `until`, the byte `until_value` ("TARGET=V") holds its value, or the program halts; `result` is
     the address of a result byte (blargg's 2005 ROMs: $F8); `peeks` TARGET[:N] reads after the run."""
@@ -137,7 +137,7 @@ def run_console(path: str | Path, *, frames: int | str = DEFAULT_FRAMES, until: 
     stop_pc, value = _stop_conditions(resolver, until, until_value)
     result_at = None if result is None else resolver.resolve(result, "--result")
     peek_counts = _checked_peeks(resolver, peeks)
-    report = run_cartridge(cartridge, frames=frames, until=stop_pc, until_value=value, result_at=result_at)
+    report = run_cartridge(cartridge, frames=frames, until=stop_pc, until_value=value, result_at=result_at, wrap=wrap)
     report.machine.symbols.update(program.symbols)
     report.peeks = {target: report.machine.peek(target, count) for target, count in peek_counts.items()}
     return report
@@ -149,7 +149,7 @@ DEFAULT_C64_FRAMES = 50  # one second of PAL time
 def run_c64_program(path: str | Path, *, entry: str | int | None = None, frames: int | str = DEFAULT_C64_FRAMES,
                     until: str | int | None = None, until_value: str | None = None,
                     labels: str | Path | None = None, load: int | str | None = None, scene: str | Path | None = None,
-                    peeks: list[str] = (), cpu: str | None = None) -> C64Run:
+                    peeks: list[str] = (), cpu: str | None = None, wrap=None) -> C64Run:
     """Run the program at `path` on a C64 from its BASIC SYS line (or `entry`) for `frames` frames or
     until a condition (as `run_console`), with `scene`'s VIC-II if given."""
     frames = parse_int(frames, field="--frames", lo=1, hi=MAX_FRAMES)
@@ -171,7 +171,7 @@ def run_c64_program(path: str | Path, *, entry: str | int | None = None, frames:
     else:
         start, line, notes = resolver.resolve(entry, "--entry"), None, ()
     report = run_c64(program, start, frames=frames, scene=loaded_scene, until=stop_pc, until_value=value,
-                     sys_line=line, notes=notes + tuple(program.notes))
+                     sys_line=line, notes=notes + tuple(program.notes), wrap=wrap)
     report.peeks = {target: report.machine.peek(target, count) for target, count in peek_counts.items()}
     return report
 

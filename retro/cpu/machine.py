@@ -162,8 +162,10 @@ class Machine:
     # ---- running ---------------------------------------------------------------------------
 
     def call(self, entry: str | int, *, a: int = 0, x: int = 0, y: int = 0, p: int = DEFAULT_FLAGS,
-             memory: dict | None = None, budget: int = DEFAULT_BUDGET, trace: bool = False) -> CallResult:
-        """Run the routine at entry as if called by JSR; stop at its RTS.
+             memory: dict | None = None, budget: int = DEFAULT_BUDGET, trace: bool = False,
+             observer=None) -> CallResult:
+        """Run the routine at entry as if called by JSR; stop at its RTS. `observer` (without
+        `trace`) is told of every step as in `MPU6510.run` (a profile).
 
         Fails (RunError) on BRK, JAM or an unstable opcode, and when the routine needs more than
         `budget` cycles (a runaway routine is stopped as soon as it has used them).
@@ -179,8 +181,10 @@ class Machine:
         entries: list[TraceEntry] | None = [] if trace else None
         start = self._enter(address, a, x, y, p)
         stolen_before = self.mpu.stolen
+        if entries is not None and observer is not None:
+            raise ValueError("Machine.call: a trace or an observer, not both")
         count = self._execute(RETURN_TRAP, CALL_STACK_TOP, start + budget,
-                              None if entries is None else _Tracer(self, entries))
+                              observer if entries is None else _Tracer(self, entries))
         cycles = self._returned(start, budget, count)
         mpu = self.mpu
         status = _status(mpu.p)
