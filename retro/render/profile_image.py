@@ -80,7 +80,7 @@ def profile_image(profile, frame: int | None = None) -> Image.Image:
     x = chart.width + 2 * MARGIN
     draw.text((x, MARGIN), f"frame {shown}: a row per {beam.unit} (0 at the top), a column per CPU cycle",
               fill=(0, 0, 0), font=font)
-    note = "darker: the VIC-II holds the bus" if profile.ba_low is not None else "black: nothing of the run"
+    note = "black: nothing of the run" + ("; darker: the VIC-II holds the bus" if profile.ba_low is not None else "")
     draw.text((x, MARGIN + ROW_HEIGHT), note, fill=(0, 0, 0), font=font)
     ranked = sorted(range(len(profile.routines)), key=lambda i: -profile.routines[i].inclusive)
     for row, i in enumerate(ranked[:MAX_LEGEND_ROWS]):
