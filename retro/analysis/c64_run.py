@@ -98,6 +98,7 @@ class C64Run:
     sys_line: int | None = None  # the BASIC line the SYS was on
     notes: tuple[str, ...] = ()
     peeks: dict[str, list[int]] = field(default_factory=dict)  # filled by the command
+    tracer: object = None  # a retro.analysis.trace.Tracer that observed the run (--trace, --watch)
 
     @property
     def vic(self) -> VicDevice:

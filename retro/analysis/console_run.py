@@ -86,6 +86,7 @@ class ConsoleRun:
     verdict: Verdict | None
     halt_pc: int | None = None  # where the program halted (HALTED)
     peeks: dict[str, list[int]] = field(default_factory=dict)  # filled by the command
+    tracer: object = None  # a retro.analysis.trace.Tracer that observed the run (--trace, --watch)
 
     @property
     def frames_run(self) -> float:

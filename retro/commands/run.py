@@ -24,7 +24,7 @@ from retro.loaders import load_program
 from retro.loaders.basic_stub import sys_line
 from retro.numbers import parse_int
 from retro.machines import build_machine
-from retro.machines.c64 import RasterBudget, call_budget
+from retro.machines.c64 import RasterBudget, call_budget, vic_of
 from retro.program import Program
 from retro.scenes import load_scene
 from retro.scenes.vic import VicScene
@@ -194,23 +194,75 @@ def refuse_console_options(given: dict) -> None:
                          f"a C64 program from its SYS line or --entry), not for a call")
 
 
+def _range(text: str | None, field: str, hi: int) -> tuple[int, int] | None:
+    """'LOW-HIGH' -> (low, high), each a number in 0..hi."""
+    if text is None:
+        return None
+    low, dash, high = str(text).partition("-")
+    if not dash:
+        raise InputError(f"{field} {text!r}: expected LOW-HIGH")
+    first, last = parse_int(low, field=field, lo=0, hi=hi), parse_int(high, field=field, lo=0, hi=hi)
+    if last < first:
+        raise InputError(f"{field} {text!r}: the range ends before it starts")
+    return first, last
+
+
+def trace_wrapper(path, *, trace: bool, trace_json: bool, trace_limit, trace_cycles, trace_pc, watches: list[str],
+                  labels=None, load=None):
+    """The `wrap` of a program run that traces it and/or watches addresses (retro.analysis.trace), or
+    None without --trace/--trace-json/--watch; every option checked before the run."""
+    if not (trace or trace_json or watches):
+        if any(v is not None for v in (trace_limit, trace_cycles, trace_pc)):
+            raise InputError("--trace-limit, --trace-cycles, --trace-pc: they bound a --trace or --trace-json")
+        return None
+    from retro.analysis.trace import MAX_TRACE_LIMIT, TraceBounds, Tracer, parse_watch, ppu_position, vic_position
+    from retro.machines.nes import ppu_of
+
+    bounds = None
+    if trace or trace_json:
+        cycles = _range(trace_cycles, "--trace-cycles", MAX_BUDGET * 100)
+        pcs = _range(trace_pc, "--trace-pc", 0xFFFF) or (0, 0xFFFF)
+        limit = None if trace_limit is None else parse_int(trace_limit, field="--trace-limit", lo=1, hi=MAX_TRACE_LIMIT)
+        bounds = TraceBounds(limit, *(cycles or (None, None)), *pcs)
+        bounds.check()
+    resolver = Machine("6510")
+    resolver.load(load_program(path, symbols=file_option(labels, "--labels"), load=load))
+    parsed = tuple(parse_watch(w, resolver.resolve) for w in watches)
+    made = []
+
+    def wrap(machine, inner):
+        vic, ppu = vic_of(machine), ppu_of(machine)
+        position = vic_position(vic) if vic is not None else ppu_position(ppu) if ppu is not None else None
+        made.append(Tracer(machine, bounds=bounds, watches=parsed, position=position, inner=inner))
+        return made[-1]
+    wrap.made = made
+    return wrap
+
+
 def run_console_or_refuse(path: str | Path, *, load=None, scene=None, trace: bool = False, cpu: str | None = None,
-                          entry: str | int | None = None, **options) -> ConsoleRun | C64Run:
+                          entry: str | int | None = None, trace_json: bool = False, trace_limit=None,
+                          trace_cycles=None, trace_pc=None, watches: list[str] = (), **options) -> ConsoleRun | C64Run:
     """`retro run FILE` as a program run: a cartridge from reset, or a C64 program from its SYS line
-    or `entry`; or a one-line error saying what does not fit."""
-    if trace:
-        raise InputError(f"--trace: not for a program run ({path} runs from its start, not as a call)")
+    or `entry`; or a one-line error saying what does not fit. `trace`/`trace_json` (bounded by
+    `trace_limit`, `trace_cycles` "FROM-TO", `trace_pc` "LOW-HIGH") and `watches` observe the run."""
+    wrap = trace_wrapper(path, trace=trace, trace_json=trace_json, trace_limit=trace_limit, trace_cycles=trace_cycles,
+                         trace_pc=trace_pc, watches=list(watches), labels=options.get("labels"), load=load)
     if not is_cartridge(path):
         if options.get("result") is not None:
             raise InputError("--result: only for an iNES image (a test ROM's result byte)")
         options.pop("result", None)
-        return run_c64_program(path, entry=entry, load=load, scene=scene, cpu=cpu, **options)
-    for name, value in (("--load", load), ("--scene", scene), ("--entry", entry)):
-        if value is not None:
-            raise InputError(f"{name}: not for a cartridge run from reset ({path} is an iNES image run without --entry)")
-    if cpu is not None and variant_named(cpu, "--cpu") != "2a03":
-        raise InputError(f"--cpu {cpu}: {path} is an iNES image: a console runs it on the 2A03")
-    return run_console(path, **options)
+        report = run_c64_program(path, entry=entry, load=load, scene=scene, cpu=cpu, wrap=wrap, **options)
+    else:
+        for name, value in (("--load", load), ("--scene", scene), ("--entry", entry)):
+            if value is not None:
+                raise InputError(f"{name}: not for a cartridge run from reset ({path} is an iNES image run without "
+                                 f"--entry)")
+        if cpu is not None and variant_named(cpu, "--cpu") != "2a03":
+            raise InputError(f"--cpu {cpu}: {path} is an iNES image: a console runs it on the 2A03")
+        report = run_console(path, wrap=wrap, **options)
+    if wrap is not None:
+        report.tracer = wrap.made[0]
+    return report
 
 
 def _cpu(cpu: str | None, program, path) -> str | None:
@@ -278,7 +330,46 @@ def console_json(report: ConsoleRun) -> dict:
             "cycles": report.cycles, "instructions": report.instructions, "halt_pc": report.halt_pc,
             "cpu": _cpu_state(mpu), "ppu": ppu_registers(report.ppu),
             "ram": bytes(memory[:RAM_END]).hex(), "prg_ram": bytes(memory[PRG_RAM_START:PRG_RAM_END]).hex(),
-            "peek": report.peeks, "verdict": report.verdict.as_dict() if report.verdict else None}
+            "peek": report.peeks, "verdict": report.verdict.as_dict() if report.verdict else None,
+            **_watch_json(report)}
+
+
+def _watch_json(report) -> dict:
+    """With --watch: the hits (and whether there were more than were kept)."""
+    tracer = report.tracer
+    if tracer is None or not tracer.watches:
+        return {}
+    return {"watch_hits": tracer.hits, "watch_hits_cut": tracer.hits_cut}
+
+
+def program_trace_lines(report, as_json_lines: bool) -> list[str]:
+    """A program run's trace: text lines, or one JSON object per step."""
+    import json
+
+    from retro.analysis.trace import entry_text
+
+    tracer = report.tracer
+    if as_json_lines:
+        out = [json.dumps(e) for e in tracer.entries]
+    else:
+        out = [entry_text(e, "") for e in tracer.entries]
+    if tracer.cut:
+        cut = f"the trace reached its limit of {tracer.bounds.limit:,} steps; the run went on untraced"
+        out.append(json.dumps({"note": cut}) if as_json_lines else f"... {cut}")
+    return out
+
+
+def watch_lines(report) -> list[str]:
+    from retro.analysis.trace import hit_text
+
+    tracer = report.tracer
+    if tracer is None or not tracer.watches:
+        return []
+    unit = "line" if isinstance(report, C64Run) else "scanline"
+    out = [hit_text(h, unit) for h in tracer.hits] or ["watch: no hit"]
+    if tracer.hits_cut:
+        out.append("watch: more hits than were kept")
+    return out
 
 
 def _cpu_state(mpu) -> dict:
@@ -290,7 +381,8 @@ def c64_json(report: C64Run) -> dict:
     return {"entry": report.entry, "sys_line": report.sys_line, "stopped": report.stopped,
             "frames": round(report.frames_run, 3), "cycles": report.cycles, "instructions": report.instructions,
             "halt_pc": report.halt_pc, "cpu": _cpu_state(report.machine.mpu), "vic": vic_registers(report.vic),
-            "ram": bytes(report.machine.memory).hex(), "peek": report.peeks, "notes": list(report.notes)}
+            "ram": bytes(report.machine.memory).hex(), "peek": report.peeks, "notes": list(report.notes),
+            **_watch_json(report)}
 
 
 def c64_lines(report: C64Run) -> list[str]:
@@ -308,7 +400,7 @@ def c64_lines(report: C64Run) -> list[str]:
            f"$D01F=${vic['d01f']:02X}"]
     out += [f"{target}: " + " ".join(f"${v:02X}" for v in values) for target, values in report.peeks.items()]
     out += [f"note: {note}" for note in report.notes]
-    return out
+    return out + watch_lines(report)
 
 
 def console_lines(report: ConsoleRun) -> list[str]:
@@ -327,7 +419,7 @@ def console_lines(report: ConsoleRun) -> list[str]:
         out.append(f"verdict: {report.verdict.summary()}")
         if report.verdict.protocol == "$6000":
             out += [f"  {line}".rstrip() for line in report.verdict.text.splitlines()]
-    return out
+    return out + watch_lines(report)
 
 
 def as_json(report: RunReport | ConsoleRun | C64Run) -> dict:
@@ -413,7 +505,15 @@ def add_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scene", metavar="SCENE.toml", help="attach a VIC-II or NES PPU scene to the machine")
     p.add_argument("--cpu", metavar="CPU", help="the CPU: 6510 (default), 2a03 (an iNES image's) or 65c02 (WDC)")
     output = p.add_mutually_exclusive_group()  # the JSON object's keys are fixed: no room for a trace
-    output.add_argument("--trace", action="store_true", help="print every instruction executed")
+    output.add_argument("--trace", action="store_true", help="print every instruction executed (a program run: with "
+                        "registers, flags, memory read and written and the beam position; needs a bound below)")
+    p.add_argument("--trace-json", action="store_true", help="program run: the trace as JSON lines, one per step")
+    p.add_argument("--trace-limit", metavar="N", help="program run: trace at most N steps")
+    p.add_argument("--trace-cycles", metavar="FROM-TO", help="program run: trace only these cycles of the run")
+    p.add_argument("--trace-pc", metavar="LOW-HIGH", help="program run: trace only instructions at these addresses")
+    p.add_argument("--watch", dest="watches", action="append", default=[], metavar="KIND:ADDR[-ADDR][=V]",
+                   help="program run: report every read (r), write (w), read or write (rw) or execution (x) of an "
+                        "address or range (a label or number), only of value V if given; repeatable")
     output.add_argument("--json", action="store_true", help="print one JSON object")
 
 
@@ -422,10 +522,21 @@ def main(args: argparse.Namespace) -> int:
     if args.entry is None or wants_program_run(args.program, console):
         report = run_console_or_refuse(args.program, labels=args.labels, peeks=args.peeks, load=args.load,
                                        scene=args.scene, trace=args.trace, cpu=args.cpu, entry=args.entry,
+                                       trace_json=args.trace_json, trace_limit=args.trace_limit,
+                                       trace_cycles=args.trace_cycles, trace_pc=args.trace_pc, watches=args.watches,
                                        **{k: v for k, v in console.items() if v is not None})
+        if args.trace or args.trace_json:
+            for line in program_trace_lines(report, args.trace_json):
+                print(line)
         options.show(lines, as_json if args.json else None, report)
         return 1 if getattr(report, "verdict", None) is not None and report.verdict.passed is False else 0
     refuse_console_options(console)
+    for name, value in (("--trace-json", args.trace_json or None), ("--trace-limit", args.trace_limit),
+                        ("--trace-cycles", args.trace_cycles), ("--trace-pc", args.trace_pc),
+                        ("--watch", args.watches or None)):
+        if value is not None:
+            raise InputError(f"{name}: for a program run (--frames, --until, --until-value, or no --entry); a "
+                             f"call's --trace lists every instruction")
     flags = {flag: getattr(args, flag) for flag in SETTABLE_FLAGS if getattr(args, flag) is not None}
     report = run(args.program, args.entry, labels=args.labels, load=args.load, a=args.a, x=args.x, y=args.y,
                  flags=flags, sets=args.sets, peeks=args.peeks, budget=args.budget, scene=args.scene,

@@ -157,3 +157,19 @@ def test_ctrl_c_ends_the_run_with_the_report_so_far(tmp_path, monkeypatch):
     assert report.stopped == "interrupted"
     assert 29780 <= report.cycles < 2 * 29781
     assert "interrupted (Ctrl-C)" in "\n".join(run.lines(report))
+
+
+def test_a_traced_cartridge_shows_scanline_and_dot_and_a_watch_sees_the_write(tmp_path, capsys):
+    # INC $10 / JMP $C000: 5 + 3 cycles a turn, 3 dots a CPU cycle
+    path = cartridge(tmp_path, [0xE6, 0x10, 0x4C, 0x00, 0xC0])
+    code, out, _ = cli(path, "--frames", "1", "--trace-json", "--trace-limit", "3", "--watch", "w:$10=3",
+                       "--json", capsys=capsys)
+    lines = out.splitlines()
+    steps = [json.loads(line) for line in lines[:3]]
+    assert code == 0 and [(s["line"], s["at"]) for s in steps] == [(0, 0), (0, 15), (0, 24)]
+    assert steps[0]["writes"] == [[0x10, 1]] and steps[0]["op"] == "INC $10"
+    report = json.loads(lines[-1])
+    hits = report["watch_hits"]   # $10 holds 3 again every 256 turns: 3722 turns in a frame
+    assert len(hits) == 15 and all(h["value"] == 3 and h["op"] == "INC $10" for h in hits)
+    assert (hits[0]["cycle"], hits[0]["line"], hits[0]["at"]) == (16, 0, 48)
+    assert hits[1]["cycle"] - hits[0]["cycle"] == 256 * 8
