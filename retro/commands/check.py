@@ -170,6 +170,11 @@ def format_coverage(check: RoutineCheck) -> str:
     return "; ".join(parts)
 
 
+def _check_html(check: RoutineCheck) -> str:
+    """A check in a notebook: the report `retro check` prints."""
+    return options.pre_html(format_check(check))
+
+
 def format_check(check: RoutineCheck) -> list[str]:
     """One routine's check as the lines `retro check` prints."""
     t = check.totals
@@ -327,3 +332,7 @@ def main(args: argparse.Namespace) -> int:
     if args.junit:
         write_junit(checks, args.junit, scene=args.scene)
     return 1 if failed(checks) else 0
+
+
+# RoutineCheck (retro.analysis.check) knows no text: its notebook display is the report written here.
+RoutineCheck._repr_html_ = _check_html

@@ -36,6 +36,16 @@ class ProfileReport:
     run: object  # the C64Run / ConsoleRun / CallResult behind it (None for a spec's cases)
     png: Path | None = None
 
+    # in a notebook (Jupyter): the table and, with a beam, the picture
+    def _repr_html_(self) -> str:
+        return options.pre_html(lines(self))
+
+    def _repr_png_(self) -> bytes | None:
+        if self.profile.beam is None:
+            return None
+        from retro.render.profile_image import profile_image
+        return options.png_of(profile_image(self.profile))
+
 
 def _profiler_for(machine, inner=None) -> Profiler:
     vic, ppu = vic_of(machine), ppu_of(machine)

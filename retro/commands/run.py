@@ -45,6 +45,9 @@ class RunReport:
     machine: Machine
     raster: RasterBudget | None  # where on the beam the call ran, with a VIC-II scene
 
+    def _repr_html_(self) -> str:  # in a notebook: the report, the trace listing first when traced
+        return options.pre_html(lines(self))
+
 
 def status_with_flags(flags: dict[str, int | str] | None) -> int:
     """The P register to enter with: the default, with each named flag (n v d i z c) set to 0 or 1."""
@@ -515,6 +518,16 @@ def add_options(p: argparse.ArgumentParser) -> None:
                    help="program run: report every read (r), write (w), read or write (rw) or execution (x) of an "
                         "address or range (a label or number), only of value V if given; repeatable")
     output.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def _program_run_html(report) -> str:
+    """A program run in a notebook: its trace listing (when traced) and its report."""
+    traced = report.tracer is not None and report.tracer.bounds is not None
+    return options.pre_html((program_trace_lines(report, False) if traced else []) + lines(report))
+
+
+# The program runs' own modules (retro.analysis) know no text: the notebook display is this module's.
+C64Run._repr_html_ = ConsoleRun._repr_html_ = _program_run_html
 
 
 def main(args: argparse.Namespace) -> int:
