@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from retro.analysis.console_run import FRAMES_DONE, HALTED, INTERRUPTED, MAX_FRAMES, REACHED, VALUE_SEEN, _Stop, \
+from retro.analysis.console_run import FRAMES_DONE, HALTED, INTERRUPTED, MAX_FRAMES, REACHED, VALUE_SEEN, StopRun, \
     run_frames
 from retro.chips.vic.constants import PAL, REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT, VIC_BASE
 from retro.chips.vic.device import VicDevice
@@ -157,13 +157,13 @@ class _C64Watch:
             self.last = self.pc
         if pc == self.pc and (mpu.p & FLAG_I or self.vic.irq_next >= NEVER):
             self.halt_pc = pc
-            raise _Stop(HALTED)
+            raise StopRun(HALTED)
         if pc == RETURN_TRAP and mpu.sp == CALL_STACK_TOP:
-            raise _Stop(RETURNED)
+            raise StopRun(RETURNED)
         if pc == self.until:
-            raise _Stop(REACHED)
+            raise StopRun(REACHED)
         if self.until_value is not None and self.peek(self.until_value[0]) == self.until_value[1]:
-            raise _Stop(VALUE_SEEN)
+            raise StopRun(VALUE_SEEN)
 
 
 def c64_for(program: Program, scene: VicScene | None) -> Machine:

@@ -98,13 +98,15 @@ class ConsoleRun:
         return ppu_of(self.machine)
 
 
-class _Stop(Exception):
+class StopRun(Exception):
+    """Raised by a run's observer after the step that meets a stop condition (`reason`)."""
+
     def __init__(self, reason: str) -> None:
         self.reason = reason
 
 
 class _Watch:
-    """Observer of the run loop: raises _Stop after the instruction that meets a condition. `quiet()`
+    """Observer of the run loop: raises StopRun after the instruction that meets a condition. `quiet()`
     says whether no interrupt can come any more (then an instruction jumping to itself halts)."""
 
     def __init__(self, machine: Machine, until: int | None, until_value: tuple[int, int] | None,
@@ -126,16 +128,16 @@ class _Watch:
             op = self.memory[pc]
             if op == JMP_ABSOLUTE or op in BRANCH_OPCODES:
                 self.halt_pc = pc
-                raise _Stop(HALTED)
+                raise StopRun(HALTED)
         if pc == self.until:
-            raise _Stop(REACHED)
+            raise StopRun(REACHED)
         if self.until_value is not None and self.peek(self.until_value[0]) == self.until_value[1]:
-            raise _Stop(VALUE_SEEN)
+            raise StopRun(VALUE_SEEN)
 
 
 def run_frames(machine: Machine, end: int, frame_cycles: int, watch, after_frame=None) -> tuple[str, int]:
     """Run `machine` on from its state to machine cycle `end`, a frame at a time, with `watch` (an
-    observer raising _Stop) told of every step; `after_frame()` True ends the run (REPORTED).
+    observer raising StopRun) told of every step; `after_frame()` True ends the run (REPORTED).
     Returns (why it stopped, instructions run); Ctrl-C ends it as INTERRUPTED with the state so far."""
     instructions = 0
     frame_end = machine.cycle
@@ -144,7 +146,7 @@ def run_frames(machine: Machine, end: int, frame_cycles: int, watch, after_frame
             frame_end = min(end, frame_end + frame_cycles)
             try:
                 instructions += machine.run_on(frame_end - machine.cycle, observer=watch)
-            except _Stop as stop:
+            except StopRun as stop:
                 return stop.reason, instructions + machine.mpu.executed
             if after_frame is not None and after_frame():
                 return REPORTED, instructions

@@ -60,7 +60,7 @@ def _machine_name(machine) -> str:
 
 def _ba_low(machine):
     vic = vic_of(machine)
-    return None if vic is None else vic._bus.low
+    return None if vic is None else vic.bus.low
 
 
 def _is_spec(target: str) -> bool:
@@ -130,7 +130,7 @@ def _cases(target, *, scene, at_line, at_cycle, cases, seed) -> ProfileReport:
                 break
             writes, registers, p = runner.inputs_for_call(case)
             if runner.vic is not None:
-                runner._restart_beam()
+                runner.restart_beam()
             profiler.enter(runner.entry, sp=CALL_STACK_TOP)
             machine.call(runner.entry, **registers, p=p, memory={address: [v] for address, v in writes},
                          budget=runner.limit, observer=profiler)

@@ -271,7 +271,7 @@ class RoutineRunner:
         """(outputs in the spec's order, cycles) of one call."""
         writes, registers, p = self.inputs_for_call(case)
         if self.vic is not None:
-            self._restart_beam()
+            self.restart_beam()
             stolen = self.machine.mpu.stolen
         cycles, a, x, y, p = self.machine.call_fast(self.entry, writes, **registers, p=p, budget=self.limit,
                                                     record=record, pointer_pcs=self.pointer_pcs)
@@ -279,7 +279,7 @@ class RoutineRunner:
             self.last_stolen = self.machine.mpu.stolen - stolen
         return self.outputs(a, x, y, p), cycles
 
-    def _restart_beam(self) -> None:
+    def restart_beam(self) -> None:
         self.vic.restart(self.machine.cycle, self.start.line, self.start.cycle, drawn=True)
         self.machine.mpu.ba_high_until = -1  # the CPU's note of how long BA stays high was for the old beam
 
@@ -307,6 +307,13 @@ class RoutineRunner:
     def engine_reason(self) -> str | None:
         """Why the batched core may or may not run the calls with the scene (None without a scene)."""
         return None if self.vic is None else self.chip_verdict[1]
+
+    @functools.cached_property
+    def bus_stalls(self) -> BusStalls:
+        """The VIC-II's stalls per lane from the start line and cycle (the scene's BA schedule)."""
+        video = self.vic.video
+        start = self.start.line * video.cycles_per_line + self.start.cycle - 1
+        return BusStalls(self.vic.bus.wait, start, self.machine.mpu.write_masks)
 
     @functools.cached_property
     def chip_verdict(self) -> tuple[bool, str]:
@@ -347,9 +354,7 @@ class RoutineRunner:
         cpu.p[:] = (p | FLAG_U) & ~FLAG_B  # as Machine sets P
         cpu.sp[:] = stack_pointer
         if self.vic is not None:  # the scene's timeline: each lane stalls as Machine would from the start
-            video = self.vic.video
-            start = self.start.line * video.cycles_per_line + self.start.cycle - 1
-            cpu.bus_stall = BusStalls(self.vic._bus.wait, start, self.machine.mpu.write_masks)
+            cpu.bus_stall = self.bus_stalls
         cpu.call(self.entry, self.limit, RETURN_TRAP, CALL_STACK_TOP)
         outputs = port_values(self.routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,
                               widen=lambda lanes: np.asarray(lanes, dtype=np.int64),
@@ -364,7 +369,7 @@ class RoutineRunner:
         """The same call with the instruction trace (for the report of a failing case)."""
         writes, registers, p = self.inputs_for_call(case)
         if self.vic is not None:
-            self._restart_beam()
+            self.restart_beam()
         return self.machine.call(self.entry, **registers, p=p, memory={address: [v] for address, v in writes},
                                  budget=self.limit, trace=True)
 

@@ -207,6 +207,11 @@ class VicDevice:
         found = [c for c in candidates if c is not None]
         self.irq_next = self.start_cycle + min(found) if found else NEVER
 
+    @property
+    def bus(self):
+        """The BA schedule of the current register state (retro.chips.vic.dma.BusSchedule)."""
+        return self._bus
+
     def catch_up(self, cycle: int) -> None:
         """Apply everything the beam draws before machine cycle `cycle` (the state a report shows)."""
         self._advance(self.time(cycle))
