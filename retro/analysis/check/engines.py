@@ -13,7 +13,7 @@ from retro.cpu.timing import model_cycles
 from retro.analysis.check.results import describe_outputs
 from retro.errors import InputError, RunError
 from retro.routines import cases as case_sets
-from retro.routines.runner import NEEDS_A_VIC_SCENE, RasterStart, RoutineRunner, row_of
+from retro.routines.runner import RasterStart, RoutineRunner, row_of
 from retro.routines.spec import Routine, load_spec
 
 ENGINES = ("auto", "scalar", "batch")
@@ -55,7 +55,8 @@ class SceneStart:
 
         scene = load_scene(self.scene)
         if not isinstance(scene, VicScene):
-            raise InputError(f"--scene {self.scene}: {NEEDS_A_VIC_SCENE}")
+            raise InputError(f"--scene {self.scene}: a spec's cases run on a VIC-II scene's timeline only (a NES "
+                             f"scene goes with one call: retro run FILE --entry E --scene S, or retro profile)")
         line = scene.start_line if self.line is None else self.line
         cycle = scene.start_cycle if self.cycle is None else self.cycle
         video = scene.state.video
