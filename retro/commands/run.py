@@ -15,7 +15,7 @@ from retro.analysis.c64_run import RETURNED, C64Run, run_c64, vic_registers
 from retro.analysis.console_run import MAX_FRAMES, ConsoleRun, ppu_registers, run_cartridge
 from retro.chips.cartridge import read_nrom
 from retro.chips.ines import INES_MAGIC
-from retro.cpu.machine import DEFAULT_BUDGET, DEFAULT_FLAGS, JSR_CYCLES, MAX_BUDGET, CallResult, Machine
+from retro.cpu.machine import DEFAULT_BUDGET, DEFAULT_FLAGS, JSR_CYCLES, MAX_BUDGET, MAX_TRACE, CallResult, Machine
 from retro.cpu.mpu import FLAG_B, FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_U, FLAG_V, FLAG_Z
 from retro.cpu.variants import variant_named
 from retro.errors import InputError
@@ -44,6 +44,7 @@ class RunReport:
     peeks: dict[str, list[int]]  # TARGET as the user gave it (without :N) -> byte values
     machine: Machine
     raster: RasterBudget | None  # where on the beam the call ran, with a VIC-II scene
+    tracer: object = None  # with --trace-json or --watch: the retro.analysis.trace.Tracer of the call
 
     def _repr_html_(self) -> str:  # in a notebook: the report, the trace listing first when traced
         return options.pre_html(lines(self))
@@ -197,14 +198,17 @@ def refuse_console_options(given: dict) -> None:
                          f"a C64 program from its SYS line or --entry), not for a call")
 
 
-def _range(text: str | None, field: str, hi: int) -> tuple[int, int] | None:
-    """'LOW-HIGH' -> (low, high), each a number in 0..hi."""
+def _range(text: str | None, field: str, hi: int, resolve=None) -> tuple[int, int] | None:
+    """'LOW-HIGH' -> (low, high), each a number in 0..hi (or, with `resolve`, a label or address)."""
     if text is None:
         return None
     low, dash, high = str(text).partition("-")
     if not dash:
         raise InputError(f"{field} {text!r}: expected LOW-HIGH")
-    first, last = parse_int(low, field=field, lo=0, hi=hi), parse_int(high, field=field, lo=0, hi=hi)
+    if resolve is not None:
+        first, last = resolve(low.strip(), field), resolve(high.strip(), field)
+    else:
+        first, last = parse_int(low, field=field, lo=0, hi=hi), parse_int(high, field=field, lo=0, hi=hi)
     if last < first:
         raise InputError(f"{field} {text!r}: the range ends before it starts")
     return first, last
@@ -221,15 +225,15 @@ def trace_wrapper(path, *, trace: bool, trace_json: bool, trace_limit, trace_cyc
     from retro.analysis.trace import MAX_TRACE_LIMIT, TraceBounds, Tracer, parse_watch, ppu_position, vic_position
     from retro.machines.nes import ppu_of
 
+    resolver = Machine("6510")
+    resolver.load(load_program(path, symbols=file_option(labels, "--labels"), load=load))
     bounds = None
     if trace or trace_json:
         cycles = _range(trace_cycles, "--trace-cycles", MAX_BUDGET * 100)
-        pcs = _range(trace_pc, "--trace-pc", 0xFFFF) or (0, 0xFFFF)
+        pcs = _range(trace_pc, "--trace-pc", 0xFFFF, resolver.resolve) or (0, 0xFFFF)
         limit = None if trace_limit is None else parse_int(trace_limit, field="--trace-limit", lo=1, hi=MAX_TRACE_LIMIT)
         bounds = TraceBounds(limit, *(cycles or (None, None)), *pcs)
         bounds.check()
-    resolver = Machine("6510")
-    resolver.load(load_program(path, symbols=file_option(labels, "--labels"), load=load))
     parsed = tuple(parse_watch(w, resolver.resolve) for w in watches)
     made = []
 
@@ -281,7 +285,7 @@ def _cpu(cpu: str | None, program, path) -> str | None:
 def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None, load: int | str | None = None,
         a: int | str = 0, x: int | str = 0, y: int | str = 0, flags: dict[str, int | str] | None = None,
         sets: list[str] = (), peeks: list[str] = (), budget: int | str = DEFAULT_BUDGET,
-        scene: str | Path | None = None, trace: bool = False, cpu: str | None = None) -> RunReport:
+        scene: str | Path | None = None, trace: bool = False, cpu: str | None = None, wrap=None) -> RunReport:
     """Call `entry` of the program at `path` (as by JSR, through its RTS). `sets` are TARGET=V[,V...]
     stores before the call, `peeks` TARGET[:N] reads after it; `scene` attaches a VIC-II or NES scene;
     `cpu` ("6510", "2a03", "65c02") is the CPU to run on (default: the file's own, else the 6510)."""
@@ -308,7 +312,9 @@ def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None,
     for target in peek_counts:
         machine.resolve(target, f"--peek {target}")
     entry_address = machine.resolve(entry, "--entry")
-    result = machine.call(entry_address, **registers, p=status, memory=memory, budget=budget, trace=trace)
+    observer = None if wrap is None else wrap(machine, None)  # --trace-json / --watch (retro.analysis.trace)
+    result = machine.call(entry_address, **registers, p=status, memory=memory, budget=budget, trace=trace,
+                          observer=observer)
     values = {target: machine.peek(target, count) for target, count in peek_counts.items()}
     return RunReport(program=program, entry=entry_address, result=result, peeks=values, machine=machine,
                      raster=call_budget(machine, result))
@@ -368,7 +374,7 @@ def watch_lines(report) -> list[str]:
     tracer = report.tracer
     if tracer is None or not tracer.watches:
         return []
-    unit = "line" if isinstance(report, C64Run) else "scanline"
+    unit = "line" if vic_of(report.machine) is not None else "scanline"
     out = [hit_text(h, unit) for h in tracer.hits] or ["watch: no hit"]
     if tracer.hits_cut:
         out.append("watch: more hits than were kept")
@@ -434,7 +440,7 @@ def as_json(report: RunReport | ConsoleRun | C64Run) -> dict:
     r = report.result
     return {"cycles": r.cycles, "instructions": r.instructions, "a": r.a, "x": r.x, "y": r.y, "s": r.s, "p": r.p,
             "peek": report.peeks, **({"raster": report.raster.as_dict()} if report.raster else {}),
-            **({"notes": list(report.program.notes)} if report.program.notes else {})}
+            **({"notes": list(report.program.notes)} if report.program.notes else {}), **_watch_json(report)}
 
 
 def trace_lines(report: RunReport) -> list[str]:
@@ -471,7 +477,7 @@ def lines(report: RunReport | ConsoleRun | C64Run) -> list[str]:
                    f"{'; crosses a frame end' if budget.frames else ''})")
     out += [f"{target}: " + " ".join(f"${v:02X}" for v in values) for target, values in report.peeks.items()]
     out += [f"note: {note}" for note in report.program.notes]  # e.g. a symbol file's skipped lines
-    return out
+    return out + watch_lines(report)
 
 
 # The command line: this command's options and how it runs from them.
@@ -510,12 +516,13 @@ def add_options(p: argparse.ArgumentParser) -> None:
     output = p.add_mutually_exclusive_group()  # the JSON object's keys are fixed: no room for a trace
     output.add_argument("--trace", action="store_true", help="print every instruction executed (a program run: with "
                         "registers, flags, memory read and written and the beam position; needs a bound below)")
-    p.add_argument("--trace-json", action="store_true", help="program run: the trace as JSON lines, one per step")
-    p.add_argument("--trace-limit", metavar="N", help="program run: trace at most N steps")
-    p.add_argument("--trace-cycles", metavar="FROM-TO", help="program run: trace only these cycles of the run")
-    p.add_argument("--trace-pc", metavar="LOW-HIGH", help="program run: trace only instructions at these addresses")
+    p.add_argument("--trace-json", action="store_true", help="the trace as JSON lines, one per step (registers, "
+                   "flags, memory read and written, the beam)")
+    p.add_argument("--trace-limit", metavar="N", help="trace at most N steps")
+    p.add_argument("--trace-cycles", metavar="FROM-TO", help="trace only these cycles of the run")
+    p.add_argument("--trace-pc", metavar="LOW-HIGH", help="trace only instructions at these addresses (labels or numbers)")
     p.add_argument("--watch", dest="watches", action="append", default=[], metavar="KIND:ADDR[-ADDR][=V]",
-                   help="program run: report every read (r), write (w), read or write (rw) or execution (x) of an "
+                   help="report every read (r), write (w), read or write (rw) or execution (x) of an "
                         "address or range (a label or number), only of value V if given; repeatable")
     output.add_argument("--json", action="store_true", help="print one JSON object")
 
@@ -544,15 +551,21 @@ def main(args: argparse.Namespace) -> int:
         options.show(lines, as_json if args.json else None, report)
         return 1 if getattr(report, "verdict", None) is not None and report.verdict.passed is False else 0
     refuse_console_options(console)
-    for name, value in (("--trace-json", args.trace_json or None), ("--trace-limit", args.trace_limit),
-                        ("--trace-cycles", args.trace_cycles), ("--trace-pc", args.trace_pc),
-                        ("--watch", args.watches or None)):
-        if value is not None:
-            raise InputError(f"{name}: for a program run (--frames, --until, --until-value, or no --entry); a "
-                             f"call's --trace lists every instruction")
+    if args.trace and args.trace_json:
+        raise InputError("--trace, --trace-json: one of them (a call's --trace lists every instruction)")
+    # a call is bounded by its budget: --trace-json needs no bound of its own (the trace's own limit holds)
+    wrap = trace_wrapper(args.program, trace=False, trace_json=args.trace_json,
+                         trace_limit=args.trace_limit or (str(MAX_TRACE) if args.trace_json else None),
+                         trace_cycles=args.trace_cycles, trace_pc=args.trace_pc, watches=args.watches,
+                         labels=args.labels, load=args.load)
     flags = {flag: getattr(args, flag) for flag in SETTABLE_FLAGS if getattr(args, flag) is not None}
     report = run(args.program, args.entry, labels=args.labels, load=args.load, a=args.a, x=args.x, y=args.y,
                  flags=flags, sets=args.sets, peeks=args.peeks, budget=args.budget, scene=args.scene,
-                 trace=args.trace, cpu=args.cpu)
+                 trace=args.trace, cpu=args.cpu, wrap=wrap)
+    if wrap is not None:
+        report.tracer = wrap.made[0]
+        if args.trace_json:
+            for line in program_trace_lines(report, True):
+                print(line)
     options.show(lines, as_json if args.json else None, report)
     return 0

@@ -60,8 +60,25 @@ def test_watchpoints_report_hits_with_the_beam_and_the_instruction(tmp_path, cap
     (["--watch", "q:$C000"], "KIND:ADDR"),
     (["--trace", "--trace-pc", "$0900-$0800"], "ends before it starts"),
     (["--trace-limit", "5"], "bound a --trace"),
-    (["--entry", "$080D", "--watch", "w:$C000"], "for a program run"),
+    (["--entry", "$080D", "--trace", "--trace-json"], "one of them"),
+    (["--entry", "$080D", "--watch", "w:nowhere"], "unknown label"),
 ])
 def test_bad_input_is_one_line_exit_2(tmp_path, capsys, args, message):
     code, _, err = run(prg(tmp_path, [0x60]), *args, capsys=capsys)
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_a_call_traced_as_json_lines_and_watched(capsys):
+    from retro.paths import EXAMPLES_DIR
+
+    code, out, err = run(EXAMPLES_DIR / "raster_irq_250.s", "--entry", "main", "--scene",
+                       EXAMPLES_DIR / "raster_irq_250.toml", "--trace-json", "--trace-pc", "irq-$C0FF",
+                       "--watch", "r:$D01E", capsys=capsys)
+    steps = [json.loads(line) for line in out.splitlines() if line.startswith("{")]
+    assert code == 0, err
+    assert steps[0]["op"] == "PHA" and (steps[0]["line"], steps[0]["at"]) == (250, 14)
+    # S is $FD in the call (the return address at $01FF/$01FE); the IRQ pushed $01FD-$01FB: PHA writes $01FA
+    assert steps[0]["writes"] == [[0x01FA, steps[0]["a"]]]
+    read = next(s for s in steps if s["op"] == "LDA $D01E")
+    assert read["read"] == [0xD01E, 0x03] and read["a"] == 0x03   # sprites 0 and 1 met above line 250
+    assert "watch r:$D01E: read $D01E = $03" in out and "line 250" in out
