@@ -25,6 +25,7 @@ from retro.loaders.basic_stub import sys_line
 from retro.numbers import parse_int
 from retro.machines import build_machine
 from retro.machines.c64 import RasterBudget, call_budget, vic_of
+from retro.machines.nes import enter_nmi, ppu_of, vblank_budget
 from retro.program import Program
 from retro.scenes import load_scene
 from retro.scenes.vic import VicScene
@@ -45,6 +46,7 @@ class RunReport:
     machine: Machine
     raster: RasterBudget | None  # where on the beam the call ran, with a VIC-II scene
     tracer: object = None  # with --trace-json or --watch: the retro.analysis.trace.Tracer of the call
+    vblank: dict | None = None  # with --in-nmi: the NMI handler's vblank budget (retro.machines.nes.vblank_budget)
 
     def _repr_html_(self) -> str:  # in a notebook: the report, the trace listing first when traced
         return options.pre_html(lines(self))
@@ -285,7 +287,8 @@ def _cpu(cpu: str | None, program, path) -> str | None:
 def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None, load: int | str | None = None,
         a: int | str = 0, x: int | str = 0, y: int | str = 0, flags: dict[str, int | str] | None = None,
         sets: list[str] = (), peeks: list[str] = (), budget: int | str = DEFAULT_BUDGET,
-        scene: str | Path | None = None, trace: bool = False, cpu: str | None = None, wrap=None) -> RunReport:
+        scene: str | Path | None = None, trace: bool = False, cpu: str | None = None, wrap=None,
+        in_nmi: bool = False) -> RunReport:
     """Call `entry` of the program at `path` (as by JSR, through its RTS). `sets` are TARGET=V[,V...]
     stores before the call, `peeks` TARGET[:N] reads after it; `scene` attaches a VIC-II or NES scene;
     `cpu` ("6510", "2a03", "65c02") is the CPU to run on (default: the file's own, else the 6510)."""
@@ -313,11 +316,18 @@ def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None,
         machine.resolve(target, f"--peek {target}")
     entry_address = machine.resolve(entry, "--entry")
     observer = None if wrap is None else wrap(machine, None)  # --trace-json / --watch (retro.analysis.trace)
+    ppu = ppu_of(machine)
+    if in_nmi:
+        if ppu is None:
+            raise InputError("--in-nmi: needs a NES scene (--scene with chip = \"nes\")")
+        enter_nmi(machine)
+    start, dma_before = machine.cycle, ppu.dma_stalled if ppu is not None else 0
     result = machine.call(entry_address, **registers, p=status, memory=memory, budget=budget, trace=trace,
                           observer=observer)
+    vblank = vblank_budget(machine, start, result.cycles, dma_before) if in_nmi else None
     values = {target: machine.peek(target, count) for target, count in peek_counts.items()}
     return RunReport(program=program, entry=entry_address, result=result, peeks=values, machine=machine,
-                     raster=call_budget(machine, result))
+                     raster=call_budget(machine, result), vblank=vblank)
 
 
 STOP_REASONS = {
@@ -440,7 +450,8 @@ def as_json(report: RunReport | ConsoleRun | C64Run) -> dict:
     r = report.result
     return {"cycles": r.cycles, "instructions": r.instructions, "a": r.a, "x": r.x, "y": r.y, "s": r.s, "p": r.p,
             "peek": report.peeks, **({"raster": report.raster.as_dict()} if report.raster else {}),
-            **({"notes": list(report.program.notes)} if report.program.notes else {}), **_watch_json(report)}
+            **({"notes": list(report.program.notes)} if report.program.notes else {}), **_watch_json(report),
+            **({"vblank": report.vblank} if report.vblank else {})}
 
 
 def trace_lines(report: RunReport) -> list[str]:
@@ -475,6 +486,11 @@ def lines(report: RunReport | ConsoleRun | C64Run) -> list[str]:
         out.append(f"raster: line {budget.start_line} cycle {budget.start_cycle} -> line {budget.end_line} cycle "
                    f"{budget.end_cycle}, {budget.lines} lines ({budget.stolen} of the cycles stolen by the VIC-II"
                    f"{'; crosses a frame end' if budget.frames else ''})")
+    v = report.vblank
+    if v is not None:
+        out.append(f"vblank: the NMI handler ran from scanline {v['start_line']} dot {v['start_dot']} to scanline "
+                   f"{v['end_line']} dot {v['end_dot']}: {v['cycles']} cycles ({v['oam_dma_cycles']} of them OAM DMA), "
+                   f"{v['vblank_cycles_left']} cycles of vblank left before rendering starts (pre-render line)")
     out += [f"{target}: " + " ".join(f"${v:02X}" for v in values) for target, values in report.peeks.items()]
     out += [f"note: {note}" for note in report.program.notes]  # e.g. a symbol file's skipped lines
     return out + watch_lines(report)
@@ -513,6 +529,8 @@ def add_options(p: argparse.ArgumentParser) -> None:
                    help=f"stop the routine after this many cycles (default {DEFAULT_BUDGET:,}, at most {MAX_BUDGET:,})")
     p.add_argument("--scene", metavar="SCENE.toml", help="attach a VIC-II or NES PPU scene to the machine")
     p.add_argument("--cpu", metavar="CPU", help="the CPU: 6510 (default), 2a03 (an iNES image's) or 65c02 (WDC)")
+    p.add_argument("--in-nmi", action="store_true", help="with a NES scene: call the routine as the NMI handler, "
+                   "at the start of vblank, and report the vblank cycles it leaves (OAM DMA counted)")
     output = p.add_mutually_exclusive_group()  # the JSON object's keys are fixed: no room for a trace
     output.add_argument("--trace", action="store_true", help="print every instruction executed (a program run: with "
                         "registers, flags, memory read and written and the beam position; needs a bound below)")
@@ -561,7 +579,7 @@ def main(args: argparse.Namespace) -> int:
     flags = {flag: getattr(args, flag) for flag in SETTABLE_FLAGS if getattr(args, flag) is not None}
     report = run(args.program, args.entry, labels=args.labels, load=args.load, a=args.a, x=args.x, y=args.y,
                  flags=flags, sets=args.sets, peeks=args.peeks, budget=args.budget, scene=args.scene,
-                 trace=args.trace, cpu=args.cpu, wrap=wrap)
+                 trace=args.trace, cpu=args.cpu, wrap=wrap, in_nmi=args.in_nmi)
     if wrap is not None:
         report.tracer = wrap.made[0]
         if args.trace_json:

@@ -173,3 +173,22 @@ def test_a_traced_cartridge_shows_scanline_and_dot_and_a_watch_sees_the_write(tm
     assert len(hits) == 15 and all(h["value"] == 3 and h["op"] == "INC $10" for h in hits)
     assert (hits[0]["cycle"], hits[0]["line"], hits[0]["at"]) == (16, 0, 48)
     assert hits[1]["cycle"] - hits[0]["cycle"] == 256 * 8
+
+
+def test_an_nmi_handlers_vblank_budget_counts_oam_dma(tmp_path, capsys):
+    # the handler: LDA #$02 / STA $4014 (OAM DMA from page 2) / RTS, called at the start of vblank
+    source = tmp_path / "nmi.s"
+    source.write_text(".org $c000\nnmi:    lda #$02\n        sta $4014\n        rts\n")
+    scene = tmp_path / "s.toml"
+    scene.write_text('chip = "nes"\n[[oam]]\ny = 100\ntile = 0\nx = 100\n')
+    code = main(["run", str(source), "--entry", "nmi", "--scene", str(scene), "--in-nmi", "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    v = json.loads(out)["vblank"]
+    # entered 7 cycles (21 dots) after the vblank flag (line 241, dot 1): line 241 dot 22, CPU cycle 27,401
+    # of the frame; the pre-render line (261) starts at dot 89,001: 2,266 cycles of vblank for the handler
+    assert (v["start_line"], v["start_dot"]) == (241, 22)
+    assert v["oam_dma_cycles"] in (513, 514) and v["cycles"] == 2 + 4 + 6 + v["oam_dma_cycles"]
+    assert v["vblank_cycles_left"] == 2266 - v["cycles"]
+    code = main(["run", str(source), "--entry", "nmi", "--in-nmi"])
+    assert code == 2 and "--in-nmi: needs a NES scene" in capsys.readouterr().err
