@@ -25,6 +25,7 @@ $6000", and the sources of the 2005 ROMs, runtime/validation.a):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from retro.chips.cartridge import NromCartridge
@@ -85,6 +86,7 @@ class ConsoleRun:
     verdict: Verdict | None
     halt_pc: int | None = None  # where the program halted (HALTED)
     peeks: dict[str, list[int]] = field(default_factory=dict)  # filled by the command
+    tracer: object = None  # a retro.analysis.trace.Tracer that observed the run (--trace, --watch)
 
     @property
     def frames_run(self) -> float:
@@ -96,18 +98,22 @@ class ConsoleRun:
         return ppu_of(self.machine)
 
 
-class _Stop(Exception):
+class StopRun(Exception):
+    """Raised by a run's observer after the step that meets a stop condition (`reason`)."""
+
     def __init__(self, reason: str) -> None:
         self.reason = reason
 
 
 class _Watch:
-    """Observer of the run loop: raises _Stop after the instruction that meets a condition."""
+    """Observer of the run loop: raises StopRun after the instruction that meets a condition. `quiet()`
+    says whether no interrupt can come any more (then an instruction jumping to itself halts)."""
 
-    def __init__(self, machine: Machine, until: int | None, until_value: tuple[int, int] | None) -> None:
+    def __init__(self, machine: Machine, until: int | None, until_value: tuple[int, int] | None,
+                 quiet: Callable[[], bool]) -> None:
         self.memory = machine.bus.memory
         self.peek = machine.bus.peek
-        self.ppu = ppu_of(machine)
+        self.quiet = quiet
         self.until = until
         self.until_value = until_value
         self.pc = -1
@@ -118,15 +124,35 @@ class _Watch:
 
     def after(self, mpu) -> None:
         pc = mpu.pc
-        if pc == self.pc and not self.ppu.ctrl & CTRL_NMI:
+        if pc == self.pc and self.quiet():
             op = self.memory[pc]
             if op == JMP_ABSOLUTE or op in BRANCH_OPCODES:
                 self.halt_pc = pc
-                raise _Stop(HALTED)
+                raise StopRun(HALTED)
         if pc == self.until:
-            raise _Stop(REACHED)
+            raise StopRun(REACHED)
         if self.until_value is not None and self.peek(self.until_value[0]) == self.until_value[1]:
-            raise _Stop(VALUE_SEEN)
+            raise StopRun(VALUE_SEEN)
+
+
+def run_frames(machine: Machine, end: int, frame_cycles: int, watch, after_frame=None) -> tuple[str, int]:
+    """Run `machine` on from its state to machine cycle `end`, a frame at a time, with `watch` (an
+    observer raising StopRun) told of every step; `after_frame()` True ends the run (REPORTED).
+    Returns (why it stopped, instructions run); Ctrl-C ends it as INTERRUPTED with the state so far."""
+    instructions = 0
+    frame_end = machine.cycle
+    try:
+        while machine.cycle < end:
+            frame_end = min(end, frame_end + frame_cycles)
+            try:
+                instructions += machine.run_on(frame_end - machine.cycle, observer=watch)
+            except StopRun as stop:
+                return stop.reason, instructions + machine.mpu.executed
+            if after_frame is not None and after_frame():
+                return REPORTED, instructions
+    except KeyboardInterrupt:
+        return INTERRUPTED, instructions + machine.mpu.executed
+    return FRAMES_DONE, instructions
 
 
 def blargg_verdict(memory: list[int]) -> Verdict | None:
@@ -155,33 +181,26 @@ def result_byte_verdict(value: int, address: int, halted: bool) -> Verdict:
 
 
 def run_cartridge(cartridge: NromCartridge, *, frames: int, until: int | None = None,
-                  until_value: tuple[int, int] | None = None, result_at: int | None = None) -> ConsoleRun:
-    """Power on a console with `cartridge`, reset, and run up to `frames` frames (module docstring)."""
+                  until_value: tuple[int, int] | None = None, result_at: int | None = None, wrap=None) -> ConsoleRun:
+    """Power on a console with `cartridge`, reset, and run up to `frames` frames (module docstring).
+    `wrap(machine, watch)`: the observer to run with instead of the stop conditions' (a profiler)."""
     if not 1 <= frames <= MAX_FRAMES:
         raise InputError(f"--frames: {frames:,} is not a frame count in 1..{MAX_FRAMES:,}")
     machine = build_nes(cartridge=cartridge)
     entry = reset(machine)
-    watch = _Watch(machine, until, until_value)
+    ppu = ppu_of(machine)
+    watch = _Watch(machine, until, until_value, lambda: not ppu.ctrl & CTRL_NMI)
+    observer = watch if wrap is None else wrap(machine, watch)
     start = machine.cycle
-    end = start + math.ceil(frames * CPU_CYCLES_PER_FRAME)
-    stopped, instructions, verdict = FRAMES_DONE, 0, None
-    frame_end = start
-    try:
-        while machine.cycle < end:
-            frame_end = min(end, frame_end + math.ceil(CPU_CYCLES_PER_FRAME))
-            try:
-                instructions += machine.run_on(frame_end - machine.cycle, observer=watch)
-            except _Stop as stop:
-                instructions += machine.mpu.executed
-                stopped = stop.reason
-                break
-            verdict = blargg_verdict(machine.memory)
-            if verdict is not None and verdict.passed is not None:
-                stopped = REPORTED
-                break
-    except KeyboardInterrupt:
-        instructions += machine.mpu.executed
-        stopped = INTERRUPTED
+    verdicts: list[Verdict | None] = [None]
+
+    def reported() -> bool:
+        verdicts[0] = blargg_verdict(machine.memory)
+        return verdicts[0] is not None and verdicts[0].passed is not None
+
+    stopped, instructions = run_frames(machine, start + math.ceil(frames * CPU_CYCLES_PER_FRAME),
+                                       math.ceil(CPU_CYCLES_PER_FRAME), observer, reported)
+    verdict = verdicts[0]
     if verdict is None or verdict.passed is None:
         verdict = blargg_verdict(machine.memory) or verdict
     if result_at is not None and (verdict is None or verdict.protocol != "$6000"):

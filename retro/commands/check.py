@@ -26,6 +26,7 @@ from retro.reports.lcov import lcov_text
 from retro.reports.listing import listing_text
 from retro.routines import cases as case_sets
 from retro.routines.entry import EntryState
+from retro.routines.chip_access import FREE_REASON
 from retro.workers import MAX_WORKERS
 import argparse
 from retro.analysis.check import AGREEMENT_PER_PART, AUTO_BATCH_CASES
@@ -276,6 +277,11 @@ def format_coverage(check: RoutineCheck) -> str:
     return "; ".join(parts)
 
 
+def _check_html(check: RoutineCheck) -> str:
+    """A check in a notebook: the report `retro check` prints."""
+    return options.pre_html(format_check(check))
+
+
 def format_check(check: RoutineCheck) -> list[str]:
     """One routine's check as the lines `retro check` prints."""
     t = check.totals
@@ -294,6 +300,14 @@ def format_check(check: RoutineCheck) -> list[str]:
         lines.append("  code: not counted on the compiled engine (--engine batch counts what the cases ran)")
     if _search_line(check):
         lines.append(_search_line(check))
+    if check.start is not None and check.engine_reason:
+        if check.engine == "batch":
+            engine = "the batched core, each lane stalled as on the scene"
+        elif check.engine_reason.startswith(FREE_REASON):
+            engine = "Machine (--engine scalar, or too few cases for the batched core to pay)"
+        else:
+            engine = "Machine"
+        lines.append(f"  engine with the scene: {engine}: {check.engine_reason}")
     if t.cycles_count:
         lines += _cycle_lines(check)
     if routine.budget is not None:
@@ -564,3 +578,7 @@ def main(args: argparse.Namespace) -> int:
             write_junit(checks, args.junit, scene=args.scene)
         write_coverage_reports(checks, listing=args.listing, lcov=args.lcov, html=args.html, scene=args.scene)
     return 1 if failed(checks) else 0
+
+
+# RoutineCheck (retro.analysis.check) knows no text: its notebook display is the report written here.
+RoutineCheck._repr_html_ = _check_html

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from retro.chips.ppu.clock import first_cycle_seeing
 from retro.chips.ppu.constants import DOTS_PER_LINE
-from retro.commands import asm, chart, cycles, nes, parry, run, vic
+from retro.commands import asm, chart, cycles, nes, parry, profile, run, vic
 from retro.fileio import all_or_nothing, output_folder, write_atomic
 from retro.machines.c64 import interrupt_budgets
 from retro.paths import ASM_DIR, EXAMPLES_DIR
@@ -49,7 +49,10 @@ def raster_budget(out: Path) -> list[str]:
             f"the raster interrupt's handler ran from line {handler.start_line} cycle {handler.start_cycle} to line "
             f"{handler.end_line} cycle {handler.end_cycle}: {handler.cycles} cycles, {handler.stolen} stolen by the "
             f"VIC-II, {handler.lines} lines; ends before line {RASTER_DEADLINE}: "
-            f"{'yes' if handler.ends_before(RASTER_DEADLINE) else 'no'}"]
+            f"{'yes' if handler.ends_before(RASTER_DEADLINE) else 'no'}",
+            "its profile (retro profile examples/raster_irq_250.s --entry main --scene ... --png):",
+            *profile.lines(profile.profile(RASTER_PROGRAM, entry="main", scene=RASTER_SCENE,
+                                           png=out / "raster_irq_profile.png"))]
 
 
 def parry_sequence(out: Path) -> list[str]:
@@ -90,7 +93,8 @@ def speed_accuracy(out: Path) -> list[str]:
 STEPS: tuple[tuple[str, Callable[[Path], list[str]]], ...] = (
     ("Assemble and run a 6502 routine", assemble_and_run),
     ("VIC-II collision scene: $D01E/$D01F/$D019 and the overlap image", latch_scene),
-    ("Raster budget: a collision check in a raster interrupt, bad lines and sprite DMA included", raster_budget),
+    ("Raster budget: a collision check in a raster interrupt, bad lines and sprite DMA included, and its profile",
+     raster_budget),
     ("Parry pipeline: padded AABB window, SAT contact, MTV knock-back", parry_sequence),
     ("NES sprite-zero hit: model, picture, polling loop", sprite_zero),
     ("Collision routines: cross-checked results and cycles", routine_table),

@@ -26,6 +26,14 @@ class NesRun:
     overflow: SpriteOverflow
     png: Path | None  # the picture written, if one was asked for
 
+    # in a notebook (Jupyter): the sprite-zero picture and the report
+    def _repr_png_(self) -> bytes:
+        from retro.render.nes_image import sprite_zero_image
+        return options.png_of(sprite_zero_image(self.scene.ppu_state(), self.hit))
+
+    def _repr_html_(self) -> str:
+        return options.pre_html(lines(self))
+
 
 @all_or_nothing
 def nes(path: str | Path, *, png: str | Path | None = None, scale: int | str = 2) -> NesRun:

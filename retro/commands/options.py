@@ -22,6 +22,18 @@ def show(lines: Callable[..., Iterable[str]], to_json: Callable | None, result, 
             print(line)
 
 
+def pre_html(lines: Iterable[str]) -> str:
+    """A command's text as a notebook shows it (`_repr_html_`): the lines, escaped, in a <pre>."""
+    import html
+    return "<pre>" + html.escape("\n".join(lines)) + "</pre>"
+
+
+def png_of(image) -> bytes:
+    """A Pillow image as the PNG bytes a notebook shows (`_repr_png_`)."""
+    from retro.render.images import png_bytes
+    return png_bytes(image)
+
+
 def out(p: argparse.ArgumentParser, default: str) -> None:
     p.add_argument("--out", default=default, metavar="DIR", help=f"output folder (default: {default})")
 

@@ -40,6 +40,14 @@ class VicRun:
     pixels: bool = False  # list every overlap pixel in the answers
     per_frame: list[dict] | None = None  # with moving sprites and --frames N: what each frame showed
 
+    # in a notebook (Jupyter): the overlap picture and the latch report
+    def _repr_png_(self) -> bytes:
+        from retro.render.vic_image import overlap_image
+        return options.png_of(overlap_image(self.scene.state, self.report.collisions))
+
+    def _repr_html_(self) -> str:
+        return options.pre_html(lines(self))
+
 
 @all_or_nothing
 def vic(path: str | Path, *, frames: int | str = 1, png: str | Path | None = None, scale: int | str = 2,

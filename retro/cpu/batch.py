@@ -249,6 +249,11 @@ class BatchCpu:
         self.error = np.zeros(lanes, dtype=np.int8)
         self.error_pc = zeros.copy()
         self.instructions = 0  # group executions (one instruction run by a group of lanes)
+        # A chip's bus stalls (retro.routines.chip_access.BusStalls), or None: bus_stall(opcode, began,
+        # spent) -> cycles each lane waits in that instruction, added to its cycles and to `stolen`
+        self.bus_stall = None
+        self.stolen = np.zeros(lanes, dtype=np.int64)
+        self._began = np.zeros(lanes, dtype=np.int64)
 
     def _everyone(self) -> Lanes:
         return Lanes(self, slice(None), self.a.copy(), self.x.copy(), self.y.copy(), self.p.copy(), self.sp.copy(),
@@ -322,7 +327,11 @@ class BatchCpu:
         if handler is None:
             group.stop(pc, LaneError.JAM if opcode in JAM_OPCODES else LaneError.UNSTABLE)
             return
+        stall = self.bus_stall
+        if stall is not None:
+            self._began[group.ids] = group.cycles
         coverage = self.coverage
+        before = None  # the lanes' cycles before an instruction whose cost varies (coverage measures it)
         if coverage is not None and isinstance(pc, int):
             executed = coverage.executed
             executed[pc] = executed.get(pc, 0) + len(group)
@@ -333,19 +342,18 @@ class BatchCpu:
                     coverage.cycles_min.get(pc) != coverage.base[opcode]
                     or coverage.cycles_max.get(pc) != coverage.ceiling.get(opcode)):
                 before = group.cycles.copy()
-                result = handler(group, pc, lo, hi)
-                if not isinstance(result, list):
-                    spent = group.cycles - before
-                    coverage.cycles(pc, int(spent.min()), int(spent.max()))
-                    yield result, group
-                    return
-                yield from result
-                return
         result = handler(group, pc, lo, hi)
-        if isinstance(result, list):
-            yield from result
-        else:
-            yield result, group
+        if before is not None and not isinstance(result, list):
+            spent = group.cycles - before  # (stolen cycles come below: coverage counts the CPU's own)
+            coverage.cycles(pc, int(spent.min()), int(spent.max()))
+        parts = result if isinstance(result, list) else [(result, group)]
+        if stall is not None:
+            for _, lanes in parts:
+                began = self._began[lanes.ids]
+                delay = stall(opcode, began, lanes.cycles - began)
+                lanes.cycles += delay
+                self.stolen[lanes.ids] += delay
+        yield from parts
 
     def read(self, address: int) -> np.ndarray:
         """Every lane's byte at address."""

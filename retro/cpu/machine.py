@@ -197,10 +197,11 @@ class Machine:
 
     def call(self, entry: str | int, *, a: int = 0, x: int = 0, y: int = 0, p: int = DEFAULT_FLAGS,
              memory: dict | None = None, budget: int = DEFAULT_BUDGET, trace: bool = False,
-             enter: str = "jsr", s: int | None = None) -> CallResult:
+             enter: str = "jsr", s: int | None = None, observer=None) -> CallResult:
         """Run the routine at entry as if called by JSR; stop at its RTS (`enter` "irq" or "nmi": as
         the CPU enters an interrupt handler, the 7 cycles of its sequence counted; stop at its RTI).
         `s`: S at the routine's first instruction (default: `stack_top` - 2, an empty stack after the JSR).
+        `observer` (without `trace`) is told of every step as in `MPU6510.run` (a profile).
 
         Fails (RunError) on BRK, JAM or an unstable opcode, and when the routine needs more than
         `budget` cycles (a runaway routine is stopped as soon as it has used them).
@@ -219,8 +220,10 @@ class Machine:
         entries: list[TraceEntry] | None = [] if trace else None
         start = self._enter(address, a, x, y, p, enter, s)
         stolen_before = self.mpu.stolen
+        if entries is not None and observer is not None:
+            raise ValueError("Machine.call: a trace or an observer, not both")
         count = self._execute(RETURN_TRAP, return_s(s), start + budget,
-                              None if entries is None else _Tracer(self, entries))
+                              observer if entries is None else _Tracer(self, entries))
         cycles = self._returned(start, budget, count, return_s(s))
         mpu = self.mpu
         status = _status(mpu.p)

@@ -12,12 +12,14 @@ the address; nesdev wiki "APU", "Standard controller", "Open bus behavior").
 
 from __future__ import annotations
 
+import math
+
 from retro.chips.cartridge import PRG_START, NromCartridge
-from retro.chips.ppu.constants import OAMDMA, PPU_REGISTER_BASE, PPU_REGISTER_END
+from retro.chips.ppu.constants import DOTS_PER_LINE, OAMDMA, PPU_REGISTER_BASE, PPU_REGISTER_END, VBLANK_DOT, VBLANK_LINE
 from retro.chips.ppu.device import PpuDevice
 from retro.chips.ppu.state import PpuState
 from retro.cpu.machine import Machine
-from retro.cpu.mpu import FLAG_I, FLAG_U, RESET_VECTOR
+from retro.cpu.mpu import FLAG_I, FLAG_U, INTERRUPT_CYCLES, RESET_VECTOR
 
 CPU = "2a03"
 RAM_SIZE = 0x800                # 2 KiB at $0000-$07FF ...
@@ -122,3 +124,41 @@ def ppu_of(machine: Machine) -> PpuDevice | None:
     """The machine's PPU, or None on a machine without one."""
     device = machine.mpu.lines
     return device if isinstance(device, PpuDevice) else None
+
+
+# An NMI handler's first cycle when the NMI is taken at once: the vblank flag is set at line 241,
+# dot 1 (nesdev wiki "PPU frame timing") and the 7-cycle interrupt sequence (21 dots on NTSC) follows.
+# A handler entered later (the NMI waits for the current instruction to end) has that much less.
+VBLANK_START_DOT = VBLANK_LINE * DOTS_PER_LINE + VBLANK_DOT
+
+
+def enter_nmi(machine: Machine) -> int:
+    """Put the NES's PPU where an NMI handler starts: the clock so that the machine's next cycle is
+    the handler's first (VBLANK_START_DOT + the sequence, on a CPU cycle boundary), the vblank flag set and this
+    frame's NMI edge taken. Returns the dot of that cycle in the frame."""
+    ppu = ppu_of(machine)
+    ratio = ppu.video.dots_per_cpu_cycle
+    entry_dot = VBLANK_START_DOT + INTERRUPT_CYCLES * ratio
+    cycles = math.ceil(entry_dot / ratio)  # the first CPU cycle at or after that dot
+    ppu.start_clock(machine.cycle - cycles)
+    ppu.advance(ppu.dot_of(machine.cycle))
+    ppu.nmi_pending = False  # the edge of this vblank is the one being handled
+    ppu._refresh_nmi_next()
+    return ppu.dot_of(machine.cycle)
+
+
+def vblank_budget(machine: Machine, start: int, cycles: int, dma_before: int) -> dict:
+    """A call that began at machine cycle `start` (after `enter_nmi`) and took `cycles`: where it began
+    and ended (line, dot), the CPU cycles of vblank left when it returned (before the pre-render line,
+    where rendering starts; negative: it ran into it), and the cycles OAM DMA held the CPU."""
+    ppu = ppu_of(machine)
+    video = ppu.video
+    frame_dots = video.dots_per_frame
+    ratio = video.dots_per_cpu_cycle
+    first = ppu.dot_of(start) % frame_dots
+    end = ppu.dot_of(start + cycles) % frame_dots
+    rendering = video.pre_render_line * DOTS_PER_LINE
+    left = (rendering - ppu.dot_of(start + cycles)) * ratio.denominator // ratio.numerator
+    return {"start_line": first // DOTS_PER_LINE, "start_dot": first % DOTS_PER_LINE,
+            "end_line": end // DOTS_PER_LINE, "end_dot": end % DOTS_PER_LINE, "cycles": cycles,
+            "vblank_cycles_left": int(left), "oam_dma_cycles": ppu.dma_stalled - dma_before}

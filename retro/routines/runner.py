@@ -16,6 +16,7 @@ only on some paths reads the same on both engines); the `[memory]` blocks once a
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
@@ -35,6 +36,7 @@ from retro.cpu.machine import (
     push_return_trap,
     return_s,
 )
+from retro.chips.vic.constants import IRQ_SOURCES, REG_IRQ_ENABLE
 from retro.cpu.mpu import FLAG_B, FLAG_I, FLAG_U
 from retro.cpu.variants import VARIANTS
 from retro.cpu.timing import TimingError, timing_of, timing_table
@@ -43,6 +45,7 @@ from retro.fileio import read_text
 from retro.machines import build_machine
 from retro.machines.c64 import vic_of
 from retro.program import Program
+from retro.routines.chip_access import BusStalls, chip_free
 from retro.routines.entry import EntryState, variant_memory, variant_stack
 from retro.routines.sandbox import bytes_of
 from retro.routines.spec import Port, Routine, call_with
@@ -183,6 +186,7 @@ class BatchOutcome:
     outputs: list
     cycles: np.ndarray
     error: np.ndarray
+    stolen: np.ndarray | None = None  # per case, the cycles a scene's chip held the CPU (None: no chip)
     coverage: LaneCoverage | None = None
     mock_calls: list | None = None  # per case, the calls of the mocks the reference takes (retro.routines.world)
 
@@ -380,7 +384,8 @@ class ViaPlan:
 @dataclass(frozen=True)
 class RasterStart:
     """Run every call with a VIC-II scene on the bus and the beam at this line and cycle (the CPU
-    then stalls on Bad Lines and sprite DMA as on a real C64)."""
+    then stalls on Bad Lines and sprite DMA as on a real C64), the frame drawn so far in the
+    collision latches and $D019 (unread, unacknowledged)."""
 
     scene: VicScene
     line: int
@@ -478,7 +483,7 @@ class RoutineRunner:
         model must add for them and for an interrupt entry; `last_calls` holds the recorded mocks' calls."""
         writes, registers, p = self.inputs_for_call(case, entry)
         if self.vic is not None:
-            self._restart_beam()
+            self.restart_beam()
             stolen = self.machine.mpu.stolen
         located = self.plan.vias.outputs(case) if self.plan.vias is not None else None
         world = self.world
@@ -507,8 +512,8 @@ class RoutineRunner:
         """P at entry; an IRQ handler's pushed P has I clear (the CPU takes an IRQ only then)."""
         return p & ~FLAG_I if self.routine.world.enter == "irq" else p
 
-    def _restart_beam(self) -> None:
-        self.vic.restart(self.machine.cycle, self.start.line, self.start.cycle)
+    def restart_beam(self) -> None:
+        self.vic.restart(self.machine.cycle, self.start.line, self.start.cycle, drawn=True)
         self.machine.mpu.ba_high_until = -1  # the CPU's note of how long BA stays high was for the old beam
 
     def answer(self, case: Sequence) -> int:
@@ -527,8 +532,33 @@ class RoutineRunner:
 
     @property
     def batchable(self) -> bool:
-        """Whether the batched core can run this routine (it has no chips: not with a scene)."""
-        return self.vic is None and self.batch_refusal is None
+        """Whether the batched core can run this routine: without a scene, or with one when no call
+        can touch a chip register or be interrupted (`engine_reason` says why or why not)."""
+        return self.chip_verdict[0] and self.batch_refusal is None
+
+    @property
+    def engine_reason(self) -> str | None:
+        """Why the batched core may or may not run the calls with the scene (None without a scene)."""
+        return None if self.vic is None else self.chip_verdict[1]
+
+    @functools.cached_property
+    def bus_stalls(self) -> BusStalls:
+        """The VIC-II's stalls per lane from the start line and cycle (the scene's BA schedule)."""
+        video = self.vic.video
+        start = self.start.line * video.cycles_per_line + self.start.cycle - 1
+        return BusStalls(self.vic.bus.wait, start, self.machine.mpu.write_masks)
+
+    @functools.cached_property
+    def chip_verdict(self) -> tuple[bool, str]:
+        if self.vic is None:
+            return True, ""
+        memory = self.machine.memory
+        pages = frozenset(page for page, device in enumerate(self.machine.bus.page_devices) if device is not None)
+        interrupts = bool(self.vic.registers[REG_IRQ_ENABLE] & IRQ_SOURCES)
+        if interrupts and (not self.plan.base_flags & FLAG_I or any(bit == FLAG_I for _, bit in self.plan.flags)):
+            return False, "the scene enables VIC-II interrupts and I may be clear on entry"
+        return chip_free(memory.__getitem__, self.entry, (self.program.origin, self.program.end), pages,
+                         self.routine.cpu, interrupts)
 
     @property
     def batch_refusal(self) -> str | None:
@@ -556,7 +586,9 @@ class RoutineRunner:
                 first.coverage.merge(second.coverage, lane_offset=half)
             return BatchOutcome([np.concatenate(pair) for pair in zip(first.outputs, second.outputs)],
                                 np.concatenate([first.cycles, second.cycles]),
-                                np.concatenate([first.error, second.error]), coverage=first.coverage,
+                                np.concatenate([first.error, second.error]),
+                                None if first.stolen is None else np.concatenate([first.stolen, second.stolen]),
+                                coverage=first.coverage,
                                 mock_calls=None if first.mock_calls is None else first.mock_calls + second.mock_calls)
 
     def compiled(self):
@@ -654,6 +686,8 @@ class RoutineRunner:
             stop = return_s(fixed_s)
         if world is not None:
             world.stack_top = stop  # where an exit ends the call
+        if self.vic is not None:  # the scene's timeline: each lane stalls as Machine would from the start
+            cpu.bus_stall = self.bus_stalls
         cpu.call(self.entry, self.limit, RETURN_TRAP, stop)
         if world is not None:
             world.finish()
@@ -664,7 +698,8 @@ class RoutineRunner:
                               world=None if world is None else world.value, located=located,
                               read_at=lambda address: _every_lane(memory.read(slice(None), address), n))
         calls = world.recorded_calls() if world is not None and self.routine.world.recorded else None
-        return BatchOutcome(outputs, cpu.cycles, cpu.error, coverage=cpu.coverage, mock_calls=calls)
+        return BatchOutcome(outputs, cpu.cycles, cpu.error, cpu.stolen if self.vic is not None else None,
+                            coverage=cpu.coverage, mock_calls=calls)
 
     def outputs(self, a: int, x: int, y: int, p: int, located: dict | None = None) -> tuple:
         read = self.machine.memory.__getitem__
@@ -676,7 +711,7 @@ class RoutineRunner:
         """The same call with the instruction trace (for the report of a failing case)."""
         writes, registers, p = self.inputs_for_call(case)
         if self.vic is not None:
-            self._restart_beam()
+            self.restart_beam()
         if self.world is not None:
             self.world.reset(self.machine.cycle)
         return self.machine.call(self.entry, **registers, p=self._entry_p(p),

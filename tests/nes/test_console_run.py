@@ -117,7 +117,7 @@ def test_the_console_around_the_cpu(tmp_path, capsys):
     (["--frames", "0"], "--frames"),
     (["--until", "nowhere"], "unknown label"),
     (["--until-value", "$10=1,2"], "one byte"),
-    (["--entry", "$C000", "--frames", "3"], "only for an iNES image run from its reset vector"),
+    (["--entry", "$C000", "--frames", "3"], "only for a program run"),
     (["--scene", "x.toml"], "--scene"),
 ])
 def test_bad_options_are_one_line_exit_2(tmp_path, capsys, args, message):
@@ -129,7 +129,7 @@ def test_without_entry_a_non_cartridge_is_refused(tmp_path, capsys):
     path = tmp_path / "p.prg"
     path.write_bytes(bytes([0x00, 0xC0, 0x60]))
     code, _, err = cli(path, capsys=capsys)
-    assert code == 2 and "--entry: required" in err
+    assert code == 2 and "loads at $C000, not at BASIC's $0801" in err and "--entry" in err
 
 
 def test_other_mappers_are_refused_naming_the_file(tmp_path, capsys):
@@ -157,3 +157,38 @@ def test_ctrl_c_ends_the_run_with_the_report_so_far(tmp_path, monkeypatch):
     assert report.stopped == "interrupted"
     assert 29780 <= report.cycles < 2 * 29781
     assert "interrupted (Ctrl-C)" in "\n".join(run.lines(report))
+
+
+def test_a_traced_cartridge_shows_scanline_and_dot_and_a_watch_sees_the_write(tmp_path, capsys):
+    # INC $10 / JMP $C000: 5 + 3 cycles a turn, 3 dots a CPU cycle
+    path = cartridge(tmp_path, [0xE6, 0x10, 0x4C, 0x00, 0xC0])
+    code, out, _ = cli(path, "--frames", "1", "--trace-json", "--trace-limit", "3", "--watch", "w:$10=3",
+                       "--json", capsys=capsys)
+    lines = out.splitlines()
+    steps = [json.loads(line) for line in lines[:3]]
+    assert code == 0 and [(s["line"], s["at"]) for s in steps] == [(0, 0), (0, 15), (0, 24)]
+    assert steps[0]["writes"] == [[0x10, 1]] and steps[0]["op"] == "INC $10"
+    report = json.loads(lines[-1])
+    hits = report["watch_hits"]   # $10 holds 3 again every 256 turns: 3722 turns in a frame
+    assert len(hits) == 15 and all(h["value"] == 3 and h["op"] == "INC $10" for h in hits)
+    assert (hits[0]["cycle"], hits[0]["line"], hits[0]["at"]) == (16, 0, 48)
+    assert hits[1]["cycle"] - hits[0]["cycle"] == 256 * 8
+
+
+def test_an_nmi_handlers_vblank_budget_counts_oam_dma(tmp_path, capsys):
+    # the handler: LDA #$02 / STA $4014 (OAM DMA from page 2) / RTS, called at the start of vblank
+    source = tmp_path / "nmi.s"
+    source.write_text(".org $c000\nnmi:    lda #$02\n        sta $4014\n        rts\n")
+    scene = tmp_path / "s.toml"
+    scene.write_text('chip = "nes"\n[[oam]]\ny = 100\ntile = 0\nx = 100\n')
+    code = main(["run", str(source), "--entry", "nmi", "--scene", str(scene), "--in-nmi", "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    v = json.loads(out)["vblank"]
+    # entered 7 cycles (21 dots) after the vblank flag (line 241, dot 1): line 241 dot 22, CPU cycle 27,401
+    # of the frame; the pre-render line (261) starts at dot 89,001: 2,266 cycles of vblank for the handler
+    assert (v["start_line"], v["start_dot"]) == (241, 22)
+    assert v["oam_dma_cycles"] in (513, 514) and v["cycles"] == 2 + 4 + 6 + v["oam_dma_cycles"]
+    assert v["vblank_cycles_left"] == 2266 - v["cycles"]
+    code = main(["run", str(source), "--entry", "nmi", "--in-nmi"])
+    assert code == 2 and "--in-nmi: needs a NES scene" in capsys.readouterr().err

@@ -98,12 +98,17 @@ def test_a_call_that_does_not_return_stops_the_check_as_on_machine(tmp_path, cap
     assert without_engine(scalar) == without_engine(batched)
 
 
-def test_the_scene_runs_on_machine_only(tmp_path, capsys):
+def test_with_a_scene_a_routine_reading_a_chip_register_runs_on_machine_only(tmp_path, capsys):
     (tmp_path / "screen.toml").write_text('chip = "vic-ii"\nvideo = "pal"\n[registers]\n"$d011" = 0x1b\n')
-    spec = _one_input_spec(tmp_path, "        rts\n")
+    spec = _one_input_spec(tmp_path, "        lda $d012\n        rts\n")
     code = main(["check", spec, "--scene", str(tmp_path / "screen.toml"), "--at-line", "48", "--engine", "batch"])
     err = capsys.readouterr().err
-    assert code == 2 and "--engine batch" in err and err.count("\n") == 1
+    assert code == 2 and "--engine batch" in err and "reaches a chip register" in err and err.count("\n") == 1
+    (tmp_path / "free").mkdir()   # touches no chip: the batched core runs it (issue 25)
+    spec = _one_input_spec(tmp_path / "free", "        rts\n")
+    code = main(["check", spec, "--scene", str(tmp_path / "screen.toml"), "--at-line", "48", "--engine", "batch"])
+    out = capsys.readouterr().out
+    assert code == 0 and "engine with the scene: the batched core" in out
 
 
 def test_an_unknown_engine_is_refused(capsys):

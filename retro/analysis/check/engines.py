@@ -15,7 +15,7 @@ from retro.analysis.check.results import describe_outputs
 from retro.analysis.coverage_model import CodeCoverage
 from retro.errors import InputError, RunError
 from retro.routines import cases as case_sets
-from retro.routines.runner import NEEDS_A_VIC_SCENE, RasterStart, RoutineRunner, row_of
+from retro.routines.runner import RasterStart, RoutineRunner, row_of
 from retro.routines.spec import Routine, load_spec
 
 ENGINES = ("auto", "scalar", "batch", "compiled")
@@ -61,7 +61,8 @@ class SceneStart:
 
         scene = load_scene(self.scene)
         if not isinstance(scene, VicScene):
-            raise InputError(f"--scene {self.scene}: {NEEDS_A_VIC_SCENE}")
+            raise InputError(f"--scene {self.scene}: a spec's cases run on a VIC-II scene's timeline only (a NES "
+                             f"scene goes with one call: retro run FILE --entry E --scene S, or retro profile)")
         line = scene.start_line if self.line is None else self.line
         cycle = scene.start_cycle if self.cycle is None else self.cycle
         video = scene.state.video
@@ -161,6 +162,8 @@ def compiled_or_why(runner: RoutineRunner) -> str | None:
 
     if not runner.routine.world.empty:  # traps, scripted reads and interrupt entry live in the other engines
         return "the routine has a world ([mocks], [hardware], an interrupt entry or an exit), which it does not model"
+    if runner.vic is not None:
+        return "a scene: the VIC-II's stalls are modelled on Machine and the batched core only"
     if runner.plan.vias is not None or runner.plan.s_varies:
         return "inputs placed by the case (on the stack, in a table slot or behind a pointer), which it does not place"
     try:
@@ -221,7 +224,8 @@ def run_on_batched_core(runner: RoutineRunner, columns: list, confirm_stop: bool
         outcome = runner.run_batch(columns, coverage)
     stopped = np.flatnonzero(outcome.error)
     n = len(outcome.cycles)
-    block = CallBlock(outcome.outputs, outcome.cycles, np.zeros(n, dtype=np.int64), None,
+    stolen = outcome.stolen if outcome.stolen is not None else np.zeros(n, dtype=np.int64)
+    block = CallBlock(outcome.outputs, outcome.cycles, stolen, None,
                       int(stopped[0]) if len(stopped) else n, lane_errors=outcome.error,
                       coverage=from_lanes(outcome.coverage) if coverage else None, mock_calls=outcome.mock_calls,
                       fallbacks=fallbacks)

@@ -51,7 +51,7 @@ class RoutineCheck:
     start: RasterStart | None = None  # with --scene: the beam position every call started at
     engine: str = "scalar"  # which engine ran the cases: "scalar" (Machine), "batch" or "compiled"
     engine_note: str = ""  # why Machine ran a check the batched core was asked for or would have run
-    engine_reason: str = ""  # why that engine (the rule, the option, or why the compiled engine was refused)
+    engine_reason: str = ""  # why that engine (the rule, the option, the scene, or why the compiled engine was refused)
     compile_seconds: float | None = None  # the compiled engine: building or loading the routine's code
     agreement: Tally | None = None  # with the batched core: the cases also run on Machine
     rows: RowsCheck | None = None  # the spec's expected rows (retro.analysis.row_check)

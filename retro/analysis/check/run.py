@@ -67,17 +67,19 @@ def machine_chunk(spec: str, seed: int, cases: list[tuple], start: SceneStart | 
                                                  entry=entry))
 
 
-def batch_chunk(spec: str, seed: int, columns: list, first: int = 0, every: int = 0, engine: str = "batch") -> Tally:
+def batch_chunk(spec: str, seed: int, columns: list, first: int = 0, every: int = 0, engine: str = "batch",
+                start: SceneStart | None = None) -> Tally:
     """A column block on an array engine ("batch" or "compiled"), tallied (run in worker processes);
-    `first` and `every` as for machine_chunk (the entry-state runs are the batched core's)."""
-    runner = runner_for(spec, seed, None)
+    `first` and `every` as for machine_chunk (the entry-state runs are the batched core's); `start`:
+    the scene, whose stalls the batched core applies per lane."""
+    runner = runner_for(spec, seed, start)
     block = run_on_batched_core(runner, columns, engine=engine)
     entry = None
     if every:
-        entry = entry_block_on_batched_core(_variants(spec, seed, None), [c[:block.calls] for c in columns], first,
+        entry = entry_block_on_batched_core(_variants(spec, seed, start), [c[:block.calls] for c in columns], first,
                                             every, seed)
-    return _named(spec, seed, None, count_block(runner.routine, block, columns, None, runner.memory_values,
-                                                entry=entry))
+    return _named(spec, seed, start, count_block(runner.routine, block, columns, None, runner.memory_values,
+                                                 entry=entry))
 
 
 def _variants(spec: str, seed: int, start: SceneStart | None) -> dict[str, RoutineRunner]:
@@ -102,10 +104,11 @@ def _named(spec: str, seed: int, start: SceneStart | None, tally: Tally) -> Tall
     return tally
 
 
-def agreement_chunk(spec: str, seed: int, cases: list[tuple], engine: str = "batch") -> Tally:
+def agreement_chunk(spec: str, seed: int, cases: list[tuple], engine: str = "batch",
+                    start: SceneStart | None = None) -> Tally:
     """Cases on both engines: Machine's tally (timing model included), its block compared with the
     array engine's call for call."""
-    runner = runner_for(spec, seed, None)
+    runner = runner_for(spec, seed, start)
     columns = case_sets.cases_to_columns(runner.routine, cases)
     against = run_on_batched_core(runner, columns, confirm_stop=False, coverage=False, engine=engine)
     return count_block(runner.routine, run_on_machine(runner, cases, coverage=False), columns, cases,
@@ -174,12 +177,13 @@ def _reporter(routine: Routine, totals: Tally, known: int, unknown: bool,
     return report
 
 
-def _agreement(spec: str, seed: int, parts: list[case_sets.Part], engine: str) -> Tally:
+def _agreement(spec: str, seed: int, parts: list[case_sets.Part], engine: str,
+               start: SceneStart | None = None) -> Tally:
     """Machine first: the reference engine's verdict on a prefix of every part, both engines compared."""
     agreement = Tally()
     for part in parts:
         for chunk in case_sets.chunks(islice(part.cases, AGREEMENT_PER_PART)):
-            agreement.merge(agreement_chunk(spec, seed, chunk, engine))
+            agreement.merge(agreement_chunk(spec, seed, chunk, engine, start))
             if agreement.run_errors:
                 break
     return agreement
@@ -226,13 +230,15 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     if refusal is not None and batched(engine, None if unknown else known, True, AUTO_BATCH_CASES):
         engine_note = f"Machine ran the calls: {refusal}"  # the batched core would have: say why not
     elif engine in ("batch", "compiled") and not on_batch:
-        raise InputError(f"--engine {engine}: with --scene the calls run on Machine (the batched core and the "
-                         f"compiled engine model no chips); use --engine scalar or auto")
-    used, reason = ("scalar", "with --scene the calls run on Machine" if start is not None else
+        raise InputError(f"--engine {engine}: with --scene the calls of {routine.name} run on Machine "
+                         f"({runner.engine_reason}); use --engine scalar or auto")
+    used, reason = ("scalar", runner.engine_reason if start is not None else
                     engine_note or (f"{engine}: {known:,} planned calls" if engine == "auto" else f"--engine {engine}"))
     compile_seconds = None
     if on_batch:
         used, reason = array_engine(engine, None if unknown else known)
+        if start is not None:
+            reason = runner.engine_reason
         if used == "compiled":
             refused = compiled_or_why(runner)
             if refused is not None:
@@ -247,18 +253,20 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
         report(rows_totals)
         if totals.run_errors:  # a row's call that stopped stops the check
             parts = []
-    agreement = _agreement(spec, seed, parts, used) if on_batch else None
+    agreement = _agreement(spec, seed, parts, used, start) if on_batch else None
     every = entry_every(known, exhaustive, bounded_product, unknown) if entry_state and parts else 0
-    work = (((batch_chunk, (spec, seed, block, first, every, used)) for block, first in _blocks(parts)) if on_batch
-            else ((machine_chunk, (spec, seed, chunk, start, first, every)) for chunk, first in _chunks(parts)))
+    work = (((batch_chunk, (spec, seed, block, first, every, used, start)) for block, first in _blocks(parts))
+            if on_batch else
+            ((machine_chunk, (spec, seed, chunk, start, first, every)) for chunk, first in _chunks(parts)))
     _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
     searched = _search(spec, seed, runner, on_batch, totals, search_budget)
     if searched.found:  # the search's cases, checked like every other case
         found = case_sets.cases_to_columns(routine, searched.found)
         parts.append(case_sets.Part("search", len(searched.found), len(searched.found), lambda: iter([found])))
         if on_batch:
-            agreement.merge(_agreement(spec, seed, parts[-1:], "batch"))
-        work = (((batch_chunk, (spec, seed, block)) for block in case_sets.batches(parts[-1:], BATCH_LANES))
+            agreement.merge(_agreement(spec, seed, parts[-1:], "batch", start))
+        work = (((batch_chunk, (spec, seed, block, 0, 0, "batch", start))
+                 for block in case_sets.batches(parts[-1:], BATCH_LANES))
                 if on_batch else ((machine_chunk, (spec, seed, chunk, start)) for chunk, _ in _chunks(parts[-1:])))
         _run_work(work, 1, report, lambda: totals.run_errors)
     require_inside(f"{routine.spec_path}: cases.where", routine.domain, totals.cases, totals.outside,

@@ -128,6 +128,7 @@ class PpuDevice:
         self.sprite_overflow = False
         self.read_memory = read_memory or (lambda address: 0)
         self.stall = stall or (lambda cycles: None)
+        self.dma_stalled = 0            # CPU cycles OAM DMA has held the CPU so far
         # clock
         self.origin = origin
         self.frame = 0
@@ -460,4 +461,6 @@ class PpuDevice:
         base = page * PAGE_SIZE
         for i in range(OAM_SIZE):
             self.oam[(self.oam_addr + i) & 0xFF] = self.read_memory(base + i)
-        self.stall(OAM_DMA_CYCLES + (OAM_DMA_ODD_EXTRA if cycle % 2 else 0))
+        stalled = OAM_DMA_CYCLES + (OAM_DMA_ODD_EXTRA if cycle % 2 else 0)
+        self.dma_stalled += stalled
+        self.stall(stalled)

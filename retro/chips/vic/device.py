@@ -111,26 +111,33 @@ class VicDevice:
     nmi_next = NEVER  # the VIC-II has no NMI output
 
     @classmethod
-    def at_beam(cls, state: VicState, cycle: int, line: int = 0, line_cycle: int = 1) -> "VicDevice":
+    def at_beam(cls, state: VicState, cycle: int, line: int = 0, line_cycle: int = 1, *,
+                drawn: bool = False) -> "VicDevice":
         """A device whose beam is at `line`, cycle `line_cycle` (1-based) at machine cycle `cycle`.
 
-        Nothing is taken to have happened earlier in that frame (no raster compare, no collision).
+        With `drawn`, the frame so far has been drawn with this state since its line 0, cycle 1: its
+        collisions are in $D01E/$D01F (unread since) and its raster compare and collision events in
+        $D019 (unacknowledged), as the machine would have them. Without it nothing is taken to have
+        happened earlier in that frame (no raster compare, no collision).
         """
         video = state.video
         if not 0 <= line < video.lines or not 1 <= line_cycle <= video.cycles_per_line:
             raise ValueError(f"no line {line}, cycle {line_cycle} on the {video.chip}")
         offset = line * video.cycles_per_line + line_cycle - 1
         device = cls(state, start_cycle=cycle - offset)
-        device.synced = offset
-        device._refresh_irq_next()
+        if drawn:
+            device._advance(offset)
+        else:
+            device.synced = offset
+            device._refresh_irq_next()
         return device
 
-    def restart(self, cycle: int, line: int, line_cycle: int = 1) -> None:
+    def restart(self, cycle: int, line: int, line_cycle: int = 1, *, drawn: bool = False) -> None:
         """Back to the scene's registers with the beam at `line`, `line_cycle` at machine cycle `cycle`,
         as `at_beam` makes it (for runs of many calls that each start at the same raster position).
         The bus keeps this object, so its state is replaced in place; the collision cache is kept."""
         schedules = self._schedules
-        fresh = type(self).at_beam(self.state, cycle, line, line_cycle)
+        fresh = type(self).at_beam(self.state, cycle, line, line_cycle, drawn=drawn)
         self.__dict__.update(fresh.__dict__)
         self._schedules.update(schedules)
 
@@ -200,6 +207,15 @@ class VicDevice:
             candidates.append(_next_event(events.sb_times, after, frame_cycles))
         found = [c for c in candidates if c is not None]
         self.irq_next = self.start_cycle + min(found) if found else NEVER
+
+    @property
+    def bus(self):
+        """The BA schedule of the current register state (retro.chips.vic.dma.BusSchedule)."""
+        return self._bus
+
+    def catch_up(self, cycle: int) -> None:
+        """Apply everything the beam draws before machine cycle `cycle` (the state a report shows)."""
+        self._advance(self.time(cycle))
 
     def irq_low(self, cycle: int) -> bool:
         self._advance(self.time(cycle) + 1)
