@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 
+from retro.cpu.flow import Fact
 from retro.cpu.mpu import VARIANTS
 from retro.machines import BARE, MACHINE_CPUS, MACHINES, machine_for
 from retro.errors import InputError
@@ -110,6 +111,7 @@ class Routine:
     coverage: str = ""  # why the cases cover the input space (an argument the report quotes)
     notes: tuple[str, ...] = ()  # what loading the program left out (a symbol file's skipped lines)
     rows: tuple[Row, ...] = ()  # expected rows written in the spec (retro.routines.rows)
+    facts: tuple[tuple[int, Fact], ...] = ()  # [facts]: (address, what the spec states there) (retro.routines.facts)
 
     @property
     def input_names(self) -> tuple[str, ...]:
