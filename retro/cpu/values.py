@@ -126,6 +126,7 @@ class State:
     stored: tuple[tuple[int, int], ...] = ()  # (address, set) the routine wrote, sorted by address
     wild: bool = False  # a store went to an unknown address: unprotected memory is unknown
     stack: tuple | None = ()  # pushed items (("a", set) or ("p", flags)); None: unknown (after TXS)
+    nz: str = ""  # the register ("a", "x", "y") whose value N and Z were last set from ("": none)
     _index: dict = field(default=None, compare=False, hash=False, repr=False)
 
     def read(self, memory: MemoryModel, address: int) -> int:
@@ -171,7 +172,7 @@ class State:
             stack = None
         return State(self.a | other.a, self.x | other.x, self.y | other.y, self.c | other.c, self.z | other.z,
                      self.n | other.n, self.v | other.v, self.d | other.d, tuple(stored), self.wild or other.wild,
-                     stack)
+                     stack, self.nz if self.nz == other.nz else "")
 
     def pushed(self, item: tuple) -> "State":
         return replace(self, stack=None if self.stack is None else (*self.stack, item))
@@ -194,8 +195,21 @@ def _join_item(p: tuple, q: tuple) -> tuple:
 
 
 def narrowed(state: State, register: str, mask: int) -> State:
-    """The state with a register (a, x, y) or flag (c, z, n, v, d) known to lie in `mask`."""
-    return replace(state, **{register: getattr(state, register) & mask})
+    """The state with a register (a, x, y) or flag (c, z, n, v, d) known to lie in `mask`; N and Z
+    and the register they were set from narrow each other (after `LDA / BEQ`, A is 0 where taken)."""
+    changes = {register: getattr(state, register) & mask}
+    source = state.nz
+    if register == source:
+        changes["z"] = state.z & zero_flag(changes[register])
+        changes["n"] = state.n & negative_flag(changes[register])
+    elif register in ("z", "n") and source:
+        value = getattr(state, source)
+        if register == "z":
+            value &= {SET: single(0), CLEAR: ANY ^ single(0)}.get(mask, ANY)
+        else:
+            value &= {SET: HIGH_HALF, CLEAR: LOW_HALF}.get(mask, ANY)
+        changes[source] = value
+    return replace(state, **changes)
 
 
 def is_empty(state: State) -> bool:
@@ -378,10 +392,26 @@ FLAG_OPS = {"CLC": ("c", CLEAR), "SEC": ("c", SET), "CLD": ("d", CLEAR), "SED": 
 COUNTERS = {"INX": ("x", increment), "INY": ("y", increment), "DEX": ("x", decrement), "DEY": ("y", decrement)}
 
 
+NZ_FROM = {"LDA": "a", "LDX": "x", "LDY": "y", "TAX": "x", "TAY": "y", "TXA": "a", "TYA": "a", "TSX": "x",
+           "INX": "x", "INY": "y", "DEX": "x", "DEY": "y", "PLA": "a", "PLX": "x", "PLY": "y", "ADC": "a",
+           "SBC": "a", "AND": "a", "ORA": "a", "EOR": "a", "LAX": "a"}
+NZ_KEPT = {"STA", "STX", "STY", "STZ", "SAX", "CLC", "SEC", "CLD", "SED", "CLV", "CLI", "SEI", "NOP", "PHA", "PHP",
+           "PHX", "PHY", "TXS", "BRA", *BRANCH_FLAGS}
+
+
 def execute(state: State, memory: MemoryModel, pc: int, mnemonic: str, mode: str, cpu: str,
             binary_only: bool = False) -> Step:
     """One instruction (not JSR, RTS or JMP, which the flow handles) from `state`. `binary_only`:
     the CPU ignores D (the 2A03)."""
+    step = _execute(state, memory, pc, mnemonic, mode, cpu, binary_only)
+    if mnemonic in NZ_KEPT or mode == "zpr" or mnemonic[:3] in ("RMB", "SMB"):
+        return step
+    source = NZ_FROM.get(mnemonic, "a" if mode == "acc" else "")
+    return replace(step, after=None if step.after is None else replace(step.after, nz=source))
+
+
+def _execute(state: State, memory: MemoryModel, pc: int, mnemonic: str, mode: str, cpu: str,
+             binary_only: bool = False) -> Step:
     if mode == "rel":  # a branch: the flag it tests, narrowed on each way
         if mnemonic == "BRA":
             return Step(None, taken=state)

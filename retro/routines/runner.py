@@ -249,6 +249,7 @@ class RoutineRunner:
         indirect_y = {opcode for opcode, op in timing_table(routine.cpu).items() if op.mode in ("iny", "zpr")}
         self.pointer_pcs = frozenset(self.program.origin + i for i, b in enumerate(self.program.code) if b in indirect_y)
         self.plan = InputPlan.of(routine)
+        self.watched_facts = {fact.address: fact for fact in routine.facts}  # held against every call
 
     @property
     def limit(self) -> int:
@@ -322,6 +323,10 @@ class RoutineRunner:
             lanes |= np.asarray(value).astype(lanes.dtype)
         cpu.p[:] = (p | FLAG_U) & ~FLAG_B  # as Machine sets P
         cpu.sp[:] = stack_pointer
+        image = self.call_image
+        cpu.watch = {pc: (lambda lanes, fact=fact, opcode=image[pc]: fact.broken(lanes.a, lanes.x, lanes.y, lanes.p,
+                                                                                 opcode))
+                     for pc, fact in self.watched_facts.items()}
         cpu.call(self.entry, self.limit, RETURN_TRAP, CALL_STACK_TOP)
         outputs = port_values(self.routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,
                               widen=lambda lanes: np.asarray(lanes, dtype=np.int64),

@@ -22,7 +22,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 
-from retro.cpu.flow import Fact
 from retro.cpu.mpu import VARIANTS
 from retro.machines import BARE, MACHINE_CPUS, MACHINES, machine_for
 from retro.errors import InputError
@@ -40,6 +39,7 @@ from retro.routines.places import (
     port_of,
     resolve,
 )
+from retro.routines.facts import StatedFact, parse_facts
 from retro.routines.rows import Row, misplaced_rows, parse_rows
 from retro.routines import sandbox
 from retro.routines.where import Condition, parse_where
@@ -52,7 +52,8 @@ MAX_LOOP_BOUND = 1 << 20
 NUMBER_CHARACTERS = 40  # the longest number a spec may write as text
 CPUS = tuple(VARIANTS)
 
-TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows"}
+TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows",
+            "facts"}
 PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays", "time_limit"}
@@ -111,7 +112,7 @@ class Routine:
     coverage: str = ""  # why the cases cover the input space (an argument the report quotes)
     notes: tuple[str, ...] = ()  # what loading the program left out (a symbol file's skipped lines)
     rows: tuple[Row, ...] = ()  # expected rows written in the spec (retro.routines.rows)
-    facts: tuple[tuple[int, Fact], ...] = ()  # [facts]: (address, what the spec states there) (retro.routines.facts)
+    facts: tuple[StatedFact, ...] = ()  # [facts]: what the spec states at addresses (retro.routines.facts)
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -192,9 +193,10 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     reference = _reference_section(r, doc, inputs, memory, rows, seconds)
     cases = _cases_section(r, doc, inputs, seconds, answered=reference["reference"] is not None)
     cycles = _cycles_section(r, doc, program.program)
+    facts = parse_facts(r, doc.get("facts", {}), program.program, program.cpu)
     routine = Routine(name=_text(r, doc, "name", "name") or path.stem, spec_path=path, **program.fields(),
                       inputs=inputs, outputs=outputs, memory=memory, **reference, **cases, **cycles,
-                      summary=_summary(r, doc), rows=rows, notes=program.program.notes)
+                      summary=_summary(r, doc), rows=rows, notes=program.program.notes, facts=facts)
     if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep or routine.rows):
         raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary, sweep or [[rows]]")
     if routine.exhaustive_count() > MAX_EXHAUSTIVE:

@@ -36,7 +36,7 @@ def static_bounds(routine: Routine, runner: RoutineRunner | None = None) -> Boun
     try:
         return analyse(memory.__getitem__, runner.entry, bounds, name=routine.name,
                        within=(program.origin, program.end), describe=describe, cpu=routine.cpu,
-                       memory=model, entry_state=entry_state(routine), facts=dict(routine.facts))
+                       memory=model, entry_state=entry_state(routine), facts={f.address: f.fact for f in routine.facts})
     except InputError as exc:
         raise InputError(f"{routine.spec_path}: static analysis: {exc} ([cycles] static = false skips it)") from None
 
