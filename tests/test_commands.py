@@ -30,10 +30,12 @@ def subparsers() -> dict:
 def test_every_command_is_one_function_in_its_own_module():
     assert set(subparsers()) == set(COMMANDS)
     package = Path(retro.commands.__file__).parent
-    assert {p.stem for p in package.glob("*.py")} - {"__init__"} == set(COMMANDS)
+    assert {p.stem for p in package.glob("*.py")} - {"__init__", "options"} == set(COMMANDS)
     for name in COMMANDS:
         module = __import__(f"retro.commands.{name}", fromlist=[name])
         assert callable(getattr(module, name)), name
+        assert cli.COMMANDS[name] is module  # the command whole in its module: options and main beside it
+        assert callable(module.add_options) and callable(module.main) and module.HELP, name
         if name != "demo":
             assert callable(module.lines), name
 

@@ -22,12 +22,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from retro.analysis.check.engines import AGREEMENT_PER_PART, BATCH_LANES, SceneStart, run_on_machine, runner_for
+from retro.analysis.check.engines import (AGREEMENT_PER_PART, BATCH_LANES, CallBlock, SceneStart, disagreement,
+                                         run_on_batched_core, run_on_machine, runner_for)
 from retro.analysis.check.reference import reference_answers
 from retro.analysis.check.results import Failure, describe_case, describe_outputs, inputs_by_name
 from retro.analysis.check.tally import Tally
 from retro.analysis.check.verdicts import static_bounds
-from retro.cpu.batch import LaneError
 from retro.cpu.flow import Bounds
 from retro.errors import InputError
 from retro.routines.cases import cases_to_columns
@@ -85,13 +85,16 @@ class _Call:
     error: str = ""
 
 
-def _on_machine(runner: RoutineRunner, case: tuple) -> _Call:
-    """One row's call on Machine, as the check runs every call there (timing model included)."""
-    block = run_on_machine(runner, [case])
+def _calls_of(block: CallBlock, timed: bool) -> list[_Call]:
+    """A block's calls as the rows read them: each returned call, then the one that stopped it."""
+    calls = []
+    for i in range(block.returned):
+        cycles = int(block.cycles[i])
+        calls.append(_Call(block.row(i), cycles, cycles - int(block.stolen[i]), int(block.modelled[i]))
+                     if timed else _Call(block.row(i), cycles))
     if block.stop is not None:
-        return _Call(None, None, error=block.stop_message)
-    cycles = int(block.cycles[0])
-    return _Call(block.row(0), cycles, cycles - int(block.stolen[0]), int(block.modelled[0]))
+        calls.append(_Call(None, None, error=block.stop_message))
+    return calls
 
 
 def check_rows(spec: str, seed: int, start: SceneStart | None, batched: bool) -> tuple[RowsCheck, Tally]:
@@ -104,11 +107,7 @@ def check_rows(spec: str, seed: int, start: SceneStart | None, batched: bool) ->
     if batched:
         calls, agreement = _batched(runner, rows)
     else:
-        calls, agreement = [], None
-        for row in rows:
-            calls.append(_on_machine(runner, row.case))
-            if calls[-1].error:
-                break
+        calls, agreement = _calls_of(run_on_machine(runner, [row.case for row in rows]), timed=True), None
     totals = Tally()
     outcomes = []
     for row, call in zip(rows, calls):
@@ -139,51 +138,45 @@ def _reference_answer(runner: RoutineRunner, row: Row) -> tuple | None:
 
 
 def _batched(runner: RoutineRunner, rows: tuple[Row, ...]) -> tuple[list[_Call], Tally]:
-    """The rows on the batched core, up to the first call that stops; the first AGREEMENT_PER_PART
-    of them also on Machine (with the timing model), compared call for call."""
+    """The rows on the batched core in batches at most as wide as the check's, up to the first call
+    that stops; the first AGREEMENT_PER_PART of them also on Machine, compared call for call."""
     routine = runner.routine
     agreement = Tally()
-    calls = []
-    outcome, first = None, 0
-    for i, row in enumerate(rows):
-        if i % BATCH_LANES == 0:  # a batch at most as wide as the check's (memory stays bounded)
-            outcome, first = runner.run_batch(cases_to_columns(routine, [r.case for r in rows[i:i + BATCH_LANES]])), i
-        stopped = bool(outcome.error[i - first])
-        machine = _on_machine(runner, row.case) if i < AGREEMENT_PER_PART or stopped else None
-        if stopped:  # Machine's message names the address (as run_on_batched_core reports a stopped lane)
-            message = machine.error or (f"the engines disagree: the batched core stopped the call "
-                                        f"({LaneError(int(outcome.error[i - first])).name}), Machine returned")
-            calls.append(_Call(None, None, error=message))
-        else:
-            calls.append(_Call(row_of(outcome.outputs, i - first), int(outcome.cycles[i - first])))
-        if i < AGREEMENT_PER_PART:
-            _agree(agreement, routine, row, machine, calls[-1], stopped)
-        if stopped:
+    calls: list[_Call] = []
+    for first in range(0, len(rows), BATCH_LANES):
+        cases = [row.case for row in rows[first:first + BATCH_LANES]]
+        batch = run_on_batched_core(runner, cases_to_columns(routine, cases))
+        compared = min(batch.calls, AGREEMENT_PER_PART - first)
+        if compared > 0:
+            _agree(agreement, routine, rows[first:], run_on_machine(runner, cases[:compared]), batch)
+        calls += _calls_of(batch, timed=False)
+        if batch.stop is not None:
             break
     return calls, agreement
 
 
-def _agree(agreement: Tally, routine: Routine, row: Row, machine: _Call, batch: _Call, stopped: bool) -> None:
-    agreement.cases += 1
-    agreement.engine_cases += 1
-    if machine.error:
-        agreement.run_errors += 1
-    elif machine.modelled != machine.cpu_cycles:
-        agreement.cycle_mismatches += 1
-        message = f"measured {machine.cpu_cycles} cycles, the timing model says {machine.modelled}"
-        agreement.failure = agreement.failure or Failure(row.case, "cycles", machine.outputs, None, message)
-        agreement.examples.append(f"{routine.name}({describe_case(routine, row.case)}): {row.key}: {message}")
-    same = (bool(machine.error) == stopped and
-            (stopped or (machine.outputs == batch.outputs and machine.cycles == batch.cycles)))
-    if not same:
-        agreement.engine_mismatches += 1
-        returned = not machine.error and not stopped
-        text = (f"Machine: {describe_outputs(routine, machine.outputs)} in {machine.cycles} cycles; batched core: "
-                f"{describe_outputs(routine, batch.outputs)} in {batch.cycles} cycles" if returned
-                else "one engine stopped the call, the other returned")
-        message = f"the engines disagree on {row.key}: {text}"
-        agreement.failure = agreement.failure or Failure(row.case, "engine", machine.outputs, None, message)
-        agreement.examples.append(f"{routine.name}({describe_case(routine, row.case)}): {message}")
+def _agree(agreement: Tally, routine: Routine, rows: tuple[Row, ...], machine: CallBlock, batch: CallBlock) -> None:
+    """Machine's calls of the rows held against the timing model and against the batched core's."""
+    for i in range(machine.calls):
+        row = rows[i]
+        agreement.cases += 1
+        agreement.engine_cases += 1
+        if machine.stopped(i):
+            agreement.run_errors += 1
+        else:
+            cpu = int(machine.cycles[i]) - int(machine.stolen[i])
+            if int(machine.modelled[i]) != cpu:
+                agreement.cycle_mismatches += 1
+                message = f"measured {cpu} cycles, the timing model says {int(machine.modelled[i])}"
+                agreement.failure = agreement.failure or Failure(row.case, "cycles", machine.row(i), None, message)
+                agreement.examples.append(f"{routine.name}({describe_case(routine, row.case)}): {row.key}: {message}")
+        message = disagreement(routine, machine, batch, i)
+        if message is not None:
+            agreement.engine_mismatches += 1
+            message = f"{row.key}: {message}"
+            outputs = None if machine.stopped(i) else machine.row(i)
+            agreement.failure = agreement.failure or Failure(row.case, "engine", outputs, None, message)
+            agreement.examples.append(f"{routine.name}({describe_case(routine, row.case)}): {message}")
 
 
 def _outcome(row: Row, call: _Call, routine: Routine) -> RowOutcome:

@@ -15,6 +15,9 @@ from retro.errors import InputError
 from retro.fileio import file_option
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
+import argparse
+from retro.commands import options
+from retro.progress import progress_printer
 
 DEFAULT_ACCURACY = 0.99
 
@@ -49,3 +52,32 @@ def advise(scene: str | Path, *, accuracy: float | str = DEFAULT_ACCURACY, metho
 
 def lines(advice: Advice) -> list[str]:
     return advice_lines(advice)
+
+
+# The command line: this command's options and how it runs from them.
+
+HELP = "the cheapest collision method (6502 cycles) that meets an accuracy target on a VIC-II or NES scene's sprites"
+
+
+def add_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("scene", metavar="SCENE.toml", help="a VIC-II scene (its enabled sprites) or an NES scene (its OAM "
+                                                       "entries on screen): the objects to test")
+    p.add_argument("--accuracy", default=str(DEFAULT_ACCURACY), metavar="A",
+                   help=f"required share of cases decided correctly, 0-1 or a percentage (default: {DEFAULT_ACCURACY})")
+    options.methods(p)
+    options.engine(p)
+    p.add_argument("--software", action="store_true",
+                   help="software methods only: leave out the hardware latch (more objects than sprites, or when the "
+                        "game must know which pair hit)")
+    p.add_argument("--objects", metavar="N",
+                   help="choose by 6502 cycles per frame for N objects (1-64, the scene's sprites in turn): "
+                        "preparation, the cheaper broad phase (every pair or a sort along X) and the tests")
+    options.jobs(p, DEFAULT_JOBS)
+    options.quiet(p)
+
+
+def main(args: argparse.Namespace) -> int:
+    result = advise(args.scene, accuracy=args.accuracy, methods=args.methods, software=args.software,
+                    objects=args.objects, jobs=args.jobs, engine=args.engine, progress=progress_printer(args.quiet))
+    options.show(lines, None, result)
+    return 0

@@ -6,10 +6,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from retro.assembler import MAX_SOURCE_BYTES, assemble_file
-from retro.cpu.mpu import variant_named
+from retro.cpu.variants import variant_named
 from retro.fileio import all_or_nothing, file_option, read_bytes, write_atomic
 from retro.loaders import refuse_foreign_source
 from retro.program import Program, format_vice_labels, prg_bytes
+import argparse
+from retro.commands import options
 
 
 @dataclass(frozen=True)
@@ -46,3 +48,23 @@ def lines(result: Assembled) -> list[str]:
     span = f"${program.origin:04X}-${program.end - 1:04X}" if program.code else f"${program.origin:04X}"
     return [f"{len(program.code)} bytes at {span}, {len(program.symbols)} labels -> "
             f"{', '.join(str(path) for path in result.written)}"]
+
+
+# The command line: this command's options and how it runs from them.
+
+HELP = "assemble a 6502 source (Ophis syntax) into a PRG and a VICE label file"
+
+
+def add_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("source", metavar="FILE.s", help="a 6502 source in Ophis syntax")
+    p.add_argument("-o", "--output", metavar="OUT.prg", help="PRG to write (default: FILE.prg)")
+    p.add_argument("--labels", metavar="OUT.lbl", help="VICE label file to write")
+    p.add_argument("--list", dest="listing", metavar="OUT.lst", help="listing to write")
+    p.add_argument("--cpu", metavar="CPU", help="65c02: assemble the WDC 65C02's opcodes (default: the NMOS "
+                                                "6502's, undocumented ones included)")
+
+
+def main(args: argparse.Namespace) -> int:
+    result = asm(args.source, output=args.output, labels=args.labels, listing=args.listing, cpu=args.cpu)
+    options.show(lines, None, result)
+    return 0

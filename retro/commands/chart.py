@@ -12,6 +12,10 @@ from retro.fileio import all_or_nothing
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
 from retro.workers import MAX_WORKERS
+import argparse
+from retro.analysis.study.chart_run import REDUCED_COST_SAMPLES
+from retro.commands import options
+from retro.progress import progress_printer
 
 DEFAULT_OUT = "retro-out/chart"
 DEFAULT_JOBS = 2
@@ -44,3 +48,33 @@ def chart(out: str | Path = DEFAULT_OUT, *, reduced: bool = False, methods: list
 
 def lines(output: ChartOutput) -> list[str]:
     return summary_lines(output)
+
+
+# The command line: this command's options and how it runs from them.
+
+HELP = "chart 6502 cycles against accuracy for every collision method (PNG, CSV, Markdown)"
+
+
+def add_options(p: argparse.ArgumentParser) -> None:
+    options.out(p, DEFAULT_OUT)
+    p.add_argument("--reduced", action="store_true", help="a small corpus (3 shapes) and fewer cycle samples: seconds")
+    options.methods(p)
+    options.engine(p)
+    p.add_argument("--sprites", action="append", default=[], metavar="FILE",
+                   help="add a file's sprites to the corpus (raw .spr frames, SpritePad .spd, Spritemate .spm, a PNG "
+                        "sprite or sheet, or a VIC-II scene's enabled sprites); repeatable")
+    p.add_argument("--samples", default="auto", metavar="N",
+                   help=f"cases per pair whose cycles are measured: a number, or `all` (default: all; "
+                        f"{REDUCED_COST_SAMPLES} with --reduced)")
+    p.add_argument("--per-frame", action="store_true",
+                   help="also chart 6502 cycles per frame against the number of objects (1-64) for each method, "
+                        "with its preparation and a broad phase (every pair, sort along X): per_frame.png/.csv/.md")
+    options.jobs(p, DEFAULT_JOBS)
+    options.quiet(p)
+
+
+def main(args: argparse.Namespace) -> int:
+    result = chart(args.out, reduced=args.reduced, methods=args.methods, sprites=args.sprites, samples=args.samples,
+                   per_frame=args.per_frame, jobs=args.jobs, engine=args.engine, progress=progress_printer(args.quiet))
+    options.show(lines, None, result)
+    return 0

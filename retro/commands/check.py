@@ -18,6 +18,11 @@ from retro.numbers import parse_int
 from retro.progress import Progress, quiet
 from retro.routines import cases as case_sets
 from retro.workers import MAX_WORKERS
+import argparse
+from retro.analysis.check import AGREEMENT_PER_PART, AUTO_BATCH_CASES
+from retro.commands import options
+from retro.progress import progress_printer
+from retro.routines.registry import builtin_names
 
 MAX_RANDOM = 10 ** 9
 MAX_JOBS = MAX_WORKERS
@@ -266,3 +271,53 @@ def input_files(checks: list[RoutineCheck], scene: str | Path | None = None) -> 
             if source:
                 files.append(Path(source))
     return files
+
+
+# The command line: this command's options and how it runs from them.
+
+HELP = ("cross-check 6502 routines (built-in or your own spec) against their references (results and cycles); "
+        "exit 1 on any mismatch or broken budget")
+
+
+def routine_options(p: argparse.ArgumentParser) -> None:
+    """What `retro check` and `retro cycles` share: the same run, two views."""
+    p.add_argument("routines", nargs="*", metavar="ROUTINE|SPEC.toml",
+                   help=f"built-in routine names ({' '.join(builtin_names())}; all when none is given) or routine "
+                        "spec files (NAME.toml, docs/specs.md)")
+    p.add_argument("--exhaustive", action="store_true",
+                   help="the full run: every exhaustive set and sweep, and each spec's full random count (minutes)")
+    p.add_argument("--seed", help="seed of the random cases and of random memory (default: the spec's, 0)")
+    p.add_argument("--random", metavar="N",
+                   help="random cases per routine (default: the spec's count, at most 2,000 without --exhaustive)")
+    options.jobs(p, None)
+    p.add_argument("--scene", metavar="SCENE.toml", help="run every call on a C64 with this VIC-II scene: the CPU "
+                   "stalls on Bad Lines and sprite DMA, and the report gives raster lines from the start line")
+    p.add_argument("--at-line", metavar="L", help="with --scene: the raster line each call starts at "
+                   "(default: the scene's [cpu] start_line)")
+    p.add_argument("--at-cycle", metavar="C", help="with --scene: the cycle in that line (default: the scene's)")
+    options.engine(p, f"; scalar is the reference and the timing model checks every call, batch is checked against "
+                      f"Machine on the first {AGREEMENT_PER_PART:,} cases of each part, auto takes batch from "
+                      f"{AUTO_BATCH_CASES:,} cases")
+    p.add_argument("--json", action="store_true", help="print a JSON list, one object per routine")
+    options.quiet(p)
+
+
+def checks_of(args: argparse.Namespace) -> list[RoutineCheck]:
+    """The run `retro check` and `retro cycles` both show, from the options `routine_options` defines."""
+    return check(args.routines, exhaustive=args.exhaustive, seed=args.seed, random=args.random, jobs=args.jobs,
+                 scene=args.scene, at_line=args.at_line, at_cycle=args.at_cycle, engine=args.engine,
+                 progress=progress_printer(args.quiet))
+
+
+def add_options(p: argparse.ArgumentParser) -> None:
+    routine_options(p)
+    p.add_argument("--junit", metavar="FILE.xml", help="also write the results as JUnit XML for CI: one testcase per "
+                                                       "routine, a failure carrying its report")
+
+
+def main(args: argparse.Namespace) -> int:
+    checks = checks_of(args)
+    options.show(lines, as_json if args.json else None, checks, indent=1)
+    if args.junit:
+        write_junit(checks, args.junit, scene=args.scene)
+    return 1 if failed(checks) else 0

@@ -8,6 +8,9 @@ from retro.analysis.check import RoutineCheck
 from retro.commands.check import check as cycles  # one run, two views: the command is the check itself
 from retro.commands.check import cycle_figures, failed
 from retro.paths import ASM_DIR
+import argparse
+from retro.commands import options
+from retro.commands.check import checks_of, routine_options
 
 __all__ = ["COST_FIELDS", "cycles", "failed", "as_json", "lines"]
 
@@ -76,3 +79,19 @@ def format_cost_table(checks: list[RoutineCheck]) -> list[str]:
     lines.append("cycles: from the routine's first instruction through its RTS (the caller's JSR, 6, not included); "
                  "bytes of tables exclude storage the caller fills")
     return lines
+
+
+# The command line: this command's options and how it runs from them.
+
+HELP = "bytes of code and tables, measured and static cycles, raster lines of routines (built-in or your own spec)"
+PARSER = {"description": f"--json prints a list of objects with the fields {', '.join(COST_FIELDS)}"}
+
+
+def add_options(p: argparse.ArgumentParser) -> None:
+    routine_options(p)
+
+
+def main(args: argparse.Namespace) -> int:
+    checks = checks_of(args)
+    options.show(lines, as_json if args.json else None, checks, indent=1)
+    return 1 if failed(checks) else 0

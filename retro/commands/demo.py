@@ -14,6 +14,8 @@ from retro.fileio import all_or_nothing, output_folder, write_atomic
 from retro.machines.c64 import interrupt_budgets
 from retro.paths import ASM_DIR, EXAMPLES_DIR
 from retro.progress import quiet
+import argparse
+from retro.commands import options
 
 DEMO_SUM = ASM_DIR / "demo_sum.s"
 VIC_SCENE = EXAMPLES_DIR / "vic_two_balls.toml"
@@ -106,3 +108,17 @@ def demo(out: str | Path = "retro-out", emit: Callable[[str], None] = print) -> 
             emit(f"   {line}")
     emit(f"Output files are in {out.resolve()}")
     return out
+
+
+# The command line: this command's options and how it runs from them.
+
+HELP = "run the built-in examples; writes its files into one folder"
+
+
+def add_options(p: argparse.ArgumentParser) -> None:
+    options.out(p, "retro-out")
+
+
+def main(args: argparse.Namespace) -> int:
+    demo(args.out)
+    return 0

@@ -13,6 +13,8 @@ from retro.fileio import all_or_nothing, file_option
 from retro.numbers import parse_int
 from retro.scenes import load_scene
 from retro.scenes.nes import NesScene
+import argparse
+from retro.commands import options
 
 MAX_SCALE = 16
 
@@ -67,3 +69,22 @@ def _describe(result: SpriteZeroHit) -> str:
     return (f"sprite-zero hit at pixel x={result.x}, line {result.line}: $2002 bit 6 set at line {result.line} "
             f"dot {result.dot}, {result.dots_after_vblank} PPU dots ({result.cpu_cycles_after_vblank:g} CPU cycles) "
             f"after the vblank flag (line {VBLANK_LINE} dot {VBLANK_DOT})")
+
+
+# The command line: this command's options and how it runs from them.
+
+HELP = "predict the NES sprite-zero hit ($2002 bit 6) of a scene: pixel, line, dot"
+
+
+def add_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("scene", metavar="SCENE.toml")
+    p.add_argument("--json", action="store_true", help="print one JSON object: hit, line, dot, x, dots_after_vblank, "
+                                                       "cpu_cycles_after_vblank")
+    p.add_argument("--png", metavar="OUT.png", help="write a picture of the frame and sprite 0")
+    options.scale(p, "picture", MAX_SCALE)
+
+
+def main(args: argparse.Namespace) -> int:
+    result = nes(args.scene, png=args.png, scale=args.scale)
+    options.show(lines, as_json if args.json else None, result)
+    return 0

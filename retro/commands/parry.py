@@ -14,6 +14,8 @@ from retro.fileio import all_or_nothing, read_text
 from retro.geometry.parry import ACTIONS, DEFAULT_FRAMES, MAX_FRAMES, Event, FrameState, events_of, simulate
 from retro.numbers import parse_int
 from retro.render.parry import write_parry
+import argparse
+from retro.commands import options
 
 DEFAULT_OUT = "retro-out/parry"
 DEFAULT_SCRIPT = "40:parry 106:parry 150:left 170:stop 192:parry"
@@ -83,3 +85,23 @@ def lines(run: ParryRun) -> list[str]:
     out = [f"frame {event.frame:4d}  {event.kind}" for event in run.events]
     return out + [f"wrote {len(run.files)} files to {run.files[0].parent} (parry.gif, one PNG per event frame, "
                   "parry_events.txt)"]
+
+
+# The command line: this command's options and how it runs from them.
+
+HELP = "run the Sekiro-style parry loop on a scripted input; writes a GIF and PNGs"
+PARSER = {"description": "Script: FRAME:ACTION tokens (ACTION = parry, left, right or stop), e.g. '40:parry 90:left "
+                         "110:stop'; '@FILE' reads them from a file (one or more per line, '#' starts a comment)."}
+
+
+def add_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--script", metavar="SCRIPT", help="input script or @FILE (default: a built-in script)")
+    options.out(p, DEFAULT_OUT)
+    p.add_argument("--frames", default=str(DEFAULT_FRAMES), metavar="N",
+                   help=f"frames to simulate (default: {DEFAULT_FRAMES}, at most {MAX_FRAMES:,})")
+
+
+def main(args: argparse.Namespace) -> int:
+    result = parry(args.script, out=args.out, frames=args.frames)
+    options.show(lines, None, result)
+    return 0

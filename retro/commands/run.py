@@ -13,7 +13,8 @@ from retro.analysis.console_run import MAX_FRAMES, ConsoleRun, ppu_registers, ru
 from retro.chips.cartridge import read_nrom
 from retro.chips.ines import INES_MAGIC
 from retro.cpu.machine import DEFAULT_BUDGET, DEFAULT_FLAGS, JSR_CYCLES, MAX_BUDGET, CallResult, Machine
-from retro.cpu.mpu import FLAG_B, FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_U, FLAG_V, FLAG_Z, variant_named
+from retro.cpu.mpu import FLAG_B, FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_U, FLAG_V, FLAG_Z
+from retro.cpu.variants import variant_named
 from retro.errors import InputError
 from retro.fileio import file_option, read_bytes
 from retro.loaders import load_program
@@ -22,6 +23,8 @@ from retro.machines import build_machine
 from retro.machines.c64 import RasterBudget, call_budget
 from retro.program import Program
 from retro.scenes import load_scene
+import argparse
+from retro.commands import options
 
 # the status flags a caller may set for the call (B and bit 5 are not flags the CPU keeps)
 SETTABLE_FLAGS = {"n": FLAG_N, "v": FLAG_V, "d": FLAG_D, "i": FLAG_I, "z": FLAG_Z, "c": FLAG_C}
@@ -277,3 +280,56 @@ def lines(report: RunReport | ConsoleRun) -> list[str]:
     out += [f"{target}: " + " ".join(f"${v:02X}" for v in values) for target, values in report.peeks.items()]
     out += [f"note: {note}" for note in report.program.notes]  # e.g. a symbol file's skipped lines
     return out
+
+
+# The command line: this command's options and how it runs from them.
+
+HELP = "call a 6502 routine in the emulator and report registers, cycles and memory"
+
+
+def add_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("program", metavar="FILE.s|FILE.prg|FILE.bin|FILE.nes",
+                   help="an Ophis source, a C64 .prg, a raw binary (with --load) or an iNES image (NROM)")
+    p.add_argument("--labels", metavar="F", help="symbol file of a .prg, .bin or .nes, in any supported format "
+                                                   "(docs/symbols.md)")
+    p.add_argument("--load", metavar="ADDR", help="load address of a raw binary")
+    p.add_argument("--entry", metavar="LABEL|ADDR", help="where the routine starts (called as by JSR); without it "
+                   "an iNES image runs on a console from its reset vector (--frames, --until, --until-value, --result)")
+    p.add_argument("--frames", metavar="N", help=f"iNES image from reset: frames to run (default {DEFAULT_FRAMES}, "
+                   f"at most {MAX_FRAMES:,}); the run also stops when the program halts (JMP * with the NMI off)")
+    p.add_argument("--until", metavar="LABEL|ADDR", help="iNES image from reset: stop when the PC reaches this address")
+    p.add_argument("--until-value", metavar="TARGET=V", help="iNES image from reset: stop when this byte holds V")
+    p.add_argument("--result", metavar="ADDR", help="iNES image from reset: a test ROM's result byte (blargg's 2005 "
+                   "ROMs: $F8, 1 = passed); the $6000 protocol is read without it; exit 1 on a failed verdict")
+    for register in ("a", "x", "y"):
+        p.add_argument(f"--{register}", default="0", metavar="V", help=f"{register.upper()} on entry (default 0)")
+    for flag in SETTABLE_FLAGS:
+        p.add_argument(f"--{flag}", metavar="0|1", help=f"{flag.upper()} flag on entry")
+    p.add_argument("--set", dest="sets", action="append", default=[], metavar="TARGET=V",
+                   help="store bytes before the call: a label or address = V[,V...] (repeatable)")
+    p.add_argument("--peek", dest="peeks", action="append", default=[], metavar="TARGET[:N]",
+                   help="show N bytes (default 1) at a label or address after the call (repeatable)")
+    p.add_argument("--budget", default=str(DEFAULT_BUDGET), metavar="CYCLES",
+                   help=f"stop the routine after this many cycles (default {DEFAULT_BUDGET:,}, at most {MAX_BUDGET:,})")
+    p.add_argument("--scene", metavar="SCENE.toml", help="attach a VIC-II or NES PPU scene to the machine")
+    p.add_argument("--cpu", metavar="CPU", help="the CPU: 6510 (default), 2a03 (an iNES image's) or 65c02 (WDC)")
+    output = p.add_mutually_exclusive_group()  # the JSON object's keys are fixed: no room for a trace
+    output.add_argument("--trace", action="store_true", help="print every instruction executed")
+    output.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def main(args: argparse.Namespace) -> int:
+    console = {"frames": args.frames, "until": args.until, "until_value": args.until_value, "result": args.result}
+    if args.entry is None:
+        report = run_console_or_refuse(args.program, labels=args.labels, peeks=args.peeks, load=args.load,
+                                       scene=args.scene, trace=args.trace, cpu=args.cpu,
+                                       **{k: v for k, v in console.items() if v is not None})
+        options.show(lines, as_json if args.json else None, report)
+        return 1 if report.verdict is not None and report.verdict.passed is False else 0
+    refuse_console_options(console)
+    flags = {flag: getattr(args, flag) for flag in SETTABLE_FLAGS if getattr(args, flag) is not None}
+    report = run(args.program, args.entry, labels=args.labels, load=args.load, a=args.a, x=args.x, y=args.y,
+                 flags=flags, sets=args.sets, peeks=args.peeks, budget=args.budget, scene=args.scene,
+                 trace=args.trace, cpu=args.cpu)
+    options.show(lines, as_json if args.json else None, report)
+    return 0

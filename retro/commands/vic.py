@@ -24,6 +24,8 @@ from retro.errors import InputError
 from retro.fileio import all_or_nothing, file_option
 from retro.numbers import parse_int
 from retro.scenes.vic import VicScene, load
+import argparse
+from retro.commands import options
 
 MAX_SCALE = 8
 C64_PALETTES = tuple(name for name in PALETTES if name.startswith("c64-"))
@@ -202,3 +204,30 @@ def _per_frame_lines(per_frame: list[dict]) -> list[str]:
     if len(hits) > 20:
         lines.append(f"  ... {len(hits) - 20} more (--json lists every frame)")
     return lines
+
+
+# The command line: this command's options and how it runs from them.
+
+HELP = "predict the VIC-II collision registers for a scene; draw the overlaps"
+
+
+def add_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("scene", metavar="SCENE.toml", help="a VIC-II scene file (docs/vic.md)")
+    p.add_argument("--frames", default="1", metavar="N",
+                   help=f"frames to run (default 1, at most {MAX_FRAMES:,}): sprites with a velocity move each "
+                        "frame, and each frame's latches are reported as a program reading them once a frame sees them")
+    p.add_argument("--json", action="store_true", help="print one JSON object: d01e, d01f, d019, first, pairs, "
+                                                       "background")
+    p.add_argument("--pixels", action="store_true", help="list every overlap pixel (raster line, X) of each pair "
+                                                         "and each sprite over graphics")
+    p.add_argument("--png", metavar="OUT.png", help="write the frame with the overlaps marked")
+    options.scale(p, "image", MAX_SCALE)
+    p.add_argument("--palette", default=C64_DEFAULT_PALETTE,
+                   help=f"{' or '.join(C64_PALETTES)} (default: {C64_DEFAULT_PALETTE})")
+
+
+def main(args: argparse.Namespace) -> int:
+    result = vic(args.scene, frames=args.frames, png=args.png, scale=args.scale, palette=args.palette,
+                 pixels=args.pixels)
+    options.show(lines, as_json if args.json else None, result)
+    return 0

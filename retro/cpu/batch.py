@@ -38,8 +38,8 @@ from retro.cpu.mpu import (
     FLAG_Z,
     IRQ_VECTOR,
     JAM_OPCODES,
-    VARIANTS,
 )
+from retro.cpu.variants import VARIANTS
 from retro.cpu.opcodes import DOCUMENTED, MODE_LENGTH, OPCODE_TABLE, STABLE
 from retro.cpu.timing import (
     BRANCH_CONDITIONS,

@@ -5,7 +5,7 @@ Rows the 65C02 runs as the NMOS 6502 does (same mnemonic, mode, cycles and page 
 NMOS handler of `retro.cpu.batch`; the others are here: the new opcodes and the (zp) mode, ADC/SBC
 with the 65C02's decimal mode (valid N and Z, one cycle more with D set), the fixed JMP (abs), shifts
 abs,X with their page penalty, BRK clearing D, the reserved opcodes as NOPs, and STP/WAI stopping the
-lane (LaneError.HALT). Semantics and cycles are those of the scalar core (`retro.cpu.mpu.MPU65C02`,
+lane (LaneError.HALT). Semantics and cycles are those of the scalar core (`retro.cpu.mpu65c02.MPU65C02`,
 where the sources are named).
 """
 
@@ -227,27 +227,35 @@ def _handler(opcode: int, row) -> Handler:
                           operate=_bit_immediate if mode == "imm" else None)
     if name in SHIFTS_ABX and mode == "abx":
         return _modify(mode, cycles, row.page_penalty, _shift(SHIFTS[name]))
-    if name in ("INC", "DEC"):  # INC A, DEC A
-        return _make_rmw(name, mode, cycles, length)
-    if name in ("TSB", "TRB"):
-        return _modify(mode, cycles, False, _test_and(name == "TSB"))
-    if name[:3] in ("RMB", "SMB"):
-        return _modify(mode, cycles, False, _memory_bit(1 << int(name[3]), name[0] == "S"))
-    if name[:3] in ("BBR", "BBS"):
-        return _bit_branch(1 << int(name[3]), name[2] == "S", cycles)
-    if name == "BRA":
-        return _branch_always(cycles)
-    if name in ("PHX", "PHY"):
-        return _push(name[2].lower(), cycles)
-    if name in ("PLX", "PLY"):
-        return _pull(name[2].lower(), cycles)
-    if name == "JMP":
-        return _jump_indirect(mode == "iax", cycles) if mode != "abs" else HANDLERS[opcode]
-    if name == "BRK":
-        return _brk_clearing_d(cycles)
-    if name in ("STP", "WAI"):
-        return _halt
-    raise AssertionError(f"no 65C02 batch operation for {name} (${opcode:02X})")  # pragma: no cover
+    if name == "JMP" and mode == "abs":
+        return HANDLERS[opcode]
+    make = _NEW_OPERATIONS.get(name[:3] if name[:3] in ("RMB", "SMB", "BBR", "BBS") else name)
+    if make is None:  # pragma: no cover - a new table row needs its operation here
+        raise AssertionError(f"no 65C02 batch operation for {name} (${opcode:02X})")
+    return make(name, mode, cycles, length)
+
+
+# The 65C02's own operations by mnemonic (RMB/SMB/BBR/BBS by their first three letters, the bit
+# number being the fourth): each makes the handler for one (mnemonic, mode, cycles, length).
+_NEW_OPERATIONS = {
+    "INC": lambda name, mode, cycles, length: _make_rmw(name, mode, cycles, length),  # INC A
+    "DEC": lambda name, mode, cycles, length: _make_rmw(name, mode, cycles, length),  # DEC A
+    "TSB": lambda name, mode, cycles, length: _modify(mode, cycles, False, _test_and(True)),
+    "TRB": lambda name, mode, cycles, length: _modify(mode, cycles, False, _test_and(False)),
+    "RMB": lambda name, mode, cycles, length: _modify(mode, cycles, False, _memory_bit(1 << int(name[3]), False)),
+    "SMB": lambda name, mode, cycles, length: _modify(mode, cycles, False, _memory_bit(1 << int(name[3]), True)),
+    "BBR": lambda name, mode, cycles, length: _bit_branch(1 << int(name[3]), False, cycles),
+    "BBS": lambda name, mode, cycles, length: _bit_branch(1 << int(name[3]), True, cycles),
+    "BRA": lambda name, mode, cycles, length: _branch_always(cycles),
+    "PHX": lambda name, mode, cycles, length: _push("x", cycles),
+    "PHY": lambda name, mode, cycles, length: _push("y", cycles),
+    "PLX": lambda name, mode, cycles, length: _pull("x", cycles),
+    "PLY": lambda name, mode, cycles, length: _pull("y", cycles),
+    "JMP": lambda name, mode, cycles, length: _jump_indirect(mode == "iax", cycles),  # JMP (abs), (abs,X)
+    "BRK": lambda name, mode, cycles, length: _brk_clearing_d(cycles),
+    "STP": lambda name, mode, cycles, length: _halt,
+    "WAI": lambda name, mode, cycles, length: _halt,
+}
 
 
 HANDLERS_65C02: dict[int, Handler] = {opcode: _handler(opcode, row) for opcode, row in OPCODE_TABLE_65C02.items()}

@@ -20,9 +20,9 @@ from retro.cpu.mpu import (
     FLAG_U,
     FLAG_V,
     FLAG_Z,
-    VARIANTS,
     CpuHalt,
 )
+from retro.cpu.variants import VARIANTS
 from retro.errors import InputError, RunError
 from retro.numbers import parse_int
 from retro.program import Program, ambiguity_message

@@ -4,7 +4,8 @@ Three variants:
 - `MPU6510` (Commodore 64): NMOS 6502 with decimal mode.
 - `MPU2A03` (NES): the same core with decimal mode removed: ADC, SBC and the undocumented
   opcodes built on them (RRA, ISC, ARR) ignore the D flag.
-- `MPU65C02`: the WDC 65C02, built from its opcode table (see the class; docs/cpu.md).
+- `MPU65C02` (retro.cpu.mpu65c02): the WDC 65C02, built on MPU6510 from its opcode table.
+`retro.cpu.variants` names them (`VARIANTS`, `variant_named`).
 
 What this adds to py65 1.2.0:
 - DEC abs ($CE) costs 6 cycles (py65 charges 3).
@@ -48,17 +49,13 @@ from py65.devices.mpu6502 import MPU as _Py65MPU
 from py65.utils.devices import make_instruction_decorator
 
 from retro.cpu.opcodes import (
-    DECIMAL_EXTRA_CYCLES,
     JAM,
     MODE_LENGTH,
     OPCODE_TABLE,
-    OPCODE_TABLE_65C02,
-    RESERVED,
     STABLE,
     UNSTABLE,
     opcodes_of,
 )
-from retro.errors import InputError
 
 ADDRESS_MASK = 0xFFFF
 PAGE_SHIFT = 8
@@ -699,207 +696,3 @@ class MPU2A03(MPU6510):
 
     instruct, cycletime, extracycles, disassemble = _copy_tables(MPU6510)
     has_decimal = False
-
-
-class MPU65C02(MPU6510):
-    """The WDC 65C02 (W65C02S): the CMOS 6502 of the Commander X16, Foenix F256 and enhanced Apple II.
-
-    Built on MPU6510 (the same bus, run loop and documented NMOS handlers, which the 65C02 shares)
-    with every row of `OPCODE_TABLE_65C02` that differs put in from that table: the new opcodes and
-    modes, the reserved opcodes as NOPs, the fixed JMP (abs), and cycles and page penalties of every
-    opcode from the table. py65 1.2.0's own MPU65C02 is not used: it lacks BBR/BBS, STP, the reserved
-    opcodes' sizes and cycles, the decimal-mode flags and extra cycle, and keeps NMOS RMW timing.
-    Decimal mode (Bruce Clark, "Decimal Mode", appendix A, the 65C02): ADC gives A and C by sequence 1,
-    V by sequence 2, N and Z from the result; SBC gives A by sequence 4, C and V from the binary
-    difference, N and Z from the result; both take one cycle more with D set. BRK and interrupts clear D.
-    STP stops the clock until a reset, WAI until an interrupt: no chip drives a 65C02's interrupt lines
-    here, so both stop the run with CpuHalt naming them. (For the same reason `step_timed`'s stall
-    model, which knows the NMOS write cycles, is not adapted to the 65C02's.)
-    Read-modify-writes (ASL ... INC DEC, TSB TRB, RMB SMB) write the result once, in their last cycle
-    (the 65C02 reads the operand twice where the NMOS writes it twice).
-    """
-
-    instruct, cycletime, extracycles, disassemble = _copy_tables(MPU6510)
-    instruction = make_instruction_decorator(instruct, disassemble, cycletime, extracycles)
-    opcode_table = OPCODE_TABLE_65C02
-    interrupt_clears = FLAG_D
-    decimal_extra_cycles = DECIMAL_EXTRA_CYCLES
-
-    def ZeroPageIndirectAddr(self):
-        pointer = self.memory[self.pc]
-        return self.ByteAt(pointer) | self.ByteAt((pointer + 1) & 0xFF) << 8
-
-    def _write_back(self, addr: int, old: int, new: int) -> None:
-        device = self.page_devices[addr >> PAGE_SHIFT]
-        if device is None:
-            self.memory[addr] = new
-        else:
-            device.write(addr, new, self._access_cycle(1))
-
-    def _adc(self, v: int) -> None:
-        if not self.p & FLAG_D:
-            MPU6510._adc(self, v)
-            return
-        self.excycles += self.decimal_extra_cycles
-        a = self.a
-        carry = self.p & FLAG_C
-        low = (a & 0x0F) + (v & 0x0F) + carry  # Clark, sequence 1
-        if low >= 0x0A:
-            low = ((low + 0x06) & 0x0F) + 0x10
-        total = (a & 0xF0) + (v & 0xF0) + low
-        signed = _signed_high(a) + _signed_high(v) + low  # sequence 2: V
-        if total >= 0xA0:
-            total += 0x60
-        result = total & 0xFF
-        self.p = (self.p & _KEEP_ALL_BUT_NVZC) | (result & FLAG_N) | (0 if result else FLAG_Z) \
-            | (FLAG_V if not -128 <= signed <= 127 else 0) | (FLAG_C if total > 0xFF else 0)
-        self.a = result
-
-    def _sbc(self, v: int) -> None:
-        if not self.p & FLAG_D:
-            MPU6510._sbc(self, v)
-            return
-        self.excycles += self.decimal_extra_cycles
-        a = self.a
-        borrow = 1 - (self.p & FLAG_C)
-        MPU6510._sbc(self, v)  # C and V from the binary difference (A is set below)
-        low = (a & 0x0F) - (v & 0x0F) - borrow  # Clark, sequence 4
-        total = a - v - borrow
-        if total < 0:
-            total -= 0x60
-        if low < 0:
-            total -= 0x06
-        result = total & 0xFF
-        self.p = (self.p & ~(FLAG_N | FLAG_Z)) | (result & FLAG_N) | (0 if result else FLAG_Z)
-        self.a = result
-
-
-def _signed_high(value: int) -> int:
-    high = value & 0xF0
-    return high - 0x100 if high & 0x80 else high
-
-
-def _register_65c02(cls) -> None:
-    """Put into cls's tables every 65C02 row that the NMOS documented handlers do not already run."""
-    ins = cls.instruction
-    table = cls.opcode_table
-
-    def op(opcode, row, body):
-        length = MODE_LENGTH[row.mode]
-
-        def handler(self):
-            body(self)
-            self.pc += length - 1
-        handler.__name__ = f"inst_0x{opcode:02x}"
-        ins(name=row.mnemonic, mode=row.mode, cycles=row.cycles, extracycles=int(row.page_penalty))(handler)
-
-    def jump(opcode, row, target):
-        def handler(self):
-            self.pc = target(self)
-        handler.__name__ = f"inst_0x{opcode:02x}"
-        ins(name=row.mnemonic, mode=row.mode, cycles=row.cycles, extracycles=0)(handler)
-
-    modes = {"zpg": "ZeroPageAddr", "zpx": "ZeroPageXAddr", "abs": "AbsoluteAddr", "abx": "AbsoluteXAddr",
-             "zpi": "ZeroPageIndirectAddr", "imm": "ProgramCounter"}
-
-    def address(s, mode):
-        return getattr(s, modes[mode])()
-
-    def bit_immediate(s):  # BIT #imm sets only Z
-        s.p = (s.p & ~FLAG_Z) | (0 if s.a & s.memory[s.pc] else FLAG_Z)
-
-    def test_and(s, mode, setting):  # TSB / TRB: Z from A AND M, then set or clear A's bits in M
-        addr = address(s, mode)
-        value = s.ByteAt(addr)
-        s.p = (s.p & ~FLAG_Z) | (0 if s.a & value else FLAG_Z)
-        s._write_back(addr, value, (value | s.a) if setting else (value & ~s.a & 0xFF))
-
-    def memory_bit(s, mask, setting):  # RMB / SMB
-        addr = s.memory[s.pc]
-        value = s.ByteAt(addr)
-        s._write_back(addr, value, (value | mask) if setting else (value & ~mask & 0xFF))
-
-    def bit_branch(s, mask, when_set):  # BBR / BBS: test a zero-page bit, then branch relative
-        value = s.ByteAt(s.memory[s.pc])
-        if bool(value & mask) == when_set:
-            s.pc = (s.pc + 1) & ADDRESS_MASK
-            s.BranchRelAddr()  # +1 taken, +1 more into another page; leaves PC at the target
-            s.pc -= 2  # the handler's length step (3 - 1) follows
-
-    def pull(s, register):
-        setattr(s, register, s._nz(s.stPop()))
-
-    def jmp_indirect(s):  # the 65C02 reads the pointer's high byte across a page correctly
-        pointer = s.AbsoluteAddr()
-        return s.ByteAt(pointer) | s.ByteAt((pointer + 1) & ADDRESS_MASK) << 8
-
-    def jmp_indexed_indirect(s):
-        pointer = (s.AbsoluteAddr() + s.x) & ADDRESS_MASK
-        return s.ByteAt(pointer) | s.ByteAt((pointer + 1) & ADDRESS_MASK) << 8
-
-    alu = {"ORA": "opORA", "AND": "opAND", "EOR": "opEOR", "ADC": "opADC", "SBC": "opSBC", "LDA": "opLDA",
-           "STA": "opSTA", "BIT": "opBIT"}
-    for opcode, row in table.items():
-        nmos = OPCODE_TABLE[opcode]
-        name, mode = row.mnemonic, row.mode
-        if row.kind == RESERVED:
-            op(opcode, row, lambda s: None)
-        elif (nmos.mnemonic, nmos.mode, nmos.kind) == (name, mode, row.kind) and opcode not in (0x00, 0x6C):
-            continue  # the NMOS handler does the same (cycles are set from the table below)
-        elif name == "JMP":
-            jump(opcode, row, jmp_indirect if mode == "ind" else jmp_indexed_indirect)
-        elif name == "BRA":
-            op(opcode, row, lambda s: (s.BranchRelAddr(), setattr(s, "pc", s.pc - 1)))
-        elif name == "CMP":
-            op(opcode, row, lambda s, m=mode: s.opCMPR(getattr(s, modes[m]), s.a))
-        elif name == "BIT" and mode == "imm":
-            op(opcode, row, bit_immediate)
-        elif name in alu:
-            op(opcode, row, lambda s, n=alu[name], m=mode: getattr(s, n)(getattr(s, modes[m])))
-        elif name == "STZ":
-            op(opcode, row, lambda s, m=mode: s.WriteByte(address(s, m), 0))
-        elif name in ("TSB", "TRB"):
-            op(opcode, row, lambda s, m=mode, setting=name == "TSB": test_and(s, m, setting))
-        elif name in ("INC", "DEC"):  # INC A, DEC A
-            op(opcode, row, lambda s, step=1 if name == "INC" else -1: setattr(s, "a", s._nz((s.a + step) & 0xFF)))
-        elif name in ("PHX", "PHY"):
-            op(opcode, row, lambda s, r=name[2].lower(): s.stPush(getattr(s, r)))
-        elif name in ("PLX", "PLY"):
-            op(opcode, row, lambda s, r=name[2].lower(): pull(s, r))
-        elif name[:3] in ("RMB", "SMB"):
-            op(opcode, row, lambda s, mask=1 << int(name[3]), setting=name[0] == "S": memory_bit(s, mask, setting))
-        elif name[:3] in ("BBR", "BBS"):
-            op(opcode, row, lambda s, mask=1 << int(name[3]), when_set=name[2] == "S": bit_branch(s, mask, when_set))
-        elif name in ("WAI", "STP"):
-            reason = "STP" if name == "STP" else "WAI with no interrupt source"
-            op(opcode, row, lambda s, r=reason: s.halt_on(r))
-        elif name == "BRK":
-            op(opcode, row, _brk_65c02)
-        else:  # pragma: no cover - a new table row needs its operation here
-            raise AssertionError(f"no 65C02 operation for {name} (${opcode:02X})")
-    for opcode, row in table.items():  # every opcode's cycles and page penalty, from the table
-        cls.cycletime[opcode] = row.cycles
-        cls.extracycles[opcode] = int(row.page_penalty)
-        cls.disassemble[opcode] = (row.mnemonic, row.mode)
-    cls.RMW_OPCODES = frozenset(opcode for opcode, row in table.items() if row.mode != "acc" and (
-        row.mnemonic in ("ASL", "LSR", "ROL", "ROR", "INC", "DEC", "TSB", "TRB") or row.mnemonic[:3] in ("RMB", "SMB")))
-
-
-def _brk_65c02(self):
-    if self.stop_on_brk:
-        self.halt_on("BRK")
-    _py65_brk(self)
-    self.p &= ~FLAG_D
-
-
-_register_65c02(MPU65C02)
-
-VARIANTS = {"6510": MPU6510, "2a03": MPU2A03, "65c02": MPU65C02}
-
-
-def variant_named(text: str, field: str) -> str:
-    """A CPU variant as a user names it (any case: "65C02"), or a one-line error naming the field."""
-    name = str(text).lower()
-    if name not in VARIANTS:
-        raise InputError(f"{field}: expected one of {', '.join(VARIANTS)}, got {text!r}")
-    return name

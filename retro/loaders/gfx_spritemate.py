@@ -141,21 +141,7 @@ def _data(pens: np.ndarray, multicolor: bool) -> bytes:
 
 def parse_spm(raw: bytes, name: str = "sprite file") -> SpritemateFile:
     """Spritemate JSON bytes -> sprites (63 bytes each) with their attributes and the shared colours."""
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise InputError(f"{name}: not a Spritemate file: not UTF-8 text (byte {exc.start})") from None
-    try:
-        doc = json.loads(text, parse_int=_strict_int, parse_float=_strict_float, parse_constant=_no_constant)
-    except _NotANumber as exc:
-        raise _number_error(text, exc.args[0], name) from None
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{name}: not a Spritemate file: JSON error at line {exc.lineno} column {exc.colno}: "
-                         f"{exc.msg}") from None
-    except RecursionError:
-        raise InputError(f"{name}: not a Spritemate file: JSON nested too deeply") from None
-    if not isinstance(doc, dict) or "sprites" not in doc:
-        raise InputError(f"{name}: not a Spritemate file: a JSON object with \"colors\" and \"sprites\" is expected")
+    doc = _json_document(raw, name)
     colours = doc.get("colors")
     if not isinstance(colours, dict):
         raise InputError(f"{name}: colors: expected an object with keys \"0\", \"2\", \"3\"")
@@ -171,24 +157,45 @@ def parse_spm(raw: bytes, name: str = "sprite file") -> SpritemateFile:
         raise InputError(f"{name}: sprites: expected a list of at least one sprite")
     if len(entries) > MAX_SPRITES:
         raise InputError(f"{name}: sprites: {len(entries)} sprites, at most {MAX_SPRITES} are read")
-    sprites = []
-    for i, sprite in enumerate(entries):
-        field = f"sprites[{i}]"
-        if not isinstance(sprite, dict):
-            raise InputError(f"{name}: {field}: expected an object, got {type(sprite).__name__}")
-        for key in ("color", "pixels"):
-            if key not in sprite:
-                raise InputError(f"{name}: {field}.{key}: missing")
-        multicolor = _flag(sprite, "multicolor", field, name)
-        pens = _pens(sprite["pixels"], f"{field}.pixels", name)
-        label = sprite.get("name", f"sprite{i + 1}")
-        sprites.append(SpritemateSprite(_data(pens, multicolor), str(label),
-                                        _colour(sprite["color"], f"{field}.color", name), multicolor,
-                                        _flag(sprite, "overlay", field, name), _flag(sprite, "double_x", field, name),
-                                        _flag(sprite, "double_y", field, name)))
+    sprites = tuple(_sprite(sprite, i, name) for i, sprite in enumerate(entries))
     version = doc.get("version")
     label = str(version) if isinstance(version, (str, int, float)) else ("legacy" if legacy else "unversioned")
-    return SpritemateFile(label, shared["0"], shared["2"], shared["3"], tuple(sprites))
+    return SpritemateFile(label, shared["0"], shared["2"], shared["3"], sprites)
+
+
+def _json_document(raw: bytes, name: str) -> dict:
+    """The file's JSON object, numbers read strictly; any fault one line naming the file."""
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{name}: not a Spritemate file: not UTF-8 text (byte {exc.start})") from None
+    try:
+        doc = json.loads(text, parse_int=_strict_int, parse_float=_strict_float, parse_constant=_no_constant)
+    except _NotANumber as exc:
+        raise _number_error(text, exc.args[0], name) from None
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{name}: not a Spritemate file: JSON error at line {exc.lineno} column {exc.colno}: "
+                         f"{exc.msg}") from None
+    except RecursionError:
+        raise InputError(f"{name}: not a Spritemate file: JSON nested too deeply") from None
+    if not isinstance(doc, dict) or "sprites" not in doc:
+        raise InputError(f"{name}: not a Spritemate file: a JSON object with \"colors\" and \"sprites\" is expected")
+    return doc
+
+
+def _sprite(sprite, i: int, name: str) -> SpritemateSprite:
+    field = f"sprites[{i}]"
+    if not isinstance(sprite, dict):
+        raise InputError(f"{name}: {field}: expected an object, got {type(sprite).__name__}")
+    for key in ("color", "pixels"):
+        if key not in sprite:
+            raise InputError(f"{name}: {field}.{key}: missing")
+    multicolor = _flag(sprite, "multicolor", field, name)
+    pens = _pens(sprite["pixels"], f"{field}.pixels", name)
+    label = sprite.get("name", f"sprite{i + 1}")
+    return SpritemateSprite(_data(pens, multicolor), str(label), _colour(sprite["color"], f"{field}.color", name),
+                            multicolor, _flag(sprite, "overlay", field, name), _flag(sprite, "double_x", field, name),
+                            _flag(sprite, "double_y", field, name))
 
 
 def read_spm(path: str | Path) -> SpritemateFile:

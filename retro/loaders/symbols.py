@@ -566,7 +566,26 @@ def symbol_tables(symbols: Iterable[Symbol]) -> tuple[dict[str, int], dict[str, 
     symbols = list(dict.fromkeys(symbols))
     table: dict[str, int] = {}
     ambiguous: dict[str, tuple[str, ...]] = {}
+    by_qualified = _addresses_by_qualified_name(symbols)
+    for qualified, addresses in by_qualified.items():
+        if len(addresses) == 1:
+            table[qualified] = addresses[0]
+        else:
+            candidates = _spellings(by_qualified, qualified)
+            ambiguous[qualified] = tuple(candidates)
+            table.update(zip(candidates, addresses))
+    by_name: dict[str, list[Symbol]] = {}
+    for symbol in symbols:
+        by_name.setdefault(symbol.name, []).append(symbol)
+    for name, definitions in by_name.items():
+        _bare_name(name, definitions, by_qualified, table, ambiguous)
+    for symbol in symbols:  # the file's own spelling, where it names one address
+        if symbol.spelling and symbol.spelling not in table and len(by_qualified[symbol.qualified]) == 1:
+            table[symbol.spelling] = symbol.address
+    return table, ambiguous
 
+
+def _addresses_by_qualified_name(symbols: list[Symbol]) -> dict[str, list[int]]:
     by_qualified: dict[str, list[int]] = {}
     for symbol in symbols:
         addresses = by_qualified.setdefault(symbol.qualified, [])
@@ -574,49 +593,38 @@ def symbol_tables(symbols: Iterable[Symbol]) -> tuple[dict[str, int], dict[str, 
             addresses.append(symbol.address)
     for addresses in by_qualified.values():
         addresses.sort()  # candidates are listed by address
+    return by_qualified
 
-    def spellings(qualified: str) -> list[str]:
-        """The names that each pick out one definition of a qualified name."""
-        addresses = by_qualified[qualified]
-        if len(addresses) == 1:
-            return [qualified]
-        return [f"{qualified}@${address:04X}" for address in addresses]
 
-    for qualified, addresses in by_qualified.items():
-        if len(addresses) == 1:
-            table[qualified] = addresses[0]
+def _spellings(by_qualified: dict[str, list[int]], qualified: str) -> list[str]:
+    """The names that each pick out one definition of a qualified name."""
+    addresses = by_qualified[qualified]
+    if len(addresses) == 1:
+        return [qualified]
+    return [f"{qualified}@${address:04X}" for address in addresses]
+
+
+def _bare_name(name: str, definitions: list[Symbol], by_qualified: dict[str, list[int]], table: dict[str, int],
+               ambiguous: dict[str, tuple[str, ...]]) -> None:
+    """Enter a bare name with scoped definitions: its address when all agree, else its candidates."""
+    scoped = [s for s in definitions if s.scope]
+    if not scoped:
+        return  # a global's bare name is its qualified name: already entered
+    addresses = {s.address for s in definitions}
+    if len(addresses) == 1 and name not in ambiguous:
+        table.setdefault(name, addresses.pop())
+        return
+    candidates: list[tuple[int, str]] = []  # (address, name), listed by address
+    if name in by_qualified:  # a global of that name as well
+        if len(by_qualified[name]) == 1:
+            table[ROOT_PREFIX + name] = by_qualified[name][0]
+            candidates.append((by_qualified[name][0], ROOT_PREFIX + name))
         else:
-            candidates = spellings(qualified)
-            ambiguous[qualified] = tuple(candidates)
-            table.update(zip(candidates, addresses))
-
-    by_name: dict[str, list[Symbol]] = {}
-    for symbol in symbols:
-        by_name.setdefault(symbol.name, []).append(symbol)
-    for name, definitions in by_name.items():
-        scoped = [s for s in definitions if s.scope]
-        if not scoped:
-            continue  # a global's bare name is its qualified name: handled above
-        addresses = {s.address for s in definitions}
-        if len(addresses) == 1 and name not in ambiguous:
-            table.setdefault(name, addresses.pop())
-            continue
-        candidates: list[tuple[int, str]] = []  # (address, name), listed by address
-        if name in by_qualified:  # a global of that name as well
-            if len(by_qualified[name]) == 1:
-                table[ROOT_PREFIX + name] = by_qualified[name][0]
-                candidates.append((by_qualified[name][0], ROOT_PREFIX + name))
-            else:
-                candidates.extend(zip(by_qualified[name], spellings(name)))
-        for qualified in dict.fromkeys(s.qualified for s in scoped):
-            candidates.extend(zip(by_qualified[qualified], spellings(qualified)))
-        ambiguous[name] = tuple(spelling for _, spelling in sorted(candidates))
-        table.pop(name, None)
-
-    for symbol in symbols:  # the file's own spelling, where it names one address
-        if symbol.spelling and symbol.spelling not in table and len(by_qualified[symbol.qualified]) == 1:
-            table[symbol.spelling] = symbol.address
-    return table, ambiguous
+            candidates.extend(zip(by_qualified[name], _spellings(by_qualified, name)))
+    for qualified in dict.fromkeys(s.qualified for s in scoped):
+        candidates.extend(zip(by_qualified[qualified], _spellings(by_qualified, qualified)))
+    ambiguous[name] = tuple(spelling for _, spelling in sorted(candidates))
+    table.pop(name, None)
 
 
 def load_symbol_tables(path: str | Path) -> tuple[dict[str, int], dict[str, tuple[str, ...]]]:

@@ -18,6 +18,7 @@ from retro.chips.vic.beam import position
 from retro.chips.vic.constants import VIC_BASE, VIC_LAST
 from retro.chips.vic.device import VicDevice
 from retro.chips.vic.model import VicState
+from retro.cpu.bus import Device
 from retro.cpu.machine import Machine
 from retro.errors import InputError
 from retro.scenes.vic import IRQ_VECTOR_HARDWARE, IRQ_VECTOR_KERNAL, VicScene
@@ -32,13 +33,18 @@ KERNAL_IRQ_EXIT = 0xEA81
 KERNAL_IRQ_EXIT_CODE = bytes([0x68, 0xA8, 0x68, 0xAA, 0x68, 0x40])  # PLA / TAY / PLA / TAX / PLA / RTI
 
 
-def build_c64(state: VicState, *, start_line: int = 0, start_cycle: int = 1,
-              irq_vector: str = IRQ_VECTOR_HARDWARE) -> Machine:
+def build_c64(state: VicState | None = None, *, start_line: int = 0, start_cycle: int = 1,
+              irq_vector: str = IRQ_VECTOR_HARDWARE, vic: Device | None = None) -> Machine:
     """A fresh C64: a 6510 with a VIC-II holding `state` at $D000-$D3FF, driving the CPU's BA and IRQ
     lines, its beam at line `start_line`, cycle `start_cycle` now; with `irq_vector` "$0314" the
-    KERNAL's IRQ entry is in RAM."""
+    KERNAL's IRQ entry is in RAM. `vic`: a device of the caller's at the VIC-II's registers instead
+    (the latch study's, which answers reads of one case's frame and leaves the CPU's lines alone)."""
     machine = Machine(CPU)
-    machine.attach(VicDevice.at_beam(state, machine.cycle, start_line, start_cycle), VIC_BASE, VIC_LAST)
+    if vic is None:
+        if state is None:
+            raise ValueError("build_c64 needs a VIC-II state or a device")
+        vic = VicDevice.at_beam(state, machine.cycle, start_line, start_cycle)
+    machine.attach(vic, VIC_BASE, VIC_LAST)
     if irq_vector == IRQ_VECTOR_KERNAL:
         install_kernal_irq_entry(machine)
     return machine

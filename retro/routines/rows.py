@@ -71,34 +71,7 @@ def parse_rows(r: Fields, value, inputs: tuple[Port, ...], outputs: tuple[Port, 
 
 def _row(r: Fields, index: int, doc: dict, inputs: tuple[Port, ...], outputs: tuple[Port, ...]) -> Row:
     key = f"rows[{index}]"
-    input_names = {p.name for p in inputs}
-    output_names = {p.name for p in outputs}
-    given_in: dict[str, tuple] = {}  # name -> (value, its key as written: rows[i].in.a or rows[i].a)
-    given_out: dict[str, tuple] = {}
-    for name, item in doc.items():
-        if name in ("in", "out") and (isinstance(item, dict) or name not in input_names | output_names):
-            names, target = (input_names, given_in) if name == "in" else (output_names, given_out)
-            what = "input" if name == "in" else "output"
-            for inner, inner_value in r.table(item, f"{key}.{name}").items():
-                if inner not in names:
-                    raise r.error(f"{key}.{name}.{inner}",
-                                  f"no {what} of that name ({what}s: {', '.join(sorted(names))})")
-                if inner in target:
-                    raise r.error(f"{key}.{name}.{inner}", "given twice (bare and under in/out)")
-                target[inner] = (inner_value, f"{key}.{name}.{inner}")
-        elif name in ROW_KEYS and name not in ("in", "out"):
-            continue
-        elif name in input_names and name in output_names:
-            raise r.error(f"{key}.{name}", f"{name!r} is both an input and an output: write in.{name} or out.{name}")
-        elif name in input_names or name in output_names:
-            target = given_in if name in input_names else given_out
-            if name in target:
-                raise r.error(f"{key}.{name}", "given twice (bare and under in/out)")
-            target[name] = (item, f"{key}.{name}")
-        else:
-            raise r.error(f"{key}.{name}", f"neither an input nor an output (inputs: "
-                                           f"{', '.join(p.name for p in inputs)}; outputs: "
-                                           f"{', '.join(p.name for p in outputs)}; a row's own keys: {', '.join(ROW_KEYS)})")
+    given_in, given_out = _given(r, key, doc, inputs, outputs)
     missing = [p.name for p in inputs if p.name not in given_in]
     if missing:
         raise r.error(f"{key}.{missing[0]}", f"missing: a row gives every input ({', '.join(p.name for p in inputs)})")
@@ -113,6 +86,39 @@ def _row(r: Fields, index: int, doc: dict, inputs: tuple[Port, ...], outputs: tu
         raise r.error(key, f"states no output, cycles or max_cycles: nothing to check (outputs: "
                            f"{', '.join(p.name for p in outputs)})")
     return Row(index, case, expected, cycles, max_cycles, note.strip())
+
+
+def _given(r: Fields, key: str, doc: dict, inputs: tuple[Port, ...],
+           outputs: tuple[Port, ...]) -> tuple[dict[str, tuple], dict[str, tuple]]:
+    """A row's inputs and outputs, name -> (value, its key as written: rows[i].in.a or rows[i].a)."""
+    input_names = {p.name for p in inputs}
+    output_names = {p.name for p in outputs}
+    given: dict[str, dict[str, tuple]] = {"in": {}, "out": {}}
+
+    def put(side: str, name: str, value, where: str) -> None:
+        if name in given[side]:
+            raise r.error(where, "given twice (bare and under in/out)")
+        given[side][name] = (value, where)
+
+    for name, item in doc.items():
+        if name in ("in", "out") and (isinstance(item, dict) or name not in input_names | output_names):
+            names, what = (input_names, "input") if name == "in" else (output_names, "output")
+            for inner, inner_value in r.table(item, f"{key}.{name}").items():
+                if inner not in names:
+                    raise r.error(f"{key}.{name}.{inner}",
+                                  f"no {what} of that name ({what}s: {', '.join(sorted(names))})")
+                put(name, inner, inner_value, f"{key}.{name}.{inner}")
+        elif name in ROW_KEYS and name not in ("in", "out"):
+            continue
+        elif name in input_names and name in output_names:
+            raise r.error(f"{key}.{name}", f"{name!r} is both an input and an output: write in.{name} or out.{name}")
+        elif name in input_names or name in output_names:
+            put("in" if name in input_names else "out", name, item, f"{key}.{name}")
+        else:
+            raise r.error(f"{key}.{name}", f"neither an input nor an output (inputs: "
+                                           f"{', '.join(p.name for p in inputs)}; outputs: "
+                                           f"{', '.join(p.name for p in outputs)}; a row's own keys: {', '.join(ROW_KEYS)})")
+    return given["in"], given["out"]
 
 
 def port_value(r: Fields, port: Port, value, key: str):

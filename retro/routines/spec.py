@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 
-from retro.cpu.mpu import VARIANTS
+from retro.cpu.variants import VARIANTS
 from retro.machines import BARE, MACHINE_CPUS, MACHINES, machine_for
 from retro.errors import InputError
 from retro.fields import Fields, describe

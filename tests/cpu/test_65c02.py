@@ -18,7 +18,8 @@ from retro.analysis.raster import format_raster, raster_figures
 from retro.cli import main
 from retro.cpu.batch import BatchCpu, LaneError
 from retro.cpu.machine import Machine
-from retro.cpu.mpu import FLAG_D, MPU65C02, MPU6510, CpuHalt
+from retro.cpu.mpu import FLAG_D, MPU6510, CpuHalt
+from retro.cpu.mpu65c02 import MPU65C02
 from retro.cpu.opcodes import DOCUMENTED, OPCODE_TABLE_65C02, RESERVED, opcodes_of
 from retro.cpu.flow import analyse
 from retro.cpu.timing import OPCODES_65C02, instruction_cycles

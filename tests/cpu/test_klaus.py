@@ -16,7 +16,8 @@ from pathlib import Path
 
 import pytest
 
-from retro.cpu.mpu import MPU65C02, MPU6510
+from retro.cpu.mpu import MPU6510
+from retro.cpu.mpu65c02 import MPU65C02
 
 CHUNK_CYCLES = 1_000_000
 MAX_CYCLES = 150_000_000  # the 6502 test takes about 96 million, the 65C02 one about 67 million

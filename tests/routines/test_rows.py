@@ -344,3 +344,27 @@ def test_a_wrong_row_shows_the_references_answer_unless_it_refuses(tmp_path, cap
     first, second = records[0]["rows"]["failures"]
     assert first["reference"] == {"out": 1} and first["outputs"] == {"out": 1}
     assert second["reference"] is None and second["outputs"] == {"out": 2}
+
+
+def test_a_row_the_engines_disagree_on_fails_naming_the_row(capsys, monkeypatch):
+    """The rows' calls on the batched core are held against Machine's, call for call: a batched core
+    one cycle slow on every call is a failure naming the first row."""
+    import dataclasses
+
+    from retro.routines.runner import RoutineRunner
+
+    real = RoutineRunner.run_batch
+
+    def one_cycle_slow(self, columns):
+        outcome = real(self, columns)
+        return dataclasses.replace(outcome, cycles=outcome.cycles + 1)
+
+    monkeypatch.setattr(RoutineRunner, "run_batch", one_cycle_slow)
+    code, (record,) = _check_json(capsys, EXAMPLE, "--engine", "batch")
+    assert code == 1
+    assert record["engine_agreement"]["cases"] == 4 and record["engine_agreement"]["mismatches"] == 4
+    # three rows state their cycles and fail on their own; all four calls are engine disagreements
+    assert record["rows"]["failed"] == 3
+    code = main(["check", str(EXAMPLE), "--engine", "batch", "--jobs", "1"])
+    text = capsys.readouterr().out
+    assert code == 1 and "on 4 of the calls Machine agrees on 0 and the timing model on 4" in text, text

@@ -24,8 +24,6 @@ from retro.chips.vic.constants import (
     REGISTER_COUNT,
     SPRITE_BYTES,
     SPRITE_COUNT,
-    VIC_BASE,
-    VIC_LAST,
 )
 from retro.chips.vic.model import VicState, frame_collisions
 from retro.chips.vic.sprite_registers import set_sprite_x
@@ -100,12 +98,11 @@ def latch_machine(program) -> tuple[object, Callable[[Pair, int], None]]:
     sets the device up for case `index` of a pair with one whole frame already drawn (so a read of
     $D01E returns that frame's bits)."""
     from retro.chips.vic.device import VicDevice
-    from retro.cpu import Machine
+    from retro.machines.c64 import build_c64
 
-    machine = Machine()
-    machine.load(program)
     slot = _Slot()
-    machine.attach(slot, VIC_BASE, VIC_LAST)
+    machine = build_c64(vic=slot)
+    machine.load(program)
 
     def prepare(pair: Pair, index: int) -> None:
         state = case_state(pair, int(pair.dx[index]), int(pair.dy[index]))

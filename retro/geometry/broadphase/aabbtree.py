@@ -59,6 +59,13 @@ def _union_perimeter(a: _Node, b: _Node) -> float:
     return _perimeter(min(a.x0, b.x0), min(a.y0, b.y0), max(a.x1, b.x1), max(a.y1, b.y1))
 
 
+def _leaves_meet(a: _Node, b: _Node) -> bool:
+    """Two leaves are a pair: their tight boxes overlap and each one's layer is in the other's mask."""
+    ax0, ay0, ax1, ay1 = a.tight
+    bx0, by0, bx1, by1 = b.tight
+    return bool(ax0 < bx1 and bx0 < ax1 and ay0 < by1 and by0 < ay1 and a.layer & b.mask and b.layer & a.mask)
+
+
 class AABBTree:
     """Incremental broad phase. Keys are any hashable, sortable ids you choose (e.g. ints)."""
 
@@ -280,10 +287,7 @@ class AABBTree:
                 continue
             if a.is_leaf and b.is_leaf:
                 tests += 1
-                ax0, ay0, ax1, ay1 = a.tight
-                bx0, by0, bx1, by1 = b.tight
-                if (ax0 < bx1 and bx0 < ax1 and ay0 < by1 and by0 < ay1
-                        and a.layer & b.mask and b.layer & a.mask):
+                if _leaves_meet(a, b):
                     pairs.append((a.key, b.key) if a.key < b.key else (b.key, a.key))  # type: ignore[operator]
             elif b.is_leaf or (not a.is_leaf and a.height >= b.height):
                 crosses.append((a.left, b))  # type: ignore[arg-type]
