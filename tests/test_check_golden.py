@@ -21,7 +21,7 @@ CASES = golden.cases()
 
 # Keys that features after the recording added to a routine's JSON (a key missing from the recording
 # fails the test unless it is named here; every recorded key must still be there with its value).
-ADDED_KEYS: set[str] = {"cpu_min", "cpu_max"}  # issue 23: measured CPU cycles, stalls excluded
+ADDED_KEYS: set[str] = {"cpu_min", "cpu_max", "static_modified"}  # issue 23: CPU cycles without stalls; SMC notes
 
 
 def test_every_case_has_a_golden_file_and_no_file_is_stale():

@@ -126,6 +126,7 @@ def check_record(check: RoutineCheck) -> dict:
               "domain": [{"condition": c.text, "cases": t.constraint_cases.get(c.text, 0),
                           "wrong": t.constraint_wrong.get(c.text, 0)} for c in check.routine.domain],
               **cycle_figures(check), "cpu_min": t.cpu_min, "cpu_max": t.cpu_max,  # stalls excluded: what static bounds
+              "static_modified": list(check.static.modified) if check.static else [],
               "worst_reached": check.worst_reached, "coverage": coverage(check),
               "input_space": space if (space := check.routine.input_space()) < JSON_EXACT else None,
               "input_space_log2": round(math.log2(space), 3), "coverage_argument": check.routine.coverage or None,
@@ -181,6 +182,8 @@ def format_check(check: RoutineCheck) -> list[str]:
         lines.append(f"  coverage: {routine.coverage}")
     if t.cycles_count:
         lines += _cycle_lines(check)
+    if check.static is not None:  # self-modifying code the static analysis followed
+        lines += [f"  self-modifying: {note}" for note in check.static.modified]
     if routine.budget is not None:
         lines.append(f"  budget: {routine.budget} cycles: {'broken' if check.budget_violations else 'kept'}")
     lines += [f"  {line}" for line in check.domain_report()[1:]] if routine.domain else []

@@ -407,13 +407,14 @@ def _check_modified(context: _Context, writes: dict[int, set[int]]) -> tuple[str
         if not hit:
             continue
         where = context.describe(pc)
-        stores = ", ".join(f"${s:04X}" for s in sorted(set().union(*(writes[a] for a in hit))))
+        writers = sorted(set().union(*(writes[a] for a in hit)))
+        stores = ("the store at " if len(writers) == 1 else "the stores at ") + ", ".join(f"${s:04X}" for s in writers)
         if pc in hit:
-            raise InputError(f"{context.name}: the store at {stores} may rewrite the opcode of {op.mnemonic} at "
+            raise InputError(f"{context.name}: {stores} may rewrite the opcode of {op.mnemonic} at "
                              f"{where}: the static analysis cannot bound code whose instructions change")
         if op.mode in ("rel", "zpr") or op.mnemonic in ("JMP", "JSR"):
-            raise InputError(f"{context.name}: the store at {stores} may rewrite the target of {op.mnemonic} at "
+            raise InputError(f"{context.name}: {stores} may rewrite the target of {op.mnemonic} at "
                              f"{where}: the static analysis cannot bound a path whose jumps change")
-        notes.append(f"{op.mnemonic} at {where}: its operand is written by the store at {stores}; "
+        notes.append(f"{op.mnemonic} at {where}: its operand is written by {stores}; "
                      f"bounded from the values stored")
     return tuple(notes)

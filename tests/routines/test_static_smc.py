@@ -31,6 +31,10 @@ def test_self_modifying_multiply_gets_one_bound_on_every_engine_and_jobs(capsys,
     assert code == 0 and record["bounds_violations"] == []
     assert (record["static_min"], record["static_max"]) == (44, 48)
     assert (record["min"], record["max"]) == (44, 48) and record["worst_reached"]
+    # the four patched reads are named (sum_lo at $C00F: four 3-byte stores, EOR # (2) and SEC (1) before it)
+    assert len(record["static_modified"]) == 4
+    assert record["static_modified"][0] == ("LDA at $C00F (sum_lo): its operand is written by the store at $C000; "
+                                            "bounded from the values stored")
 
 
 def test_values_of_the_stored_byte_decide_the_crossing(capsys):
