@@ -188,7 +188,7 @@ def analyse(read: Callable[[int], int], entry: int, loop_bounds: dict[int, int] 
     describe = describe or (lambda a: f"${a:04X}")
     if memory is None:
         code: set[int] = set()
-        for pc, length in _instruction_bytes(read, entry, within, cpu).items():
+        for pc, length in instruction_lengths(read, [entry], within, cpu).items():
             code.update((pc + k) & 0xFFFF for k in range(length))
         memory = MemoryModel(lambda address: single(read(address)) if address in code else ANY,
                              within or (0, 0))
@@ -198,10 +198,13 @@ def analyse(read: Callable[[int], int], entry: int, loop_bounds: dict[int, int] 
     return Bounds(best=summary.best, worst=summary.worst, instructions=summary.instructions, modified=modified)
 
 
-def _instruction_bytes(read, entry: int, within, cpu: str) -> dict[int, int]:
-    """{pc: length} of every instruction reachable from entry, subroutines included."""
+def instruction_lengths(read, entries: list[int], within: tuple[int, int] | None, cpu: str = "6510",
+                        skip_undecodable: bool = False) -> dict[int, int]:
+    """{pc: length} of every instruction reachable from the entries, following branches, JMP and JSR
+    into `within` (None: anywhere), as `decode` reads them. `skip_undecodable`: an entry whose code
+    the decoder does not follow counts none of its code (else its InputError is raised)."""
     found: dict[int, int] = {}
-    pending = [entry]
+    pending = list(entries)
     while pending:
         start = pending.pop()
         if start in found:
@@ -212,7 +215,13 @@ def _instruction_bytes(read, entry: int, within, cpu: str) -> dict[int, int]:
             if within is None or within[0] <= target < within[1]:
                 callees.append(target)
             return (0, 0)
-        for pc in decode(read, start, note, cpu):
+        try:
+            nodes = decode(read, start, note, cpu)
+        except (InputError, KeyError, ValueError):
+            if not skip_undecodable:
+                raise
+            continue
+        for pc in nodes:
             found[pc] = timing_of(read(pc), cpu).length
         pending.extend(callees)
     return found

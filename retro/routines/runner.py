@@ -57,30 +57,10 @@ class Size:
 
 def routine_code(read, entries: list[int], within: tuple[int, int], cpu: str = "6510") -> dict[int, int]:
     """{address: length} of every instruction reachable from the entries (following branches, JMP and
-    JSR into the program), as the static analysis decodes them."""
-    from retro.cpu.flow import decode
-    from retro.cpu.timing import timing_of
+    JSR into the program), as the static analysis decodes them; code it does not follow counts none."""
+    from retro.cpu.flow import instruction_lengths
 
-    found: dict[int, int] = {}
-    pending = list(entries)
-    while pending:
-        entry = pending.pop()
-        if entry in found:
-            continue
-        callees: list[int] = []
-
-        def note_call(pc: int, target: int) -> tuple[int, int]:
-            if within[0] <= target < within[1]:
-                callees.append(target)
-            return (0, 0)
-        try:
-            nodes = decode(read, entry, note_call, cpu)
-        except (InputError, KeyError, ValueError):  # code the decoder does not follow: count none of it
-            continue
-        for pc in nodes:
-            found[pc] = timing_of(read(pc), cpu).length
-        pending.extend(callees)
-    return found
+    return instruction_lengths(read, entries, within, cpu, skip_undecodable=True)
 
 
 def program_size(program: Program, source_text: str | None, entries: list[int], read, cpu: str = "6510") -> Size:
