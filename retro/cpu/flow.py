@@ -325,7 +325,7 @@ def _analyse(context: _Context, entry: int, entry_state: State, calling: tuple) 
             costs[state] = (op.cycles, op.cycles)
             taken_state = here
         else:
-            step = execute(here, memory, pc, op.mnemonic, op.mode, context.cpu, binary_only)
+            step = execute(here, memory, pc, op.mnemonic, op.mode, context.cpu, binary_only, op.page_penalty)
             if step.writes is not None:  # an unknown address: assumed outside the program (_check_modified)
                 for address in step.writes:
                     writes.setdefault(address, set()).add(pc)

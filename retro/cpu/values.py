@@ -400,10 +400,11 @@ NZ_KEPT = {"STA", "STX", "STY", "STZ", "SAX", "CLC", "SEC", "CLD", "SED", "CLV",
 
 
 def execute(state: State, memory: MemoryModel, pc: int, mnemonic: str, mode: str, cpu: str,
-            binary_only: bool = False) -> Step:
+            binary_only: bool = False, page_penalty: bool = True) -> Step:
     """One instruction (not JSR, RTS or JMP, which the flow handles) from `state`. `binary_only`:
-    the CPU ignores D (the 2A03)."""
-    step = _execute(state, memory, pc, mnemonic, mode, cpu, binary_only)
+    the CPU ignores D (the 2A03); `page_penalty`: the instruction pays a page crossing (indexed reads;
+    stores and most read-modify-writes take the longer count always, retro.cpu.opcodes)."""
+    step = _execute(state, memory, pc, mnemonic, mode, cpu, binary_only, page_penalty)
     if mnemonic in NZ_KEPT or mode == "zpr" or mnemonic[:3] in ("RMB", "SMB"):
         return step
     source = NZ_FROM.get(mnemonic, "a" if mode == "acc" else "")
@@ -411,7 +412,7 @@ def execute(state: State, memory: MemoryModel, pc: int, mnemonic: str, mode: str
 
 
 def _execute(state: State, memory: MemoryModel, pc: int, mnemonic: str, mode: str, cpu: str,
-             binary_only: bool = False) -> Step:
+             binary_only: bool, page_penalty: bool) -> Step:
     if mode == "rel":  # a branch: the flag it tests, narrowed on each way
         if mnemonic == "BRA":
             return Step(None, taken=state)
@@ -439,7 +440,7 @@ def _execute(state: State, memory: MemoryModel, pc: int, mnemonic: str, mode: st
         addresses = None if found is None else frozenset(found)
         operand = None  # read below only by the instructions that read
     decimal = (not binary_only) and mnemonic in ("ADC", "SBC", "ISC", "RRA") and bool(state.d & SET)
-    extra = crossing
+    extra = crossing if page_penalty else (0, 0)
     if cpu == "65c02" and mnemonic in ("ADC", "SBC") and state.d & SET:
         extra = (extra[0] + (1 if state.d == SET else 0), extra[1] + 1)
 

@@ -109,3 +109,10 @@ def test_a_subroutine_is_analysed_from_the_state_at_its_call():
               " .advance $c0ff\ntbl: .byte 0, 0\n")
     # 2 + (6 + 4 + 6) + 2 + (6 + 5 + 6) + 6
     assert _bounds(source)[:2] == (2 + 16 + 2 + 17 + 6,) * 2
+
+
+def test_stores_pay_no_page_crossing():
+    # STA abs,X takes 5 cycles whether or not obj + X crosses (opcodes.py: no page penalty): X = 2
+    # from $C0FE crosses, and neither bound may count it (a best case above the real one would fail)
+    source = "entry: ldx #2\n sta obj,x\n rts\n .advance $c0fe\nobj: .byte 0, 0, 0\n"
+    assert _bounds(source)[:2] == (2 + 5 + 6, 2 + 5 + 6)

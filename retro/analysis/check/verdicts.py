@@ -16,7 +16,7 @@ from retro.routines.runner import RoutineRunner
 from retro.routines.spec import Routine
 
 FLAG_NAMES = {FLAG_C: "c", FLAG_Z: "z", FLAG_D: "d", FLAG_V: "v", FLAG_N: "n"}  # I: no timing depends on it
-IO_FIRST, IO_LAST = 0xD000, 0xDFFF  # the C64's I/O area: chip registers, never plain memory
+IO_AREAS = ((0xD000, 0xDFFF), (0x2000, 0x401F))  # with a scene: the C64's I/O, the NES PPU and APU registers
 
 
 def static_bounds(routine: Routine, runner: RoutineRunner | None = None) -> Bounds | None:
@@ -32,7 +32,7 @@ def static_bounds(routine: Routine, runner: RoutineRunner | None = None) -> Boun
 
     def describe(address: int) -> str:
         return f"${address:04X}" + (f" ({names[address]})" if address in names else "")
-    model = MemoryModel(entry_memory(routine, memory, runner.vic is not None, runner.memory_values), (program.origin, program.end))
+    model = MemoryModel(entry_memory(routine, memory, runner.start is not None, runner.memory_values), (program.origin, program.end))
     try:
         return analyse(memory.__getitem__, runner.entry, bounds, name=routine.name,
                        within=(program.origin, program.end), describe=describe, cpu=routine.cpu,
@@ -73,7 +73,8 @@ def entry_state(routine: Routine) -> State:
 
 def entry_memory(routine: Routine, image: bytes, io: bool, generated: dict[str, tuple[int, ...]]) -> Callable[[int], int]:
     """Memory on entry as sets: the image after init, the inputs' `values` where they go, any value in
-    blocks made from the seed (another seed makes other bytes) and, with a scene, in the I/O area."""
+    blocks made from the seed (another seed makes other bytes) and, with a scene (`io`), in the chips'
+    register areas."""
     overrides: dict[int, int] = {}
     for port in routine.inputs:
         for place, values in zip(port.places, _port_byte_sets(port)):
@@ -88,7 +89,7 @@ def entry_memory(routine: Routine, image: bytes, io: bool, generated: dict[str, 
     def initial(address: int) -> int:
         if address in overrides:
             return overrides[address]
-        if io and IO_FIRST <= address <= IO_LAST:
+        if io and any(first <= address <= last for first, last in IO_AREAS):
             return ANY
         return singles[address]
     return initial
