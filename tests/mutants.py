@@ -47,6 +47,7 @@ STABILITY_TESTS = ("tests/study/test_stability_pinned.py", "tests/study/test_sta
                    "tests/study/test_study_cli.py")
 FIELD_TESTS = ("tests/test_fields.py",)
 COMPILED_TESTS = ("tests/cpu/test_compiled.py",)
+FLOW_TESTS = ("tests/cpu/test_flow_values.py", "tests/routines/test_static_smc.py")
 COMMAND_TESTS = ("tests/test_commands.py", "tests/test_cli_foundation.py", "tests/routines/test_routines_cli.py")
 
 MUTANTS = [
@@ -101,8 +102,22 @@ MUTANTS = [
            "cpu = block.cycles[:n] - block.stolen[:n]", "cpu = block.cycles[:n]", CHECK_TESTS),
     # ---- routine specs and static analysis -------------------------------------------------------
     Mutant("jsr-callee-cost-dropped", "retro/cpu/flow.py",
-           "node.cycles = (op.cycles + best, op.cycles + worst)", "node.cycles = (op.cycles, op.cycles)",
+           "costs[state] = (op.cycles + callee.best, op.cycles + callee.worst)", "costs[state] = (op.cycles, op.cycles)",
            CHECK_TESTS),
+    Mutant("page-crossing-always-possible", "retro/cpu/values.py",
+           "return int(lowest(low_bytes) + lowest(index) > 0xFF), int(highest(low_bytes) + highest(index) > 0xFF)",
+           "return int(lowest(low_bytes) + lowest(index) > 0xFF), 1", FLOW_TESTS),
+    Mutant("page-crossing-never-certain", "retro/cpu/values.py",
+           "return int(lowest(low_bytes) + lowest(index) > 0xFF), int(highest(low_bytes) + highest(index) > 0xFF)",
+           "return 0, int(highest(low_bytes) + highest(index) > 0xFF)", FLOW_TESTS),
+    Mutant("known-branch-counted-both-ways", "retro/cpu/values.py",
+           "return Step(narrowed(state, flag, other) if value & other else None,",
+           "return Step(narrowed(state, flag, other),", FLOW_TESTS),
+    Mutant("self-modified-operand-read-as-loaded", "retro/cpu/values.py",
+           "    b1 = state.read(memory, pc + 1)\n    if mode == \"zpg\":",
+           "    b1 = memory.initial(pc + 1)\n    if mode == \"zpg\":", FLOW_TESTS),
+    Mutant("analysis-reads-memory-after-the-cases", "retro/analysis/check/verdicts.py",
+           "memory = bytes(runner.call_image)", "memory = bytes(runner.machine.memory)", FLOW_TESTS),
     Mutant("flag-input-ignored", "retro/routines/runner.py",
            "p |= (values[index] != 0) * bit", "p |= 0 * bit",
            ("tests/routines",)),

@@ -143,7 +143,9 @@ def check_record(check: RoutineCheck) -> dict:
               "outside_domain": t.outside, "outside_domain_wrong": t.outside_wrong,
               "domain": [{"condition": c.text, "cases": t.constraint_cases.get(c.text, 0),
                           "wrong": t.constraint_wrong.get(c.text, 0)} for c in check.routine.domain],
-              **cycle_figures(check), "worst_reached": check.worst_reached, "coverage": coverage(check),
+              **cycle_figures(check), "cpu_min": t.cpu_min, "cpu_max": t.cpu_max,  # stalls excluded: what static bounds
+              "static_modified": list(check.static.modified) if check.static else [],
+              "worst_reached": check.worst_reached, "coverage": coverage(check),
               "input_space": space if (space := check.routine.input_space()) < JSON_EXACT else None,
               "input_space_log2": round(math.log2(space), 3), "coverage_argument": check.routine.coverage or None,
               "examples": t.examples, "outside_examples": t.outside_examples, "engine": check.engine,
@@ -310,6 +312,8 @@ def format_check(check: RoutineCheck) -> list[str]:
         lines.append(f"  engine with the scene: {engine}: {check.engine_reason}")
     if t.cycles_count:
         lines += _cycle_lines(check)
+    if check.static is not None:  # self-modifying code the static analysis followed
+        lines += [f"  self-modifying: {note}" for note in check.static.modified]
     if routine.budget is not None:
         lines.append(f"  budget: {routine.budget} cycles: {'broken' if check.budget_violations else 'kept'}")
     lines += [f"  {line}" for line in check.domain_report()[1:]] if routine.domain else []
@@ -330,11 +334,14 @@ def format_check(check: RoutineCheck) -> list[str]:
 def _headline(check: RoutineCheck) -> str:
     t = check.totals
     verdict = "OK" if not check.mismatches else f"{check.mismatches} MISMATCH(ES)"
-    static = (f"static {check.static.best}-{check.static.worst}, worst case "
-              f"{'reached' if check.worst_reached else 'not reached'}" if check.static else
+    stolen = check.start is not None and t.cycles_count  # with a scene the static bounds count the CPU's cycles only
+    static = (f"static {check.static.best}-{check.static.worst}{' CPU cycles (stolen cycles not included)' if stolen else ''}"
+              f", worst case {'reached' if check.worst_reached else 'not reached'}" if check.static else
               "static bounds unknown" if check.rows is not None and check.rows.static_note else "static analysis off")
     cost = (f"cycles {t.cycles_min}-{t.cycles_max} (mean {check.mean:.2f})" if t.cycles_count
             else "no case inside the domain")
+    if stolen:
+        cost += f", CPU {t.cpu_min}-{t.cpu_max} without the cycles the chip stole"
     if check.agreement is None:
         checked = f"timing model equal on {t.cases - t.cycle_mismatches - t.run_errors} of {t.cases} calls"
     else:

@@ -74,6 +74,7 @@ class LaneError(IntEnum):
     UNSTABLE = 3
     BUDGET = 4
     HALT = 5  # the 65C02's STP, or WAI with no interrupt source
+    FACT = 6  # the lane contradicted a `watch` (a fact its spec states) before the instruction there
 
 
 def _signed(offset):
@@ -254,6 +255,8 @@ class BatchCpu:
         self.bus_stall = None
         self.stolen = np.zeros(lanes, dtype=np.int64)
         self._began = np.zeros(lanes, dtype=np.int64)
+        # address -> (Lanes -> bool per lane): lanes for which it is true stop there with LaneError.FACT
+        self.watch: dict = {}
 
     def _everyone(self) -> Lanes:
         return Lanes(self, slice(None), self.a.copy(), self.x.copy(), self.y.copy(), self.p.copy(), self.sp.copy(),
@@ -291,6 +294,13 @@ class BatchCpu:
                     if spent.all():
                         continue
                     group = group.take(np.flatnonzero(~spent))
+            if pc in self.watch:
+                broken = np.asarray(self.watch[pc](group), dtype=bool)
+                if broken.any():
+                    group.take(np.flatnonzero(broken)).stop(pc, LaneError.FACT)
+                    if broken.all():
+                        continue
+                    group = group.take(np.flatnonzero(~broken))
             for target, lanes in self._run_at(group, pc):
                 for where, part in _by_address(target, lanes):
                     pending.setdefault(where, []).append(part)

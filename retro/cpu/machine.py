@@ -265,7 +265,7 @@ class Machine:
 
         `address` is the entry as a number, `writes` are raw (address, byte) pairs stored into RAM,
         register values are trusted. Returns (cycles, a, x, y, p) with p as `call` reports it.
-        With `record` (a list), each executed instruction appends (pc, x, y, p, pointer) as they were
+        With `record` (a list), each executed instruction appends (pc, x, y, p, pointer, a) as they were
         before it ran; pointer is the zero-page word its operand names when its PC is in
         `pointer_pcs` (for (indirect),Y instructions), else 0. Failures are RunErrors as in `call`.
         """
@@ -361,8 +361,9 @@ class Machine:
 
 
 class _Recorder:
-    """Observer of the run loop: each instruction's (pc, x, y, p, pointer) before it runs, for the
-    timing model (pointer: the zero-page word of an (indirect),Y instruction in `pointer_pcs`, else 0)."""
+    """Observer of the run loop: each instruction's (pc, x, y, p, pointer, a) before it runs, for the
+    timing model (pointer: the zero-page word of an (indirect),Y instruction in `pointer_pcs`, else 0)
+    and the spec's stated facts (retro.routines.facts)."""
 
     def __init__(self, record: list, pointer_pcs: frozenset[int]) -> None:
         self.append = record.append
@@ -375,9 +376,9 @@ class _Recorder:
         if pc in self.pointer_pcs:
             memory = mpu.memory
             zp = memory[(pc + 1) & 0xFFFF]
-            self.append((pc, mpu.x, mpu.y, _status(mpu.p), memory[zp] | memory[(zp + 1) & 0xFF] << 8))
+            self.append((pc, mpu.x, mpu.y, _status(mpu.p), memory[zp] | memory[(zp + 1) & 0xFF] << 8, mpu.a))
         else:
-            self.append((pc, mpu.x, mpu.y, _status(mpu.p), 0))
+            self.append((pc, mpu.x, mpu.y, _status(mpu.p), 0, mpu.a))
 
     def after(self, mpu) -> None:
         pass

@@ -257,5 +257,5 @@ def instruction_cycles(read: Callable[[int], int], pc: int, x: int, y: int, p: i
 
 def model_cycles(read: Callable[[int], int], steps: Iterable[tuple[int, int, int, int, int]],
                  cpu: str = "6510") -> int:
-    """Total cycles of an executed path; steps are (pc, x, y, p, pointer) before each instruction."""
-    return sum(instruction_cycles(read, pc, x, y, p, pointer, cpu) for pc, x, y, p, pointer in steps)
+    """Total cycles of an executed path; steps are (pc, x, y, p, pointer, ...) before each instruction."""
+    return sum(instruction_cycles(read, pc, x, y, p, pointer, cpu) for pc, x, y, p, pointer, *_ in steps)

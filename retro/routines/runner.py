@@ -98,32 +98,12 @@ def routine_code(read, entries: list[int], within: tuple[int, int], cpu: str = "
                  world: World = NO_WORLD) -> dict[int, int]:
     """{address: length} of every instruction reachable from the entries (following branches, JMP and
     JSR into the program), as the static analysis decodes them (an interrupt handler's RTI and the
-    world's exits end a path)."""
-    from retro.cpu.flow import OPCODE_RTI, OPCODE_RTS, decode
-    from retro.cpu.timing import timing_of
+    world's exits end a path); code it does not follow counts none."""
+    from retro.cpu.flow import OPCODE_RTI, OPCODE_RTS, instruction_lengths
 
-    found: dict[int, int] = {}
-    pending = list(entries)
-    while pending:
-        entry = pending.pop()
-        if entry in found:
-            continue
-        callees: list[int] = []
-
-        def note_call(pc: int, target: int) -> tuple[int, int]:
-            if within[0] <= target < within[1]:
-                callees.append(target)
-            return (0, 0)
-        try:
-            nodes = decode(read, entry, note_call, cpu, frozenset({OPCODE_RTS, OPCODE_RTI}) if world.enter != "jsr"
-                           else frozenset({OPCODE_RTS}), frozenset(world.exits))
-        except (InputError, KeyError, ValueError):  # code the decoder does not follow: count none of it
-            continue
-        for pc in nodes:
-            if pc not in world.exits:
-                found[pc] = timing_of(read(pc), cpu).length
-        pending.extend(callees)
-    return found
+    ends = frozenset({OPCODE_RTS, OPCODE_RTI}) if world.enter != "jsr" else frozenset({OPCODE_RTS})
+    return instruction_lengths(read, entries, within, cpu, skip_undecodable=True, ends=ends,
+                               exits=frozenset(world.exits))
 
 
 def program_size(program: Program, source_text: str | None, entries: list[int], read, cpu: str = "6510",
@@ -444,6 +424,7 @@ class RoutineRunner:
         self.pointer_pcs = frozenset(self.program.origin + i for i, b in enumerate(self.program.code) if b in indirect_y)
         self.plan = InputPlan.of(routine, self.call_image, seed)
         self._dirty: list[int] = []  # addresses the last call's ports placed by the case took (restored)
+        self.watched_facts = {fact.address: fact for fact in routine.facts}  # held against every call
         self.written_kept: dict[str, int] = {}  # per hardware entry, the values written that outputs show
         for port in routine.outputs:
             for place in port.places:
@@ -688,6 +669,10 @@ class RoutineRunner:
             world.stack_top = stop  # where an exit ends the call
         if self.vic is not None:  # the scene's timeline: each lane stalls as Machine would from the start
             cpu.bus_stall = self.bus_stalls
+        image = self.call_image
+        cpu.watch = {pc: (lambda lanes, fact=fact, opcode=image[pc]: fact.broken(lanes.a, lanes.x, lanes.y, lanes.p,
+                                                                                 opcode))
+                     for pc, fact in self.watched_facts.items()}
         cpu.call(self.entry, self.limit, RETURN_TRAP, stop)
         if world is not None:
             world.finish()

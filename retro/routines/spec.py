@@ -44,6 +44,7 @@ from retro.routines.places import (
     resolve,
 )
 from retro.routines.entry import parse_entry
+from retro.routines.facts import StatedFact, parse_facts
 from retro.routines.rows import Row, misplaced_rows, parse_rows
 from retro.routines import sandbox
 from retro.routines.world import NO_WORLD, World, check_names, is_world_output, parse_world, recorded_mocks, world_output
@@ -58,7 +59,7 @@ NUMBER_CHARACTERS = 40  # the longest number a spec may write as text
 CPUS = tuple(VARIANTS)
 
 TOP_KEYS = {"name", "summary", "program", "inputs", "outputs", "memory", "reference", "cases", "cycles", "rows",
-            "mocks", "hardware", "entry"}
+            "mocks", "hardware", "entry", "facts"}
 PROGRAM_KEYS = {"file", "symbols", "entry", "cpu", "machine", "init", "load", "listing", "interrupt", "exit", "s"}
 MEMORY_KEYS = {"at", "bytes", "file", "generator", "values", "size", "fill", "skip"}
 REFERENCE_KEYS = {"function", "arrays", "time_limit"}
@@ -129,6 +130,7 @@ class Routine:
     random_values: tuple[tuple[str, Values], ...] = ()
     random_inside: bool | None = None  # draw the random part inside the domain (None: when it is a small share)
     shown_path: str = ""  # the spec's path as the user gave it (reports print it; spec_path is resolved)
+    facts: tuple[StatedFact, ...] = ()  # [facts]: what the spec states at addresses (retro.routines.facts)
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -218,10 +220,12 @@ def parse_spec(doc: dict, path: Path, shown: str | None = None) -> Routine:
     world = reference.pop("world")
     cases = _cases_section(r, doc, inputs, seconds, answered=reference["reference"] is not None)
     cycles = _cycles_section(r, doc, program.program)
+    facts = parse_facts(r, doc.get("facts", {}), program.program, program.cpu)
     routine = Routine(name=_text(r, doc, "name", "name") or path.stem, spec_path=path, **program.fields(),
                       inputs=inputs, outputs=outputs, memory=memory, **reference, **cases, **cycles,
                       summary=_summary(r, doc), rows=rows, notes=program.program.notes, world=world,
-                      entry_state=parse_entry(r, doc.get("entry", {}), inputs), shown_path=shown or str(path))
+                      entry_state=parse_entry(r, doc.get("entry", {}), inputs), shown_path=shown or str(path),
+                      facts=facts)
     if not (routine.random or routine.exhaustive or routine.boundary or routine.sweep or routine.rows):
         raise r.error("cases", "no cases: give random = N, exhaustive = [...], boundary, sweep or [[rows]]")
     if routine.exhaustive_count() > MAX_EXHAUSTIVE:

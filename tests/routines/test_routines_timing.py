@@ -73,9 +73,16 @@ def test_static_bounds_of_a_hand_counted_routine():
     memory[program.origin:program.end] = program.code
     loop = program.symbols["loop"]
     bounds = analyse(memory.__getitem__, program.symbols["entry"], {loop: 3})
-    # best: 2 + (2+3)*0 ... the loop runs at least once: 2 + 2 + 2 + 3 + 3 + 6 = 18
-    # worst: 2 + (2+3)*2 + 2 + 2 + 3 + 2 + 2 + 6 = 29
-    assert (bounds.best, bounds.worst) == (18, 29)
+    # X = 3 is known, so the loop runs exactly three times (taken twice, then falls through):
+    # 2 + (2+3) + (2+3) + (2+2) = 16, LDA 3 = 19; $10 is unknown (only the code is known by default):
+    # best: BEQ taken 3, RTS 6 = 28; worst: BEQ 2, NOP 2, RTS 6 = 29
+    assert (bounds.best, bounds.worst) == (28, 29)
+    # with X unknown (read from $11), the bound of 3 is all that limits the loop: it runs 1 to 3 times
+    unknown = list(memory)
+    unknown[program.symbols["entry"]:program.symbols["entry"] + 2] = [0xA6, 0x11]  # ldx $11 (3 cycles)
+    bounds = analyse(unknown.__getitem__, program.symbols["entry"], {loop: 3})
+    # best: 3 + (2+2) + 3 + 3 + 6 = 19; worst: 3 + (2+3)*2 + (2+2) + 3 + 2 + 2 + 6 = 30
+    assert (bounds.best, bounds.worst) == (19, 30)
     with pytest.raises(InputError, match="needs a bound"):
         analyse(memory.__getitem__, program.symbols["entry"], {})
 

@@ -188,6 +188,10 @@ def run_on_machine(runner: RoutineRunner, cases: list[tuple], coverage: bool = T
         except RunError as exc:
             stop, message = "run", str(exc)
             break
+        broken = facts_broken(runner, steps)
+        if broken:
+            stop, message = "run", broken
+            break
         answers.append(answer)
         cycles.append(spent)
         stolen.append(runner.last_stolen)
@@ -199,6 +203,18 @@ def run_on_machine(runner: RoutineRunner, cases: list[tuple], coverage: bool = T
     return CallBlock(_output_arrays(runner.routine, answers), np.asarray(cycles, dtype=np.int64),
                      np.asarray(stolen, dtype=np.int64), np.asarray(modelled, dtype=np.int64), len(answers),
                      stop, message, coverage=covered, mock_calls=calls)
+
+
+def facts_broken(runner: RoutineRunner, steps: list) -> str:
+    """The first stated fact (`[facts]`) the recorded call contradicts, as a message ('' when none)."""
+    watched = runner.watched_facts
+    if not watched:
+        return ""
+    for pc, x, y, p, _, a in steps:
+        fact = watched.get(pc)
+        if fact is not None and fact.broken(a, x, y, p, runner.call_image[pc]):
+            return f"the call {fact.describe_break()} at ${pc:04X} (A={a}, X={x}, Y={y}, P=${p:02X})"
+    return ""
 
 
 def _output_arrays(routine: Routine, answers: list[tuple]) -> list[np.ndarray]:
