@@ -735,7 +735,7 @@ class RoutineRunner:
                 self.run(case, steps)
             except RunError:
                 break
-            for pc, x, y, _, pointer in steps:
+            for pc, x, y, _, pointer, *_ in steps:
                 address = data_address(read, pc, x, y, pointer, self.routine.cpu)
                 if address is not None:
                     found.update(name for start, end, name in spans if start <= address < end)

@@ -38,7 +38,7 @@ def count_steps(coverage: CodeCoverage, read: Callable[[int], int], steps: Itera
     executed, taken, not_taken = coverage.executed, coverage.taken, coverage.not_taken
     low, high = coverage.cycles_min, coverage.cycles_max
     total = 0
-    for pc, x, y, p, pointer in steps:
+    for pc, x, y, p, pointer, *_ in steps:
         cycles = instruction_cycles(read, pc, x, y, p, pointer, cpu)
         total += cycles
         executed[pc] = executed.get(pc, 0) + 1
@@ -63,7 +63,7 @@ def directions_of(read: Callable[[int], int], steps: Iterable[tuple[int, int, in
     table = timing_table(cpu)
     branches = _conditional_branches(cpu)
     went = set()
-    for pc, x, y, p, pointer in steps:
+    for pc, x, y, p, pointer, *_ in steps:
         opcode = read(pc)
         if opcode in branches:
             went.add((pc, instruction_cycles(read, pc, x, y, p, pointer, cpu) > table[opcode].cycles))
