@@ -90,6 +90,9 @@ function = "refs.py:mul"
 
 [cases]
 random = 3000
+
+[entry]
+d = 0        # its ADC needs binary mode
 """
 
 
