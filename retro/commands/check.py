@@ -192,6 +192,9 @@ def engine_lines(check: RoutineCheck) -> list[str]:
     lines = [line]
     for reason, count in fallback_counts(check.totals).items():
         lines.append(f"  engine: {count:,} calls ran on the batched core: {reason}")
+    return lines
+
+
 def entry_record(check: RoutineCheck) -> dict | None:
     """The entry-state runs (retro.analysis.check.entry_runs): null when none ran."""
     if not check.entry_every:

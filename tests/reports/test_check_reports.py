@@ -78,8 +78,8 @@ def test_without_code_coverage_one_line_and_exit_2(folder, tmp_path, monkeypatch
     out = tmp_path / "sumto.lst"
     assert cli.main(["check", str(folder / "sumto.toml"), "--quiet", "--listing", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["retro check: no code coverage was recorded for sumto (the engine ran without it), so --listing, "
-                   "--lcov and --html cannot be written"]
+    assert err == ["retro check: no code coverage was recorded for sumto (the compiled engine counts none: use "
+                   "--engine batch), so --listing, --lcov and --html cannot be written"]
     assert not out.exists()
 
 

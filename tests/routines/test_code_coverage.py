@@ -203,10 +203,34 @@ def test_a_bad_search_budget_is_one_line_naming_the_key(tmp_path, capsys):
     assert "--search" in capsys.readouterr().err
 
 
+SAME = """\
+        .org $c000
+same:   lda a
+        sta t
+        lda a
+        cmp t           ; always equal: the three NOPs never run
+        beq done
+        nop
+        nop
+        nop
+done:   rts
+a:      .byte 0
+t:      .byte 0
+"""
+
+
 def test_a_bound_no_input_reaches_is_known_unreachable_when_every_input_ran(tmp_path):
-    spec = _magic(tmp_path, cases='exhaustive = ["a", "b"]', a_values=', values = [1, 2, 3]')
+    """The static analysis knows sets of values, not that A equals the byte it was stored to: its worst
+    case falls through to the NOPs, which no input can; every input ran, so that is known. By hand:
+    LDA, STA, LDA, CMP (abs, 4 each), BEQ taken 3, RTS 6 = 25; the fall-through BEQ 2 + 3 NOPs 6 = 30."""
+    (tmp_path / "same.s").write_text(SAME)
+    (tmp_path / "ref.py").write_text("def same(a):\n    return a\n")
+    spec = tmp_path / "same.toml"
+    spec.write_text('[program]\nfile = "same.s"\nentry = "same"\n\n[inputs]\na = "a"\n\n[outputs]\nr = "A"\n\n'
+                    '[reference]\nfunction = "ref.py:same"\n\n[cases]\nexhaustive = ["a"]\n')
     report = check(spec, engine="batch")
-    assert report.every_input_run and not report.worst_reached  # a is never $A7: the slow path cannot run
+    assert report.every_input_run and not report.worst_reached
+    assert (report.totals.cycles_max, report.static.worst) == (25, 30)
     from retro.commands.check import bounds_reached
 
     assert bounds_reached(report)["worst"]["unreachable"] is True

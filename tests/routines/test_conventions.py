@@ -313,6 +313,9 @@ function = "refs.py:total"
 
 [cases]
 random = 2000
+
+[entry]
+d = 0
 """
     assert both(spec_file(tmp_path, sum3, "sum3")).mismatches == 0
     # a word in slots 0, 2, 4, 6; the routine reads its high byte with `lda words+1,x` only if right

@@ -68,9 +68,17 @@ def _port_byte_sets(port: Port) -> list[int]:
 def entry_state(routine: Routine) -> State:
     """Registers and flags on entry: an input's `values`, anything for what the spec does not name."""
     known: dict[str, int] = {}
+    for name, value in routine.entry_state:  # `[entry]`: what the caller guarantees
+        name = name.lower()
+        if name in ("a", "x", "y"):
+            known[name] = single(value)
+        elif name in ("c", "z", "n", "v", "d"):
+            known[name] = SET if value else CLEAR
     for port in routine.inputs:
+        if port.via is not None:
+            continue  # placed on the stack, in a slot or behind a pointer: memory, unknown here
         for place, values in zip(port.places, _port_byte_sets(port)):
-            if place.kind == "register":
+            if place.kind == "register" and place.register in ("a", "x", "y"):
                 known[place.register] = values
             elif place.kind == "flag" and place.bit in FLAG_NAMES:
                 known[FLAG_NAMES[place.bit]] = values
@@ -90,6 +98,8 @@ def entry_memory(routine: Routine, image: bytes, io: bool, generated: dict[str, 
         if block.data is None:
             for offset in range(len(generated[block.name])):
                 overrides[block.address + offset] = ANY
+    for hardware in routine.world.hardware:  # a scripted read gives what the script says: any value here
+        overrides[hardware.address] = ANY
     singles = [single(b) for b in image]
 
     def initial(address: int) -> int:
