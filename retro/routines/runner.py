@@ -199,10 +199,14 @@ class InputPlan:
     vias: "ViaPlan | None" = None  # inputs and outputs placed by the case (stack, table slot, pointer)
     entry_s: int = ENTRY_S  # S at entry when no input sets it
 
+    def __post_init__(self) -> None:  # what every call starts from, worked out once (a call is microseconds)
+        object.__setattr__(self, "_start", {**dict(self.base_registers), "s": self.entry_s})
+        object.__setattr__(self, "_s_varies", any(register == "s" for _, register, _ in self.registers))
+
     @property
     def s_varies(self) -> bool:
         """An input sets S (each call, or each lane, has its own)."""
-        return any(register == "s" for _, register, _ in self.registers)
+        return self._s_varies
 
     @classmethod
     def of(cls, routine: Routine, image: Sequence[int] | None = None, salt: int = 0) -> "InputPlan":
@@ -247,7 +251,7 @@ class InputPlan:
                 write(address, table_byte(values[index], k))
         if self.vias is not None:
             self.vias.place(values, table_byte, scatter or write, select or _case_select)
-        registers = {**dict(self.base_registers), "s": self.entry_s}
+        registers = dict(self._start)
         p = self.base_flags
         if entry is not None:
             free, bits, mask = entry
@@ -431,6 +435,7 @@ class RoutineRunner:
                 if place.kind == "written":
                     self.written_kept[place.register] = max(self.written_kept.get(place.register, 0), place.bit + 1)
         self.fallbacks: dict[int, int] = {}  # compiled engine: calls it left to the batched core, by status
+        self._machine_s = not self.plan.s_varies and routine.entry_s == ENTRY_S  # S from the machine's stack top
 
     @property
     def limit(self) -> int:
@@ -448,7 +453,7 @@ class RoutineRunner:
             writes += [(address, image[address]) for address in self._dirty + touched]
             self._dirty = touched
         registers, p = self.plan.place(case, _case_byte, lambda address, byte: writes.append((address, byte)), entry)
-        if not self.plan.s_varies and self.routine.entry_s == ENTRY_S:
+        if self._machine_s:
             registers["s"] = self.machine.entry_s  # the machine's stack top (the entry-state runs vary it)
         return writes, registers, p
 
