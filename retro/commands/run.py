@@ -404,36 +404,37 @@ def c64_json(report: C64Run) -> dict:
             **_watch_json(report)}
 
 
-def c64_lines(report: C64Run) -> list[str]:
+def _frames_run_lines(report: C64Run | ConsoleRun, ran: str, chip: str) -> list[str]:
+    """What a program run of either machine prints: how far it ran, why it stopped, the CPU's
+    registers, the chip's line `chip`, and the bytes peeked."""
     r = _cpu_state(report.machine.mpu)
+    return ([f"ran {report.frames_run:.2f} of {report.frames_asked} frames ({report.cycles} cycles, {ran}",
+             f"stopped: {STOP_REASONS[report.stopped]}"
+             + (f" at ${report.halt_pc:04X}" if report.halt_pc is not None else ""),
+             f"PC=${r['pc']:04X} A=${r['a']:02X} X=${r['x']:02X} Y=${r['y']:02X} S=${r['s']:02X} P=${r['p']:02X}",
+             chip]
+            + [f"{target}: " + " ".join(f"${v:02X}" for v in values) for target, values in report.peeks.items()])
+
+
+def c64_lines(report: C64Run) -> list[str]:
     vic = vic_registers(report.vic)
     start = (f"the SYS of BASIC line {report.sys_line}, ${report.entry:04X}" if report.sys_line is not None
              else f"${report.entry:04X}")
-    out = [f"ran {report.frames_run:.2f} of {report.frames_asked} frames ({report.cycles} cycles, "
-           f"{report.instructions} instructions, {report.machine.mpu.stolen} stolen by the VIC-II) from {start}",
-           f"stopped: {STOP_REASONS[report.stopped]}"
-           + (f" at ${report.halt_pc:04X}" if report.halt_pc is not None else ""),
-           f"PC=${r['pc']:04X} A=${r['a']:02X} X=${r['x']:02X} Y=${r['y']:02X} S=${r['s']:02X} P=${r['p']:02X}",
-           f"VIC-II: frame {vic['frame']} line {vic['line']} cycle {vic['cycle']}, $D011=${report.vic.peek(0xD011):02X} "
-           f"$D019=${vic['d019']:02X} $D01A=${report.vic.peek(0xD01A):02X} $D01E=${vic['d01e']:02X} "
-           f"$D01F=${vic['d01f']:02X}"]
-    out += [f"{target}: " + " ".join(f"${v:02X}" for v in values) for target, values in report.peeks.items()]
+    out = _frames_run_lines(
+        report, f"{report.instructions} instructions, {report.machine.mpu.stolen} stolen by the VIC-II) from {start}",
+        f"VIC-II: frame {vic['frame']} line {vic['line']} cycle {vic['cycle']}, $D011=${report.vic.peek(0xD011):02X} "
+        f"$D019=${vic['d019']:02X} $D01A=${report.vic.peek(0xD01A):02X} $D01E=${vic['d01e']:02X} "
+        f"$D01F=${vic['d01f']:02X}")
     out += [f"note: {note}" for note in report.notes]
     return out + watch_lines(report)
 
 
 def console_lines(report: ConsoleRun) -> list[str]:
-    mpu = report.machine.mpu
     ppu = ppu_registers(report.ppu)
-    p = (mpu.p | FLAG_U) & ~FLAG_B
-    out = [f"ran {report.frames_run:.2f} of {report.frames_asked} frames ({report.cycles} cycles, "
-           f"{report.instructions} instructions) from the reset vector ${report.entry:04X}",
-           f"stopped: {STOP_REASONS[report.stopped]}"
-           + (f" at ${report.halt_pc:04X}" if report.halt_pc is not None else ""),
-           f"PC=${mpu.pc:04X} A=${mpu.a:02X} X=${mpu.x:02X} Y=${mpu.y:02X} S=${mpu.sp:02X} P=${p:02X}",
-           f"PPU: frame {ppu['frame']} line {ppu['line']} dot {ppu['dot']}, $2000=${ppu['ctrl']:02X} "
-           f"$2001=${ppu['mask']:02X} $2002=${ppu['status']:02X}"]
-    out += [f"{target}: " + " ".join(f"${v:02X}" for v in values) for target, values in report.peeks.items()]
+    out = _frames_run_lines(
+        report, f"{report.instructions} instructions) from the reset vector ${report.entry:04X}",
+        f"PPU: frame {ppu['frame']} line {ppu['line']} dot {ppu['dot']}, $2000=${ppu['ctrl']:02X} "
+        f"$2001=${ppu['mask']:02X} $2002=${ppu['status']:02X}")
     if report.verdict is not None:
         out.append(f"verdict: {report.verdict.summary()}")
         if report.verdict.protocol == "$6000":
