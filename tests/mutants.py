@@ -5,12 +5,17 @@ Run: `python tests/mutants.py [NAME ...] [--list]`.
 Every mutant is applied to a private copy of the tree (so other work in the checkout is never
 disturbed), then the tests that guard its rule run against that copy. A mutant that survives is a
 rule no test can see: docs/mutation.md lists the last run and explains every survivor.
+The test that killed a mutant last time is remembered (~/.cache/retro/mutant-killers.json, or
+$RETRO_MUTANT_KILLERS) and run alone first; only when it no longer kills does the mutant's whole guard
+set run, so a rerun of the whole set costs about one test per mutant. Only a test inside the mutant's
+guard set is remembered or trusted.
 Exit status: 0 when every mutant was killed or is explained, 1 otherwise.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import shutil
 import subprocess
@@ -333,7 +338,39 @@ def copy_tree(destination: Path) -> Path:
     return destination
 
 
-def run_mutant(mutant: Mutant, tree: Path) -> tuple[str, float]:
+KILLERS = Path(os.environ.get("RETRO_MUTANT_KILLERS", Path.home() / ".cache" / "retro" / "mutant-killers.json"))
+
+
+def _pytest(tree: Path, arguments: list[str]) -> tuple[int, list[str], str]:
+    """Run pytest in the mutated tree: its exit status, the failing test ids, and its last words."""
+    env = {**os.environ, "PYTHONPATH": str(tree), "PYTHONDONTWRITEBYTECODE": "1",
+           "RETRO_CPU_VECTORS": os.environ.get("RETRO_CPU_VECTORS", str(ROOT.parent / "shared" / "cpu-vectors"))}
+    done = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", *arguments],
+                          cwd=tree, env=env, capture_output=True, text=True, timeout=TIMEOUT_SECONDS)
+    failed = [line.split(" ", 2)[1] for line in done.stdout.splitlines() if line.startswith(("FAILED ", "ERROR "))]
+    return done.returncode, failed, (done.stderr or done.stdout).strip()[-120:]
+
+
+def _guards(mutant: Mutant, test_id: str) -> bool:
+    """Whether a test id lies inside the mutant's own guard set (only those may kill it)."""
+    path = test_id.split("::")[0]
+    return any(path == t.split("::")[0] or path.startswith(t.rstrip("/") + "/") for t in mutant.tests)
+
+
+def _killer_first(mutant: Mutant, tree: Path, killers: dict[str, str]) -> str | None:
+    """The test that killed this mutant last time, run alone first: a mutant it kills again is killed
+    without running the whole guard set (the full set still runs when it does not)."""
+    known = killers.get(mutant.name)
+    if not known or not _guards(mutant, known) or not (tree / known.split("::")[0]).exists():
+        return None
+    status, failed, _ = _pytest(tree, ["-n", "0", known])
+    if status == 1 and failed:
+        return f"killed by {failed[0].split('::')[-1][:60]}"
+    return None
+
+
+def run_mutant(mutant: Mutant, tree: Path, killers: dict[str, str] | None = None) -> tuple[str, float]:
+    killers = {} if killers is None else killers
     path = tree / mutant.file
     original = path.read_text()
     if original.count(mutant.old) != 1:
@@ -341,20 +378,34 @@ def run_mutant(mutant: Mutant, tree: Path) -> tuple[str, float]:
     path.write_text(original.replace(mutant.old, mutant.new))
     started = time.monotonic()
     try:
-        env = {**os.environ, "PYTHONPATH": str(tree), "PYTHONDONTWRITEBYTECODE": "1",
-               "RETRO_CPU_VECTORS": os.environ.get("RETRO_CPU_VECTORS", str(ROOT.parent / "shared" / "cpu-vectors"))}
-        done = subprocess.run([sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", *mutant.tests],
-                              cwd=tree, env=env, capture_output=True, text=True, timeout=TIMEOUT_SECONDS)
-        failed = [line.split(" ", 2)[1] for line in done.stdout.splitlines() if line.startswith(("FAILED ", "ERROR "))]
-        if done.returncode in PYTEST_NOT_RUN:  # a usage error or no test collected proves nothing
-            verdict = f"BROKEN (pytest exit {done.returncode}: {(done.stderr or done.stdout).strip()[-120:]})"
-        else:
-            verdict = (f"killed by {failed[0].split('::')[-1][:60]}" if failed else "killed") if done.returncode else "SURVIVED"
+        verdict = _killer_first(mutant, tree, killers)
+        if verdict is None:
+            status, failed, last = _pytest(tree, list(mutant.tests))
+            if status in PYTEST_NOT_RUN:  # a usage error or no test collected proves nothing
+                verdict = f"BROKEN (pytest exit {status}: {last})"
+            else:
+                verdict = (f"killed by {failed[0].split('::')[-1][:60]}" if failed else "killed") if status else "SURVIVED"
+                if status and failed:
+                    killers[mutant.name] = failed[0]
     except subprocess.TimeoutExpired:
         verdict = "killed (timeout)"
     finally:
         path.write_text(original)
     return verdict, time.monotonic() - started
+
+
+def _load_killers() -> dict[str, str]:
+    try:
+        return json.loads(KILLERS.read_text())
+    except (OSError, ValueError):
+        return {}
+
+
+def _save_killers(killers: dict[str, str]) -> None:
+    KILLERS.parent.mkdir(parents=True, exist_ok=True)
+    staged = KILLERS.with_suffix(".tmp")
+    staged.write_text(json.dumps(killers, indent=1, sort_keys=True))
+    staged.replace(KILLERS)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -379,8 +430,10 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory(prefix="retro-mutants-") as tmp:
         tree = copy_tree(Path(tmp) / "tree")
         print("| mutant | file | verdict | seconds |\n|---|---|---|---|", flush=True)
+        killers = _load_killers()
         for mutant in chosen:
-            verdict, seconds = run_mutant(mutant, tree)
+            verdict, seconds = run_mutant(mutant, tree, killers)
+            _save_killers(killers)
             if verdict == "SURVIVED" and mutant.explained:
                 verdict = f"survived, explained: {mutant.explained}"
             elif not verdict.startswith("killed"):
