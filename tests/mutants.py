@@ -102,7 +102,8 @@ MUTANTS = [
            "cpu = block.cycles[:n] - block.stolen[:n]", "cpu = block.cycles[:n]", CHECK_TESTS),
     # ---- routine specs and static analysis -------------------------------------------------------
     Mutant("jsr-callee-cost-dropped", "retro/cpu/flow.py",
-           "costs[state] = (op.cycles + callee.best, op.cycles + callee.worst)", "costs[state] = (op.cycles, op.cycles)",
+           "return _Effect((cycles + callee.best, cycles + callee.worst), after=_returned(callee.exit))",
+           "return _Effect((cycles, cycles), after=_returned(callee.exit))",
            CHECK_TESTS),
     Mutant("page-crossing-always-possible", "retro/cpu/values.py",
            "return int(lowest(low_bytes) + lowest(index) > 0xFF), int(highest(low_bytes) + highest(index) > 0xFF)",
