@@ -44,7 +44,8 @@ from retro.cpu.timing import (
     crosses_page,
     timing_of,
 )
-from retro.cpu.values import ANY, MemoryModel, State, execute, is_empty, narrowed, single
+from retro.cpu.value_steps import execute
+from retro.cpu.values import ANY, MemoryModel, State, is_empty, narrowed, single
 from retro.errors import InputError
 
 OPCODE_JMP_ABS = 0x4C
@@ -428,7 +429,7 @@ class _Walk:
         return _Effect((cycles + callee.best, cycles + callee.worst), after=_returned(callee.exit))
 
     def _step(self, pc: int, here: State, op, fact: Fact | None) -> _Effect:
-        """Any other instruction, through retro.cpu.values (a fact may decide its branch)."""
+        """Any other instruction, through retro.cpu.value_steps (a fact may decide its branch)."""
         context = self.context
         step = execute(here, context.memory, pc, op.mnemonic, op.mode, context.cpu, context.cpu == "2a03",
                        op.page_penalty)
