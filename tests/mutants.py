@@ -127,7 +127,8 @@ MUTANTS = [
            ("tests/routines",)),
     # ---- the batched core and its checks --------------------------------------------------------
     Mutant("batch-branch-page-costs-nothing", "retro/cpu/batch_handlers.py",
-           "extra_taken + crossed * BRANCH_PAGE_CYCLES)", "extra_taken)", BATCH_TESTS),
+           "extra_taken + crossed * BRANCH_PAGE_CYCLES, pc, cycles)", "extra_taken, pc, cycles)",
+           BATCH_TESTS),
     Mutant("batch-page-cross-costs-nothing", "retro/cpu/batch_handlers.py",
            "if penalised and crossed is not False:", "if False:", BATCH_TESTS),
     Mutant("batch-decimal-high-adjust-off-by-one", "retro/cpu/batch_handlers.py",
