@@ -4,7 +4,7 @@ way of a branch), and where it may write. retro.cpu.flow drives it along the pat
 
 Results that would need too many combinations of operands or addresses are taken as unknown
 (MAX_COMBINATIONS, MAX_ADDRESSES): the sets only ever grow toward "any value". The instructions
-with an operand are dispatched by mnemonic (MEMORY_OPERATIONS), the implied ones in `_implied`;
+with an operand are dispatched by mnemonic (MEMORY_OPERATIONS), the implied ones too (IMPLIED_OPERATIONS);
 the assumptions are values.py's (docs/specs.md).
 """
 
@@ -423,34 +423,60 @@ MEMORY_OPERATIONS: dict[str, Callable[[_Operand, str], Step]] = {
 
 
 def _implied(state: State, mnemonic: str, mode: str) -> State:
-    if mnemonic in TRANSFERS:
-        source, target = TRANSFERS[mnemonic]
-        return _with_nz(state, target, ANY if source is None else getattr(state, source))
-    if mnemonic == "TXS":
-        return replace(state, stack=None)
-    if mnemonic in COUNTERS:
-        register, function = COUNTERS[mnemonic]
-        return _with_nz(state, register, function(getattr(state, register)))
-    if mnemonic in FLAG_OPS:
-        flag, value = FLAG_OPS[mnemonic]
-        return state if flag is None else replace(state, **{flag: value})
-    if mode == "acc":  # ASL A and friends; the 65C02's INC A and DEC A
-        if mnemonic in ("INC", "DEC"):
-            return _with_nz(state, "a", increment(state.a) if mnemonic == "INC" else decrement(state.a))
-        result, carry = _shift(state.a, state.c, mnemonic)
-        return _with_nz(state, "a", result, c=carry)
-    if mnemonic in ("PHA", "PHX", "PHY"):
-        return state.pushed(("a", getattr(state, mnemonic[2].lower())))
-    if mnemonic == "PHP":
-        return state.pushed(("p", state.flags()))
-    if mnemonic in ("PLA", "PLX", "PLY"):
-        item, after = state.pulled()
-        value = item[1] if item is not None and item[0] == "a" else ANY
-        return _with_nz(after, mnemonic[2].lower(), value)
-    if mnemonic == "PLP":
-        item, after = state.pulled()
-        c, z, n, v, d = item[1] if item is not None and item[0] == "p" else (EITHER,) * 5
-        return replace(after, c=c, z=z, n=n, v=v, d=d)
-    if mnemonic == "NOP":
-        return state
+    """An instruction without an operand byte (the others of the 6502's rows: A, X, Y and the flags
+    unknown)."""
+    if mode == "acc":
+        return _on_accumulator(state, mnemonic)
+    return IMPLIED_OPERATIONS.get(mnemonic, _unknown_registers)(state, mnemonic)
+
+
+def _on_accumulator(state: State, mnemonic: str) -> State:
+    """ASL A and friends; the 65C02's INC A and DEC A."""
+    if mnemonic in ("INC", "DEC"):
+        return _with_nz(state, "a", increment(state.a) if mnemonic == "INC" else decrement(state.a))
+    result, carry = _shift(state.a, state.c, mnemonic)
+    return _with_nz(state, "a", result, c=carry)
+
+
+def _transfer(state: State, mnemonic: str) -> State:
+    source, target = TRANSFERS[mnemonic]
+    return _with_nz(state, target, ANY if source is None else getattr(state, source))
+
+
+def _count(state: State, mnemonic: str) -> State:
+    register, function = COUNTERS[mnemonic]
+    return _with_nz(state, register, function(getattr(state, register)))
+
+
+def _set_flag(state: State, mnemonic: str) -> State:
+    flag, value = FLAG_OPS[mnemonic]
+    return state if flag is None else replace(state, **{flag: value})
+
+
+def _push_register(state: State, mnemonic: str) -> State:  # PHA, PHX, PHY
+    return state.pushed(("a", getattr(state, mnemonic[2].lower())))
+
+
+def _pull_register(state: State, mnemonic: str) -> State:  # PLA, PLX, PLY
+    item, after = state.pulled()
+    value = item[1] if item is not None and item[0] == "a" else ANY
+    return _with_nz(after, mnemonic[2].lower(), value)
+
+
+def _pull_flags(state: State, mnemonic: str) -> State:  # PLP
+    item, after = state.pulled()
+    c, z, n, v, d = item[1] if item is not None and item[0] == "p" else (EITHER,) * 5
+    return replace(after, c=c, z=z, n=n, v=v, d=d)
+
+
+def _unknown_registers(state: State, mnemonic: str) -> State:
     return replace(state, a=ANY, x=ANY, y=ANY, c=EITHER, z=EITHER, n=EITHER, v=EITHER)
+
+
+# The implied instructions by mnemonic (others: _unknown_registers).
+IMPLIED_OPERATIONS: dict[str, Callable[[State, str], State]] = {
+    **{m: _transfer for m in TRANSFERS}, "TXS": lambda state, _: replace(state, stack=None),
+    **{m: _count for m in COUNTERS}, **{m: _set_flag for m in FLAG_OPS},
+    **{m: _push_register for m in ("PHA", "PHX", "PHY")}, "PHP": lambda state, _: state.pushed(("p", state.flags())),
+    **{m: _pull_register for m in ("PLA", "PLX", "PLY")}, "PLP": _pull_flags, "NOP": lambda state, _: state,
+}
