@@ -2,7 +2,7 @@
 `retro.cpu.opcodes.OPCODE_TABLE_65C02`.
 
 Rows the 65C02 runs as the NMOS 6502 does (same mnemonic, mode, cycles and page penalty) take the
-NMOS handler of `retro.cpu.batch`; the others are here: the new opcodes and the (zp) mode, ADC/SBC
+NMOS handler of `retro.cpu.batch_handlers`; the others are here: the new opcodes and the (zp) mode, ADC/SBC
 with the 65C02's decimal mode (valid N and Z, one cycle more with D set), the fixed JMP (abs), shifts
 abs,X with their page penalty, BRK clearing D, the reserved opcodes as NOPs, and STP/WAI stopping the
 lane (LaneError.HALT). Semantics and cycles are those of the scalar core (`retro.cpu.mpu65c02.MPU65C02`,
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from retro.cpu.batch import (
+from retro.cpu.batch_handlers import (
     ADDRESSING,
     BYTE,
     HANDLERS,

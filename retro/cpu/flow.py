@@ -44,7 +44,8 @@ from retro.cpu.timing import (
     crosses_page,
     timing_of,
 )
-from retro.cpu.values import ANY, MemoryModel, State, execute, is_empty, narrowed, single
+from retro.cpu.value_steps import execute
+from retro.cpu.values import ANY, MemoryModel, State, is_empty, narrowed, single
 from retro.errors import InputError
 
 OPCODE_JMP_ABS = 0x4C
@@ -259,11 +260,19 @@ class _Context:
 
 
 def _analyse(context: _Context, entry: int, entry_state: State, calling: tuple) -> _Summary:
+    """The routine (or subroutine) at `entry` from `entry_state`, once per (entry, state)."""
     key = (entry, entry_state)
-    if key in context.done:
-        return context.done[key]
+    if key not in context.done:
+        nodes = _decode_routine(context, entry, calling)
+        walk = _Walk(context, nodes, _LoopNest(context, nodes, entry), (*calling, entry))
+        context.done[key] = walk.summary(entry, entry_state)
+    return context.done[key]
+
+
+def _decode_routine(context: _Context, entry: int, calling: tuple) -> dict[int, Node]:
+    """The routine's instructions; a JSR outside the program (unless mocked), a recursive one, or a
+    subroutine reaching an exit is an error."""
     name, describe, within = context.name, context.describe, context.within
-    bounds = context.bounds
 
     def check_call(pc: int, target: int) -> tuple[int, int]:
         if target in context.mocks:
@@ -282,124 +291,180 @@ def _analyse(context: _Context, entry: int, entry_state: State, calling: tuple) 
     if calling and reached:  # the call would end inside a subroutine: its caller's rest is not run
         raise InputError(f"{name}: the subroutine at {describe(entry)} reaches the exit {describe(reached[0])}; the "
                          "static analysis bounds exits reached by the routine itself, not by its subroutines")
-    loops = _loops(nodes, entry)
-    for header in loops:
-        if header not in bounds:
-            raise InputError(f"{name}: the loop at {describe(header)} needs a bound (the most times it runs per "
-                             f"entry), e.g. [cycles] loops = {{ LABEL = N }} with a label at its first instruction")
-    # Loops ordered outermost first (a larger body contains the smaller ones nested in it).
-    order = sorted(loops, key=lambda h: -len(loops[h]))
-    containing = {pc: tuple(h for h in order if pc in loops[h]) for pc in nodes}
+    return nodes
 
-    def next_state(state, target: int):
+
+class _LoopNest:
+    """The routine's loops and the states of its acyclic graph: (pc, the iteration count of every
+    loop the pc is in, outermost first)."""
+
+    def __init__(self, context: _Context, nodes: dict[int, Node], entry: int) -> None:
+        loops = _loops(nodes, entry)
+        for header in loops:
+            if header not in context.bounds:
+                raise InputError(f"{context.name}: the loop at {context.describe(header)} needs a bound (the most "
+                                 f"times it runs per entry), e.g. [cycles] loops = {{ LABEL = N }} with a label at "
+                                 f"its first instruction")
+        # Loops ordered outermost first (a larger body contains the smaller ones nested in it).
+        order = sorted(loops, key=lambda h: -len(loops[h]))
+        self.containing = {pc: tuple(h for h in order if pc in loops[h]) for pc in nodes}
+        self.bounds, self.name = context.bounds, context.name
+        self.start = (entry, tuple(1 for _ in self.containing[entry]))
+
+    def following(self, state: tuple, target: int) -> tuple | None:
+        """The state after going from `state` to `target`; None past a loop's bound."""
         source_pc, counts = state
-        active = dict(zip(containing[source_pc], counts))
+        active = dict(zip(self.containing[source_pc], counts))
         new_counts = []
-        for header in containing[target]:
+        for header in self.containing[target]:
             if header == target:
                 count = active[header] + 1 if header in active else 1
-                if count > bounds[header]:
+                if count > self.bounds[header]:
                     return None
             elif header in active:
                 count = active[header]
             else:
-                raise InputError(f"{name}: ${target:04X} enters the loop at ${header:04X} other than through its start")
+                raise InputError(f"{self.name}: ${target:04X} enters the loop at ${header:04X} other than through "
+                                 f"its start")
             new_counts.append(count)
         return target, tuple(new_counts)
 
-    start = (entry, tuple(1 for _ in containing[entry]))
-    topological = _topological(start, lambda state: [s for s in (next_state(state, t) for t, _ in
-                                                                  nodes[state[0]].successors) if s is not None])
-    values: dict = {start: entry_state}
-    edges: dict = {}  # state -> [(next state, extra cycles)] of the ways the values allow
-    costs: dict = {}  # state -> (least, most) cycles of its instruction
-    exit_state: State | None = None
-    writes: dict[int, set[int]] = {}  # address -> the stores that may write it
-    memory = context.memory
-    binary_only = context.cpu == "2a03"
-    for state in topological:
-        here = values.pop(state, None)
-        if here is None:
-            continue  # no way the values allow reaches it
+
+@dataclass(frozen=True)
+class _Effect:
+    """One instruction in one state: its cycles (least, most), the state going on through it and
+    the state where it branches or jumps (None: that way cannot happen), or the routine ends there."""
+
+    cost: tuple[int, int]
+    after: State | None = None
+    taken: State | None = None
+    ends: bool = False
+
+
+class _Walk:
+    """The values carried along one routine's acyclic graph of states, then its extremes."""
+
+    def __init__(self, context: _Context, nodes: dict[int, Node], nest: _LoopNest, calling: tuple) -> None:
+        self.context, self.nodes, self.nest, self.calling = context, nodes, nest, calling
+        self.values: dict = {}  # state -> what the registers and memory may hold there
+        self.edges: dict = {}  # state -> [(next state, extra cycles)] of the ways the values allow
+        self.costs: dict = {}  # state -> (least, most) cycles of its instruction
+        self.exit_state: State | None = None  # joined over every way out
+        self.writes: dict[int, set[int]] = {}  # address -> the stores that may write it
+
+    def summary(self, entry: int, entry_state: State) -> _Summary:
+        start = self.nest.start
+        order = _topological(start, self._successors)
+        self.values[start] = entry_state
+        for state in order:
+            here = self.values.pop(state, None)
+            if here is not None:  # else no way the values allow reaches it
+                self._visit(state, here)
+        best, worst = self._extremes(order)
+        if start not in worst:
+            raise InputError(f"{self.context.name}: no path from {self.context.describe(entry)} reaches an RTS "
+                             f"within the loop bounds")
+        return _Summary(best[start], worst[start], self.exit_state, len(self.nodes), self.writes)
+
+    def _successors(self, state: tuple) -> list:
+        following = (self.nest.following(state, t) for t, _ in self.nodes[state[0]].successors)
+        return [s for s in following if s is not None]
+
+    def _visit(self, state: tuple, here: State) -> None:
         pc = state[0]
-        node = nodes[pc]
-        fact = context.facts.get(pc)
+        fact = self.context.facts.get(pc)
         if fact is not None:
             for register, mask in fact.registers:
                 here = narrowed(here, register, mask)
             if is_empty(here):
-                continue
-        if pc in context.exits:  # the routine ends here (the JMP that reached it was counted)
-            costs[state] = (0, 0)
-            exit_state = here if exit_state is None else exit_state.join(here, memory)
-            edges[state] = []
-            continue
-        opcode = context.read(pc)
-        op = timing_of(opcode, context.cpu)
-        taken_state = after = None
-        if opcode == OPCODE_JSR and _jsr_target(context.read, pc) in context.mocks:
-            cost = context.mocks[_jsr_target(context.read, pc)]
-            costs[state] = (op.cycles + cost, op.cycles + cost)
-            after = State()  # what a mock leaves is not followed: any value
-        elif opcode == OPCODE_JSR:
-            callee = _analyse(context, _jsr_target(context.read, pc), _called(here), (*calling, entry))
-            for address, stores in callee.writes.items():
-                writes.setdefault(address, set()).update(stores)
-            if callee.exit is None:
-                continue
-            after = _returned(callee.exit)
-            costs[state] = (op.cycles + callee.best, op.cycles + callee.worst)
-        elif opcode == OPCODE_RTS or opcode in context.ends:
-            costs[state] = (op.cycles, op.cycles)
-            exit_state = here if exit_state is None else exit_state.join(here, memory)
-            edges[state] = []
-            continue
-        elif opcode == OPCODE_JMP_ABS:
-            costs[state] = (op.cycles, op.cycles)
-            taken_state = here
-        else:
-            step = execute(here, memory, pc, op.mnemonic, op.mode, context.cpu, binary_only, op.page_penalty)
-            if step.writes is not None:  # an unknown address: assumed outside the program (_check_modified)
-                for address in step.writes:
-                    writes.setdefault(address, set()).add(pc)
-            costs[state] = (op.cycles + step.extra[0], op.cycles + step.extra[1])
-            after, taken_state = step.after, step.taken
-            if fact is not None and fact.taken is not None:
-                after, taken_state = (None, taken_state) if fact.taken else (after, None)
-        if op.mode in ("rel", "zpr") and op.mnemonic != "BRA":
-            flows = (after, taken_state)  # decode lists the way through first, then the branch
-        elif op.mode in ("rel", "zpr") or opcode == OPCODE_JMP_ABS:
-            flows = (taken_state,)
-        else:
-            flows = (after,)
+                return
+        effect = self._effect(pc, here, fact)
+        if effect is None:
+            return  # a subroutine that never returns
+        self.costs[state] = effect.cost
+        if effect.ends:
+            self.exit_state = here if self.exit_state is None else self.exit_state.join(here, self.context.memory)
+            self.edges[state] = []
+            return
+        self.edges[state] = self._flow(state, _flows(timing_of(self.context.read(pc), self.context.cpu), effect))
+
+    def _flow(self, state: tuple, flows: tuple) -> list:
+        """The ways on from `state`, each carrying its state (decode's successors, in its order)."""
         ways = []
-        for (target, extra), flowing in zip(node.successors, flows):
-            if flowing is None:
-                continue
-            successor = next_state(state, target)
+        for (target, extra), flowing in zip(self.nodes[state[0]].successors, flows):
+            successor = None if flowing is None else self.nest.following(state, target)
             if successor is None:
                 continue
             ways.append((successor, extra))
-            values[successor] = flowing if successor not in values else values[successor].join(flowing, memory)
-        edges[state] = ways
-    best: dict = {}
-    worst: dict = {}
-    for state in reversed(topological):
-        if state not in costs:
-            continue
-        low, high = costs[state]
-        if nodes[state[0]].returns:
-            best[state], worst[state] = low, high
-            continue
-        options = [(best[s] + extra, worst[s] + extra) for s, extra in edges.get(state, []) if s in worst]
-        if options:
-            best[state] = low + min(b for b, _ in options)
-            worst[state] = high + max(w for _, w in options)
-    if start not in worst:
-        raise InputError(f"{name}: no path from {describe(entry)} reaches an RTS within the loop bounds")
-    summary = _Summary(best[start], worst[start], exit_state, len(nodes), writes)
-    context.done[key] = summary
-    return summary
+            known = self.values.get(successor)
+            self.values[successor] = flowing if known is None else known.join(flowing, self.context.memory)
+        return ways
+
+    def _effect(self, pc: int, here: State, fact: Fact | None) -> _Effect | None:
+        context = self.context
+        if pc in context.exits:  # the routine ends here (the JMP that reached it was counted)
+            return _Effect((0, 0), ends=True)
+        opcode = context.read(pc)
+        op = timing_of(opcode, context.cpu)
+        if opcode == OPCODE_JSR:
+            return self._call(pc, here, op.cycles)
+        if opcode == OPCODE_RTS or opcode in context.ends:
+            return _Effect((op.cycles, op.cycles), ends=True)
+        if opcode == OPCODE_JMP_ABS:
+            return _Effect((op.cycles, op.cycles), taken=here)
+        return self._step(pc, here, op, fact)
+
+    def _call(self, pc: int, here: State, cycles: int) -> _Effect | None:
+        """A JSR: a mock's cycles (what it leaves is not followed: any value), or the callee analysed
+        from the state at the call (None when it never returns)."""
+        target = _jsr_target(self.context.read, pc)
+        if target in self.context.mocks:
+            cost = cycles + self.context.mocks[target]
+            return _Effect((cost, cost), after=State())
+        callee = _analyse(self.context, target, _called(here), self.calling)
+        for address, stores in callee.writes.items():
+            self.writes.setdefault(address, set()).update(stores)
+        if callee.exit is None:
+            return None
+        return _Effect((cycles + callee.best, cycles + callee.worst), after=_returned(callee.exit))
+
+    def _step(self, pc: int, here: State, op, fact: Fact | None) -> _Effect:
+        """Any other instruction, through retro.cpu.value_steps (a fact may decide its branch)."""
+        context = self.context
+        step = execute(here, context.memory, pc, op.mnemonic, op.mode, context.cpu, context.cpu == "2a03",
+                       op.page_penalty)
+        if step.writes is not None:  # an unknown address: assumed outside the program (_check_modified)
+            for address in step.writes:
+                self.writes.setdefault(address, set()).add(pc)
+        after, taken = step.after, step.taken
+        if fact is not None and fact.taken is not None:
+            after, taken = (None, taken) if fact.taken else (after, None)
+        return _Effect((op.cycles + step.extra[0], op.cycles + step.extra[1]), after, taken)
+
+    def _extremes(self, order: list) -> tuple[dict, dict]:
+        """Fewest and most cycles from each state through the end, last state first."""
+        best: dict = {}
+        worst: dict = {}
+        for state in reversed(order):
+            if state not in self.costs:
+                continue
+            low, high = self.costs[state]
+            if self.nodes[state[0]].returns:
+                best[state], worst[state] = low, high
+                continue
+            options = [(best[s] + extra, worst[s] + extra) for s, extra in self.edges.get(state, []) if s in worst]
+            if options:
+                best[state] = low + min(b for b, _ in options)
+                worst[state] = high + max(w for _, w in options)
+        return best, worst
+
+
+def _flows(op, effect: _Effect) -> tuple:
+    """The states along decode's successors of an instruction: a conditional branch's way through,
+    then its branch; an unconditional branch's or JMP's target; else the way through."""
+    if op.mode in ("rel", "zpr"):
+        return (effect.after, effect.taken) if op.mnemonic != "BRA" else (effect.taken,)
+    return (effect.taken,) if op.mnemonic == "JMP" else (effect.after,)
 
 
 def _jsr_target(read, pc: int) -> int:

@@ -458,34 +458,50 @@ def _block_columns(routine: Routine, block, where: str) -> Columns:
     if not isinstance(block, dict):
         raise InputError(f"{where}: after a column block (a dict of arrays) every item must be one, got "
                          f"{type(block).__name__}")
-    names = routine.input_names
-    missing = [n for n in names if n not in block]
-    extra = [k for k in block if k not in names]
-    if missing or extra:
-        raise InputError(f"{where}: a column block " + (f"lacks {missing[0]!r}" if missing else f"has unknown input {extra[0]!r}"))
-    columns = []
-    length = None
+    wrong = _wrong_names(block, routine.input_names)
+    if wrong:
+        raise InputError(f"{where}: a column block {wrong}")
+    columns: Columns = []
     for port in routine.inputs:
-        try:
-            column = np.asarray(block[port.name])
-        except (TypeError, ValueError):
-            column = np.asarray([])
-        if column.dtype == bool or not np.issubdtype(column.dtype, np.integer):
-            raise InputError(f"{where}: column {port.name} must hold whole numbers, got {column.dtype}")
-        shape_ok = column.ndim == 2 and column.shape[1] == len(port.places) if port.table else column.ndim == 1
-        if not shape_ok:
-            raise InputError(f"{where}: column {port.name} must be " + (
-                f"n rows of {len(port.places)} bytes" if port.table else "one value per case (1-D)"))
-        length = len(column) if length is None else length
-        if len(column) != length:
-            raise InputError(f"{where}: column {port.name} has {len(column)} cases, {routine.inputs[0].name} {length}")
-        limit = 1 << (8 if port.table else port.bits)
-        if column.size and (column.min() < 0 or column.max() >= limit):
-            bad = column.min() if column.min() < 0 else column.max()
-            raise InputError(f"{where}: column {port.name} holds {int(bad)}, which does not fit in {port.describe()} "
-                             f"(0..{limit - 1})")
+        column = _port_column(port, block[port.name], where)
+        if columns and len(column) != len(columns[0]):
+            raise InputError(f"{where}: column {port.name} has {len(column)} cases, {routine.inputs[0].name} "
+                             f"{len(columns[0])}")
+        _check_column_fits(port, column, where)
         columns.append(column.astype(np.int64, copy=False))
     return columns
+
+
+def _wrong_names(given, names: tuple[str, ...]) -> str:
+    """What is wrong with the input names of a case or block by name ("" when nothing)."""
+    missing = [n for n in names if n not in given]
+    if missing:
+        return f"lacks {missing[0]!r}"
+    extra = [k for k in given if k not in names]
+    return f"has unknown input {extra[0]!r}" if extra else ""
+
+
+def _port_column(port: Port, values, where: str) -> np.ndarray:
+    """One input's column of a block, checked: whole numbers in its shape."""
+    try:
+        column = np.asarray(values)
+    except (TypeError, ValueError):
+        column = np.asarray([])
+    if column.dtype == bool or not np.issubdtype(column.dtype, np.integer):
+        raise InputError(f"{where}: column {port.name} must hold whole numbers, got {column.dtype}")
+    shape_ok = column.ndim == 2 and column.shape[1] == len(port.places) if port.table else column.ndim == 1
+    if not shape_ok:
+        raise InputError(f"{where}: column {port.name} must be " + (
+            f"n rows of {len(port.places)} bytes" if port.table else "one value per case (1-D)"))
+    return column
+
+
+def _check_column_fits(port: Port, column: np.ndarray, where: str) -> None:
+    limit = 1 << (8 if port.table else port.bits)
+    if column.size and (column.min() < 0 or column.max() >= limit):
+        bad = column.min() if column.min() < 0 else column.max()
+        raise InputError(f"{where}: column {port.name} holds {int(bad)}, which does not fit in {port.describe()} "
+                         f"(0..{limit - 1})")
 
 
 def _checked(routine: Routine, key: str, made, expected: int | None = None) -> Iterator[tuple]:
@@ -509,11 +525,9 @@ def _checked(routine: Routine, key: str, made, expected: int | None = None) -> I
 
 def _normalise(case, names: tuple[str, ...], where: str) -> tuple:
     if isinstance(case, dict):
-        missing = [n for n in names if n not in case]
-        extra = [k for k in case if k not in names]
-        if missing or extra:
-            raise InputError(f"{where}: case {_short(case)} " + (f"lacks {missing[0]!r}" if missing else
-                                                                 f"has unknown input {extra[0]!r}"))
+        wrong = _wrong_names(case, names)
+        if wrong:
+            raise InputError(f"{where}: case {_short(case)} {wrong}")
         case = tuple(case[n] for n in names)
     elif isinstance(case, np.ndarray):
         case = tuple(case.tolist())

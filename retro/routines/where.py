@@ -255,60 +255,74 @@ class _Kinds:
         return kind, magnitude, columnar and magnitude < COLUMN_LIMIT
 
     def _visit(self, node: ast.AST) -> tuple[str, int, bool]:
-        if isinstance(node, ast.Name):
-            if node.id in FUNCTIONS:
-                raise self.error(node, f"{node.id} is a function: call it")
-            if node.id in self.tables:
-                return SEQUENCE, BYTE, False
-            lo, hi = self.bounds.get(node.id, (-DEFAULT_BOUND, DEFAULT_BOUND))
-            return NUMBER, max(abs(lo), abs(hi)), True
-        if isinstance(node, ast.Constant):
-            return NUMBER, abs(int(node.value)), True
-        if isinstance(node, (ast.List, ast.Tuple)):
-            return SEQUENCE, max((self.number(e, "a list")[0] for e in node.elts), default=0), False
-        if isinstance(node, ast.Subscript):
-            magnitude = self.sequence(node.value, "indexing")
-            if isinstance(node.slice, ast.Slice):
-                for part in (node.slice.lower, node.slice.upper, node.slice.step):
-                    if part is not None:
-                        self.number(part, "a slice")
-                return SEQUENCE, magnitude, False
-            self.number(node.slice, "an index")
-            return NUMBER, magnitude, False
-        if isinstance(node, ast.UnaryOp):
-            if isinstance(node.op, ast.Not):
-                _, _, columnar = self.visit(node.operand)
-                return NUMBER, 1, columnar
-            magnitude, columnar = self.number(node.operand, "arithmetic")
-            return NUMBER, magnitude + (1 if isinstance(node.op, ast.Invert) else 0), columnar
-        if isinstance(node, ast.BinOp):
-            (a, left), (b, right) = self.number(node.left, "arithmetic"), self.number(node.right, "arithmetic")
-            return NUMBER, _magnitude(node.op, a, b, node.right), left and right
-        if isinstance(node, ast.BoolOp):
-            values = [self.number(v, "and/or") for v in node.values]
-            return NUMBER, max(m for m, _ in values), all(c for _, c in values)
-        if isinstance(node, ast.Compare):
-            operands = [node.left, *node.comparators]
-            kinds = [self.visit(operand) for operand in operands]  # once each: nested comparisons stay linear
-            columnar = all(kind == NUMBER and c for kind, _, c in kinds)
-            for k, op in enumerate(node.ops):
-                (left, right), (left_kind, right_kind) = operands[k:k + 2], (kinds[k][0], kinds[k + 1][0])
-                if isinstance(op, (ast.In, ast.NotIn)):
-                    if left_kind != NUMBER or right_kind != SEQUENCE:
-                        raise self.error(node, "`in` asks whether a number is in a table or a list")
-                    columnar = False
-                elif not isinstance(op, (ast.Eq, ast.NotEq)) and (left_kind, right_kind) != (NUMBER, NUMBER):
-                    raise self.error(node, "<, <=, >, >= compare numbers, not tables or lists")
+        rule = self._RULES.get(type(node))
+        if rule is None:
+            raise self.error(node, f"{type(node).__name__} is not allowed")
+        return rule(self, node)
+
+    def _name(self, node: ast.Name) -> tuple[str, int, bool]:
+        if node.id in FUNCTIONS:
+            raise self.error(node, f"{node.id} is a function: call it")
+        if node.id in self.tables:
+            return SEQUENCE, BYTE, False
+        lo, hi = self.bounds.get(node.id, (-DEFAULT_BOUND, DEFAULT_BOUND))
+        return NUMBER, max(abs(lo), abs(hi)), True
+
+    def _constant(self, node: ast.Constant) -> tuple[str, int, bool]:
+        return NUMBER, abs(int(node.value)), True
+
+    def _literal(self, node: ast.List | ast.Tuple) -> tuple[str, int, bool]:
+        return SEQUENCE, max((self.number(e, "a list")[0] for e in node.elts), default=0), False
+
+    def _subscript(self, node: ast.Subscript) -> tuple[str, int, bool]:
+        magnitude = self.sequence(node.value, "indexing")
+        if isinstance(node.slice, ast.Slice):
+            for part in (node.slice.lower, node.slice.upper, node.slice.step):
+                if part is not None:
+                    self.number(part, "a slice")
+            return SEQUENCE, magnitude, False
+        self.number(node.slice, "an index")
+        return NUMBER, magnitude, False
+
+    def _unary(self, node: ast.UnaryOp) -> tuple[str, int, bool]:
+        if isinstance(node.op, ast.Not):
+            _, _, columnar = self.visit(node.operand)
             return NUMBER, 1, columnar
-        if isinstance(node, ast.IfExp):
-            _, _, test = self.visit(node.test)
-            (kind, a, body), (other, b, orelse) = self.visit(node.body), self.visit(node.orelse)
-            if kind != other:
-                raise self.error(node, "both branches must be numbers, or both tables or lists")
-            return kind, max(a, b), test and body and orelse and kind == NUMBER
-        if isinstance(node, ast.Call):
-            return self.call(node)
-        raise self.error(node, f"{type(node).__name__} is not allowed")
+        magnitude, columnar = self.number(node.operand, "arithmetic")
+        return NUMBER, magnitude + (1 if isinstance(node.op, ast.Invert) else 0), columnar
+
+    def _binary(self, node: ast.BinOp) -> tuple[str, int, bool]:
+        (a, left), (b, right) = self.number(node.left, "arithmetic"), self.number(node.right, "arithmetic")
+        return NUMBER, _magnitude(node.op, a, b, node.right), left and right
+
+    def _boolean(self, node: ast.BoolOp) -> tuple[str, int, bool]:
+        values = [self.number(v, "and/or") for v in node.values]
+        return NUMBER, max(m for m, _ in values), all(c for _, c in values)
+
+    def _compare(self, node: ast.Compare) -> tuple[str, int, bool]:
+        operands = [node.left, *node.comparators]
+        kinds = [self.visit(operand) for operand in operands]  # once each: nested comparisons stay linear
+        columnar = all(kind == NUMBER and c for kind, _, c in kinds)
+        for k, op in enumerate(node.ops):
+            self._comparison(node, op, kinds[k][0], kinds[k + 1][0])
+            if isinstance(op, (ast.In, ast.NotIn)):
+                columnar = False
+        return NUMBER, 1, columnar
+
+    def _comparison(self, node: ast.Compare, op: ast.cmpop, left_kind: str, right_kind: str) -> None:
+        """One operator of a comparison between operands of these kinds, or an error."""
+        if isinstance(op, (ast.In, ast.NotIn)):
+            if left_kind != NUMBER or right_kind != SEQUENCE:
+                raise self.error(node, "`in` asks whether a number is in a table or a list")
+        elif not isinstance(op, (ast.Eq, ast.NotEq)) and (left_kind, right_kind) != (NUMBER, NUMBER):
+            raise self.error(node, "<, <=, >, >= compare numbers, not tables or lists")
+
+    def _if(self, node: ast.IfExp) -> tuple[str, int, bool]:
+        _, _, test = self.visit(node.test)
+        (kind, a, body), (other, b, orelse) = self.visit(node.body), self.visit(node.orelse)
+        if kind != other:
+            raise self.error(node, "both branches must be numbers, or both tables or lists")
+        return kind, max(a, b), test and body and orelse and kind == NUMBER
 
     def call(self, node: ast.Call) -> tuple[str, int, bool]:
         name, args = node.func.id, node.args
@@ -330,6 +344,11 @@ class _Kinds:
             raise self.error(node, f"{name} takes numbers, or one table")
         values = [self.number(a, name) for a in args]
         return NUMBER, max(m for m, _ in values), all(c for _, c in values)
+
+    # each kind of node the checked AST may hold -> its rule
+    _RULES = {ast.Name: _name, ast.Constant: _constant, ast.List: _literal, ast.Tuple: _literal,
+              ast.Subscript: _subscript, ast.UnaryOp: _unary, ast.BinOp: _binary, ast.BoolOp: _boolean,
+              ast.Compare: _compare, ast.IfExp: _if, ast.Call: call}
 
 
 def _magnitude(op: ast.operator, a: int, b: int, right: ast.expr) -> int:
@@ -429,65 +448,72 @@ class _Columns:
         return InputError(f"{self.where}: {segment[:60]}: {message} at {_describe(self.names, case)}")
 
     def evaluate(self, node: ast.AST, active: np.ndarray, columns: tuple):
-        if isinstance(node, ast.Name):
-            return columns[self.names.index(node.id)]
-        if isinstance(node, ast.Constant):
-            return np.int64(int(node.value))
-        if isinstance(node, ast.UnaryOp):
-            value = self.evaluate(node.operand, active, columns)
-            if isinstance(node.op, ast.Not):
-                return ~_truth(value)
-            value = _integers(value)
-            return -value if isinstance(node.op, ast.USub) else ~value if isinstance(node.op, ast.Invert) else value
-        if isinstance(node, ast.BinOp):
-            return self.binary(node, active, columns)
-        if isinstance(node, (ast.BoolOp, ast.Compare, ast.IfExp)) and id(node) not in self.fallible:
-            return self.plain(node, active, columns)
-        if isinstance(node, ast.BoolOp):
-            value = self.evaluate(node.values[0], active, columns)
-            for following in node.values[1:]:
-                go_on = _truth(value) if isinstance(node.op, ast.And) else ~_truth(value)
-                reach = active & go_on
-                value = np.where(go_on, self.evaluate(following, reach, columns), value) if reach.any() else value
-            return value
-        if isinstance(node, ast.Compare):
-            result = np.ones(len(active), dtype=bool)
-            left = self.evaluate(node.left, active, columns)
-            for op, comparator in zip(node.ops, node.comparators):
-                reach = active & result
-                right = self.evaluate(comparator, reach, columns)
-                result = result & _ORDER[type(op)](left, right)
-                left = right
-            return result
-        if isinstance(node, ast.IfExp):
-            test = _truth(self.evaluate(node.test, active, columns))
-            body = self.evaluate(node.body, active & test, columns) if (active & test).any() else np.int64(0)
-            orelse = self.evaluate(node.orelse, active & ~test, columns) if (active & ~test).any() else np.int64(0)
-            return np.where(test, body, orelse)
-        if isinstance(node, ast.Call):
-            values = [_integers(self.evaluate(a, active, columns)) for a in node.args]
-            if node.func.id == "abs":
-                return np.abs(values[0])
-            return (np.minimum if node.func.id == "min" else np.maximum).reduce(np.broadcast_arrays(*values))
-        raise AssertionError(f"no column form for {type(node).__name__}")  # the kinds check admits none
+        """The node's values over the columns; `active`: the cases Python evaluates it for."""
+        rule = self._RULES.get(type(node))
+        if rule is None:
+            raise AssertionError(f"no column form for {type(node).__name__}")  # the kinds check admits none
+        return rule(self, node, active, columns)
 
-    def plain(self, node: ast.AST, active: np.ndarray, columns: tuple):
-        """A node under which nothing can fail: both sides of `and`, `or` and `if` computed, no masks."""
-        if isinstance(node, ast.BoolOp):
-            value = self.evaluate(node.values[0], active, columns)
-            for following in node.values[1:]:
-                truth = _truth(value)
-                value = np.where(truth if isinstance(node.op, ast.And) else ~truth,
-                                 self.evaluate(following, active, columns), value)
-            return value
-        if isinstance(node, ast.Compare):
+    def _name(self, node: ast.Name, active: np.ndarray, columns: tuple):
+        return columns[self.names.index(node.id)]
+
+    def _constant(self, node: ast.Constant, active: np.ndarray, columns: tuple):
+        return np.int64(int(node.value))
+
+    def _unary(self, node: ast.UnaryOp, active: np.ndarray, columns: tuple):
+        value = self.evaluate(node.operand, active, columns)
+        if isinstance(node.op, ast.Not):
+            return ~_truth(value)
+        value = _integers(value)
+        return -value if isinstance(node.op, ast.USub) else ~value if isinstance(node.op, ast.Invert) else value
+
+    def _boolean(self, node: ast.BoolOp, active: np.ndarray, columns: tuple):
+        """`and` / `or`: each value after the first evaluated only where Python goes on to it (both
+        sides computed, no masks, when nothing under the node can fail)."""
+        fallible = id(node) in self.fallible
+        value = self.evaluate(node.values[0], active, columns)
+        for following in node.values[1:]:
+            go_on = _truth(value) if isinstance(node.op, ast.And) else ~_truth(value)
+            if not fallible:
+                value = np.where(go_on, self.evaluate(following, active, columns), value)
+                continue
+            reach = active & go_on
+            value = np.where(go_on, self.evaluate(following, reach, columns), value) if reach.any() else value
+        return value
+
+    def _compare(self, node: ast.Compare, active: np.ndarray, columns: tuple):
+        """A chained comparison: each comparator evaluated only where the chain still holds (every
+        operand once, no masks, when nothing under the node can fail)."""
+        if id(node) not in self.fallible:
             operands = [self.evaluate(o, active, columns) for o in (node.left, *node.comparators)]
             result = _ORDER[type(node.ops[0])](operands[0], operands[1])
             for k, op in enumerate(node.ops[1:], 1):
                 result = result & _ORDER[type(op)](operands[k], operands[k + 1])
             return result
-        return np.where(_truth(self.evaluate(node.test, active, columns)), self.evaluate(node.body, active, columns),
-                        self.evaluate(node.orelse, active, columns))
+        result = np.ones(len(active), dtype=bool)
+        left = self.evaluate(node.left, active, columns)
+        for op, comparator in zip(node.ops, node.comparators):
+            reach = active & result
+            right = self.evaluate(comparator, reach, columns)
+            result = result & _ORDER[type(op)](left, right)
+            left = right
+        return result
+
+    def _if(self, node: ast.IfExp, active: np.ndarray, columns: tuple):
+        """`x if test else y`: each branch evaluated only where it is taken (both, no masks, when
+        nothing under the node can fail)."""
+        test = _truth(self.evaluate(node.test, active, columns))
+        if id(node) not in self.fallible:
+            return np.where(test, self.evaluate(node.body, active, columns), self.evaluate(node.orelse, active, columns))
+        body = self.evaluate(node.body, active & test, columns) if (active & test).any() else np.int64(0)
+        orelse = self.evaluate(node.orelse, active & ~test, columns) if (active & ~test).any() else np.int64(0)
+        return np.where(test, body, orelse)
+
+    def _call(self, node: ast.Call, active: np.ndarray, columns: tuple):
+        values = [_integers(self.evaluate(a, active, columns)) for a in node.args]
+        if node.func.id == "abs":
+            return np.abs(values[0])
+        return (np.minimum if node.func.id == "min" else np.maximum).reduce(np.broadcast_arrays(*values))
 
     def binary(self, node: ast.BinOp, active: np.ndarray, columns: tuple):
         left = _integers(self.evaluate(node.left, active, columns))
@@ -507,6 +533,10 @@ class _Columns:
                 raise self.fail(node, "negative shift count", negative, columns)
             return left >> np.clip(right, 0, 63)  # Python: x >> 63 and beyond is 0 or -1 for int64 x
         return left << right  # a constant of at most MAX_SHIFT, the result within int64 (the kinds check)
+
+    # each kind of node a columnar term may hold -> how it is evaluated
+    _RULES = {ast.Name: _name, ast.Constant: _constant, ast.UnaryOp: _unary, ast.BinOp: binary, ast.BoolOp: _boolean,
+              ast.Compare: _compare, ast.IfExp: _if, ast.Call: _call}
 
 
 def _truth(value) -> np.ndarray:

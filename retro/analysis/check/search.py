@@ -164,74 +164,108 @@ def search(runner: RoutineRunner, *, on_batch: bool, seed: int, budget: int, cov
            slowest: tuple[int, tuple] | None, fastest: tuple[int, tuple] | None) -> SearchResult:
     """Search for cases that go new ways at branches and that take more (or fewer) cycles than
     `slowest` / `fastest` ((cycles, case) of the check's cases so far); `covered`: what they ran."""
-    routine = runner.routine
     result = SearchResult(budget, slowest=None if slowest is None else slowest[0],
                           fastest=None if fastest is None else fastest[0])
     if budget <= 0:
         return result
-    rng = np.random.default_rng(seed + SEARCH_RNG_OFFSET)
-    gone = {(pc, True) for pc, n in covered.taken.items() if n} | {(pc, False) for pc, n in covered.not_taken.items() if n}
-    mutate = _Mutator(routine, rng, code_constants(runner))
-    fresh = _fresh_cases(routine, seed, budget)
-    reachers: dict[int, list[tuple]] = {}  # branch address -> the first REACHERS_KEPT cases that ran it
-    slow = [slowest] if slowest else []
-    fast = [fastest] if fastest else []
-    kept: list[tuple] = []
-    stale = 0
-    cycle_budget = budget * CYCLES_PER_CANDIDATE
-    # cycles a call is expected to take (the slowest case's at first, then the last generation's mean):
-    # a generation is sized to fit what is left of the budget
-    per_call = max(1, result.slowest or 1)
-    while result.candidates < budget and result.cycles < cycle_budget:
-        n = min(GENERATION, budget - result.candidates, max(1, (cycle_budget - result.cycles) // per_call))
-        wanting = [case for pc in sorted(reachers) if ((pc, True) in gone) != ((pc, False) in gone)
-                   for case in reachers[pc]]
-        cases = _generation(mutate, rng, n, wanting, [c for _, c in slow + fast] + kept, fresh)
+    return _Search(runner, on_batch, seed, covered, slowest, fastest, result).run()
+
+
+class _Search:
+    """One search between its generations: the directions gone so far, the parents it keeps (the
+    cases that reached each branch, the extremes, the cases found) and what is left of its budget."""
+
+    def __init__(self, runner: RoutineRunner, on_batch: bool, seed: int, covered: CodeCoverage,
+                 slowest: tuple[int, tuple] | None, fastest: tuple[int, tuple] | None, result: SearchResult) -> None:
+        self.runner, self.on_batch, self.result = runner, on_batch, result
+        self.rng = np.random.default_rng(seed + SEARCH_RNG_OFFSET)
+        self.gone: set[Direction] = ({(pc, True) for pc, n in covered.taken.items() if n}
+                                     | {(pc, False) for pc, n in covered.not_taken.items() if n})
+        self.mutate = _Mutator(runner.routine, self.rng, code_constants(runner))
+        self.fresh = _fresh_cases(runner.routine, seed, result.budget)
+        self.reachers: dict[int, list[tuple]] = {}  # branch address -> the first REACHERS_KEPT cases that ran it
+        self.slow = [slowest] if slowest else []
+        self.fast = [fastest] if fastest else []
+        self.kept: list[tuple] = []
+        self.stale = 0  # generations in a row that found nothing
+        self.cycle_budget = result.budget * CYCLES_PER_CANDIDATE
+        # cycles a call is expected to take (the slowest case's at first, then the last generation's mean):
+        # a generation is sized to fit what is left of the budget
+        self.per_call = max(1, result.slowest or 1)
+
+    def run(self) -> SearchResult:
+        result = self.result
+        while result.candidates < result.budget and result.cycles < self.cycle_budget:
+            ended = self._run_generation()
+            if ended:
+                result.ended = ended
+                return result
+        result.ended = "budget"
+        return result
+
+    def _run_generation(self) -> str | None:
+        """One generation run and what it found kept; how the search ended, when it did."""
+        result = self.result
+        n = min(GENERATION, result.budget - result.candidates,
+                max(1, (self.cycle_budget - result.cycles) // self.per_call))
+        wanting = [case for pc in sorted(self.reachers) if ((pc, True) in self.gone) != ((pc, False) in self.gone)
+                   for case in self.reachers[pc]]
+        parents = [c for _, c in self.slow + self.fast] + self.kept
+        cases = _inside_domain(self.runner.routine, _generation(self.mutate, self.rng, n, wanting, parents, self.fresh))
         result.candidates += n
         result.generations += 1
-        cases = _inside_domain(routine, cases)
         if not cases:
-            stale += 1
-            if stale >= STALE_GENERATIONS:
-                result.ended = "stale"
-                return result
-            continue
-        probe = _probe(runner, cases, on_batch)
-        found = set()
-        for (pc, way), i in sorted(probe.first.items(), key=lambda item: (item[1], item[0])):
-            known = reachers.setdefault(pc, [])
-            if len(known) < REACHERS_KEPT:
-                known.append(cases[i])
-            if (pc, way) not in gone:
-                gone.add((pc, way))
-                result.new_directions += 1
-                found.add(i)
-        if len(probe.cycles):
-            high, low = int(np.argmax(probe.cycles)), int(np.argmin(probe.cycles))
-            if result.slowest is None or probe.cycles[high] > result.slowest:
-                result.slowest = int(probe.cycles[high])
-                found.add(high)
-            if result.fastest is None or probe.cycles[low] < result.fastest:
-                result.fastest = int(probe.cycles[low])
-                found.add(low)
-            slow = _extremes(slow, probe.cycles, cases, -1)
-            fast = _extremes(fast, probe.cycles, cases, 1)
-            result.cycles += int(probe.cycles.sum())
-            per_call = max(1, int(probe.cycles.sum()) // len(probe.cycles))
+            return self._found_nothing()
+        probe = _probe(self.runner, cases, self.on_batch)
+        found = self._new_directions(probe, cases) | self._new_extremes(probe, cases)
         if probe.stopped:
             found.add(len(probe.cycles))  # the call that stopped: the check reports it
         new = [cases[i] for i in sorted(found)]
         result.found += new
-        kept += new
+        self.kept += new
         if probe.stopped:
-            result.ended = "stopped"
-            return result
-        stale = 0 if new else stale + 1
-        if stale >= STALE_GENERATIONS:
-            result.ended = "stale"
-            return result
-    result.ended = "budget"
-    return result
+            return "stopped"
+        if new:
+            self.stale = 0
+            return None
+        return self._found_nothing()
+
+    def _found_nothing(self) -> str | None:
+        self.stale += 1
+        return "stale" if self.stale >= STALE_GENERATIONS else None
+
+    def _new_directions(self, probe: _Probe, cases: list[tuple]) -> set[int]:
+        """The candidates that first went a way no case went before; each branch's first reachers kept."""
+        found = set()
+        for (pc, way), i in sorted(probe.first.items(), key=lambda item: (item[1], item[0])):
+            known = self.reachers.setdefault(pc, [])
+            if len(known) < REACHERS_KEPT:
+                known.append(cases[i])
+            if (pc, way) not in self.gone:
+                self.gone.add((pc, way))
+                self.result.new_directions += 1
+                found.add(i)
+        return found
+
+    def _new_extremes(self, probe: _Probe, cases: list[tuple]) -> set[int]:
+        """The candidates slower or faster than every case so far; the extremes kept as parents, the
+        generation's cycles counted against the budget."""
+        result, cycles = self.result, probe.cycles
+        if not len(cycles):
+            return set()
+        found = set()
+        high, low = int(np.argmax(cycles)), int(np.argmin(cycles))
+        if result.slowest is None or cycles[high] > result.slowest:
+            result.slowest = int(cycles[high])
+            found.add(high)
+        if result.fastest is None or cycles[low] < result.fastest:
+            result.fastest = int(cycles[low])
+            found.add(low)
+        self.slow = _extremes(self.slow, cycles, cases, -1)
+        self.fast = _extremes(self.fast, cycles, cases, 1)
+        result.cycles += int(cycles.sum())
+        self.per_call = max(1, int(cycles.sum()) // len(cycles))
+        return found
 
 
 def _extremes(kept: list[tuple[int, tuple]], cycles: np.ndarray, cases: list[tuple], sign: int) -> list:
