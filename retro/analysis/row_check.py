@@ -33,7 +33,8 @@ from retro.cpu.flow import Bounds
 from retro.errors import InputError
 from retro.routines.cases import cases_to_columns
 from retro.routines.rows import Row
-from retro.routines.runner import RoutineRunner, describe_value, row_of
+from retro.routines.outputs import describe_value, row_of
+from retro.routines.runner import RoutineRunner
 from retro.routines.spec import Routine
 
 ROWS_SHOWN = 10  # failing rows listed in the text report (JSON lists every one)

@@ -26,7 +26,7 @@ from retro.analysis.check.reference import reference_answers
 from retro.analysis.check.results import Failure, describe_case, describe_outputs
 from retro.analysis.coverage_model import CodeCoverage
 from retro.routines import cases as case_sets
-from retro.routines.runner import row_of
+from retro.routines.outputs import row_of
 from retro.routines.spec import Routine
 
 EXAMPLES_KEPT = 5
