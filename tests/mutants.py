@@ -124,10 +124,10 @@ MUTANTS = [
            "    b1 = memory.initial(pc + 1)\n    if mode == \"zpg\":", FLOW_TESTS),
     Mutant("analysis-reads-memory-after-the-cases", "retro/analysis/check/verdicts.py",
            "memory = bytes(runner.call_image)", "memory = bytes(runner.machine.memory)", FLOW_TESTS),
-    Mutant("flag-input-ignored", "retro/routines/runner.py",
+    Mutant("flag-input-ignored", "retro/routines/input_plan.py",
            "p |= (values[index] != 0) * bit", "p |= 0 * bit",
            ("tests/routines",)),
-    Mutant("high-byte-of-output-dropped", "retro/routines/runner.py",
+    Mutant("high-byte-of-output-dropped", "retro/routines/outputs.py",
            "value = value | widen(byte) << (8 * shift)", "value = value | (widen(byte) if shift == 0 else widen(0))",
            ("tests/routines",)),
     # ---- the batched core and its checks --------------------------------------------------------

@@ -40,6 +40,24 @@ def diagram_blocks() -> list[set[str]]:
     return [b for b in blocks if b]
 
 
+def table_rows() -> list[str]:
+    """The modules the docs' table ("## Modules") names, as paths or patterns: `retro/x/a.py`, `b.py`
+    after it in one cell (the same folder), `retro/x/gfx_*.py`, a package `retro/x/` for all of it."""
+    text = ARCHITECTURE.read_text()
+    named = []
+    for line in text[text.index("## Modules"):].splitlines():
+        if not line.startswith("| `"):
+            continue
+        folder = ""
+        for item in re.findall(r"`([^`]+)`", line.split("|")[1]):
+            if item.startswith("retro/"):
+                folder = item if item.endswith("/") else item.rsplit("/", 1)[0] + "/"
+                named.append(item)
+            elif folder and item.endswith(".py"):
+                named.append(folder + item)
+    return named
+
+
 def package_imports() -> dict[str, set[str]]:
     edges: dict[str, set[str]] = defaultdict(set)
     for path in RETRO.rglob("*.py"):
@@ -62,6 +80,18 @@ def test_the_diagram_places_every_package_and_module():
                if (p.suffix == ".py" and p.name != "__init__.py") or (p.is_dir() and (p / "__init__.py").exists())}
     assert present - placed == set(), "not in docs/architecture.md's diagram"
     assert placed - present == set(), "in the diagram but not in retro/"
+
+
+def test_the_table_names_every_module():
+    """Each module of retro/ has its row in docs/architecture.md's table (itself, a pattern, or its package)."""
+    from fnmatch import fnmatch
+
+    named = table_rows()
+    modules = [path.relative_to(RETRO.parent).as_posix() for path in RETRO.rglob("*.py") if path.name != "__init__.py"]
+    unnamed = [m for m in modules if not any(fnmatch(m, pattern) or (pattern.endswith("/") and m.startswith(pattern))
+                                             for pattern in named)]
+    assert unnamed == [], "no row in docs/architecture.md's module table"
+    assert all("retro/routines/" + name in named for name in ("input_plan.py", "outputs.py", "world_spec.py")), named
 
 
 def test_no_package_imports_one_from_a_block_below_it():

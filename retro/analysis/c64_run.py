@@ -51,6 +51,7 @@ from retro.program import Program
 from retro.scenes.vic import VicScene
 
 RETURNED = "returned"  # why a run stopped, besides console_run's reasons
+DEFAULT_C64_FRAMES = 50  # one second of PAL time
 
 # The KERNAL's VIC-II initialisation (TVIC, $ECB9-$ECE7, written to $D000-$D02E at reset) [Mapping
 # the Commodore 64, $ECB9]: sprites at 0, $D011 $9B, $D012 $37 (compare line 311), $D016 $08,

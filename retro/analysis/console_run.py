@@ -39,6 +39,7 @@ from retro.machines.nes import build_nes, ppu_of, reset
 JMP_ABSOLUTE = 0x4C
 CPU_CYCLES_PER_FRAME = NTSC.dots_per_frame / NTSC.dots_per_cpu_cycle  # 29,780.67 (no odd-frame skip)
 MAX_FRAMES = 36_000             # ten minutes of NES time (the host runs about 30 frames a second)
+DEFAULT_FRAMES = 600  # ten seconds of NES time: every blargg ROM of the standard suites reports within it
 STATUS_ADDRESS = 0x6000
 SIGNATURE_ADDRESS = 0x6001
 SIGNATURE = (0xDE, 0xB0, 0x61)

@@ -22,18 +22,19 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from retro.analysis.check.engines import (AGREEMENT_PER_PART, BATCH_LANES, CallBlock, SceneStart, disagreement,
-                                         run_on_batched_core, run_on_machine, runner_for)
+from retro.analysis.check.engines import (AGREEMENT_PER_PART, BATCH_LANES, CallBlock, SceneStart, run_on_batched_core,
+                                         run_on_machine, runner_for)
 from retro.analysis.check.reference import reference_answers
 from retro.analysis.check.results import Failure, describe_case, describe_outputs, inputs_by_name
-from retro.analysis.check.tally import Tally
+from retro.analysis.check.tally import Tally, count_block
 from retro.analysis.check.verdicts import static_bounds
 from retro.analysis.coverage_model import CodeCoverage
 from retro.cpu.flow import Bounds
 from retro.errors import InputError
 from retro.routines.cases import cases_to_columns
 from retro.routines.rows import Row
-from retro.routines.runner import RoutineRunner, describe_value, row_of
+from retro.routines.outputs import describe_value, row_of
+from retro.routines.runner import RoutineRunner
 from retro.routines.spec import Routine
 
 ROWS_SHOWN = 10  # failing rows listed in the text report (JSON lists every one)
@@ -157,37 +158,15 @@ def _batched(runner: RoutineRunner, rows: tuple[Row, ...]) -> tuple[list[_Call],
         batch = run_on_batched_core(runner, cases_to_columns(routine, cases))
         coverage = coverage.merge(batch.coverage)
         compared = min(batch.calls, AGREEMENT_PER_PART - first)
-        if compared > 0:
+        if compared > 0:  # Machine's calls held against the timing model and the batched core's, as any part's
             machine = run_on_machine(runner, cases[:compared], coverage=False)
-            _agree(agreement, routine, rows[first:], machine, batch)
+            agreement.merge(count_block(routine, machine, cases_to_columns(routine, cases[:compared]), cases[:compared],
+                                        runner.memory_values, against=batch,
+                                        row_keys=[row.key for row in rows[first:first + compared]]))
         calls += _calls_of(batch, timed=False)
         if batch.stop is not None:
             break
     return calls, agreement, coverage
-
-
-def _agree(agreement: Tally, routine: Routine, rows: tuple[Row, ...], machine: CallBlock, batch: CallBlock) -> None:
-    """Machine's calls of the rows held against the timing model and against the batched core's."""
-    for i in range(machine.calls):
-        row = rows[i]
-        agreement.cases += 1
-        agreement.engine_cases += 1
-        if machine.stopped(i):
-            agreement.run_errors += 1
-        else:
-            cpu = int(machine.cycles[i]) - int(machine.stolen[i])
-            if int(machine.modelled[i]) != cpu:
-                agreement.cycle_mismatches += 1
-                message = f"measured {cpu} cycles, the timing model says {int(machine.modelled[i])}"
-                agreement.failure = agreement.failure or Failure(row.case, "cycles", machine.row(i), None, message)
-                agreement.examples.append(f"{routine.name}({describe_case(routine, row.case)}): {row.key}: {message}")
-        message = disagreement(routine, machine, batch, i)
-        if message is not None:
-            agreement.engine_mismatches += 1
-            message = f"{row.key}: {message}"
-            outputs = None if machine.stopped(i) else machine.row(i)
-            agreement.failure = agreement.failure or Failure(row.case, "engine", outputs, None, message)
-            agreement.examples.append(f"{routine.name}({describe_case(routine, row.case)}): {message}")
 
 
 def _outcome(row: Row, call: _Call, routine: Routine) -> RowOutcome:

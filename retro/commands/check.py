@@ -288,11 +288,15 @@ def _check_html(check: RoutineCheck) -> str:
 
 
 def format_check(check: RoutineCheck) -> list[str]:
-    """One routine's check as the lines `retro check` prints."""
-    t = check.totals
+    """One routine's check as the lines `retro check` prints: the headline, what ran, what it cost,
+    then every mismatch."""
+    return ([_headline(check)] + _run_lines(check) + _measure_lines(check) + _mismatch_lines(check))
+
+
+def _run_lines(check: RoutineCheck) -> list[str]:
+    """What ran: the engine, the spec's notes, the cases and their coverage, the search, the scene's engine."""
     routine = check.routine
-    lines = [_headline(check)]
-    lines += engine_lines(check)
+    lines = engine_lines(check)
     lines += [f"  note: {note}" for note in routine.notes]
     if check.parts:
         lines.append(f"  cases: {format_coverage(check)}; input space {format_space(check.routine.input_space())}")
@@ -306,15 +310,24 @@ def format_check(check: RoutineCheck) -> list[str]:
     if _search_line(check):
         lines.append(_search_line(check))
     if check.start is not None and check.engine_reason:
-        if check.engine == "batch":
-            engine = "the batched core, each lane stalled as on the scene"
-        elif check.engine_reason.startswith(FREE_REASON):
-            engine = "Machine (--engine scalar, or too few cases for the batched core to pay)"
-        else:
-            engine = "Machine"
-        lines.append(f"  engine with the scene: {engine}: {check.engine_reason}")
-    if t.cycles_count:
-        lines += _cycle_lines(check)
+        lines.append(f"  engine with the scene: {_scene_engine(check)}: {check.engine_reason}")
+    return lines
+
+
+def _scene_engine(check: RoutineCheck) -> str:
+    if check.engine == "batch":
+        return "the batched core, each lane stalled as on the scene"
+    if check.engine_reason.startswith(FREE_REASON):
+        return "Machine (--engine scalar, or too few cases for the batched core to pay)"
+    return "Machine"
+
+
+def _measure_lines(check: RoutineCheck) -> list[str]:
+    """What the calls cost and where they fell: cycles, self-modifying code, the budget, the domain,
+    the rows, the entry-state runs."""
+    t = check.totals
+    routine = check.routine
+    lines = _cycle_lines(check) if t.cycles_count else []
     if check.static is not None:  # self-modifying code the static analysis followed
         lines += [f"  self-modifying: {note}" for note in check.static.modified]
     if routine.budget is not None:
@@ -325,8 +338,12 @@ def format_check(check: RoutineCheck) -> list[str]:
                      + (f", e.g. {t.outside_examples[0]}" if t.outside_examples else ""))
     if check.rows is not None:
         lines += rows_lines(routine, check.rows)
-    lines += entry_lines(check)
-    lines += [f"  MISMATCH {example}" for example in t.examples]
+    return lines + entry_lines(check)
+
+
+def _mismatch_lines(check: RoutineCheck) -> list[str]:
+    t = check.totals
+    lines = [f"  MISMATCH {example}" for example in t.examples]
     lines += [f"  MISMATCH {violation}" for violation in check.bounds_violations]
     lines += [f"  BUDGET {violation}" for violation in check.budget_violations]
     if t.failure is not None:

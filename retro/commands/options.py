@@ -1,6 +1,7 @@
 """What the command modules share at the command line: the options several commands have, defined
-once so each means the same everywhere (--jobs, --engine, --method, --quiet, --out, --scale), and how a
-command's result is printed (its module's `lines` or `as_json`)."""
+once so each means the same everywhere (--jobs, --engine, --method, --quiet, --out, --scale, the program
+run's --labels, --load, --frames, --until, --until-value), and how a command's result is printed (its
+module's `lines` or `as_json`)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,9 @@ import argparse
 import json
 from collections.abc import Callable, Iterable
 
+from retro.analysis.c64_run import DEFAULT_C64_FRAMES
 from retro.analysis.check import ENGINES
+from retro.analysis.console_run import DEFAULT_FRAMES, MAX_FRAMES
 from retro.workers import MAX_WORKERS
 
 
@@ -62,3 +65,20 @@ def engine(p: argparse.ArgumentParser, detail: str = "") -> None:
 
 def scale(p: argparse.ArgumentParser, what: str, top: int) -> None:
     p.add_argument("--scale", default="2", metavar="K", help=f"integer {what} scale 1-{top} (default 2)")
+
+
+def program_run(p: argparse.ArgumentParser) -> None:
+    """The program run `retro run` and `retro profile` share: the program as loaded (--labels, --load)
+    and its run as the machine would run it, for N frames or until a condition (--frames, --until,
+    --until-value); the command checks which of them its other options allow."""
+    group = p.add_argument_group("program run", "the program file's symbols and load address; a run of the "
+                                 "program for N frames or until a condition")
+    group.add_argument("--labels", metavar="F", help="symbol file of a .prg, .bin or .nes, in any supported format "
+                                                       "(docs/symbols.md): the names of entries, stops, peeks and "
+                                                       "(retro profile) subroutines")
+    group.add_argument("--load", metavar="ADDR", help="load address of a raw binary")
+    group.add_argument("--frames", metavar="N", help=f"program run: frames to run (default {DEFAULT_FRAMES} on a NES, "
+                       f"{DEFAULT_C64_FRAMES} on a C64, at most {MAX_FRAMES:,}); the run also stops when the program "
+                       f"halts (JMP * with no interrupt to come)")
+    group.add_argument("--until", metavar="LABEL|ADDR", help="program run: stop when the PC reaches this address")
+    group.add_argument("--until-value", metavar="TARGET=V", help="program run: stop when this byte holds V")

@@ -226,11 +226,7 @@ def add_options(p: argparse.ArgumentParser) -> None:
                    "spec (built-in name or SPEC.toml)")
     p.add_argument("--entry", metavar="LABEL|ADDR", help="call this routine or handler (as by JSR); with --frames, "
                    "--until or --until-value: run a C64 program from here")
-    p.add_argument("--frames", metavar="N", help="program run: frames to run (as retro run)")
-    p.add_argument("--until", metavar="LABEL|ADDR", help="program run: stop when the PC reaches this address")
-    p.add_argument("--until-value", metavar="TARGET=V", help="program run: stop when this byte holds V")
-    p.add_argument("--labels", metavar="F", help="symbol file naming the subroutines (any supported format)")
-    p.add_argument("--load", metavar="ADDR", help="load address of a raw binary")
+    options.program_run(p)
     p.add_argument("--scene", metavar="SCENE.toml", help="a VIC-II scene (a C64 program run, a call, a spec's cases)")
     p.add_argument("--at-line", metavar="L", help="spec: the raster line every call starts at (with --scene)")
     p.add_argument("--at-cycle", metavar="C", help="spec: the cycle in that line (with --scene)")

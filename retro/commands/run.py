@@ -11,8 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from retro.analysis.c64_run import RETURNED, C64Run, run_c64, vic_registers
-from retro.analysis.console_run import MAX_FRAMES, ConsoleRun, ppu_registers, run_cartridge
+from retro.analysis.c64_run import DEFAULT_C64_FRAMES, RETURNED, C64Run, run_c64, vic_registers
+from retro.analysis.console_run import DEFAULT_FRAMES, MAX_FRAMES, ConsoleRun, ppu_registers, run_cartridge
 from retro.chips.cartridge import read_nrom
 from retro.chips.ines import INES_MAGIC
 from retro.cpu.machine import DEFAULT_BUDGET, DEFAULT_FLAGS, JSR_CYCLES, MAX_BUDGET, MAX_TRACE, CallResult, Machine
@@ -99,7 +99,6 @@ def _peek_counts(peeks: list[str]) -> dict[str, int]:
     return counts
 
 
-DEFAULT_FRAMES = 600  # ten seconds of NES time: every blargg ROM of the standard suites reports within it
 RAM_END = 0x0800
 PRG_RAM_START, PRG_RAM_END = 0x6000, 0x8000
 
@@ -147,9 +146,6 @@ def run_console(path: str | Path, *, frames: int | str = DEFAULT_FRAMES, until: 
     report.machine.symbols.update(program.symbols)
     report.peeks = {target: report.machine.peek(target, count) for target, count in peek_counts.items()}
     return report
-
-
-DEFAULT_C64_FRAMES = 50  # one second of PAL time
 
 
 def run_c64_program(path: str | Path, *, entry: str | int | None = None, frames: int | str = DEFAULT_C64_FRAMES,
@@ -295,25 +291,12 @@ def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None,
     registers = {name: parse_int(value, field=f"--{name}", lo=0, hi=0xFF) for name, value in (("a", a), ("x", x), ("y", y))}
     budget = parse_int(budget, field="--budget", lo=1, hi=MAX_BUDGET)
     status = status_with_flags(flags)
-    program = load_program(path, symbols=file_option(labels, "--labels"), load=load,
-                           cpu=variant_named(cpu, "--cpu") if cpu else None)
-    from_binary_without_symbols = labels is None and not program.listing
-    if from_binary_without_symbols and _is_label(str(entry)) and str(entry).strip() not in program.symbols:
-        how = " (read as a raw binary: --load)" if load is not None else ""
-        raise InputError(f"{path}{how} has no symbols: pass --labels with the symbol file your assembler wrote, "
-                         f"or give --entry as an address")
-    loaded_scene = None if scene is None else load_scene(scene)
-    if loaded_scene is not None and program.cpu and loaded_scene.cpu_variant != program.cpu:
-        raise InputError(f"--scene {scene}: a scene for the {loaded_scene.cpu_variant.upper()}, "
-                         f"but {path} is a program for the {program.cpu.upper()}")
-    machine = build_machine(loaded_scene, cpu=_cpu(cpu, program, path))
-    machine.load(program)
+    program = _call_program(path, entry, labels, load, cpu)
+    machine = _call_machine(path, program, scene, cpu)
     memory = dict(parse_assignment(s) for s in sets)
     for target in memory:
         machine.resolve(target, f"--set {target}")
-    peek_counts = _peek_counts(peeks)
-    for target in peek_counts:
-        machine.resolve(target, f"--peek {target}")
+    peek_counts = _checked_peeks(machine, peeks)
     entry_address = machine.resolve(entry, "--entry")
     observer = None if wrap is None else wrap(machine, None)  # --trace-json / --watch (retro.analysis.trace)
     ppu = ppu_of(machine)
@@ -328,6 +311,29 @@ def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None,
     values = {target: machine.peek(target, count) for target, count in peek_counts.items()}
     return RunReport(program=program, entry=entry_address, result=result, peeks=values, machine=machine,
                      raster=call_budget(machine, result), vblank=vblank)
+
+
+def _call_program(path: str | Path, entry: str | int, labels, load, cpu: str | None) -> Program:
+    """The program a call runs; an entry given as a label needs symbols (a raw binary has none)."""
+    program = load_program(path, symbols=file_option(labels, "--labels"), load=load,
+                           cpu=variant_named(cpu, "--cpu") if cpu else None)
+    from_binary_without_symbols = labels is None and not program.listing
+    if from_binary_without_symbols and _is_label(str(entry)) and str(entry).strip() not in program.symbols:
+        how = " (read as a raw binary: --load)" if load is not None else ""
+        raise InputError(f"{path}{how} has no symbols: pass --labels with the symbol file your assembler wrote, "
+                         f"or give --entry as an address")
+    return program
+
+
+def _call_machine(path: str | Path, program: Program, scene: str | Path | None, cpu: str | None) -> Machine:
+    """The machine a call runs on (with the scene's chip, for the program's CPU), the program loaded."""
+    loaded_scene = None if scene is None else load_scene(scene)
+    if loaded_scene is not None and program.cpu and loaded_scene.cpu_variant != program.cpu:
+        raise InputError(f"--scene {scene}: a scene for the {loaded_scene.cpu_variant.upper()}, "
+                         f"but {path} is a program for the {program.cpu.upper()}")
+    machine = build_machine(loaded_scene, cpu=_cpu(cpu, program, path))
+    machine.load(program)
+    return machine
 
 
 STOP_REASONS = {
@@ -505,17 +511,10 @@ HELP = "call a 6502 routine in the emulator and report registers, cycles and mem
 def add_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("program", metavar="FILE.s|FILE.prg|FILE.bin|FILE.nes",
                    help="an Ophis source, a C64 .prg, a raw binary (with --load) or an iNES image (NROM)")
-    p.add_argument("--labels", metavar="F", help="symbol file of a .prg, .bin or .nes, in any supported format "
-                                                   "(docs/symbols.md)")
-    p.add_argument("--load", metavar="ADDR", help="load address of a raw binary")
     p.add_argument("--entry", metavar="LABEL|ADDR", help="where the routine starts (called as by JSR); without it "
                    "the program runs as the machine would (--frames, --until, --until-value): an iNES image from its "
                    "reset vector, a C64 program from its BASIC SYS line; with those options, a C64 program from here")
-    p.add_argument("--frames", metavar="N", help=f"program run: frames to run (default {DEFAULT_FRAMES} on a NES, "
-                   f"{DEFAULT_C64_FRAMES} on a C64, at most {MAX_FRAMES:,}); the run also stops when the program "
-                   f"halts (JMP * with no interrupt to come)")
-    p.add_argument("--until", metavar="LABEL|ADDR", help="program run: stop when the PC reaches this address")
-    p.add_argument("--until-value", metavar="TARGET=V", help="program run: stop when this byte holds V")
+    options.program_run(p)
     p.add_argument("--result", metavar="ADDR", help="iNES image from reset: a test ROM's result byte (blargg's 2005 "
                    "ROMs: $F8, 1 = passed); the $6000 protocol is read without it; exit 1 on a failed verdict")
     for register in ("a", "x", "y"):
@@ -559,17 +558,28 @@ C64Run._repr_html_ = ConsoleRun._repr_html_ = _program_run_html
 def main(args: argparse.Namespace) -> int:
     console = {"frames": args.frames, "until": args.until, "until_value": args.until_value, "result": args.result}
     if args.entry is None or wants_program_run(args.program, console):
-        report = run_console_or_refuse(args.program, labels=args.labels, peeks=args.peeks, load=args.load,
-                                       scene=args.scene, trace=args.trace, cpu=args.cpu, entry=args.entry,
-                                       trace_json=args.trace_json, trace_limit=args.trace_limit,
-                                       trace_cycles=args.trace_cycles, trace_pc=args.trace_pc, watches=args.watches,
-                                       **{k: v for k, v in console.items() if v is not None})
-        if args.trace or args.trace_json:
-            for line in program_trace_lines(report, args.trace_json):
-                print(line)
-        options.show(lines, as_json if args.json else None, report)
-        return 1 if getattr(report, "verdict", None) is not None and report.verdict.passed is False else 0
+        return _program_run_main(args, console)
     refuse_console_options(console)
+    return _call_main(args)
+
+
+def _program_run_main(args: argparse.Namespace, console: dict) -> int:
+    """`retro run` of a whole program (a cartridge from reset, a C64 program from SYS or --entry):
+    exit 1 on a test ROM's failed verdict."""
+    report = run_console_or_refuse(args.program, labels=args.labels, peeks=args.peeks, load=args.load,
+                                   scene=args.scene, trace=args.trace, cpu=args.cpu, entry=args.entry,
+                                   trace_json=args.trace_json, trace_limit=args.trace_limit,
+                                   trace_cycles=args.trace_cycles, trace_pc=args.trace_pc, watches=args.watches,
+                                   **{k: v for k, v in console.items() if v is not None})
+    if args.trace or args.trace_json:
+        for line in program_trace_lines(report, args.trace_json):
+            print(line)
+    options.show(lines, as_json if args.json else None, report)
+    return 1 if getattr(report, "verdict", None) is not None and report.verdict.passed is False else 0
+
+
+def _call_main(args: argparse.Namespace) -> int:
+    """`retro run --entry`: one call of a routine, through its RTS."""
     if args.trace and args.trace_json:
         raise InputError("--trace, --trace-json: one of them (a call's --trace lists every instruction)")
     # a call is bounded by its budget: --trace-json needs no bound of its own (the trace's own limit holds)

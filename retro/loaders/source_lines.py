@@ -55,9 +55,31 @@ def _resolved_name(name: str, beside: str) -> str:
 # ---- ca65/ld65 --dbgfile ---------------------------------------------------------------------
 
 def _parse_dbg(text: str, source: str) -> dict[int, SourceLine]:
+    """address -> the line that produced its byte: where several lines cover one address, the line
+    of the kind `_DBG_LINE_PREFERENCE` ranks first, then the smallest span."""
+    files, segments, spans, line_records = _dbg_records(text, source)
+    best: dict[int, tuple[tuple[int, int], SourceLine]] = {}  # address -> (preference, line)
+    names = {file_id: _resolved_name(name, source) for file_id, name in files.items()}
+    for number, fields in line_records:
+        file_id = dbg_int(fields, "file", source, number)
+        if file_id not in names:
+            raise InputError(f"{source}:{number}: file {file_id} is not defined in the file")
+        where = SourceLine(names[file_id], dbg_int(fields, "line", source, number))
+        kind = dbg_int(fields, "type", source, number) if "type" in fields else 0
+        for first, size in _line_spans(fields["span"], spans, segments, source, number):
+            preference = (_DBG_LINE_PREFERENCE.get(kind, len(_DBG_LINE_PREFERENCE)), size)
+            for address in range(first, first + size):
+                if address not in best or preference < best[address][0]:
+                    best[address] = (preference, where)
+    return {address: where for address, (_, where) in best.items()}
+
+
+def _dbg_records(text: str, source: str) -> tuple[dict, dict, dict, list]:
+    """The records of a --dbgfile the lines need: files (id -> name), segments (id -> start address),
+    spans (id -> (segment, start in it, size)) and the line records that name spans."""
     files: dict[int, str] = {}
-    segments: dict[int, int] = {}  # id -> start address
-    spans: dict[int, tuple[int, int, int]] = {}  # id -> (segment, start in it, size)
+    segments: dict[int, int] = {}
+    spans: dict[int, tuple[int, int, int]] = {}
     line_records: list[tuple[int, dict[str, str]]] = []
     for number, raw in enumerate(text.splitlines(), start=1):
         if not raw.strip():
@@ -73,29 +95,23 @@ def _parse_dbg(text: str, source: str) -> dict[int, SourceLine]:
                 dbg_int(fields, "size", source, number))
         elif kind == "line" and fields.get("span"):
             line_records.append((number, fields))
+    return files, segments, spans, line_records
 
-    best: dict[int, tuple[tuple[int, int], SourceLine]] = {}  # address -> (preference, line)
-    names = {file_id: _resolved_name(name, source) for file_id, name in files.items()}
-    for number, fields in line_records:
-        file_id = dbg_int(fields, "file", source, number)
-        if file_id not in names:
-            raise InputError(f"{source}:{number}: file {file_id} is not defined in the file")
-        where = SourceLine(names[file_id], dbg_int(fields, "line", source, number))
-        kind = dbg_int(fields, "type", source, number) if "type" in fields else 0
-        for span_text in fields["span"].split("+"):
-            if not span_text.isdigit() or int(span_text) not in spans:
-                raise InputError(f"{source}:{number}: span {span_text!r} is not defined in the file")
-            segment, start, size = spans[int(span_text)]
-            if segment not in segments:
-                raise InputError(f"{source}:{number}: segment {segment} is not defined in the file")
-            first = segments[segment] + start
-            if size > ADDRESS_SPACE or first + size > ADDRESS_SPACE:
-                continue  # bytes outside the 6502's address space (a bank's file offsets): no address to map
-            preference = (_DBG_LINE_PREFERENCE.get(kind, len(_DBG_LINE_PREFERENCE)), size)
-            for address in range(first, first + size):
-                if address not in best or preference < best[address][0]:
-                    best[address] = (preference, where)
-    return {address: where for address, (_, where) in best.items()}
+
+def _line_spans(text: str, spans: dict, segments: dict, source: str, number: int) -> list[tuple[int, int]]:
+    """A line record's `span=A+B` -> (first address, size) of each span inside the 6502's address
+    space (a bank's file offsets have no address to map)."""
+    out = []
+    for span_text in text.split("+"):
+        if not span_text.isdigit() or int(span_text) not in spans:
+            raise InputError(f"{source}:{number}: span {span_text!r} is not defined in the file")
+        segment, start, size = spans[int(span_text)]
+        if segment not in segments:
+            raise InputError(f"{source}:{number}: segment {segment} is not defined in the file")
+        first = segments[segment] + start
+        if size <= ADDRESS_SPACE and first + size <= ADDRESS_SPACE:
+            out.append((first, size))
+    return out
 
 
 # ---- ACME --report ---------------------------------------------------------------------------

@@ -115,38 +115,13 @@ def _source_cells(row: Row, source_text: Callable[[str], list[str] | None]) -> s
 
 
 def routine_page(annotated: Annotated, source_text: Callable[[str], list[str] | None] = lambda file: None) -> str:
+    """One routine's page: its summary, the worst case, a legend and a table with one row per
+    instruction (labels and gaps between them), heat-coloured by hits and cycles."""
     code = annotated.code
-    top_hits = max((row.hits for row in annotated.rows), default=0)
-    top_cycles = max((row.cycles_max or 0 for row in annotated.rows), default=0)
     has_source = any(row.source is not None for row in annotated.rows)
     head = ("<tr><th></th><th>address</th><th>bytes</th><th class=\"code\">instruction</th><th>hits</th>"
             "<th title=\"taken\">taken</th><th title=\"not taken\">not taken</th><th>min cycles</th><th>max cycles</th>"
             + ("<th class=\"line\">line</th><th class=\"src\">source</th>" if has_source else "") + "</tr>")
-    columns = 11 if has_source else 9
-    body = []
-    for piece in annotated.pieces():
-        if isinstance(piece, Gap):
-            text = (f"${piece.start:04X}-${piece.end - 1:04X}: {piece.end - piece.start:,} byte(s) no path from the entry runs"
-                    if piece.end > piece.start else "the next instruction overlaps this one")
-            body.append(f'<tr class="gap"><td colspan="{columns}">{html.escape(text)}</td></tr>')
-            continue
-        row = piece
-        body += [f'<tr class="label"><td></td><td colspan="{columns - 1}">{html.escape(label)}:</td></tr>'
-                 for label in row.labels]
-        instruction = row.instruction
-        data = " ".join(f"{b:02X}" for b in instruction.data) if instruction else "??"
-        text = instruction.text if instruction else "(outside the program's bytes)"
-        hits = f"{row.hits:,}" if row.run else '<span class="never">never run</span>'
-        cells = [f'<td class="mark" title="{"on the worst case&#39;s path" if row.on_worst_path else ""}"></td>',
-                 f'<td class="addr">${row.address:04X}</td>', f'<td class="bytes">{data}</td>',
-                 f'<td class="code">{html.escape(text)}</td>', f'<td class="hits"{_heat(row.hits, top_hits)}>{hits}</td>',
-                 f'<td class="taken">{_count(row.taken, row, "&#8594;", "never taken")}</td>',
-                 f'<td class="nottaken">{_count(row.not_taken, row, "&#8595;", "never fell through")}</td>',
-                 f'<td class="cmin">{"" if row.cycles_min is None else row.cycles_min}</td>',
-                 f'<td class="cmax"{_heat(row.cycles_max, top_cycles)}>{"" if row.cycles_max is None else row.cycles_max}</td>']
-        if has_source:
-            cells.append(_source_cells(row, source_text))
-        body.append(f'<tr id="a{row.address:04X}" class="{_row_class(row)}">{"".join(cells)}</tr>')
     worst = (f"<p>Worst case: {annotated.worst_cycles:,} cycles over {annotated.worst_length:,} instructions; its path "
              f"is marked by the bar at the left.</p>" if annotated.worst_cycles is not None else "")
     legend = (f'<p class="legend"><span style="background: {RUN_COLOUR}">run</span>'
@@ -157,8 +132,45 @@ def routine_page(annotated: Annotated, source_text: Callable[[str], list[str] | 
     origin = f" ({html.escape(code.program_file)})" if code.program_file else ""
     content = (f'<p><a href="{INDEX}">all routines</a></p>\n<h1>{html.escape(code.name)}</h1>\n'
                f"<p>entry ${code.entry:04X}{origin}</p>\n<p class=\"summary\">{html.escape(annotated.summary())}</p>\n"
-               f"{worst}\n{legend}\n<table>\n{head}\n" + "\n".join(body) + "\n</table>")
+               f"{worst}\n{legend}\n<table>\n{head}\n" + "\n".join(_table_rows(annotated, has_source, source_text))
+               + "\n</table>")
     return _page(f"{code.name}: coverage", content)
+
+
+def _table_rows(annotated: Annotated, has_source: bool, source_text: Callable[[str], list[str] | None]) -> list[str]:
+    """The table's rows in address order: a gap's one line, an instruction's labels and its row."""
+    columns = 11 if has_source else 9
+    top_hits = max((row.hits for row in annotated.rows), default=0)
+    top_cycles = max((row.cycles_max or 0 for row in annotated.rows), default=0)
+    body = []
+    for piece in annotated.pieces():
+        if isinstance(piece, Gap):
+            text = (f"${piece.start:04X}-${piece.end - 1:04X}: {piece.end - piece.start:,} byte(s) no path from the entry runs"
+                    if piece.end > piece.start else "the next instruction overlaps this one")
+            body.append(f'<tr class="gap"><td colspan="{columns}">{html.escape(text)}</td></tr>')
+            continue
+        body += [f'<tr class="label"><td></td><td colspan="{columns - 1}">{html.escape(label)}:</td></tr>'
+                 for label in piece.labels]
+        cells = _instruction_cells(piece, top_hits, top_cycles)
+        if has_source:
+            cells.append(_source_cells(piece, source_text))
+        body.append(f'<tr id="a{piece.address:04X}" class="{_row_class(piece)}">{"".join(cells)}</tr>')
+    return body
+
+
+def _instruction_cells(row: Row, top_hits: int, top_cycles: int) -> list[str]:
+    """An instruction's cells: worst-path mark, address, bytes, text, hits, branch directions, cycles."""
+    instruction = row.instruction
+    data = " ".join(f"{b:02X}" for b in instruction.data) if instruction else "??"
+    text = instruction.text if instruction else "(outside the program's bytes)"
+    hits = f"{row.hits:,}" if row.run else '<span class="never">never run</span>'
+    return [f'<td class="mark" title="{"on the worst case&#39;s path" if row.on_worst_path else ""}"></td>',
+            f'<td class="addr">${row.address:04X}</td>', f'<td class="bytes">{data}</td>',
+            f'<td class="code">{html.escape(text)}</td>', f'<td class="hits"{_heat(row.hits, top_hits)}>{hits}</td>',
+            f'<td class="taken">{_count(row.taken, row, "&#8594;", "never taken")}</td>',
+            f'<td class="nottaken">{_count(row.not_taken, row, "&#8595;", "never fell through")}</td>',
+            f'<td class="cmin">{"" if row.cycles_min is None else row.cycles_min}</td>',
+            f'<td class="cmax"{_heat(row.cycles_max, top_cycles)}>{"" if row.cycles_max is None else row.cycles_max}</td>']
 
 
 def page_names(routines: list[Annotated]) -> list[str]:

@@ -85,50 +85,58 @@ def _allowed_table(allowed: tuple[int, ...]) -> np.ndarray:
 
 def parse_facts(r: Fields, doc, program: Program, cpu: str) -> tuple[StatedFact, ...]:
     """`[facts]` -> StatedFacts, each bad entry one error naming `facts.KEY`."""
-    facts = []
-    for key, value in r.table(doc, "facts").items():
-        field = f"facts.{key}"
-        address = resolve(r, program, key, field)
-        if not program.origin <= address < program.end:
-            raise r.error(field, f"${address:04X} is outside the program (${program.origin:04X}-${program.end - 1:04X})")
-        if isinstance(value, str):
-            value = {"branch": value}
-        if not isinstance(value, dict):
-            raise r.error(field, f"expected \"taken\", \"not taken\" or a table {{ x = \"0..7\", c = 1 }}, got "
-                                 f"{describe(value)}")
-        r.known(value, field, FACT_KEYS)
-        if not value:
-            raise r.error(field, "states nothing: give branch = \"taken\" | \"not taken\", a register or a flag")
-        taken = None
-        if "branch" in value:
-            word = value["branch"]
-            if not isinstance(word, str) or word.strip().lower() not in BRANCH_WORDS:
-                raise r.error(f"{field}.branch" if len(value) > 1 else field,
-                              f"expected \"taken\" or \"not taken\", got {word!r:.40}")
-            opcode = program.code[address - program.origin]
-            if opcode not in BRANCH_CONDITIONS:
-                mnemonic = _mnemonic(opcode, cpu)
-                raise r.error(field, f"the instruction at ${address:04X} is {mnemonic}, not a conditional branch "
-                                     f"(BPL BMI BVC BVS BCC BCS BNE BEQ)")
-            taken = BRANCH_WORDS[word.strip().lower()]
-        registers = []
-        for register in REGISTERS:
-            if register in value:
-                values = parse_values(r, value[register], f"{field}.{register}")
-                if values.hi >= BYTE_VALUES:
-                    raise r.error(f"{field}.{register}", f"{values.describe()} does not fit a register (0..255)")
-                listed = values.listed if values.listed is not None else tuple(range(values.lo, values.hi + 1))
-                registers.append((register, tuple(sorted(listed))))
-        flags = [(flag, r.integer(value[flag], f"{field}.{flag}", 0, 1)) for flag in FLAG_BITS if flag in value]
-        text = ", ".join([f"branch {'taken' if taken else 'not taken'}"] if taken is not None else []) or ""
-        text = ", ".join(filter(None, [text, *(f"{n.upper()} in {_span(v)}" for n, v in registers),
-                                       *(f"{n.upper()} = {v}" for n, v in flags)]))
-        facts.append(StatedFact(key, address, taken, tuple(registers), tuple(flags), text))
+    facts = [_fact(r, key, value, program, cpu) for key, value in r.table(doc, "facts").items()]
     addresses = [f.address for f in facts]
     for fact in facts:
         if addresses.count(fact.address) > 1:
             raise r.error(f"facts.{fact.key}", f"${fact.address:04X} is stated twice (one entry per address)")
     return tuple(facts)
+
+
+def _fact(r: Fields, key: str, value, program: Program, cpu: str) -> StatedFact:
+    """One `[facts]` entry: its address inside the program, the branch, registers and flags it states."""
+    field = f"facts.{key}"
+    address = resolve(r, program, key, field)
+    if not program.origin <= address < program.end:
+        raise r.error(field, f"${address:04X} is outside the program (${program.origin:04X}-${program.end - 1:04X})")
+    if isinstance(value, str):
+        value = {"branch": value}
+    if not isinstance(value, dict):
+        raise r.error(field, f"expected \"taken\", \"not taken\" or a table {{ x = \"0..7\", c = 1 }}, got "
+                             f"{describe(value)}")
+    r.known(value, field, FACT_KEYS)
+    if not value:
+        raise r.error(field, "states nothing: give branch = \"taken\" | \"not taken\", a register or a flag")
+    taken = _branch(r, field, value, program, address, cpu) if "branch" in value else None
+    registers = [(register, _register_values(r, value[register], f"{field}.{register}"))
+                 for register in REGISTERS if register in value]
+    flags = [(flag, r.integer(value[flag], f"{field}.{flag}", 0, 1)) for flag in FLAG_BITS if flag in value]
+    text = ", ".join([f"branch {'taken' if taken else 'not taken'}"] if taken is not None else []) or ""
+    text = ", ".join(filter(None, [text, *(f"{n.upper()} in {_span(v)}" for n, v in registers),
+                                   *(f"{n.upper()} = {v}" for n, v in flags)]))
+    return StatedFact(key, address, taken, tuple(registers), tuple(flags), text)
+
+
+def _branch(r: Fields, field: str, value: dict, program: Program, address: int, cpu: str) -> bool:
+    """`branch = "taken" | "not taken"` (True: always taken), at a conditional branch."""
+    word = value["branch"]
+    if not isinstance(word, str) or word.strip().lower() not in BRANCH_WORDS:
+        raise r.error(f"{field}.branch" if len(value) > 1 else field,
+                      f"expected \"taken\" or \"not taken\", got {word!r:.40}")
+    opcode = program.code[address - program.origin]
+    if opcode not in BRANCH_CONDITIONS:
+        raise r.error(field, f"the instruction at ${address:04X} is {_mnemonic(opcode, cpu)}, not a conditional branch "
+                             f"(BPL BMI BVC BVS BCC BCS BNE BEQ)")
+    return BRANCH_WORDS[word.strip().lower()]
+
+
+def _register_values(r: Fields, value, field: str) -> tuple[int, ...]:
+    """A register's stated values ("LO..HI" or a list of bytes), sorted."""
+    values = parse_values(r, value, field)
+    if values.hi >= BYTE_VALUES:
+        raise r.error(field, f"{values.describe()} does not fit a register (0..255)")
+    listed = values.listed if values.listed is not None else tuple(range(values.lo, values.hi + 1))
+    return tuple(sorted(listed))
 
 
 def _span(values: tuple[int, ...]) -> str:

@@ -153,24 +153,12 @@ def resolve(r: Fields, program: Program, text: str, field_name: str) -> int:
 
 
 def places_of(r: Fields, program: Program, at, size: int | None, key: str) -> tuple[Place, ...]:
+    """`at` (one item or a list: registers, flags, `S`, labels or addresses) -> its places; with
+    `size`, that many bytes from one memory location."""
     items = at if isinstance(at, list) else [at]
     if not items:
         raise r.error(key, "expected a register, flag, label or address")
-    places: list[Place] = []
-    for item in items:
-        if isinstance(item, int) and not isinstance(item, bool):
-            item = str(item)
-        if not isinstance(item, str) or not item.strip():
-            raise r.error(key, f"expected a register, flag, label or address, got {item!r:.40}")
-        text = item.strip()
-        if text == "S":  # the stack pointer at entry (an input only: after the RTS it is S + 2)
-            places.append(Place("register", register="s"))
-        elif text in REGISTERS:
-            places.append(Place("register", register=text.lower()))
-        elif text in FLAGS:
-            places.append(Place("flag", bit=FLAGS[text]))
-        else:
-            places.append(Place("memory", address=resolve(r, program, text, key)))
+    places = [_place(r, program, item, key) for item in items]
     if size is not None:
         if len(places) != 1 or places[0].kind != "memory":
             raise r.error(key, "size goes with one memory location (a label or an address)")
@@ -178,11 +166,28 @@ def places_of(r: Fields, program: Program, at, size: int | None, key: str) -> tu
         if start + size > 0x10000:
             raise r.error(key, f"{size} bytes from ${start:04X} run past $FFFF")
         places = [Place("memory", address=start + i) for i in range(size)]
-    if any(p.kind == "flag" for p in places) and len(places) > 1:
-        raise r.error(key, "a flag is one bit: it cannot be combined with other places")
-    if any(p.register == "s" for p in places) and len(places) > 1:
-        raise r.error(key, "S is one byte: it cannot be combined with other places")
+    if len(places) > 1:
+        if any(p.kind == "flag" for p in places):
+            raise r.error(key, "a flag is one bit: it cannot be combined with other places")
+        if any(p.register == "s" for p in places):
+            raise r.error(key, "S is one byte: it cannot be combined with other places")
     return tuple(places)
+
+
+def _place(r: Fields, program: Program, item, key: str) -> Place:
+    """One item of `at`: `S`, a register, a flag, or a label or address of memory."""
+    if isinstance(item, int) and not isinstance(item, bool):
+        item = str(item)
+    if not isinstance(item, str) or not item.strip():
+        raise r.error(key, f"expected a register, flag, label or address, got {item!r:.40}")
+    text = item.strip()
+    if text == "S":  # the stack pointer at entry (an input only: after the RTS it is S + 2)
+        return Place("register", register="s")
+    if text in REGISTERS:
+        return Place("register", register=text.lower())
+    if text in FLAGS:
+        return Place("flag", bit=FLAGS[text])
+    return Place("memory", address=resolve(r, program, text, key))
 
 
 def via_of(r: Fields, program: Program, at, key: str) -> Via | None:
@@ -229,6 +234,7 @@ def parse_values(r: Fields, value, key: str) -> Values:
 
 
 def port_of(r: Fields, program: Program, name: str, value, section: str, is_input: bool) -> Port:
+    """An `[inputs]` or `[outputs]` entry (a location, or a table { at, size, values, table }) -> its Port."""
     key = f"{section}.{name}"
     if not name.isidentifier() or name.startswith("__"):
         raise r.error(key, "a name must be a Python identifier (it names the reference's argument)")
@@ -246,28 +252,47 @@ def port_of(r: Fields, program: Program, name: str, value, section: str, is_inpu
     if not is_input and places[0].register == "s":
         raise r.error(f"{key}.at", "S after the routine's RTS is S at entry + 2: it is not an output")
     values = parse_values(r, doc["values"], f"{key}.values") if "values" in doc else None
-    table_flag = r.flag(doc["table"], f"{key}.table") if "table" in doc else None
-    if is_input and size is not None and size > 1 and values is None and table_flag is None:
-        raise r.error(f"{key}.size", f"size = {size} without values is ambiguous: a {8 * size}-bit number, or a table "
-                                     f"of {size} bytes? Say which: table = false (a number; or values = \"LO..HI\"), "
-                                     f"or values = \"0..255\" (a table, each byte from those values; or table = true)")
-    # `size` N with byte values is a table of N bytes; otherwise an N-byte little-endian number
-    table = table_flag if table_flag is not None else (
-        size is not None and size > 1 and values is not None and values.hi < BYTE_VALUES)
+    table = _is_table(r, doc, key, size, values, is_input)
     if table and (size is None or places[0].kind not in ("memory", "via")):
         raise r.error(f"{key}.table", "a table needs a memory location and a size")
     return Port(name, places, table, _port_values(r, Port(name, places, table, None), values, key, is_input), via)
 
 
+def _is_table(r: Fields, doc: dict, key: str, size: int | None, values: Values | None, is_input: bool) -> bool:
+    """Whether a port is a table of bytes: as `table` says, else `size` N with byte values is a table
+    of N bytes and anything else an N-byte little-endian number; an input's size > 1 with neither
+    values nor `table` is ambiguous (an error saying how to choose)."""
+    table_flag = r.flag(doc["table"], f"{key}.table") if "table" in doc else None
+    if table_flag is not None:
+        return table_flag
+    wide = size is not None and size > 1
+    if is_input and wide and values is None:
+        raise r.error(f"{key}.size", f"size = {size} without values is ambiguous: a {8 * size}-bit number, or a table "
+                                     f"of {size} bytes? Say which: table = false (a number; or values = \"LO..HI\"), "
+                                     f"or values = \"0..255\" (a table, each byte from those values; or table = true)")
+    return wide and values is not None and values.hi < BYTE_VALUES
+
+
 def _port_values(r: Fields, port: Port, values: Values | None, key: str, is_input: bool) -> Values | None:
     """The values an input takes (all that fit when not given), each fitting its places."""
-    limit = BYTE_VALUES if port.table else 1 << port.bits
     if values is None and is_input:
-        values = Values(0, limit - 1)
-    if values is not None and values.hi >= limit:
-        raise r.error(f"{key}.values", f"{values.describe()} does not fit in {port.describe()} "
-                                      f"({'each byte ' if port.table else ''}0..{limit - 1})")
+        values = Values(0, value_limit(port) - 1)
+    if values is not None:
+        check_fits(r, port, values, f"{key}.values")
     return values
+
+
+def value_limit(port: Port) -> int:
+    """One more than the largest value that fits the port's places (a table's: each byte's)."""
+    return BYTE_VALUES if port.table else 1 << port.bits
+
+
+def check_fits(r: Fields, port: Port, values: Values, key: str) -> None:
+    """Values given for a port (its own, or a part's of the cases) must fit its places."""
+    limit = value_limit(port)
+    if values.hi >= limit:
+        raise r.error(key, f"{values.describe()} does not fit in {port.describe()} "
+                           f"({'each byte ' if port.table else ''}0..{limit - 1})")
 
 
 def no_overlap(r: Fields, ports: tuple[Port, ...], section: str) -> None:
@@ -299,6 +324,7 @@ def bind_vias(r: Fields, program: Program, inputs: tuple[Port, ...], outputs: tu
 
 def _bind(r: Fields, program: Program, port: Port, key: str, inputs: tuple[Port, ...],
           register_inputs: dict[str, int]) -> Port:
+    """A port placed by the case tied to the inputs that place it: the index register's, S's, the pointer's."""
     via = port.via
     if via is None:
         return port
@@ -312,15 +338,23 @@ def _bind(r: Fields, program: Program, port: Port, key: str, inputs: tuple[Port,
         return replace(port, via=replace(via, s_input=register_inputs.get("s", -1)))
     if via.mode != "pointer":
         return replace(port, via=via)
-    names = {p.name: i for i, p in enumerate(inputs)}
-    if via.pointer_name in names:
-        holder = inputs[names[via.pointer_name]]
-        if holder.via is not None or holder.table or holder.places[0].kind != "memory" or len(holder.places) != 2:
-            raise r.error(key, f"{via.text}: inputs.{holder.name} is not a pointer (a two-byte number at a label or "
-                               f"address: {{ at = \"$fb\", size = 2, values = \"...\" }})")
-        base = holder.places[0].address
-    else:
-        base = resolve(r, program, via.pointer_name, key)
+    base = _pointer_address(r, program, via, key, inputs)
+    return replace(port, via=replace(via, base=base, pointer_input=_pointer_input(r, via, key, inputs, base)))
+
+
+def _pointer_address(r: Fields, program: Program, via: Via, key: str, inputs: tuple[Port, ...]) -> int:
+    """Where the pointer in `(ptr)` lies: the input it names (a two-byte number in memory), or a label or address."""
+    holder = next((p for p in inputs if p.name == via.pointer_name), None)
+    if holder is None:
+        return resolve(r, program, via.pointer_name, key)
+    if holder.via is not None or holder.table or holder.places[0].kind != "memory" or len(holder.places) != 2:
+        raise r.error(key, f"{via.text}: inputs.{holder.name} is not a pointer (a two-byte number at a label or "
+                           f"address: {{ at = \"$fb\", size = 2, values = \"...\" }})")
+    return holder.places[0].address
+
+
+def _pointer_input(r: Fields, via: Via, key: str, inputs: tuple[Port, ...], base: int) -> int:
+    """The input that sets the pointer's two bytes at `base` (-1: none); one that holds only a part of them is an error."""
     pointer_bytes = (base, (base + 1) & 0xFF if base < 0x100 else (base + 1) & 0xFFFF)  # ($FF) wraps as the 6502 does
     pointer_input = -1
     for i, holder in enumerate(inputs):
@@ -331,7 +365,7 @@ def _bind(r: Fields, program: Program, port: Port, key: str, inputs: tuple[Port,
             raise r.error(key, f"{via.text}: the pointer's bytes ${pointer_bytes[0]:04X}/${pointer_bytes[1]:04X} are "
                                f"split over inputs.{holder.name}: make the pointer one input of size 2 at ${base:04X}")
         pointer_input = i
-    return replace(port, via=replace(via, base=base, pointer_input=pointer_input))
+    return pointer_input
 
 
 def via_span(via: Via, size: int, inputs: tuple[Port, ...], entry_s: int):

@@ -37,6 +37,7 @@ from retro.routines.places import (
     Port,
     Values,
     bind_vias,
+    check_fits,
     no_overlap,
     parse_values,
     places_of,
@@ -47,7 +48,8 @@ from retro.routines.entry import parse_entry
 from retro.routines.facts import StatedFact, parse_facts
 from retro.routines.rows import Row, misplaced_rows, parse_rows
 from retro.routines import sandbox
-from retro.routines.world import NO_WORLD, World, check_names, is_world_output, parse_world, recorded_mocks, world_output
+from retro.routines.world import NO_WORLD, World, recorded_mocks
+from retro.routines.world_spec import check_names, is_world_output, parse_world, world_output
 from retro.routines.where import Condition, parse_where
 
 MAX_EXHAUSTIVE = 1 << 32  # cases in an exhaustive set
@@ -337,32 +339,13 @@ def _cases_section(r: Fields, doc: dict, inputs: tuple[Port, ...], seconds: int,
     """[cases]: exhaustive inputs, random count and seed, the `where` domain, generators. `answered`:
     the spec has a reference (rows only: no generated cases unless asked for)."""
     cases_doc = r.table(doc.get("cases", {}), "cases", CASES_KEYS)
-    names = tuple(p.name for p in inputs)
-    exhaustive = cases_doc.get("exhaustive", [])
-    exhaustive_values = ()
-    if isinstance(exhaustive, dict):  # { name = values }: the exhaustive part's own values of each input
-        exhaustive_values = _part_values(r, exhaustive, inputs, "cases.exhaustive")
-        exhaustive = list(exhaustive)
-    if not isinstance(exhaustive, list) or not all(isinstance(n, str) for n in exhaustive):
-        raise r.error("cases.exhaustive", "expected a list of input names, or a table of input names and their "
-                                          "values ({ a = \"0..7\" })")
-    for n in exhaustive:
-        if n not in names:
-            raise r.error("cases.exhaustive", f"unknown input {n!r} (inputs: {', '.join(names)})")
-    if len(set(exhaustive)) != len(exhaustive):
-        raise r.error("cases.exhaustive", "an input is named twice")
+    exhaustive, exhaustive_values = _exhaustive(r, cases_doc.get("exhaustive", []), inputs)
     where = cases_doc.get("where")
-    tables = frozenset(p.name for p in inputs if p.table)
-    bounds = {p.name: (p.values.lo, p.values.hi) for p in inputs if not p.table}  # what int64 columns must hold
-    domain = parse_where(where, names, f"{r.source}: cases.where", tables, bounds) if where is not None else ()
-    generators = {key: load_function(_text(r, cases_doc, key, f"cases.{key}"), r, f"cases.{key}", seconds)
-                  for key in ("boundary", "sweep", "random_generator") if key in cases_doc}
-    for key in ("random_inside", "random_values"):
-        if key in cases_doc and "random_generator" in generators:
-            raise r.error(f"cases.{key}", "the random_generator draws the random cases itself")
+    domain = _domain(r, where, inputs) if where is not None else ()
+    generators = _generators(r, cases_doc, seconds)
     if cases_doc.get("random_inside") is True and where is None:
         raise r.error("cases.random_inside", "there is no domain (where) to draw inside")
-    return {"exhaustive": tuple(exhaustive),
+    return {"exhaustive": exhaustive,
             "random": r.integer(cases_doc.get("random", DEFAULT_RANDOM if answered else 0), "cases.random", 0,
                                 MAX_RANDOM),
             "seed": r.integer(cases_doc.get("seed", 0), "cases.seed", 0, 2 ** 63 - 1),
@@ -378,6 +361,44 @@ def _cases_section(r: Fields, doc: dict, inputs: tuple[Port, ...], seconds: int,
             "random_generator": generators.get("random_generator")}
 
 
+def _exhaustive(r: Fields, exhaustive, inputs: tuple[Port, ...]) -> tuple[tuple[str, ...], tuple]:
+    """`cases.exhaustive`: the inputs whose every combination is a case (a list of names), and with a
+    table ({ name = values }) the exhaustive part's own values of each."""
+    names = tuple(p.name for p in inputs)
+    exhaustive_values = ()
+    if isinstance(exhaustive, dict):
+        exhaustive_values = _part_values(r, exhaustive, inputs, "cases.exhaustive")
+        exhaustive = list(exhaustive)
+    if not isinstance(exhaustive, list) or not all(isinstance(n, str) for n in exhaustive):
+        raise r.error("cases.exhaustive", "expected a list of input names, or a table of input names and their "
+                                          "values ({ a = \"0..7\" })")
+    unknown = next((n for n in exhaustive if n not in names), None)
+    if unknown is not None:
+        raise r.error("cases.exhaustive", f"unknown input {unknown!r} (inputs: {', '.join(names)})")
+    if len(set(exhaustive)) != len(exhaustive):
+        raise r.error("cases.exhaustive", "an input is named twice")
+    return tuple(exhaustive), exhaustive_values
+
+
+def _domain(r: Fields, where, inputs: tuple[Port, ...]) -> tuple:
+    """`cases.where` checked against the inputs (tables by element, numbers within what int64 columns hold)."""
+    names = tuple(p.name for p in inputs)
+    tables = frozenset(p.name for p in inputs if p.table)
+    bounds = {p.name: (p.values.lo, p.values.hi) for p in inputs if not p.table}  # what int64 columns must hold
+    return parse_where(where, names, f"{r.source}: cases.where", tables, bounds)
+
+
+def _generators(r: Fields, cases_doc: dict, seconds: int) -> dict:
+    """The users' case generators (`boundary`, `sweep`, `random_generator`) loaded under guard; a
+    random_generator draws the random cases itself (no random_inside or random_values beside it)."""
+    generators = {key: load_function(_text(r, cases_doc, key, f"cases.{key}"), r, f"cases.{key}", seconds)
+                  for key in ("boundary", "sweep", "random_generator") if key in cases_doc}
+    for key in ("random_inside", "random_values"):
+        if key in cases_doc and "random_generator" in generators:
+            raise r.error(f"cases.{key}", "the random_generator draws the random cases itself")
+    return generators
+
+
 def _part_values(r: Fields, doc: dict, inputs: tuple[Port, ...], key: str) -> tuple[tuple[str, Values], ...]:
     """{ input = values } of one part of the cases: each a range or a list that fits the input's place
     (it may reach past the input's own `values`: the part's cases take these instead)."""
@@ -387,12 +408,8 @@ def _part_values(r: Fields, doc: dict, inputs: tuple[Port, ...], key: str) -> tu
         field_name = f"{key}.{name}"
         if name not in ports:
             raise r.error(field_name, f"unknown input (inputs: {', '.join(ports)})")
-        port = ports[name]
         values = parse_values(r, value, field_name)
-        limit = 256 if port.table else 1 << port.bits
-        if values.hi >= limit:
-            raise r.error(field_name, f"{values.describe()} does not fit in {port.describe()} "
-                                      f"({'each byte ' if port.table else ''}0..{limit - 1})")
+        check_fits(r, ports[name], values, field_name)
         out.append((name, values))
     return tuple(out)
 

@@ -16,7 +16,7 @@ from retro.cli import main
 from retro.cpu import batch, lane_memory
 from retro.errors import InputError
 from retro.routines import cases as case_sets
-from retro.routines import runner as runner_module
+from retro.routines import batch_runs
 from retro.routines.registry import builtin_names, get
 from retro.routines.runner import RoutineRunner
 
@@ -163,7 +163,7 @@ def test_a_batch_too_big_for_lane_memory_is_split(monkeypatch):
     block = next(case_sets.batches(case_sets.plan(routine, exhaustive=False), 512))
     whole = RoutineRunner(routine, routine.seed).run_batch(block)
     small = lambda *args, **kw: batch.BatchCpu(*args, **kw, memory_limit=64 * 4 * 40)  # noqa: E731
-    monkeypatch.setattr(runner_module, "BatchCpu", small)
+    monkeypatch.setattr(batch_runs, "BatchCpu", small)
     split = RoutineRunner(routine, routine.seed).run_batch(block)
     assert all(np.array_equal(a, b) for a, b in zip(whole.outputs, split.outputs))
     assert np.array_equal(whole.cycles, split.cycles)

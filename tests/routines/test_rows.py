@@ -368,3 +368,29 @@ def test_a_row_the_engines_disagree_on_fails_naming_the_row(capsys, monkeypatch)
     code = main(["check", str(EXAMPLE), "--engine", "batch", "--jobs", "1"])
     text = capsys.readouterr().out
     assert code == 1 and "on 4 of the calls Machine agrees on 0 and the timing model on 4" in text, text
+
+
+def test_the_rows_machine_calls_are_held_to_the_timing_model_naming_the_row(capsys, monkeypatch):
+    """On the batched core the rows' calls also run on Machine are tallied as any part's (count_block):
+    a timing model one cycle off on the second row is one timing-model mismatch, the first failure
+    naming that row; the rows themselves still hold."""
+    import dataclasses
+
+    from retro.analysis import row_check
+
+    real = row_check.run_on_machine
+
+    def second_row_mistimed(runner, cases, *args, **kwargs):
+        block = real(runner, cases, *args, **kwargs)
+        modelled = block.modelled.copy()
+        modelled[1] += 1
+        return dataclasses.replace(block, modelled=modelled)
+
+    monkeypatch.setattr(row_check, "run_on_machine", second_row_mistimed)
+    code, (record,) = _check_json(capsys, EXAMPLE, "--engine", "batch")
+    assert code == 1
+    assert record["engine_agreement"] == {"cases": 4, "mismatches": 0, "timing_model_mismatches": 1}
+    assert record["rows"]["failed"] == 0
+    failure = record["first_failure"]
+    assert failure["kind"] == "cycles" and failure["inputs"] == {"a": 3, "b": 5}, failure
+    assert failure["message"].startswith("rows[1]: measured 142 cycles, the timing model says 143"), failure

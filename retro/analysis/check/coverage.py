@@ -17,7 +17,8 @@ from retro.analysis.coverage_model import CodeCoverage
 from retro.cpu.batch import LaneCoverage
 from retro.cpu.timing import instruction_cycles, is_conditional_branch, timing_table
 from retro.program import Program
-from retro.routines.runner import RoutineRunner, routine_code
+from retro.routines.runner import RoutineRunner
+from retro.routines.size import routine_code
 
 UNCOVERED_SHOWN = 8  # addresses named in the text line (JSON lists them all)
 NO_FEWER = 1 << 62  # above any instruction's cycles

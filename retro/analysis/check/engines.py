@@ -15,7 +15,8 @@ from retro.analysis.check.results import describe_outputs
 from retro.analysis.coverage_model import CodeCoverage
 from retro.errors import InputError, RunError
 from retro.routines import cases as case_sets
-from retro.routines.runner import RasterStart, RoutineRunner, row_of
+from retro.routines.outputs import row_of
+from retro.routines.runner import RasterStart, RoutineRunner
 from retro.routines.spec import Routine, load_spec
 
 ENGINES = ("auto", "scalar", "batch", "compiled")

@@ -8,7 +8,9 @@ from typing import TYPE_CHECKING
 
 from retro.analysis.coverage_model import CodeCoverage
 from retro.cpu.flow import Bounds
-from retro.routines.runner import RasterStart, Size, describe_value
+from retro.routines.outputs import describe_value
+from retro.routines.runner import RasterStart
+from retro.routines.size import Size
 from retro.routines.spec import Routine
 
 if TYPE_CHECKING:

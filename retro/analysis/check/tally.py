@@ -7,7 +7,9 @@ answers and the domain, counted the same way for both. What counts as a mismatch
 - run: a call did not return (BRK, JAM, a runaway), which ends the check;
 - row: a spec's expected row whose call gave other outputs or cycles than the row states (the rows
   are compared with what they state, not with the reference: retro.analysis.row_check, which adds
-  its calls' cycle figures to the same Tally).
+  its calls' cycle figures to the same Tally; on the batched core the rows' calls also run on
+  Machine are counted here, `count_block(..., row_keys=...)`: held to the timing model and to the
+  other engine only).
 
 Cases outside the domain are counted (per condition they break, and how many of them the routine
 gets wrong) but are no mismatch. To add a statistic: a field of `Tally`, its line in `Tally.merge`,
@@ -16,6 +18,7 @@ its count in `count_block`, and its key in the report (retro/commands/check.py: 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -26,7 +29,7 @@ from retro.analysis.check.reference import reference_answers
 from retro.analysis.check.results import Failure, describe_case, describe_outputs
 from retro.analysis.coverage_model import CodeCoverage
 from retro.routines import cases as case_sets
-from retro.routines.runner import row_of
+from retro.routines.outputs import row_of
 from retro.routines.spec import Routine
 
 EXAMPLES_KEPT = 5
@@ -116,6 +119,7 @@ class _Calls:
     expected: list[np.ndarray]
     answerable: np.ndarray
     equal: np.ndarray
+    row_keys: Sequence[str] | None = None  # the calls are a spec's rows (these their keys): no reference
 
     def case(self, i: int) -> tuple:
         return self.cases[i] if self.cases is not None else case_sets.case_of(self.columns, i)
@@ -123,32 +127,30 @@ class _Calls:
     def described(self, i: int) -> str:
         return f"{self.routine.name}({describe_case(self.routine, self.case(i))})"
 
+    def keyed(self, i: int, message: str) -> str:
+        """A message about call i, naming its row first when the calls are rows."""
+        return message if self.row_keys is None else f"{self.row_keys[i]}: {message}"
+
     def expected_row(self, i: int) -> tuple | None:
         return row_of(self.expected, i) if self.answerable[i] else None
 
 
 def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[tuple] | None, memory: dict,
-                against: CallBlock | None = None, entry: EntryBlock | None = None) -> Tally:
+                against: CallBlock | None = None, entry: EntryBlock | None = None,
+                row_keys: Sequence[str] | None = None) -> Tally:
     """Tally the calls of one block (either engine) against the reference's answers. `cases`: the
     block's cases as tuples when they are at hand (else made when the reference or a condition needs
     them); `against`: the batched core's block for the same calls, compared call for call; `entry`:
-    the entry-state runs of some of its cases, compared with the block's own calls."""
-    calls = _calls(routine, block, columns, cases, memory)
+    the entry-state runs of some of its cases, compared with the block's own calls. `row_keys`: the
+    calls are a spec's rows (retro.analysis.row_check), held to the timing model and to `against`
+    only, never to the reference or the domain; every example and failure names the row."""
+    calls = _calls(routine, block, columns, cases, memory, row_keys)
     out = Tally()
     n = block.returned
-    inside, broken_by = calls.inside, calls.broken_by
-    wrong_inside = np.flatnonzero(inside & ~calls.equal)
-    wrong_outside = ~inside & ~calls.equal & calls.answerable
     out.cases = n
     if block.coverage is not None:
         out.code_coverage = block.coverage
     out.fallbacks = dict(block.fallbacks or {})
-    out.result_mismatches = len(wrong_inside)
-    out.outside = int((~inside).sum())
-    out.outside_wrong = int(wrong_outside.sum())
-    for condition, broken in zip(routine.domain, broken_by):
-        out.constraint_cases[condition.text] = int(broken.sum())
-        out.constraint_wrong[condition.text] = int((broken & wrong_outside).sum())
     cpu = block.cycles[:n] - block.stolen[:n]  # the timing model and the static bounds know no stalls
     cycle_wrong = (np.flatnonzero(block.modelled[:n] != cpu) if block.modelled is not None
                    else np.zeros(0, dtype=np.int64))
@@ -161,9 +163,11 @@ def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[t
             if message is not None:
                 engine_wrong[i] = message
         out.engine_mismatches = len(engine_wrong)
-    _cycle_figures(out, calls, cpu)
+    wrong_inside = np.zeros(0, dtype=np.int64)
+    if row_keys is None:
+        wrong_inside = _reference_figures(out, calls)
+        _cycle_figures(out, calls, cpu)
     _examples(out, calls, wrong_inside, cycle_wrong, cpu, engine_wrong)
-    _outside_examples(out, calls, wrong_outside)
     if entry is not None:
         _entry_figures(out, calls, entry)
     if block.stop is not None:  # the call that did not return ends the block, as it ends the check
@@ -172,12 +176,34 @@ def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[t
     return out
 
 
-def _calls(routine: Routine, block: CallBlock, columns: list, cases: list[tuple] | None, memory: dict) -> _Calls:
+def _reference_figures(out: Tally, calls: _Calls) -> np.ndarray:
+    """The returned calls against the reference and the domain: result mismatches inside it, the
+    cases outside it (per condition they break, and those the routine gets wrong) with examples;
+    the positions of the wrong calls inside the domain."""
+    routine = calls.routine
+    inside = calls.inside
+    wrong_inside = np.flatnonzero(inside & ~calls.equal)
+    wrong_outside = ~inside & ~calls.equal & calls.answerable
+    out.result_mismatches = len(wrong_inside)
+    out.outside = int((~inside).sum())
+    out.outside_wrong = int(wrong_outside.sum())
+    for condition, broken in zip(routine.domain, calls.broken_by):
+        out.constraint_cases[condition.text] = int(broken.sum())
+        out.constraint_wrong[condition.text] = int((broken & wrong_outside).sum())
+    _outside_examples(out, calls, wrong_outside)
+    return wrong_inside
+
+
+def _calls(routine: Routine, block: CallBlock, columns: list, cases: list[tuple] | None, memory: dict,
+           row_keys: Sequence[str] | None = None) -> _Calls:
     n = block.returned
     columns = [c[:n] for c in columns]
     if cases is not None:
         cases = cases[:n]
-    elif not routine.reference_arrays or any(c.test_columns is None for c in routine.domain):
+    if row_keys is not None:  # rows: what they state is compared elsewhere; no reference, no domain
+        nothing = np.zeros(n, dtype=bool)
+        return _Calls(routine, block, columns, cases, [], ~nothing, [], nothing, ~nothing, row_keys)
+    if cases is None and (not routine.reference_arrays or any(c.test_columns is None for c in routine.domain)):
         cases = case_sets.columns_to_cases(columns)
     broken_by = [~condition.over(columns, cases) for condition in routine.domain]
     inside = np.ones(n, dtype=bool)
@@ -222,10 +248,10 @@ def _examples(out: Tally, calls: _Calls, wrong_inside: np.ndarray, cycle_wrong: 
     for i, kind in events:
         answer, expected = calls.block.row(i), calls.expected_row(i)
         if kind == "engine":
-            message = engine_wrong[i]
+            message = calls.keyed(i, engine_wrong[i])
             example, failure = message, Failure(calls.case(i), "engine", answer, None, message)
         elif kind == "cycles":
-            message = f"measured {int(cpu[i])} cycles, the timing model says {int(calls.block.modelled[i])}"
+            message = calls.keyed(i, f"measured {int(cpu[i])} cycles, the timing model says {int(calls.block.modelled[i])}")
             example, failure = message, Failure(calls.case(i), "cycles", answer, expected, message)
         else:
             example = (f"returned {describe_outputs(calls.routine, answer)}, "
@@ -278,6 +304,7 @@ def _stop(out: Tally, calls: _Calls, case: tuple, engine_message: str | None) ->
     for kind, message in ((block.stop, block.stop_message), ("engine", engine_message)):
         if message is None:
             continue
+        message = calls.keyed(block.returned, message)
         if len(out.examples) < EXAMPLES_KEPT:
             out.examples.append(f"{described}: {message}")
         out.failure = out.failure or Failure(case, kind, message=message)

@@ -1,0 +1,225 @@
+"""A block of cases run at once: on the batched core (retro.cpu.batch; every lane starts from the
+memory as it stood after `init`, with its inputs in place through the runner's InputPlan) or on the
+compiled engine (retro.cpu.compiled; the calls it leaves run on the batched core). Both give a
+`BatchOutcome`; a block too big for the lanes' memory is run in halves."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from retro.cpu.batch import BatchCpu, LaneCoverage, LaneError
+from retro.cpu.lane_memory import LaneMemoryFull
+from retro.cpu.machine import (
+    RETURN_TRAP,
+    STACK_BASE,
+    interrupt_entry_flags,
+    push_interrupt_frame,
+    push_return_trap,
+    return_s,
+)
+from retro.cpu.mpu import FLAG_B, FLAG_U
+from retro.cpu.variants import VARIANTS
+from retro.routines.input_plan import column_byte
+from retro.routines.outputs import port_values
+from retro.routines.world_lanes import BatchWorld
+
+if TYPE_CHECKING:
+    from retro.routines.runner import RoutineRunner
+
+
+@dataclass(frozen=True)
+class BatchOutcome:
+    """What a batch of calls did: per output an array (n,) or (n, bytes), cycles, and per case the
+    retro.cpu.batch.LaneError that stopped it (0: returned); `coverage`: what the lanes ran, when asked."""
+
+    outputs: list
+    cycles: np.ndarray
+    error: np.ndarray
+    stolen: np.ndarray | None = None  # per case, the cycles a scene's chip held the CPU (None: no chip)
+    coverage: LaneCoverage | None = None
+    mock_calls: list | None = None  # per case, the calls of the mocks the reference takes (retro.routines.world)
+
+
+def _widen(values) -> np.ndarray:
+    return np.asarray(values, dtype=np.int64)
+
+
+def _table(columns: list) -> np.ndarray:
+    return np.stack(columns, axis=1).astype(np.int64)
+
+
+def run_batch(runner: RoutineRunner, columns: list, coverage: bool = False, first_lanes: bool = False,
+              entry: tuple[dict, np.ndarray, int] | None = None) -> BatchOutcome:
+    """Every case of a column block on the batched core (RoutineRunner.run_batch); when the lanes'
+    memory is full, the two halves one after the other, joined as one outcome."""
+    n = len(columns[0])
+    try:
+        return _run_lanes(runner, columns, n, coverage, first_lanes, entry)
+    except LaneMemoryFull:
+        if n <= 1:
+            raise
+    half = n // 2
+    halves = [None, None] if entry is None else [
+        ({k: v[:half] for k, v in entry[0].items()}, entry[1][:half], entry[2]),
+        ({k: v[half:] for k, v in entry[0].items()}, entry[1][half:], entry[2])]
+    first = runner.run_batch([c[:half] for c in columns], coverage, first_lanes, halves[0])
+    second = runner.run_batch([c[half:] for c in columns], coverage, first_lanes, halves[1])
+    return _joined(first, second, half)
+
+
+def _joined(first: BatchOutcome, second: BatchOutcome, half: int) -> BatchOutcome:
+    if first.coverage is not None:
+        first.coverage.merge(second.coverage, lane_offset=half)
+    return BatchOutcome([np.concatenate(pair) for pair in zip(first.outputs, second.outputs)],
+                        np.concatenate([first.cycles, second.cycles]),
+                        np.concatenate([first.error, second.error]),
+                        None if first.stolen is None else np.concatenate([first.stolen, second.stolen]),
+                        coverage=first.coverage,
+                        mock_calls=None if first.mock_calls is None else first.mock_calls + second.mock_calls)
+
+
+def _run_lanes(runner: RoutineRunner, columns: list, n: int, coverage: bool = False, first_lanes: bool = False,
+               entry: tuple[dict, np.ndarray, int] | None = None) -> BatchOutcome:
+    routine = runner.routine
+    image = bytearray(runner.call_image)
+    fixed_s = None if runner.plan.s_varies else runner.fixed_entry_s
+    stack_pointer = None if fixed_s is None else _push_entry_frame(image, routine.world.enter, fixed_s)
+    cpu = BatchCpu(routine.cpu, image, n, coverage=coverage, first_lanes=first_lanes)
+    memory = cpu.memory
+    world = None if routine.world.empty else BatchWorld(routine.world, cpu, runner.written_kept, str(routine.spec_path))
+    registers, p = runner.plan.place(columns, column_byte, memory.fill, entry,
+                                     scatter=lambda address, byte: memory.write(slice(None), address, byte),
+                                     select=np.where)
+    s = registers.pop("s")
+    for name, value in registers.items():
+        lanes = getattr(cpu, name)
+        lanes |= np.asarray(value).astype(lanes.dtype)
+    cpu.p[:] = (runner._entry_p(p) | FLAG_U) & ~FLAG_B  # as Machine sets P
+    stop = _enter_lanes(runner, cpu, s, fixed_s, stack_pointer)
+    if world is not None:
+        world.stack_top = stop  # where an exit ends the call
+    if runner.vic is not None:  # the scene's timeline: each lane stalls as Machine would from the start
+        cpu.bus_stall = runner.bus_stalls
+    cpu.watch = _fact_watches(runner)
+    cpu.call(runner.entry, runner.limit, RETURN_TRAP, stop)
+    if world is not None:
+        world.finish()
+    located = runner.plan.vias.outputs(columns) if runner.plan.vias is not None else None
+    outputs = port_values(routine.outputs, {"a": cpu.a, "x": cpu.x, "y": cpu.y}, cpu.p, cpu.read,
+                          widen=_widen, table=_table, world=None if world is None else world.value, located=located,
+                          read_at=lambda address: _every_lane(memory.read(slice(None), address), n))
+    calls = world.recorded_calls() if world is not None and routine.world.recorded else None
+    return BatchOutcome(outputs, cpu.cycles, cpu.error, cpu.stolen if runner.vic is not None else None,
+                        coverage=cpu.coverage, mock_calls=calls)
+
+
+def _push_entry_frame(image: bytearray, enter: str, s: int) -> int:
+    """The caller's frame on the stack every lane shares (a JSR's return trap, or an interrupt's
+    return address and a slot for P); S after it."""
+    return push_return_trap(image, s) if enter == "jsr" else push_interrupt_frame(image, 0, return_s(s))
+
+
+def _enter_lanes(runner: RoutineRunner, cpu: BatchCpu, s, fixed_s: int | None, stack_pointer: int | None):
+    """S of every lane at entry, and the S at which a lane's call has returned."""
+    if fixed_s is None:  # each lane's return address where its own JSR put it, as Machine does
+        cpu.sp[:] = s
+        push_return_trap(_LaneStores(cpu.memory), cpu.sp.copy())
+        return return_s(cpu.sp.copy())
+    world = runner.routine.world
+    if world.enter != "jsr":  # the interrupt sequence: P pushed (per lane), I set, its 7 cycles counted
+        cpu.memory.fill(STACK_BASE | (stack_pointer + 1), cpu.p.copy())
+        cpu.p[:] = interrupt_entry_flags(VARIANTS[runner.routine.cpu], cpu.p)
+        cpu.cycles[:] = world.entry_cycles
+    cpu.sp[:] = stack_pointer
+    return return_s(fixed_s)
+
+
+def _fact_watches(runner: RoutineRunner) -> dict:
+    """The spec's stated facts, held against every lane at their addresses."""
+    image = runner.call_image
+    return {pc: (lambda lanes, fact=fact, opcode=image[pc]: fact.broken(lanes.a, lanes.x, lanes.y, lanes.p, opcode))
+            for pc, fact in runner.watched_facts.items()}
+
+
+def compiled_routine(runner: RoutineRunner):
+    """The routine compiled (`retro.cpu.compiled`), made on first use and again when the code bytes
+    changed (set_memory); Untranslatable when the compiled engine does not take it."""
+    from retro.cpu.compiled import compile_routine
+
+    image = bytes(runner.call_image)
+    held = runner._compiled
+    if held is not None and (held[2] == image or all(image[a] == b for a, b in held[1])):
+        return held[0]
+    plan = runner.plan
+    inputs_at = [address for _, address, _ in plan.bytes] + [a for _, addresses in plan.tables for a in addresses]
+    trapped = bytearray(image)
+    push_return_trap(trapped)
+    routine = compile_routine(bytes(trapped), runner.entry, runner.routine.cpu, RETURN_TRAP, inputs_at)
+    runner._compiled = (routine, [(a, image[a]) for a in sorted(routine.translation.code_bytes)], image)
+    return routine
+
+
+def run_compiled(runner: RoutineRunner, columns: list) -> BatchOutcome:
+    """Every case of a column block on the compiled engine; calls it leaves (`fallbacks`, by
+    reason) run on the batched core."""
+    compiled = runner.compiled()
+    n = len(columns[0])
+    placed: list[tuple[int, np.ndarray]] = []
+    registers, p = runner.plan.place(columns, column_byte, lambda address, lanes: placed.append((address, lanes)))
+    in_addr = np.asarray([address for address, _ in placed], dtype=np.int64)
+    in_bytes = np.empty((len(placed), n), dtype=np.uint8)
+    for k, (_, lanes) in enumerate(placed):
+        in_bytes[k] = lanes
+    image = bytearray(runner.call_image)
+    s = runner.fixed_entry_s
+    stack_pointer = push_return_trap(image, s)
+    registers.pop("s", None)
+    lanes = {name: np.broadcast_to(np.asarray(value, dtype=np.int64), (n,)).copy() for name, value in registers.items()}
+    flags = np.broadcast_to(np.asarray((p | FLAG_U) & ~FLAG_B, dtype=np.int64), (n,)).copy()
+    out_addr = np.asarray(runner.plan.output_addresses, dtype=np.int64)
+    done = compiled.run(bytes(image), in_addr, in_bytes, lanes["a"], lanes["x"], lanes["y"], flags, stack_pointer,
+                        runner.limit, RETURN_TRAP, return_s(s), out_addr)
+    column_of = {int(address): k for k, address in enumerate(out_addr)}
+    out_bytes = done["bytes"]
+    outputs = port_values(runner.routine.outputs, {"a": done["a"], "x": done["x"], "y": done["y"]}, done["p"],
+                          lambda address: out_bytes[column_of[address]].astype(np.int64), widen=_widen, table=_table)
+    status = done["status"]
+    error = np.where(status == LaneError.BUDGET, LaneError.BUDGET, 0).astype(np.int8)
+    cycles = done["cycles"]
+    _rerun_fallbacks(runner, columns, status, outputs, cycles, error)
+    return BatchOutcome(outputs, cycles, error)
+
+
+def _rerun_fallbacks(runner: RoutineRunner, columns: list, status: np.ndarray, outputs: list, cycles: np.ndarray,
+                     error: np.ndarray) -> None:
+    """The calls the compiled engine left (counted by reason in `runner.fallbacks`) run again on the
+    batched core, their results written over the compiled block's."""
+    from retro.cpu.compiled import FALLBACK
+
+    left = np.flatnonzero(status >= FALLBACK)
+    if not len(left):
+        return
+    for code, count in zip(*np.unique(status[left], return_counts=True)):
+        runner.fallbacks[int(code)] = runner.fallbacks.get(int(code), 0) + int(count)
+    batch = runner.run_batch([c[left] for c in columns])
+    for output, redone in zip(outputs, batch.outputs):
+        output[left] = redone
+    cycles[left] = batch.cycles
+    error[left] = batch.error
+
+
+class _LaneStores:
+    """`memory[address] = byte` on every lane of a batch (an address per lane): push_return_trap's view."""
+
+    def __init__(self, memory) -> None:
+        self.memory = memory
+
+    def __setitem__(self, address, byte) -> None:
+        self.memory.write(slice(None), address, byte)
+
+
+def _every_lane(value, lanes: int) -> np.ndarray:
+    return np.full(lanes, value, dtype=np.int64) if isinstance(value, (int, np.integer)) else value
