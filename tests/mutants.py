@@ -71,6 +71,12 @@ MUTANTS = [
            "COLLISION_LATCH_DELAY = 4", "COLLISION_LATCH_DELAY = 3", VIC_TESTS),
     Mutant("d019-ack-ignored", "retro/chips/vic/device.py",
            "self.irq_latch &= ~value & IRQ_SOURCES", "self.irq_latch &= IRQ_SOURCES", VIC_TESTS),
+    # ---- the late timing rules (issue 26 part 5: tests/vic/test_timing_rules_late.py) ----------------
+    Mutant("d012-write-onto-the-line-ignored", "retro/chips/vic/device.py",
+           "if compare != old_compare and compare == self._raster_line(t + 1):", "if False:", VIC_TESTS),
+    Mutant("d012-write-latches-without-a-change", "retro/chips/vic/device.py",
+           "if compare != old_compare and compare == self._raster_line(t + 1):",
+           "if compare == self._raster_line(t + 1):", VIC_TESTS),
     # ---- CPU -------------------------------------------------------------------------------------
     Mutant("branch-taken-costs-nothing", "retro/cpu/timing.py",
            "BRANCH_TAKEN_CYCLES = 1", "BRANCH_TAKEN_CYCLES = 0", CPU_TESTS + ("tests/routines/test_routines_timing.py",)),

@@ -56,6 +56,7 @@ from retro.chips.vic.model import (
     VicState,
     frame_collisions,
     irq_register,
+    raster_compare_line,
     raster_irq_time,
 )
 from retro.cpu.bus import NEVER
@@ -261,15 +262,20 @@ class VicDevice:
         if register >= REGISTER_COUNT:
             return UNUSED_READ
         if register in (REG_CONTROL1, REG_RASTER):
-            _, line, cycle = position(self.video, max(t, 0))
-            if line == 0 and cycle <= RASTER_IRQ_LINE0_DELAY:
-                line = self.video.lines - 1  # the counter reaches 0 a cycle late (why line 0's IRQ is late)
+            line = self._raster_line(t)
             if register == REG_RASTER:
                 return line & Y_COMPARE_MASK
             return (self.registers[REG_CONTROL1] & ~CONTROL1_RST8) | (CONTROL1_RST8 if line > Y_COMPARE_MASK else 0)
         if register == REG_IRQ_LATCH:
             return irq_register(self.irq_latch, self.registers[REG_IRQ_ENABLE])
         return self.registers[register] | UNUSED_BITS.get(register, 0)
+
+    def _raster_line(self, t: int) -> int:
+        """The raster counter at device time t (what $D012 and $D011 bit 7 read)."""
+        _, line, cycle = position(self.video, max(t, 0))
+        if line == 0 and cycle <= RASTER_IRQ_LINE0_DELAY:
+            line = self.video.lines - 1  # the counter reaches 0 a cycle late (why line 0's IRQ is late)
+        return line
 
     def write(self, address: int, value: int, cycle: int) -> None:
         t = self.time(cycle)
@@ -282,9 +288,15 @@ class VicDevice:
             self._refresh_irq_next()
             return
         old = self.registers[register]
+        old_compare = raster_compare_line(self.registers)
         self.registers[register] = value & 0xFF
         if old == value:
             return
+        # The compare runs every cycle and latches on its change from no match to a match, so a
+        # write that moves the compare line onto the current line latches now [VICE-src vicii-cycle.c]
+        compare = raster_compare_line(self.registers)
+        if compare != old_compare and compare == self._raster_line(t + 1):
+            self.irq_latch |= IRQ_RASTER
         if register in _COLLISION_SET:
             self.state = self.state.with_registers(self.registers)
             self._schedule = self._schedule_for(self.state)
