@@ -88,3 +88,128 @@ def test_compare_line_0_written_in_cycle_1_of_line_0_latches_once_in_cycle_2():
     vic.write(D012, 0, frame + at(0, 1) - 1)  # the last cycle of line 311
     assert vic.read(D019, frame + at(0, 1)) & 0x01 == 0
     assert vic.read(D019, frame + at(0, 2) + 1) & 0x01 == 1
+
+
+# ---- $D015 written while a sprite is being displayed -------------------------------------------------
+# Sprites 0 (X 100) and 1 (X 110) at Y 100 overlap on lines 101-121 (rows 0-20); sprite 1's
+# DMA check is in cycles 55 and 56 of line 100, its fetches in cycles 60-61 (sprite 0 holds BA low through 59, so cycle 61 is sprite 1 alone).
+
+def two_sprites(enable: int) -> VicDevice:
+    """Sprite 1 enabled in $D015 or not (sprite 0 always)."""
+    made = VicDevice(scene(sprite(0, 100, 100), sprite(1, 110, 100, enabled=bool(enable & 2))).state)
+    assert made.registers[0x15] == enable
+    return made
+
+
+def test_clearing_d015_does_not_stop_a_sprite_whose_dma_runs():
+    """[Bauer 3.8.1; VICE-src check_sprite_display] $D015 is looked at only when the DMA starts:
+    sprite 1 switched off in line 102 keeps fetching and showing its rows to row 20, and it
+    collides there; in the next frame it does not start."""
+    vic = two_sprites(0x03)
+    vic.write(D015, 0x01, at(102, 30))
+    assert vic.read(D01E, at(103, 1)) == 0b11  # the overlap drawn so far
+    assert vic.read(D01E, at(120, 1)) == 0b11  # drawn again on lines 103-119
+    assert vic.ba_wait(at(110, 61)) > 0  # its fetch in line 110 still holds the CPU
+    frame = PAL.frame_cycles
+    assert vic.read(D01E, frame + at(99, 1)) == 0b11  # rows 19-20 drawn in frame 0
+    assert vic.read(D01E, frame + at(125, 1)) == 0  # frame 1: sprite 1 never started
+    assert vic.ba_wait(frame + at(110, 61)) == 0
+
+
+def test_setting_d015_shows_a_sprite_only_from_its_next_dma_start():
+    vic = two_sprites(0x01)
+    vic.write(D015, 0x03, at(102, 30))
+    assert vic.read(D01E, at(125, 1)) == 0
+    assert vic.ba_wait(at(110, 61)) == 0
+    frame = PAL.frame_cycles
+    assert vic.read(D01E, frame + at(99, 1)) == 0
+    assert vic.read(D01E, frame + at(125, 1)) == 0b11
+
+
+def test_the_dma_check_sees_d015_in_cycles_55_and_56():
+    """A write in cycle c is seen from c + 1: enabling in cycle 55 reaches the check of cycle 56 (the
+    sprite starts this frame), in cycle 56 none; clearing in cycle 54 reaches both checks (it does not
+    start), in cycle 55 only the second (the first already started it)."""
+    def collides_this_frame(before: int, after: int, cycle: int) -> bool:
+        vic = two_sprites(before)
+        vic.write(D015, after, at(100, cycle))
+        return vic.read(D01E, at(125, 1)) == 0b11
+
+    assert collides_this_frame(0x01, 0x03, 55)
+    assert not collides_this_frame(0x01, 0x03, 56)
+    assert not collides_this_frame(0x03, 0x01, 54)
+    assert collides_this_frame(0x03, 0x01, 55)
+
+
+# ---- DEN switched late or off in the middle of a frame ---------------------------------------------
+# YSCROLL 3: Bad Lines $33, $3B, ... ($6B = 107 among them); BA low in cycles 12-54 of a Bad Line.
+# Sprite 0 at (100, 140) over a screen of solid characters collides with the graphics on lines
+# 141-161 (text rows 11-14).
+
+SOLID = {"screen": {"fill": 0xA0}, "charset": {"160": [0xFF] * 8}}
+
+
+def den_device(control1: int) -> VicDevice:
+    return VicDevice(scene(sprite(0, 100, 140), registers={"$d011": control1}, memory=SOLID).state)
+
+
+def bad_line_107(vic: VicDevice, frame: int = 0) -> bool:
+    return vic.ba_wait(frame * PAL.frame_cycles + at(107, 20)) > 0
+
+
+def sprite_background(vic: VicDevice, frame: int = 0) -> int:
+    """$D01F as read after line 165 of the frame, cleared before line 130."""
+    vic.read(0xD01F, frame * PAL.frame_cycles + at(130, 1))
+    return vic.read(0xD01F, frame * PAL.frame_cycles + at(165, 1))
+
+
+def test_den_cleared_after_line_30_keeps_the_frame_drawn_and_its_bad_lines():
+    """[Bauer 3.5, 3.9] Bad Lines need DEN in line $30 only, and the border opened in line 51 stays
+    open to line 251: DEN cleared in line 100 changes nothing until the next frame, which has no Bad
+    Line and no graphics."""
+    vic = den_device(0x1B)
+    vic.write(D011, 0x0B, at(100, 30))
+    assert bad_line_107(vic)
+    assert sprite_background(vic) == 0x01
+    assert not bad_line_107(vic, 1)
+    assert sprite_background(vic, 1) == 0
+
+
+def test_den_set_after_line_30_waits_for_the_next_frame():
+    vic = den_device(0x0B)
+    vic.write(D011, 0x1B, at(60, 30))
+    assert not bad_line_107(vic)
+    assert sprite_background(vic) == 0
+    assert bad_line_107(vic, 1)
+    assert sprite_background(vic, 1) == 0x01
+
+
+def test_den_counts_in_any_cycle_of_line_30():
+    """[Bauer 3.5: "set during an arbitrary cycle of raster line $30"; VICII/dentest den01-48-*]"""
+    vic = den_device(0x0B)
+    vic.write(D011, 0x1B, at(0x30, 60))
+    assert bad_line_107(vic)
+    assert sprite_background(vic) == 0x01
+    late = den_device(0x0B)
+    late.write(D011, 0x1B, at(0x31, 1))
+    assert not bad_line_107(late)
+
+
+def test_den_set_in_line_30_then_cleared_keeps_bad_lines_but_not_the_display():
+    """DEN set in line $30 then cleared before line 51: Bad Lines this frame, but the vertical border
+    stays closed (no graphics, no $D01F) [Bauer 3.9; VICII/dentest den10-48-*: idle or closed]."""
+    vic = den_device(0x1B)
+    vic.write(D011, 0x0B, at(0x30, 20))
+    assert bad_line_107(vic)
+    assert sprite_background(vic) == 0
+
+
+def test_the_display_opens_if_den_is_set_in_any_cycle_of_the_first_window_line():
+    """[Bauer 3.9; VICE-src check_vborder_top] DEN set in line $30, off in line 49, on again in
+    line 51 (RSEL 1) cycle 40: the border opens. On again in line 52: it stays closed."""
+    for line, opened in ((51, True), (52, False)):
+        vic = den_device(0x1B)
+        vic.write(D011, 0x0B, at(49, 10))
+        vic.write(D011, 0x1B, at(line, 40))
+        assert sprite_background(vic) == (0x01 if opened else 0), line
+        assert bad_line_107(vic)

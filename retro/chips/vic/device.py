@@ -29,7 +29,11 @@ import numpy as np
 
 from retro.chips.vic.beam import position
 from retro.chips.vic.constants import (
+    BA_LEAD,
+    CONTROL1_DEN,
+    CONTROL1_RSEL,
     CONTROL1_RST8,
+    GRAPHICS_FIRST_LINE,
     IRQ_RASTER,
     IRQ_SOURCES,
     IRQ_SPRITE_BACKGROUND,
@@ -43,10 +47,16 @@ from retro.chips.vic.constants import (
     REG_LIGHTPEN_Y,
     REG_RASTER,
     REG_SPRITE_BACKGROUND,
+    REG_SPRITE_ENABLE,
+    REG_SPRITE_EXPAND_Y,
     REG_SPRITE_SPRITE,
+    REG_SPRITE_Y0,
     REGISTER_COUNT,
+    SPRITE_COUNT,
+    SPRITE_DMA_CHECK_CYCLES,
     UNUSED_BITS,
     UNUSED_READ,
+    WINDOW_LINES,
     Y_COMPARE_MASK,
 )
 from retro.chips.vic.dma import DMA_REGISTERS, bus_schedule
@@ -58,6 +68,7 @@ from retro.chips.vic.model import (
     irq_register,
     raster_compare_line,
     raster_irq_time,
+    sprite_rows,
 )
 from retro.cpu.bus import NEVER
 
@@ -65,6 +76,9 @@ SCHEDULE_CACHE_SIZE = 256
 _COLLISION_SET = frozenset(COLLISION_REGISTERS)
 _READ_ONLY = frozenset({REG_SPRITE_SPRITE, REG_SPRITE_BACKGROUND, REG_LIGHTPEN_X, REG_LIGHTPEN_Y})
 _DMA_SET = frozenset(DMA_REGISTERS)
+_SAMPLED_SET = frozenset({REG_CONTROL1, REG_SPRITE_ENABLE})
+LATCH_BAD_LINES = 2 * SPRITE_COUNT
+LATCH_DISPLAY = 2 * SPRITE_COUNT + 1
 
 
 def _next_event(times: np.ndarray, after: int, frame_cycles: int) -> int | None:
@@ -147,6 +161,13 @@ class VicDevice:
         self.video = state.video
         self.start_cycle = start_cycle
         self.registers = bytearray(state.registers)
+        # What the chip acts on where it samples a register only at certain cycles (see _latch):
+        # each sprite's $D015 bit when its DMA starts, DEN in line $30 and in the first window line.
+        self.sprite_enable = self.registers[REG_SPRITE_ENABLE]
+        self.bad_lines_allowed = self.display_opened = bool(self.registers[REG_CONTROL1] & CONTROL1_DEN)
+        self._latching = False  # some of those differ from the registers as written
+        self._sampled_until = 0  # device time up to which (exclusive) the samples have been taken
+        self._next_latch_at = NEVER  # device time of the next sample that can change something
         self.sprite_sprite = 0  # $D01E as accumulated since the last read
         self.sprite_background = 0  # $D01F
         self.irq_latch = 0  # $D019 bits 0-3
@@ -170,6 +191,102 @@ class VicDevice:
 
     def _advance(self, until: int) -> None:
         """Apply everything the beam draws in device time [synced, until)."""
+        while self._latching:
+            point = self._next_latch_point(max(self.synced, self._sampled_until), until)
+            if point is None:
+                break
+            self._apply(point)
+            self._latch(point)
+            self._sampled_until = point + 1
+        self._apply(until)
+
+    # ---- registers the chip samples at certain cycles ------------------------------------------
+    # [Bauer 3.5, 3.8.1, 3.9; VICE-src vicii-cycle.c: check_sprite_dma, check_vborder_top, allow_bad_lines]
+    # - sprite n's DMA starts where Y matches the line in the first or second DMA check cycle
+    #   (SPRITE_DMA_CHECK_CYCLES from sprite0_fetch_cycle - BA_LEAD) only if its $D015 bit is set
+    #   then; once on, it runs its 21 rows (42 expanded) whatever $D015 says, and a sprite enabled
+    #   later shows from its next start on;
+    # - Bad Lines exist in a frame only if DEN was set in some cycle of line $30;
+    # - the vertical border opens in the first line of the window (51, or 55 with RSEL = 0) only
+    #   if DEN is set in some cycle of that line, so graphics collide only then.
+    # The model takes each sampled bit as holding all frame (sprites from their start, Bad Lines
+    # from line $30, the display from the window's first line).
+
+    def _latch_points(self) -> list[tuple[int, int]]:
+        """(frame time, what is sampled there) in frame order: a sprite number for its first DMA
+        check, SPRITE_COUNT + n for its second, LATCH_BAD_LINES, LATCH_DISPLAY."""
+        video = self.video
+        cpl = video.cycles_per_line
+        first_check = video.sprite0_fetch_cycle - BA_LEAD - 1  # 0-based cycle in the line
+        points = [(GRAPHICS_FIRST_LINE * cpl, LATCH_BAD_LINES),
+                  (WINDOW_LINES[1 if self.registers[REG_CONTROL1] & CONTROL1_RSEL else 0][0] * cpl, LATCH_DISPLAY)]
+        for n in range(SPRITE_COUNT):
+            if (self.registers[REG_SPRITE_ENABLE] ^ self.sprite_enable) >> n & 1:
+                y = self.registers[REG_SPRITE_Y0 + 2 * n]
+                expand = bool(self.registers[REG_SPRITE_EXPAND_Y] >> n & 1)
+                rows = sprite_rows(video, y, expand)
+                for line in range(y, video.lines, Y_COMPARE_MASK + 1):
+                    if rows[(line + 1) % video.lines] == 0:  # the DMA starts at this match
+                        for k in range(SPRITE_DMA_CHECK_CYCLES):
+                            points.append((line * cpl + first_check + k, n + k * SPRITE_COUNT))
+        return sorted(points)
+
+    def _next_latch_point(self, lo: int, hi: int) -> int | None:
+        """The first device time in [lo, hi) where a sampled bit can change."""
+        frame_cycles = self.video.frame_cycles
+        found = [lo + (p - lo) % frame_cycles for p, _ in self._latch_points()]
+        first = min(found, default=None)
+        return first if first is not None and first < hi else None
+
+    def _latch(self, t: int) -> None:
+        """The chip samples the registers as written at device time t."""
+        within = t % self.video.frame_cycles
+        den = bool(self.registers[REG_CONTROL1] & CONTROL1_DEN)
+        for point, what in self._latch_points():
+            if point != within:
+                continue
+            if what == LATCH_BAD_LINES:
+                self.bad_lines_allowed = den
+            elif what == LATCH_DISPLAY:
+                self.display_opened = den
+            else:
+                n, second = what % SPRITE_COUNT, what >= SPRITE_COUNT
+                bit = self.registers[REG_SPRITE_ENABLE] & (1 << n)
+                self.sprite_enable = (self.sprite_enable | bit) if second else (self.sprite_enable & ~(1 << n) | bit)
+        self._use_sampled()
+
+    def _sample_within_line(self, t: int) -> None:
+        """A DEN write in line $30 or in the window's first line counts for that line (any cycle)."""
+        if not self.registers[REG_CONTROL1] & CONTROL1_DEN:
+            return
+        _, line, _ = position(self.video, t)
+        if line == GRAPHICS_FIRST_LINE:
+            self.bad_lines_allowed = True
+        if line == WINDOW_LINES[1 if self.registers[REG_CONTROL1] & CONTROL1_RSEL else 0][0]:
+            self.display_opened = True
+
+    def _sampled_registers(self, den: bool) -> bytes:
+        registers = bytearray(self.registers)
+        registers[REG_SPRITE_ENABLE] = self.sprite_enable
+        registers[REG_CONTROL1] = registers[REG_CONTROL1] & ~CONTROL1_DEN | (CONTROL1_DEN if den else 0)
+        return bytes(registers)
+
+    def _use_sampled(self) -> None:
+        """Switch the collision and BA schedules to what the chip acts on now."""
+        written_den = bool(self.registers[REG_CONTROL1] & CONTROL1_DEN)
+        self._latching = (self.sprite_enable != self.registers[REG_SPRITE_ENABLE]
+                          or self.bad_lines_allowed != written_den or self.display_opened != written_den)
+        if self._latching:
+            collision_registers = self._sampled_registers(self.bad_lines_allowed and self.display_opened)
+            bus_registers = self._sampled_registers(self.bad_lines_allowed)
+        else:
+            collision_registers = bus_registers = self.registers
+        self.state = self.state.with_registers(collision_registers)
+        self._schedule = self._schedule_for(self.state)
+        self._bus = bus_schedule(self.video, bus_registers)
+
+    def _apply(self, until: int) -> None:
+        """Apply the current schedule's events in device time [synced, until)."""
         lo = self.synced
         if until <= lo:
             return
@@ -206,6 +323,11 @@ class VicDevice:
             candidates.append(_next_event(events.ss_times, after, frame_cycles))
         if enabled & IRQ_SPRITE_BACKGROUND and not self.sprite_background:
             candidates.append(_next_event(events.sb_times, after, frame_cycles))
+        self._next_latch_at = NEVER
+        if self._latching:  # a sampled bit may change the schedules there: ask again then
+            self._next_latch_at = self._next_latch_point(max(after, self._sampled_until),
+                                                         after + 2 * frame_cycles) or NEVER
+            candidates.append(self._next_latch_at)
         found = [c for c in candidates if c is not None]
         self.irq_next = self.start_cycle + min(found) if found else NEVER
 
@@ -227,10 +349,14 @@ class VicDevice:
 
     def ba_wait(self, cycle: int) -> int:
         t = cycle - self.start_cycle
+        if t >= self._next_latch_at:  # the BA schedule changes there (see _latch)
+            self._advance(t)
         return self._bus.wait[t % self.video.frame_cycles] if t >= 0 else 0
 
     def ba_free(self, cycle: int) -> int:
         t = cycle - self.start_cycle
+        if t >= self._next_latch_at:
+            self._advance(t)
         if t < 0:
             return -t + self._bus.free[0]
         return self._bus.free[t % self.video.frame_cycles]
@@ -297,11 +423,16 @@ class VicDevice:
         compare = raster_compare_line(self.registers)
         if compare != old_compare and compare == self._raster_line(t + 1):
             self.irq_latch |= IRQ_RASTER
-        if register in _COLLISION_SET:
-            self.state = self.state.with_registers(self.registers)
-            self._schedule = self._schedule_for(self.state)
-        if register in _DMA_SET:
-            self._bus = bus_schedule(self.video, self.registers)
+        if register in _SAMPLED_SET:
+            self._sample_within_line(t + 1)
+        if register in _SAMPLED_SET or (self._latching and register in _COLLISION_SET | _DMA_SET):
+            self._use_sampled()
+        else:
+            if register in _COLLISION_SET:
+                self.state = self.state.with_registers(self.registers)
+                self._schedule = self._schedule_for(self.state)
+            if register in _DMA_SET:
+                self._bus = bus_schedule(self.video, self.registers)
         self._refresh_irq_next()
 
     def peek(self, address: int) -> int:
