@@ -214,4 +214,5 @@ BAD_LINE_LAST_STOLEN = 54
 SPRITE_DMA_CHECK_CYCLES = 2
 SPRITE_DMA_CYCLES = 2  # two s-accesses fall in the CPU's half of the cycles taken per sprite and line
 # Bad Line condition [Bauer 3.5]: a line in GRAPHICS_FIRST_LINE ($30) .. BAD_LINE_LAST ($F7) whose
-# low 3 bits equal YSCROLL, while DEN was set in line $30 (the model takes DEN from the current $D011).
+# low 3 bits equal YSCROLL, while DEN was set in some cycle of line $30 (the device samples it there:
+# device.VicDevice._latch; dma.ba_low takes the DEN it is given).
