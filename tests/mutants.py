@@ -96,6 +96,9 @@ MUTANTS = [
     Mutant("den-in-window-line-only-at-its-start", "retro/chips/vic/device.py",
            "if line == WINDOW_LINES[1 if self.registers[REG_CONTROL1] & CONTROL1_RSEL else 0][0]:",
            "if False:", VIC_TESTS),
+    Mutant("yscroll-write-keeps-the-bad-lines", "retro/chips/vic/dma.py",
+           "(_BAD_LINE_BITS if r == REG_CONTROL1 else 0xFF)", "(CONTROL1_DEN if r == REG_CONTROL1 else 0xFF)",
+           ("tests/vic/test_timing_rules_late.py",)),
     # ---- CPU -------------------------------------------------------------------------------------
     Mutant("branch-taken-costs-nothing", "retro/cpu/timing.py",
            "BRANCH_TAKEN_CYCLES = 1", "BRANCH_TAKEN_CYCLES = 0", CPU_TESTS + ("tests/routines/test_routines_timing.py",)),

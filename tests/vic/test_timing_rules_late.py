@@ -213,3 +213,29 @@ def test_the_display_opens_if_den_is_set_in_any_cycle_of_the_first_window_line()
         vic.write(D011, 0x1B, at(line, 40))
         assert sprite_background(vic) == (0x01 if opened else 0), line
         assert bad_line_107(vic)
+
+
+# ---- collision IRQs with Y-scroll changes ----------------------------------------------------------
+# Sprites 0 and 1 overlap first at line 101, X 110: latched in cycle 27 (docs/vic.md, timing model).
+
+def test_a_yscroll_write_moves_the_bad_line_under_a_sprite_sprite_irq():
+    """[Bauer 3.5] The Bad Line condition is (line & 7) == YSCROLL in every cycle: with YSCROLL 3
+    ($1B) line 99 is a Bad Line and 101 is not; YSCROLL 5 written in line 100 makes 101 one (BA low from
+    cycle 12 through the sprites' DMA in 55-61, so the CPU is held when the collision IRQ latches in cycle 27); written in cycle
+    20 of line 101 it holds the CPU from cycle 21. The IRQ itself latches in cycle 27 either way:
+    sprite-sprite collisions do not depend on the graphics."""
+    def device() -> VicDevice:
+        return VicDevice(scene(sprite(0, 100, 100), sprite(1, 110, 100), registers={"$d01a": 0x04}).state)
+
+    steady = device()
+    assert steady.ba_wait(at(99, 20)) > 0 and steady.ba_wait(at(101, 20)) == 0
+    moved = device()
+    moved.write(D011, 0x1D, at(100, 5))
+    assert moved.ba_wait(at(99, 20) + PAL.frame_cycles) == 0
+    assert moved.ba_wait(at(101, 12)) == 61 - 12 + 1  # merged with sprites 0-1 DMA (55-61)
+    assert not moved.irq_low(at(101, 26) - 1) and moved.irq_low(at(101, 27))
+    late = device()
+    assert late.ba_wait(at(101, 20)) == 0
+    late.write(D011, 0x1D, at(101, 20))
+    assert late.ba_wait(at(101, 21)) == 61 - 21 + 1
+    assert not late.irq_low(at(101, 26) - 1) and late.irq_low(at(101, 27))
