@@ -325,9 +325,9 @@ class VicDevice:
             candidates.append(_next_event(events.sb_times, after, frame_cycles))
         self._next_latch_at = NEVER
         if self._latching:  # a sampled bit may change the schedules there: ask again then
-            self._next_latch_at = self._next_latch_point(max(after, self._sampled_until),
-                                                         after + 2 * frame_cycles) or NEVER
-            candidates.append(self._next_latch_at)
+            point = self._next_latch_point(max(after, self._sampled_until), after + 2 * frame_cycles)
+            self._next_latch_at = NEVER if point is None else point
+            candidates.append(point)
         found = [c for c in candidates if c is not None]
         self.irq_next = self.start_cycle + min(found) if found else NEVER
 
