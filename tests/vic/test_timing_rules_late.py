@@ -43,8 +43,9 @@ def test_a_d012_write_onto_the_current_line_latches_the_raster_irq():
     vic = quiet_device()
     assert vic.read(D019, at(100, 29)) & 0x01 == 0
     vic.write(D012, 100, at(100, 30))
-    assert vic.read(D019, at(100, 31)) == 0xF1  # bit 0, bit 7 (enabled in $D01A), unused bits
-    assert vic.irq_low(at(100, 31))
+    assert not vic.irq_low(at(100, 30))  # the compare is made in the next cycle ...
+    assert vic.irq_low(at(100, 31))  # ... where the IRQ line goes low, as at a line's cycle 1
+    assert vic.read(D019, at(100, 32)) == 0xF1  # bit 0, bit 7 (enabled in $D01A), unused bits
 
 
 def test_a_d012_write_onto_a_line_already_passed_waits_for_the_next_frame():
@@ -239,3 +240,15 @@ def test_a_yscroll_write_moves_the_bad_line_under_a_sprite_sprite_irq():
     late.write(D011, 0x1D, at(101, 20))
     assert late.ba_wait(at(101, 21)) == 61 - 21 + 1
     assert not late.irq_low(at(101, 26) - 1) and late.irq_low(at(101, 27))
+
+
+def test_a_program_writing_the_current_line_to_d012_takes_the_irq_at_once():
+    """On the 6510 (docs/vic.md, CPU timeline): entered at line 100 cycle 1 with I clear, LDA #
+    (cycles 1-2), STA $D012 writing in its 4th cycle (6): the compare matches from cycle 7, the NOP
+    that follows polls in its first cycle (7) and the 7-cycle sequence (9-15) reaches the handler in
+    cycle 16 of line 100. Without the rule no interrupt comes in the call at all."""
+    from test_vic_timeline import DEN_OFF, irq_run, handler_start  # the IRQ harness of the timeline tests
+
+    result, entries = irq_run(100, 1, "", "lda #100\n sta $d012\n nop\n nop\n nop", compare=200)
+    assert DEN_OFF & 0x10 == 0  # no Bad Line moves the cycles
+    assert handler_start(entries) == (100, 16)

@@ -168,6 +168,7 @@ class VicDevice:
         self._latching = False  # some of those differ from the registers as written
         self._sampled_until = 0  # device time up to which (exclusive) the samples have been taken
         self._next_latch_at = NEVER  # device time of the next sample that can change something
+        self._raster_match_at: int | None = None  # a compare matched by a write latches here
         self.sprite_sprite = 0  # $D01E as accumulated since the last read
         self.sprite_background = 0  # $D01F
         self.irq_latch = 0  # $D019 bits 0-3
@@ -302,6 +303,9 @@ class VicDevice:
         self.sprite_background |= new_sb
         if _time_between(raster_irq_time(self.video, self.registers), lo, until, frame_cycles):
             self.irq_latch |= IRQ_RASTER
+        if self._raster_match_at is not None and self._raster_match_at < until:
+            self.irq_latch |= IRQ_RASTER
+            self._raster_match_at = None
         self.synced = until
         self._refresh_irq_next()
 
@@ -318,6 +322,8 @@ class VicDevice:
         raster = raster_irq_time(self.video, self.registers)
         if enabled & IRQ_RASTER and raster is not None:
             candidates.append(after + (raster - after) % frame_cycles)
+        if enabled & IRQ_RASTER and self._raster_match_at is not None:
+            candidates.append(self._raster_match_at)
         events = self._schedule
         if enabled & IRQ_SPRITE_SPRITE and not self.sprite_sprite:
             candidates.append(_next_event(events.ss_times, after, frame_cycles))
@@ -422,7 +428,7 @@ class VicDevice:
         # write that moves the compare line onto the current line latches now [VICE-src vicii-cycle.c]
         compare = raster_compare_line(self.registers)
         if compare != old_compare and compare == self._raster_line(t + 1):
-            self.irq_latch |= IRQ_RASTER
+            self._raster_match_at = t + 1  # the compare's cycle, as a raster event (seen after it)
         if register in _SAMPLED_SET:
             self._sample_within_line(t + 1)
         if register in _SAMPLED_SET or (self._latching and register in _COLLISION_SET | _DMA_SET):
