@@ -74,8 +74,8 @@ MUTANTS = [
     # ---- the late timing rules (issue 26 part 5: tests/vic/test_timing_rules_late.py) ----------------
     Mutant("d012-write-onto-the-line-ignored", "retro/chips/vic/device.py",
            "if compare != old_compare and compare == self._raster_line(t + 1):", "if False:", VIC_TESTS),
-    Mutant("d012-write-match-seen-in-its-own-cycle", "retro/chips/vic/device.py",
-           "self._raster_match_at = t + 1  # the compare's cycle", "self._raster_match_at = t  # the compare's cycle",
+    Mutant("d012-write-match-seen-by-the-writing-instruction", "retro/chips/vic/device.py",
+           "self._raster_match_at = t + 1  # the compare's cycle", "self.irq_latch |= IRQ_RASTER  # the compare's cycle",
            VIC_TESTS),
     Mutant("d012-write-latches-without-a-change", "retro/chips/vic/device.py",
            "if compare != old_compare and compare == self._raster_line(t + 1):",
