@@ -127,19 +127,23 @@ def test_setting_d015_shows_a_sprite_only_from_its_next_dma_start():
     assert vic.read(D01E, frame + at(125, 1)) == 0b11
 
 
-def test_the_dma_check_sees_d015_in_cycles_55_and_56():
-    """A write in cycle c is seen from c + 1: enabling in cycle 55 reaches the check of cycle 56 (the
-    sprite starts this frame), in cycle 56 none; clearing in cycle 54 reaches both checks (it does not
-    start), in cycle 55 only the second (the first already started it)."""
-    def collides_this_frame(before: int, after: int, cycle: int) -> bool:
+def test_the_dma_check_sees_d015_in_cycles_55_and_56_the_display_check_in_58():
+    """A write in cycle c is seen from c + 1. The DMA starts if $D015 is set in cycle 55 or 56
+    [Bauer 3.8.1]; the sprite is shown only if it is still set in cycle 58 [VICE-src
+    check_sprite_display]. Enabling in cycle 55 reaches the second check (DMA and display), in 56
+    neither; clearing in 54 reaches both DMA checks (nothing), in 55 or 57 only the display check
+    (the sprite fetches and steals cycles, unseen), in 58 nothing (fetched and shown)."""
+    def this_frame(before: int, after: int, cycle: int) -> tuple[bool, bool]:
         vic = two_sprites(before)
         vic.write(D015, after, at(100, cycle))
-        return vic.read(D01E, at(125, 1)) == 0b11
+        return vic.ba_wait(at(110, 61)) > 0, vic.read(D01E, at(125, 1)) == 0b11
 
-    assert collides_this_frame(0x01, 0x03, 55)
-    assert not collides_this_frame(0x01, 0x03, 56)
-    assert not collides_this_frame(0x03, 0x01, 54)
-    assert collides_this_frame(0x03, 0x01, 55)
+    assert this_frame(0x01, 0x03, 55) == (True, True)
+    assert this_frame(0x01, 0x03, 56) == (False, False)
+    assert this_frame(0x03, 0x01, 54) == (False, False)
+    assert this_frame(0x03, 0x01, 55) == (True, False)
+    assert this_frame(0x03, 0x01, 57) == (True, False)
+    assert this_frame(0x03, 0x01, 58) == (True, True)
 
 
 # ---- DEN switched late or off in the middle of a frame ---------------------------------------------

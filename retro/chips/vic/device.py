@@ -77,8 +77,11 @@ _COLLISION_SET = frozenset(COLLISION_REGISTERS)
 _READ_ONLY = frozenset({REG_SPRITE_SPRITE, REG_SPRITE_BACKGROUND, REG_LIGHTPEN_X, REG_LIGHTPEN_Y})
 _DMA_SET = frozenset(DMA_REGISTERS)
 _SAMPLED_SET = frozenset({REG_CONTROL1, REG_SPRITE_ENABLE})
-LATCH_BAD_LINES = 2 * SPRITE_COUNT
-LATCH_DISPLAY = 2 * SPRITE_COUNT + 1
+# What a sample point samples (see VicDevice._latch_points): sprite n's first and second DMA check
+# and its display check are n + SPRITE_COUNT * (LATCH_DMA_FIRST, LATCH_DMA_SECOND, LATCH_SPRITE_DISPLAY)
+LATCH_DMA_FIRST, LATCH_DMA_SECOND, LATCH_SPRITE_DISPLAY = range(3)
+LATCH_BAD_LINES = 3 * SPRITE_COUNT
+LATCH_BORDER = 3 * SPRITE_COUNT + 1
 
 
 def _next_event(times: np.ndarray, after: int, frame_cycles: int) -> int | None:
@@ -163,7 +166,8 @@ class VicDevice:
         self.registers = bytearray(state.registers)
         # What the chip acts on where it samples a register only at certain cycles (see _latch):
         # each sprite's $D015 bit when its DMA starts, DEN in line $30 and in the first window line.
-        self.sprite_enable = self.registers[REG_SPRITE_ENABLE]
+        self.sprite_enable = self.registers[REG_SPRITE_ENABLE]  # the DMA started with $D015 set
+        self.sprite_display = self.registers[REG_SPRITE_ENABLE]  # ... and shown ($D015 still set at its display check)
         self.bad_lines_allowed = self.display_opened = bool(self.registers[REG_CONTROL1] & CONTROL1_DEN)
         self._latching = False  # some of those differ from the registers as written
         self._sampled_until = 0  # device time up to which (exclusive) the samples have been taken
@@ -206,7 +210,9 @@ class VicDevice:
     # - sprite n's DMA starts where Y matches the line in the first or second DMA check cycle
     #   (SPRITE_DMA_CHECK_CYCLES from sprite0_fetch_cycle - BA_LEAD) only if its $D015 bit is set
     #   then; once on, it runs its 21 rows (42 expanded) whatever $D015 says, and a sprite enabled
-    #   later shows from its next start on;
+    #   later shows from its next start on; it is shown only if $D015 is still set in the display
+    #   check of that line (display_check_cycle, 58 on the 6569: VICE's check_sprite_display tests
+    #   MxE there; Bauer 3.8.1 does not say), else it fetches and steals cycles unseen;
     # - Bad Lines exist in a frame only if DEN was set in some cycle of line $30;
     # - the vertical border opens in the first line of the window (51, or 55 with RSEL = 0) only
     #   if DEN is set in some cycle of that line, so graphics collide only then.
@@ -214,22 +220,24 @@ class VicDevice:
     # from line $30, the display from the window's first line).
 
     def _latch_points(self) -> list[tuple[int, int]]:
-        """(frame time, what is sampled there) in frame order: a sprite number for its first DMA
-        check, SPRITE_COUNT + n for its second, LATCH_BAD_LINES, LATCH_DISPLAY."""
+        """(frame time, what is sampled there) in frame order (the LATCH_ codes above)."""
         video = self.video
         cpl = video.cycles_per_line
         first_check = video.sprite0_fetch_cycle - BA_LEAD - 1  # 0-based cycle in the line
+        display_check = video.display_check_cycle - 1
         points = [(GRAPHICS_FIRST_LINE * cpl, LATCH_BAD_LINES),
-                  (WINDOW_LINES[1 if self.registers[REG_CONTROL1] & CONTROL1_RSEL else 0][0] * cpl, LATCH_DISPLAY)]
+                  (WINDOW_LINES[1 if self.registers[REG_CONTROL1] & CONTROL1_RSEL else 0][0] * cpl, LATCH_BORDER)]
+        written = self.registers[REG_SPRITE_ENABLE]
         for n in range(SPRITE_COUNT):
-            if (self.registers[REG_SPRITE_ENABLE] ^ self.sprite_enable) >> n & 1:
+            if ((written ^ self.sprite_enable) | (written ^ self.sprite_display)) >> n & 1:
                 y = self.registers[REG_SPRITE_Y0 + 2 * n]
                 expand = bool(self.registers[REG_SPRITE_EXPAND_Y] >> n & 1)
                 rows = sprite_rows(video, y, expand)
                 for line in range(y, video.lines, Y_COMPARE_MASK + 1):
                     if rows[(line + 1) % video.lines] == 0:  # the DMA starts at this match
                         for k in range(SPRITE_DMA_CHECK_CYCLES):
-                            points.append((line * cpl + first_check + k, n + k * SPRITE_COUNT))
+                            points.append((line * cpl + first_check + k, n + (LATCH_DMA_FIRST + k) * SPRITE_COUNT))
+                        points.append((line * cpl + display_check, n + LATCH_SPRITE_DISPLAY * SPRITE_COUNT))
         return sorted(points)
 
     def _next_latch_point(self, lo: int, hi: int) -> int | None:
@@ -248,12 +256,17 @@ class VicDevice:
                 continue
             if what == LATCH_BAD_LINES:
                 self.bad_lines_allowed = den
-            elif what == LATCH_DISPLAY:
+            elif what == LATCH_BORDER:
                 self.display_opened = den
             else:
-                n, second = what % SPRITE_COUNT, what >= SPRITE_COUNT
+                kind, n = divmod(what, SPRITE_COUNT)
                 bit = self.registers[REG_SPRITE_ENABLE] & (1 << n)
-                self.sprite_enable = (self.sprite_enable | bit) if second else (self.sprite_enable & ~(1 << n) | bit)
+                if kind == LATCH_DMA_FIRST:
+                    self.sprite_enable = self.sprite_enable & ~(1 << n) | bit
+                elif kind == LATCH_DMA_SECOND:
+                    self.sprite_enable |= bit
+                else:
+                    self.sprite_display = self.sprite_display & ~(1 << n) | (bit & self.sprite_enable)
         self._use_sampled()
 
     def _sample_within_line(self, t: int) -> None:
@@ -266,20 +279,22 @@ class VicDevice:
         if line == WINDOW_LINES[1 if self.registers[REG_CONTROL1] & CONTROL1_RSEL else 0][0]:
             self.display_opened = True
 
-    def _sampled_registers(self, den: bool) -> bytes:
+    def _sampled_registers(self, den: bool, sprites: int) -> bytes:
         registers = bytearray(self.registers)
-        registers[REG_SPRITE_ENABLE] = self.sprite_enable
+        registers[REG_SPRITE_ENABLE] = sprites
         registers[REG_CONTROL1] = registers[REG_CONTROL1] & ~CONTROL1_DEN | (CONTROL1_DEN if den else 0)
         return bytes(registers)
 
     def _use_sampled(self) -> None:
         """Switch the collision and BA schedules to what the chip acts on now."""
         written_den = bool(self.registers[REG_CONTROL1] & CONTROL1_DEN)
-        self._latching = (self.sprite_enable != self.registers[REG_SPRITE_ENABLE]
+        written = self.registers[REG_SPRITE_ENABLE]
+        self._latching = (self.sprite_enable != written or self.sprite_display != written
                           or self.bad_lines_allowed != written_den or self.display_opened != written_den)
         if self._latching:
-            collision_registers = self._sampled_registers(self.bad_lines_allowed and self.display_opened)
-            bus_registers = self._sampled_registers(self.bad_lines_allowed)
+            collision_registers = self._sampled_registers(self.bad_lines_allowed and self.display_opened,
+                                                          self.sprite_enable & self.sprite_display)
+            bus_registers = self._sampled_registers(self.bad_lines_allowed, self.sprite_enable)
         else:
             collision_registers = bus_registers = self.registers
         self.state = self.state.with_registers(collision_registers)
