@@ -209,6 +209,10 @@ BA_LEAD = 3
 # A Bad Line's c-accesses take cycles 15-54 (all three chips), so BA is low from cycle 12 to 54.
 BAD_LINE_FIRST_STOLEN = 15
 BAD_LINE_LAST_STOLEN = 54
+# Sprite DMA is switched on in the two cycles from sprite0_fetch_cycle - BA_LEAD (6569: 55 and 56)
+# when $D015's bit is set and Y matches the line [Bauer 3.8.1; VICE-src cycle tables, check_spr_dma]
+SPRITE_DMA_CHECK_CYCLES = 2
 SPRITE_DMA_CYCLES = 2  # two s-accesses fall in the CPU's half of the cycles taken per sprite and line
 # Bad Line condition [Bauer 3.5]: a line in GRAPHICS_FIRST_LINE ($30) .. BAD_LINE_LAST ($F7) whose
-# low 3 bits equal YSCROLL, while DEN was set in line $30 (the model takes DEN from the current $D011).
+# low 3 bits equal YSCROLL, while DEN was set in some cycle of line $30 (the device samples it there:
+# device.VicDevice._latch; dma.ba_low takes the DEN it is given).

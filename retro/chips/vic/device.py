@@ -29,7 +29,11 @@ import numpy as np
 
 from retro.chips.vic.beam import position
 from retro.chips.vic.constants import (
+    BA_LEAD,
+    CONTROL1_DEN,
+    CONTROL1_RSEL,
     CONTROL1_RST8,
+    GRAPHICS_FIRST_LINE,
     IRQ_RASTER,
     IRQ_SOURCES,
     IRQ_SPRITE_BACKGROUND,
@@ -43,10 +47,16 @@ from retro.chips.vic.constants import (
     REG_LIGHTPEN_Y,
     REG_RASTER,
     REG_SPRITE_BACKGROUND,
+    REG_SPRITE_ENABLE,
+    REG_SPRITE_EXPAND_Y,
     REG_SPRITE_SPRITE,
+    REG_SPRITE_Y0,
     REGISTER_COUNT,
+    SPRITE_COUNT,
+    SPRITE_DMA_CHECK_CYCLES,
     UNUSED_BITS,
     UNUSED_READ,
+    WINDOW_LINES,
     Y_COMPARE_MASK,
 )
 from retro.chips.vic.dma import DMA_REGISTERS, bus_schedule
@@ -56,7 +66,9 @@ from retro.chips.vic.model import (
     VicState,
     frame_collisions,
     irq_register,
+    raster_compare_line,
     raster_irq_time,
+    sprite_rows,
 )
 from retro.cpu.bus import NEVER
 
@@ -64,6 +76,12 @@ SCHEDULE_CACHE_SIZE = 256
 _COLLISION_SET = frozenset(COLLISION_REGISTERS)
 _READ_ONLY = frozenset({REG_SPRITE_SPRITE, REG_SPRITE_BACKGROUND, REG_LIGHTPEN_X, REG_LIGHTPEN_Y})
 _DMA_SET = frozenset(DMA_REGISTERS)
+_SAMPLED_SET = frozenset({REG_CONTROL1, REG_SPRITE_ENABLE})
+# What a sample point samples (see VicDevice._latch_points): sprite n's first and second DMA check
+# and its display check are n + SPRITE_COUNT * (LATCH_DMA_FIRST, LATCH_DMA_SECOND, LATCH_SPRITE_DISPLAY)
+LATCH_DMA_FIRST, LATCH_DMA_SECOND, LATCH_SPRITE_DISPLAY = range(3)
+LATCH_BAD_LINES = 3 * SPRITE_COUNT
+LATCH_BORDER = 3 * SPRITE_COUNT + 1
 
 
 def _next_event(times: np.ndarray, after: int, frame_cycles: int) -> int | None:
@@ -146,6 +164,15 @@ class VicDevice:
         self.video = state.video
         self.start_cycle = start_cycle
         self.registers = bytearray(state.registers)
+        # What the chip acts on where it samples a register only at certain cycles (see _latch):
+        # each sprite's $D015 bit when its DMA starts, DEN in line $30 and in the first window line.
+        self.sprite_enable = self.registers[REG_SPRITE_ENABLE]  # the DMA started with $D015 set
+        self.sprite_display = self.registers[REG_SPRITE_ENABLE]  # ... and shown ($D015 still set at its display check)
+        self.bad_lines_allowed = self.display_opened = bool(self.registers[REG_CONTROL1] & CONTROL1_DEN)
+        self._latching = False  # some of those differ from the registers as written
+        self._sampled_until = 0  # device time up to which (exclusive) the samples have been taken
+        self._next_latch_at = NEVER  # device time of the next sample that can change something
+        self._raster_match_at: int | None = None  # a compare matched by a write latches here
         self.sprite_sprite = 0  # $D01E as accumulated since the last read
         self.sprite_background = 0  # $D01F
         self.irq_latch = 0  # $D019 bits 0-3
@@ -169,6 +196,113 @@ class VicDevice:
 
     def _advance(self, until: int) -> None:
         """Apply everything the beam draws in device time [synced, until)."""
+        while self._latching:
+            point = self._next_latch_point(max(self.synced, self._sampled_until), until)
+            if point is None:
+                break
+            self._apply(point)
+            self._latch(point)
+            self._sampled_until = point + 1
+        self._apply(until)
+
+    # ---- registers the chip samples at certain cycles ------------------------------------------
+    # [Bauer 3.5, 3.8.1, 3.9; VICE-src vicii-cycle.c: check_sprite_dma, check_vborder_top, allow_bad_lines]
+    # - sprite n's DMA starts where Y matches the line in the first or second DMA check cycle
+    #   (SPRITE_DMA_CHECK_CYCLES from sprite0_fetch_cycle - BA_LEAD) only if its $D015 bit is set
+    #   then; once on, it runs its 21 rows (42 expanded) whatever $D015 says, and a sprite enabled
+    #   later shows from its next start on; it is shown only if $D015 is still set in the display
+    #   check of that line (display_check_cycle, 58 on the 6569: VICE's check_sprite_display tests
+    #   MxE there; Bauer 3.8.1 does not say), else it fetches and steals cycles unseen;
+    # - Bad Lines exist in a frame only if DEN was set in some cycle of line $30;
+    # - the vertical border opens in the first line of the window (51, or 55 with RSEL = 0) only
+    #   if DEN is set in some cycle of that line, so graphics collide only then.
+    # The model takes each sampled bit as holding all frame (sprites from their start, Bad Lines
+    # from line $30, the display from the window's first line).
+
+    def _latch_points(self) -> list[tuple[int, int]]:
+        """(frame time, what is sampled there) in frame order (the LATCH_ codes above)."""
+        video = self.video
+        cpl = video.cycles_per_line
+        first_check = video.sprite0_fetch_cycle - BA_LEAD - 1  # 0-based cycle in the line
+        display_check = video.display_check_cycle - 1
+        points = [(GRAPHICS_FIRST_LINE * cpl, LATCH_BAD_LINES),
+                  (WINDOW_LINES[1 if self.registers[REG_CONTROL1] & CONTROL1_RSEL else 0][0] * cpl, LATCH_BORDER)]
+        written = self.registers[REG_SPRITE_ENABLE]
+        for n in range(SPRITE_COUNT):
+            if ((written ^ self.sprite_enable) | (written ^ self.sprite_display)) >> n & 1:
+                y = self.registers[REG_SPRITE_Y0 + 2 * n]
+                expand = bool(self.registers[REG_SPRITE_EXPAND_Y] >> n & 1)
+                rows = sprite_rows(video, y, expand)
+                for line in range(y, video.lines, Y_COMPARE_MASK + 1):
+                    if rows[(line + 1) % video.lines] == 0:  # the DMA starts at this match
+                        for k in range(SPRITE_DMA_CHECK_CYCLES):
+                            points.append((line * cpl + first_check + k, n + (LATCH_DMA_FIRST + k) * SPRITE_COUNT))
+                        points.append((line * cpl + display_check, n + LATCH_SPRITE_DISPLAY * SPRITE_COUNT))
+        return sorted(points)
+
+    def _next_latch_point(self, lo: int, hi: int) -> int | None:
+        """The first device time in [lo, hi) where a sampled bit can change."""
+        frame_cycles = self.video.frame_cycles
+        found = [lo + (p - lo) % frame_cycles for p, _ in self._latch_points()]
+        first = min(found, default=None)
+        return first if first is not None and first < hi else None
+
+    def _latch(self, t: int) -> None:
+        """The chip samples the registers as written at device time t."""
+        within = t % self.video.frame_cycles
+        den = bool(self.registers[REG_CONTROL1] & CONTROL1_DEN)
+        for point, what in self._latch_points():
+            if point != within:
+                continue
+            if what == LATCH_BAD_LINES:
+                self.bad_lines_allowed = den
+            elif what == LATCH_BORDER:
+                self.display_opened = den
+            else:
+                kind, n = divmod(what, SPRITE_COUNT)
+                bit = self.registers[REG_SPRITE_ENABLE] & (1 << n)
+                if kind == LATCH_DMA_FIRST:
+                    self.sprite_enable = self.sprite_enable & ~(1 << n) | bit
+                elif kind == LATCH_DMA_SECOND:
+                    self.sprite_enable |= bit
+                else:
+                    self.sprite_display = self.sprite_display & ~(1 << n) | (bit & self.sprite_enable)
+        self._use_sampled()
+
+    def _sample_within_line(self, t: int) -> None:
+        """A DEN write in line $30 or in the window's first line counts for that line (any cycle)."""
+        if not self.registers[REG_CONTROL1] & CONTROL1_DEN:
+            return
+        _, line, _ = position(self.video, t)
+        if line == GRAPHICS_FIRST_LINE:
+            self.bad_lines_allowed = True
+        if line == WINDOW_LINES[1 if self.registers[REG_CONTROL1] & CONTROL1_RSEL else 0][0]:
+            self.display_opened = True
+
+    def _sampled_registers(self, den: bool, sprites: int) -> bytes:
+        registers = bytearray(self.registers)
+        registers[REG_SPRITE_ENABLE] = sprites
+        registers[REG_CONTROL1] = registers[REG_CONTROL1] & ~CONTROL1_DEN | (CONTROL1_DEN if den else 0)
+        return bytes(registers)
+
+    def _use_sampled(self) -> None:
+        """Switch the collision and BA schedules to what the chip acts on now."""
+        written_den = bool(self.registers[REG_CONTROL1] & CONTROL1_DEN)
+        written = self.registers[REG_SPRITE_ENABLE]
+        self._latching = (self.sprite_enable != written or self.sprite_display != written
+                          or self.bad_lines_allowed != written_den or self.display_opened != written_den)
+        if self._latching:
+            collision_registers = self._sampled_registers(self.bad_lines_allowed and self.display_opened,
+                                                          self.sprite_enable & self.sprite_display)
+            bus_registers = self._sampled_registers(self.bad_lines_allowed, self.sprite_enable)
+        else:
+            collision_registers = bus_registers = self.registers
+        self.state = self.state.with_registers(collision_registers)
+        self._schedule = self._schedule_for(self.state)
+        self._bus = bus_schedule(self.video, bus_registers)
+
+    def _apply(self, until: int) -> None:
+        """Apply the current schedule's events in device time [synced, until)."""
         lo = self.synced
         if until <= lo:
             return
@@ -184,6 +318,9 @@ class VicDevice:
         self.sprite_background |= new_sb
         if _time_between(raster_irq_time(self.video, self.registers), lo, until, frame_cycles):
             self.irq_latch |= IRQ_RASTER
+        if self._raster_match_at is not None and self._raster_match_at < until:
+            self.irq_latch |= IRQ_RASTER
+            self._raster_match_at = None
         self.synced = until
         self._refresh_irq_next()
 
@@ -200,11 +337,18 @@ class VicDevice:
         raster = raster_irq_time(self.video, self.registers)
         if enabled & IRQ_RASTER and raster is not None:
             candidates.append(after + (raster - after) % frame_cycles)
+        if enabled & IRQ_RASTER and self._raster_match_at is not None:
+            candidates.append(self._raster_match_at)
         events = self._schedule
         if enabled & IRQ_SPRITE_SPRITE and not self.sprite_sprite:
             candidates.append(_next_event(events.ss_times, after, frame_cycles))
         if enabled & IRQ_SPRITE_BACKGROUND and not self.sprite_background:
             candidates.append(_next_event(events.sb_times, after, frame_cycles))
+        self._next_latch_at = NEVER
+        if self._latching:  # a sampled bit may change the schedules there: ask again then
+            point = self._next_latch_point(max(after, self._sampled_until), after + 2 * frame_cycles)
+            self._next_latch_at = NEVER if point is None else point
+            candidates.append(point)
         found = [c for c in candidates if c is not None]
         self.irq_next = self.start_cycle + min(found) if found else NEVER
 
@@ -226,10 +370,14 @@ class VicDevice:
 
     def ba_wait(self, cycle: int) -> int:
         t = cycle - self.start_cycle
+        if t >= self._next_latch_at:  # the BA schedule changes there (see _latch)
+            self._advance(t)
         return self._bus.wait[t % self.video.frame_cycles] if t >= 0 else 0
 
     def ba_free(self, cycle: int) -> int:
         t = cycle - self.start_cycle
+        if t >= self._next_latch_at:
+            self._advance(t)
         if t < 0:
             return -t + self._bus.free[0]
         return self._bus.free[t % self.video.frame_cycles]
@@ -261,15 +409,20 @@ class VicDevice:
         if register >= REGISTER_COUNT:
             return UNUSED_READ
         if register in (REG_CONTROL1, REG_RASTER):
-            _, line, cycle = position(self.video, max(t, 0))
-            if line == 0 and cycle <= RASTER_IRQ_LINE0_DELAY:
-                line = self.video.lines - 1  # the counter reaches 0 a cycle late (why line 0's IRQ is late)
+            line = self._raster_line(t)
             if register == REG_RASTER:
                 return line & Y_COMPARE_MASK
             return (self.registers[REG_CONTROL1] & ~CONTROL1_RST8) | (CONTROL1_RST8 if line > Y_COMPARE_MASK else 0)
         if register == REG_IRQ_LATCH:
             return irq_register(self.irq_latch, self.registers[REG_IRQ_ENABLE])
         return self.registers[register] | UNUSED_BITS.get(register, 0)
+
+    def _raster_line(self, t: int) -> int:
+        """The raster counter at device time t (what $D012 and $D011 bit 7 read)."""
+        _, line, cycle = position(self.video, max(t, 0))
+        if line == 0 and cycle <= RASTER_IRQ_LINE0_DELAY:
+            line = self.video.lines - 1  # the counter reaches 0 a cycle late (why line 0's IRQ is late)
+        return line
 
     def write(self, address: int, value: int, cycle: int) -> None:
         t = self.time(cycle)
@@ -282,14 +435,25 @@ class VicDevice:
             self._refresh_irq_next()
             return
         old = self.registers[register]
+        old_compare = raster_compare_line(self.registers)
         self.registers[register] = value & 0xFF
         if old == value:
             return
-        if register in _COLLISION_SET:
-            self.state = self.state.with_registers(self.registers)
-            self._schedule = self._schedule_for(self.state)
-        if register in _DMA_SET:
-            self._bus = bus_schedule(self.video, self.registers)
+        # The compare runs every cycle and latches on its change from no match to a match, so a
+        # write that moves the compare line onto the current line latches now [VICE-src vicii-cycle.c]
+        compare = raster_compare_line(self.registers)
+        if compare != old_compare and compare == self._raster_line(t + 1):
+            self._raster_match_at = t + 1  # the compare's cycle, as a raster event (seen after it)
+        if register in _SAMPLED_SET:
+            self._sample_within_line(t + 1)
+        if register in _SAMPLED_SET or (self._latching and register in _COLLISION_SET | _DMA_SET):
+            self._use_sampled()
+        else:
+            if register in _COLLISION_SET:
+                self.state = self.state.with_registers(self.registers)
+                self._schedule = self._schedule_for(self.state)
+            if register in _DMA_SET:
+                self._bus = bus_schedule(self.video, self.registers)
         self._refresh_irq_next()
 
     def peek(self, address: int) -> int:

@@ -2,7 +2,7 @@
 
 Rules [Bauer 3.5, 3.6.3, 3.8.1; the timing diagrams of 3.6.3]:
 - A Bad Line is a line in $30-$F7 whose low three bits equal YSCROLL ($D011 bits 0-2) while DEN
-  ($D011 bit 4) is set. Its c-accesses take cycles 15-54 on all three chips; BA is low from cycle 12
+  ($D011 bit 4) is set (the DEN the device sampled in line $30: device.VicDevice._latch). Its c-accesses take cycles 15-54 on all three chips; BA is low from cycle 12
   (BA_LEAD earlier).
 - Sprite n whose row is shown on line D fetches it in the line before: its two s-accesses take
   cycles sprite0_fetch_cycle + 2n and the next one, counted from line D-1 (6569: 58-59 for sprite 0,
