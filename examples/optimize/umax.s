@@ -1,0 +1,7 @@
+; umax: A = the larger of A and m (unsigned). The textbook way: compare, keep A when it is larger.
+        .org $c000
+umax:   cmp m
+        bcs done
+        lda m
+done:   rts
+m:      .byte 0
