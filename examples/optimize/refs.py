@@ -19,3 +19,7 @@ def overlap8(a, b):
 
 def sum_x(a, b):
     return (a + b) & 0xFF
+
+
+def copy_b(b):
+    return b
