@@ -1,5 +1,6 @@
 ; absdiff: A = |A - m|. The textbook way: subtract, and negate (two's complement) when it borrowed.
         .org $c000
+.alias m $fb                ; the second operand, in zero page
 absdiff:
         sec
         sbc m
@@ -7,4 +8,4 @@ absdiff:
         eor #$ff
         adc #1
 done:   rts
-m:      .byte 0
+

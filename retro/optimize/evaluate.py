@@ -121,16 +121,19 @@ def answered(routine: Routine, columns: list, memory: dict) -> tuple[list, np.nd
 
 
 def sample_cases(routine: Routine, seed: int, memory: dict, size: int = SAMPLE) -> Samples:
-    """The spec's boundary cases and its first random (or exhaustive) cases inside the domain, up to `size`."""
+    """Random cases inside the domain (size - size // 4 of them), then the spec's boundary cases, up
+    to `size` (an exhaustive part's first cases when there are too few)."""
     parts = case_sets.plan(routine, exhaustive=False, seed=seed, random=max(size, 64))
     parts = [p for p in parts if p.name in ("boundary", "random", "exhaustive")]
     taken: list = []
     count = 0
-    for part in sorted(parts, key=lambda p: p.name != "boundary"):
+    order = {"boundary": 1, "random": 0, "exhaustive": 2}  # random first: an exhaustive part's first cases share inputs
+    for part in sorted(parts, key=lambda p: order[p.name]):
         block_iter = part.blocks()
         for block in block_iter:
             answers, keep = answered(routine, block, memory)
-            keep = np.flatnonzero(keep)[:size - count]
+            wanted = size - count if part.name != "random" else size - size // 4 - count
+            keep = np.flatnonzero(keep)[:max(wanted, 0)]
             if len(keep):
                 taken.append(([c[keep] for c in block], [a[keep] for a in answers]))
                 count += len(keep)

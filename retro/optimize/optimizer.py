@@ -15,17 +15,18 @@ from retro.errors import InputError, RunError
 from retro.optimize.code import Instruction, Listing, assemble, code_bytes, program_with, read_listing
 from retro.optimize.effects import ALL_MEMORY, live_after, windowable
 from retro.optimize.evaluate import LaneRunner, Proof, Prover, outputs_equal, sample_cases, scratch_of
-from retro.optimize.search import (BRK, FLAG_BITS, Executor, cycles_of, enumerate_window, instruction_pool,
-                                   state_of, state_ports)
+from retro.optimize.search import (BRANCHES, BRK, END, FLAG_BITS, Executor, cycles_of, enumerate_window,
+                                   instruction_pool, rank, state_of, state_ports)
 from retro.routines.places import FLAGS, Place, Port
 from retro.routines.spec import Routine
 
 OBJECTIVES = ("worst", "mean", "bytes")
 PRESERVABLE = ("A", "X", "Y", "C", "Z", "N", "V", "D")
 DEFAULT_WINDOW = 3
-WINDOW_SHARE = 8  # a window's enumeration takes at most this share of the budget ...
+WINDOW_SHARE = 8  # a window's enumeration takes at most 1/this of the budget (synthesis: half) ...
 MIN_WINDOW_SECONDS = 0.5  # ... but at least this long
-SYNTHESIS_LENGTH = 6  # a routine of at most this many instructions (before its RTS) is also searched whole
+SYNTHESIS_LENGTH = 6
+SYNTHESIS_LANES = 64  # sample cases the synthesis enumerates on (it searches deeper, on more states)  # a routine of at most this many instructions (before its RTS) is also searched whole
 
 
 @dataclass(frozen=True)
@@ -189,6 +190,7 @@ class Search:
         deadline = began + self.options.budget
         routine = self.routine
         code = assemble(self.listing, routine.cpu)
+        began_cpu = time.process_time()
         first = self.prover.prove(code, routine.entry_address)
         if not first.passed:
             columns, expected, index = first.counterexample
@@ -197,7 +199,8 @@ class Search:
                            f" with the entry state the spec leaves free random): run `retro check` and fix it first")
         self.prover.reference_cycles = first.per_case
         self.refresh_kept(code)
-        outcome = Outcome(routine, self.listing, self.listing, first, first, proofs=1)
+        outcome = Outcome(routine, self.listing, self.listing, first, first, proofs=1,
+                          prove_seconds=time.process_time() - began_cpu)
         best_score = score(self.options.objective, first, self.size)
         current = self.listing
         improved = True
@@ -240,71 +243,89 @@ class Search:
 
     def search_window(self, listing: Listing, start: int, stop: int, kind: str, deadline: float,
                       outcome: Outcome, best_score: tuple):
-        routine, cpu = self.routine, self.routine.cpu
+        routine, cpu, objective = self.routine, self.routine.cpu, self.options.objective
         outcome.windows += 1
         code = assemble(listing, cpu)
         addresses = [listing.origin]
         for i in listing.instructions:
             addresses.append(addresses[-1] + i.length)
-        began = time.monotonic()
+        began, cpu_began = time.monotonic(), time.process_time()
         state, lanes, probe = self.window_states(code, addresses[start])
         if not len(lanes):
             return None
         window = listing.instructions[start:stop]
         executor = Executor(cpu, bytes(probe.runner.call_image), len(lanes), addresses[start])
-        by_bytes = self.options.objective == "bytes"
+        pool = instruction_pool(cpu, listing, window, self.addresses)
         if kind == "synthesis":
+            state, lanes = _first_lanes(state, lanes, SYNTHESIS_LANES)
             target, live = self.synthesis_target(state, lanes)
-            bound = ((addresses[stop] - addresses[start], 1 << 30) if by_bytes
-                     else (self.prover_worst(outcome) - cycles_of(cpu, listing.instructions[-1]) + 1, 1 << 30))
-            length = min(SYNTHESIS_LENGTH, max(self.options.window, 4))
+            worst_cycles = outcome.best_proof.cycles["max"] - cycles_of(cpu, listing.instructions[-1])
+            mean_cycles = outcome.best_proof.cycles["mean"] - cycles_of(cpu, listing.instructions[-1])
+            size = addresses[stop] - addresses[start]
+            bound = {"worst": (worst_cycles, size + 1), "mean": (mean_cycles, size + 1), "bytes": (size, worst_cycles + 1)}[
+                objective]
+            length = max(self.options.window, SYNTHESIS_LENGTH)
+            pool = [i for i in pool if i.mode != "rel"] + [Instruction(b, "rel", target=END) for b in BRANCHES]
         else:
             target = state
             for instruction in window:
                 target = executor.step(target, instruction)
             live = live_after(listing, self.at_return)[stop - 1]
-            window_cycles = sum(cycles_of(cpu, i) for i in window)
-            window_bytes = addresses[stop] - addresses[start]
-            # fewer cycles, or as many in fewer bytes (bytes: the other way round)
-            bound = (window_bytes, window_cycles) if by_bytes else (window_cycles, window_bytes)
+            bound = rank(objective, target.filled().cycles[None, :], addresses[stop] - addresses[start])[0]
             length = stop - start
-        pool = instruction_pool(cpu, listing, window, self.addresses)
-        share = max(self.options.budget / WINDOW_SHARE, MIN_WINDOW_SECONDS)  # no window takes the whole budget
+        share = max(self.options.budget / (2 if kind == "synthesis" else WINDOW_SHARE), MIN_WINDOW_SECONDS)
         found = enumerate_window(executor, cpu, state, target, live, pool, length, bound,
-                                 min(deadline, time.monotonic() + share), by_bytes)
+                                 min(deadline, time.monotonic() + share), objective)
         outcome.tested += found.tested
         outcome.complete &= found.complete
-        outcome.search_seconds += time.monotonic() - began
-        for cycles, size, sequence in found.found:
+        outcome.search_seconds += time.process_time() - cpu_began
+        del began
+        for _, sequence in found.found:
             if kind == "window" and tuple(sequence) == tuple(window):
                 continue
-            if kind == "window" and (cycles, size) >= (sum(cycles_of(cpu, i) for i in window),
-                                                        addresses[stop] - addresses[start]) and not by_bytes:
-                continue
-            new = listing.with_window(start, stop, sequence)
+            new = self.replaced(listing, start, stop, sequence)
             new_code = assemble(new, cpu)
             if new_code is None or len(new_code) > self.size:
                 continue
             outcome.routine_tests += 1
             if not self.sample_ok(new_code):
                 continue
-            began = time.monotonic()
-            proof = self.prover.prove(new_code, routine.entry_address)
-            outcome.prove_seconds += time.monotonic() - began
-            outcome.proofs += 1
+            proof = self.proven(new_code, outcome)
             if not proof.passed:
-                outcome.failed_proofs += 1
-                outcome.counterexamples += 1
-                columns, expected, index = proof.counterexample
-                self.samples.add(columns, expected, index)
-                self.refresh_kept(assemble(self.listing, cpu))
                 continue
             if self.options.no_slower and proof.slower:
                 continue
-            new_score = score(self.options.objective, proof, len(new_code))
+            new_score = score(objective, proof, len(new_code))
             if new_score < best_score:
                 return new, new_score, Change(start, tuple(window), tuple(sequence), kind, proof)
         return None
+
+    def proven(self, code: bytes, outcome: Outcome) -> Proof:
+        """The proof of a candidate; a counterexample joins the samples."""
+        began = time.process_time()
+        proof = self.prover.prove(code, self.routine.entry_address)
+        outcome.prove_seconds += time.process_time() - began
+        outcome.proofs += 1
+        if not proof.passed:
+            outcome.failed_proofs += 1
+            outcome.counterexamples += 1
+            columns, expected, index = proof.counterexample
+            self.samples.add(columns, expected, index)
+            self.refresh_kept(assemble(self.listing, self.routine.cpu))
+        return proof
+
+    @staticmethod
+    def replaced(listing: Listing, start: int, stop: int, sequence) -> Listing:
+        """The listing with the window replaced; a synthesised branch's END becomes a label at the
+        instruction after the window (the one there, or a new one)."""
+        if not any(i.target == END for i in sequence):
+            return listing.with_window(start, stop, sequence)
+        names = [name for name, at in listing.labels if at == stop]
+        taken = {name for name, _ in listing.labels}
+        name = names[0] if names else next(f"done{k or ''}" for k in range(len(taken) + 1) if f"done{k or ''}" not in taken)
+        sequence = tuple(replace(i, target=name) if i.target == END else i for i in sequence)
+        labels = listing.labels if names else listing.labels + ((name, stop),)
+        return replace(listing, labels=labels).with_window(start, stop, sequence)
 
     def prover_worst(self, outcome: Outcome) -> int:
         return outcome.best_proof.cycles["max"]
@@ -336,6 +357,15 @@ class Search:
                     target.p = np.where(kept[lanes] != 0, target.p | place.bit, target.p & ~place.bit).astype(np.int32)
                     live.add(next(n for n, b in FLAG_BITS.items() if b == place.bit))
         return target, frozenset(live)
+
+
+def _first_lanes(state, lanes: np.ndarray, count: int):
+    """The state on its first `count` sample cases only (synthesis enumerates on fewer cases; the
+    whole-routine run and the proof see them all)."""
+    if len(lanes) <= count:
+        return state, lanes
+    return (type(state)(state.a[:count], state.x[:count], state.y[:count], state.p[:count],
+                        {a: v[:count] for a, v in state.memory.items()}), lanes[:count])
 
 
 def optimize(routine: Routine, options: Options, progress: Callable[[str], None] | None = None) -> Outcome:
