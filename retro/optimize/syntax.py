@@ -4,7 +4,7 @@ by name, its value given as an equate first (the routine's data lives elsewhere 
 
 Sources for the syntax: the ACME manual (docs/QuickRef.txt: `* = ADDR`, `+2` forcing absolute), the
 64tass manual (`* =`, `@w`), the ca65 users guide (`.org`, `label:`, `a:` address size), the DASM
-manual (`processor`, `org`, `equ`, `.w`), the xa65 man page (`* =`, `!` forcing 16 bits), the Kick
+manual (`processor`, `org`, `equ`, `.w`), the xa65 man page (`* =`, `!` before an operand forcing 16 bits), the Kick
 Assembler manual (`.label`, `.abs`), the Ophis manual (`.org`, `.alias`)."""
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ def _label(syntax: str, name: str) -> str:
 def _absolute(syntax: str, mnemonic: str, operand: str) -> str:
     """An absolute operand below $100: forced to two bytes, as the routine's bytes have it."""
     return {"acme": f"{mnemonic}+2 {operand}", "64tass": f"{mnemonic} @w {operand}", "ca65": f"{mnemonic} a:{operand}",
-            "dasm": f"{mnemonic}.w {operand}", "xa": f"!{mnemonic} {operand}", "kickass": f"{mnemonic}.abs {operand}",
+            "dasm": f"{mnemonic}.w {operand}", "xa": f"{mnemonic} !{operand}", "kickass": f"{mnemonic}.abs {operand}",
             "ophis": f"{mnemonic} {operand}  ; absolute: the assembler may shorten it"}[syntax]
 
 

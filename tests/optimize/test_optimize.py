@@ -115,12 +115,26 @@ def test_the_wasteful_routine_loses_its_waste(tmp_path):
     assert not failed([check]) and check.totals.cycles_max == result.after["worst"]
 
 
-@pytest.mark.parametrize("name, textbook_worst", [("umax", 16), ("absdiff", 18), ("clamp", 12), ("overlap8", 20)])
+@pytest.mark.parametrize("name, textbook_worst", [("umax", 14), ("absdiff", 17), ("clamp", 12), ("overlap8", 20)])
 def test_short_specs_end_at_least_as_fast_as_the_textbook(tmp_path, name, textbook_worst):
     result = optimize_command(str(EXAMPLES / f"{name}.toml"), budget=6, out=str(tmp_path))
     assert result.before["worst"] == textbook_worst  # measured: the textbook routine as written
     assert result.after["worst"] <= textbook_worst
     assert not failed([check_routine(str(tmp_path / f"{name}_optimized.toml"), exhaustive=True)])
+
+
+@pytest.mark.exhaustive
+def test_absdiff_beats_the_textbook_as_the_issue_reports(tmp_path):
+    """`SEC / SBC m / BCS + / EOR #$FF / ADC #1` (17 cycles worst, 10 bytes with the RTS) ->
+    `CMP m / SBC m / BCS + / EOR #$FF` (16, 9), proven over all 65,536 inputs. The synthesis needs
+    about a minute of a shared 2-core machine: the bounded form (CI) gives it 3 s and asks only
+    that nothing worse comes back."""
+    result = optimize_command(str(EXAMPLES / "absdiff.toml"), budget=150 if FULL else 3, out=str(tmp_path))
+    assert result.before["worst"] == 17 and result.before["bytes"] == 10
+    if FULL:
+        assert (result.after["worst"], result.after["bytes"]) == (16, 9)
+        assert [i.mnemonic for i in result.outcome.best.instructions] == ["CMP", "SBC", "BCS", "EOR", "RTS"]
+    assert result.after["worst"] <= 17 and result.proof["kind"] == "exhaustive"
 
 
 @pytest.mark.exhaustive
@@ -191,3 +205,43 @@ def test_json_output_names_the_proof(tmp_path, capsys):
     data = json.loads(capsys.readouterr().out)
     assert code == 0 and data["proof"]["kind"] == "exhaustive" and data["proof"]["space"] == 256
     assert set(data["before"]) == {"worst", "mean", "best", "bytes", "raster"}
+
+
+# ---- the sources assemble back to the routine's bytes with the real assemblers --------------------
+
+_FORCED = Listing(0xC000, (Instruction("LDA", "abs", 0x12), Instruction("STA", "abx", 0x80),
+                           Instruction("LDX", "aby", 0x05), Instruction("ASL", "acc"), Instruction("LDA", "zpx", 0x10),
+                           Instruction("LDA", "iny", 0xFB), Instruction("LDA", "inx", 0x20),
+                           Instruction("BNE", "rel", target="top"), Instruction("JMP", "abs", target=0xC000),
+                           Instruction("LDX", "zpy", 0x33), Instruction("RTS", "imp")), (("top", 0),))
+_ASSEMBLE = {  # assembler -> (program, arguments with SOURCE and OUT): raw bytes from $C000
+    "acme": ("acme", ["-f", "plain", "-o", "OUT", "SOURCE"]),
+    "64tass": ("64tass", ["--nostart", "-o", "OUT", "SOURCE"]),
+    "ca65": ("cl65", ["-t", "none", "--start-addr", "0xc000", "-o", "OUT", "SOURCE"]),
+    "dasm": ("dasm", ["SOURCE", "-f3", "-oOUT"]),
+    "xa": ("xa", ["-o", "OUT", "SOURCE"]),
+}
+
+
+@pytest.mark.parametrize("syntax", sorted(_ASSEMBLE))
+@pytest.mark.parametrize("case", ["absdiff", "mul8", "forced"])
+def test_sources_assemble_back_with_the_real_assembler(tmp_path, syntax, case):
+    import shutil
+    import subprocess
+    program, arguments = _ASSEMBLE[syntax]
+    if shutil.which(program) is None:
+        pytest.skip(f"{program} is not installed (Debian: apt-get install {'cc65' if syntax == 'ca65' else program})")
+    if case == "forced":  # absolute operands below $100 must stay absolute; indexed and indirect modes
+        listing, names = _FORCED, {0xFB: "ptr"}
+    else:
+        routine = load_spec(EXAMPLES / "absdiff.toml" if case == "absdiff" else ASM_DIR / "mul8.toml")
+        listing = read_listing(routine.program, routine.entry_address, routine.cpu)
+        names = {}
+        for name, value in sorted(routine.program.symbols.items()):
+            names.setdefault(value, name)
+    source, out = tmp_path / "r.s", tmp_path / "r.bin"
+    source.write_text(format_source(listing, syntax, names))
+    done = subprocess.run([program] + [str(source) if a == "SOURCE" else a.replace("OUT", str(out)) for a in arguments],
+                          capture_output=True, text=True, cwd=tmp_path, timeout=60)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert out.read_bytes() == assemble(listing)
