@@ -249,7 +249,7 @@ class Search:
         addresses = [listing.origin]
         for i in listing.instructions:
             addresses.append(addresses[-1] + i.length)
-        began, cpu_began = time.monotonic(), time.process_time()
+        cpu_began = time.process_time()
         state, lanes, probe = self.window_states(code, addresses[start])
         if not len(lanes):
             return None
@@ -279,8 +279,10 @@ class Search:
         outcome.tested += found.tested
         outcome.complete &= found.complete
         outcome.search_seconds += time.process_time() - cpu_began
-        del began
         for _, sequence in found.found:
+            if time.monotonic() > deadline:  # candidates left untested: the search is not complete
+                outcome.complete = False
+                break
             if kind == "window" and tuple(sequence) == tuple(window):
                 continue
             new = self.replaced(listing, start, stop, sequence)
@@ -326,9 +328,6 @@ class Search:
         sequence = tuple(replace(i, target=name) if i.target == END else i for i in sequence)
         labels = listing.labels if names else listing.labels + ((name, stop),)
         return replace(listing, labels=labels).with_window(start, stop, sequence)
-
-    def prover_worst(self, outcome: Outcome) -> int:
-        return outcome.best_proof.cycles["max"]
 
     def synthesis_target(self, state, lanes):
         """The state the whole routine must end in: the reference's answers in the output places."""

@@ -53,10 +53,10 @@ def test_liveness_frees_what_the_routine_overwrites_and_keeps_the_outputs():
     listing = read_listing(routine.program, routine.entry_address, routine.cpu)
     after = live_after(listing, frozenset({"A"}))
     temp = routine.program.symbols["temp"]
-    assert temp not in after[0] or "nothing"  # after STX temp: temp is read next (LDA temp) ...
-    assert temp in after[0] and temp not in after[1]  # ... and dead once it has been
+    assert temp in after[0] and temp not in after[1]  # read by the next instruction, dead once it has been
     assert "C" not in after[2] and "C" in after[3]  # the first CLC's carry is overwritten by the second
-    assert after[-1] == frozenset({"A"})
+    assert after[-1] == frozenset({"A"})  # at the RTS: the output
+    assert after[4] == frozenset({"A"})  # after ADC: only A goes on (its flags and X are free)
 
 
 # ---- the entry state a candidate may not rely on ----------------------------------------------------
@@ -93,6 +93,22 @@ def test_a_candidate_relying_on_untouched_memory_is_rejected():
                                 Instruction("ORA", "zpg", scratch)])
     proof = Prover(routine, 1, scratch_of(routine, [scratch])).prove(code, routine.entry_address)
     assert not proof.passed
+
+
+def test_a_candidate_whose_cycles_depend_on_the_free_carry_is_rejected():
+    """BCC to the next instruction then LDA b: the right answer always, but one cycle more when the
+    carry the spec leaves free is clear: `retro check` fails such a routine (its cycles change with
+    the entry state), so the proof must too."""
+    routine = load_spec(EXAMPLES / "copy_b.toml")
+    load = Instruction("LDA", "abs", routine.program.symbols["b_val"])
+    listing = Listing(routine.entry_address, (Instruction("BCC", "rel", target="next"), load,
+                                              Instruction("RTS", "imp")), (("copy_b", 0), ("next", 1)))
+    code = assemble(listing, routine.cpu)
+    proof = Prover(routine, 1, ()).prove(code, routine.entry_address)
+    assert not proof.passed
+    steady = Listing(routine.entry_address, (Instruction("CLC", "imp"), Instruction("BCC", "rel", target="next"), load,
+                                             Instruction("RTS", "imp")), (("copy_b", 0), ("next", 2)))
+    assert Prover(routine, 1, ()).prove(assemble(steady, routine.cpu), routine.entry_address).passed
 
 
 def test_a_wrong_routine_from_the_search_is_never_reported(monkeypatch):
