@@ -15,6 +15,7 @@ from retro.errors import InputError, RunError
 from retro.optimize.code import Instruction, Listing, assemble, code_bytes, program_with, read_listing
 from retro.optimize.effects import ALL_MEMORY, live_after, windowable
 from retro.optimize.evaluate import LaneRunner, Proof, Prover, outputs_equal, sample_cases, scratch_of
+from retro.optimize.stochastic import rewrite
 from retro.optimize.search import (BRANCHES, BRK, END, FLAG_BITS, Executor, cycles_of, enumerate_window,
                                    instruction_pool, rank, state_of, state_ports)
 from retro.routines.places import FLAGS, Place, Port
@@ -26,6 +27,7 @@ DEFAULT_WINDOW = 3
 WINDOW_SHARE = 8  # a window's enumeration takes at most 1/this of the budget (synthesis: half) ...
 MIN_WINDOW_SECONDS = 0.5  # ... but at least this long
 SYNTHESIS_LENGTH = 6
+STOCHASTIC_MIN_LIMIT = 200  # cycles a rewrite's call may take at least (else 4 x the best's worst case)
 SYNTHESIS_LANES = 64  # sample cases the synthesis enumerates on (it searches deeper, on more states)  # a routine of at most this many instructions (before its RTS) is also searched whole
 
 
@@ -38,6 +40,8 @@ class Options:
     seed: int | None = None
     preserve: tuple[str, ...] = ()
     synthesis: bool = True
+    windows: bool = True  # the enumerative window search (off: only synthesis and stochastic rewriting)
+    stochastic: bool = True  # rewrite at random for the budget the windows leave
 
 
 def check_options(options: Options) -> None:
@@ -79,6 +83,7 @@ class Outcome:
     prove_seconds: float = 0.0
     complete: bool = True  # every window was searched to its length within the budget
     windows: int = 0
+    rewrites: int = 0  # stochastic moves tried
     program: object = None  # the new Program
 
 
@@ -204,7 +209,7 @@ class Search:
         best_score = score(self.options.objective, first, self.size)
         current = self.listing
         improved = True
-        while improved and time.monotonic() < deadline:
+        while improved and self.options.windows and time.monotonic() < deadline:
             improved = False
             for start, stop, kind in self.windows(current):
                 if time.monotonic() > deadline:
@@ -220,9 +225,52 @@ class Search:
                                   f"{change.proof.cycles['mean']:.2f}, {code_bytes(current)} bytes")
                     improved = True
                     break
+        if self.options.stochastic and time.monotonic() < deadline:
+            self.rewrite(outcome, deadline)
         outcome.seconds = time.monotonic() - began
         outcome.program = program_with(routine.program, outcome.best, routine.cpu, self.size)
         return outcome
+
+    def rewrite(self, outcome: Outcome, deadline: float) -> None:
+        """Stochastic rewriting of the best routine for the rest of the budget (retro.optimize.stochastic):
+        moves run on the samples with a tight cycle limit (a move can make a loop that never ends)."""
+        routine, objective = self.routine, self.options.objective
+        limit = max(4 * outcome.best_proof.cycles["max"], STOCHASTIC_MIN_LIMIT)
+        lanes = LaneRunner(replace(routine, limit=limit, outputs=routine.outputs + self.preserve), self.seed,
+                           self.scratch)
+        best_score = [score(objective, outcome.best_proof, code_bytes(outcome.best))]
+
+        def cost(code: bytes):
+            s = self.samples
+            run = lanes.run(code, routine.entry_address, s.columns, s.indices)
+            ok = outputs_equal(run, s.expected)
+            if self.preserve:
+                ok &= outputs_equal(run, [None] * len(routine.outputs) + list(self.kept_samples), skip=True)
+            outcome.routine_tests += 1
+            cycles = run.cycles[run.error == 0]
+            if not len(cycles):
+                return None
+            value = {"worst": float(cycles.max()), "mean": float(cycles.mean()), "bytes": float(len(code))}[objective]
+            return int((~ok).sum()), value
+
+        def found(listing: Listing, code: bytes) -> bool:
+            if not self.sample_ok(code):
+                return False
+            proof = self.proven(code, outcome)
+            if not proof.passed or (self.options.no_slower and proof.slower):
+                return False
+            new_score = score(objective, proof, len(code))
+            if new_score >= best_score[0]:
+                return False
+            best_score[0] = new_score
+            outcome.changes.append(Change(0, outcome.best.instructions, listing.instructions, "stochastic", proof))
+            outcome.best, outcome.best_proof = listing, proof
+            self.progress(f"stochastic rewrite: worst {proof.cycles['max']}, mean {proof.cycles['mean']:.2f}, "
+                          f"{len(code)} bytes")
+            return True
+
+        pool = instruction_pool(routine.cpu, outcome.best, (), self.addresses)
+        outcome.rewrites += rewrite(outcome.best, cost, pool, routine.cpu, self.size, deadline, self.seed, found)
 
     def windows(self, listing: Listing):
         """(start, stop, kind): the whole routine first when it is short, then every window of up to

@@ -131,6 +131,15 @@ def test_the_wasteful_routine_loses_its_waste(tmp_path):
     assert not failed([check]) and check.totals.cycles_max == result.after["worst"]
 
 
+def test_stochastic_rewriting_alone_drops_the_waste_and_proves_it():
+    routine = load_spec(EXAMPLES / "wasteful.toml")
+    outcome = optimize(routine, Options(budget=15, synthesis=False, windows=False, seed=3))
+    assert outcome.changes and {c.kind for c in outcome.changes} == {"stochastic"} and outcome.rewrites > 0
+    assert outcome.best_proof.cycles["max"] < 22 and outcome.best_proof.passed
+    check = check_routine(replace(routine, program=outcome.program), exhaustive=True, search_budget=0)
+    assert not failed([check]) and check.totals.cycles_max == outcome.best_proof.cycles["max"]
+
+
 @pytest.mark.parametrize("name, textbook_worst", [("umax", 14), ("absdiff", 17), ("clamp", 12), ("overlap8", 20)])
 def test_short_specs_end_at_least_as_fast_as_the_textbook(tmp_path, name, textbook_worst):
     result = optimize_command(str(EXAMPLES / f"{name}.toml"), budget=6, out=str(tmp_path))
