@@ -158,6 +158,7 @@ class Search:
         self.prover = Prover(routine, self.seed, self.scratch, preserve)
         self.at_return = live_at_return(routine, options.preserve)
         self.kept_samples = None
+        self.synthesised = False
 
     # ---- whole-routine runs --------------------------------------------------------------------
 
@@ -277,9 +278,10 @@ class Search:
         `window` straight-line instructions with no branch target inside, shortest first."""
         instructions = listing.instructions
         n = len(instructions)
-        if (self.options.synthesis and instructions and instructions[-1].mnemonic == "RTS"
+        if (self.options.synthesis and not self.synthesised and instructions and instructions[-1].mnemonic == "RTS"
                 and 1 < n <= SYNTHESIS_LENGTH + 1
                 and not any(i.mnemonic in ("RTS", "RTI", "JMP", "JSR", "BRK") for i in instructions[:-1])):
+            self.synthesised = True  # once: a second run on its own result would search the same space again
             yield 0, n - 1, "synthesis"
         targets = listing.targets
         for length in range(1, min(self.options.window, n) + 1):  # short windows first: cheap, and most gains
