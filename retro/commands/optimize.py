@@ -95,7 +95,7 @@ def optimize(spec: str, *, objective: str = "worst", no_slower: bool = False, bu
     doc = new_spec(read_spec_document(routine.spec_path), routine.spec_path.parent, folder.resolve(),
                    stem + ".prg", stem + ".lbl", stem)
     proof = {**best.record(), "check": {"cases": checked.totals.cases, "mismatches": checked.mismatches,
-                                        "exhaustive": exhaustive, "engine": checked.engine if hasattr(checked, "engine") else None},
+                                        "exhaustive": exhaustive, "engine": checked.engine},
              "optimal": ("none cheaper among the windows searched (every window of up to "
                          f"{opts.window} instructions over the pruned instruction set)" if outcome.complete else None)}
     outputs = {folder / files[0]: source, folder / files[1]: prg_bytes(replace(outcome.program, symbols=symbols)),

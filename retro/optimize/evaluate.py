@@ -160,8 +160,9 @@ class Proof:
     passed: bool = True
     counterexample: tuple | None = None  # (columns of one case, expected, index)
     slower: bool = False  # some case takes more cycles than the original (for --no-slower)
-    cycles: dict = field(default_factory=dict)  # min, mean, max over the proof's cases (random entry state)
+    cycles: dict = field(default_factory=dict)  # min, mean, max over the proof's cases (the baseline run)
     note: str = ""
+    per_case: list = field(default_factory=list)  # the baseline run's cycles per block (for --no-slower)
 
     def record(self) -> dict:
         return {"kind": self.kind, "space": self.space, "cases": self.cases, "calls": self.calls,

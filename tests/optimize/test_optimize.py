@@ -111,6 +111,21 @@ def test_a_candidate_whose_cycles_depend_on_the_free_carry_is_rejected():
     assert Prover(routine, 1, ()).prove(assemble(steady, routine.cpu), routine.entry_address).passed
 
 
+def test_preserved_registers_are_held_to_what_the_original_leaves():
+    """A = b as LDX b / TXA is right, but X no longer holds what the caller had: refused with
+    --preserve X, accepted without."""
+    from retro.optimize.optimizer import preserved_ports
+    routine = load_spec(EXAMPLES / "copy_b.toml")
+    b = routine.program.symbols["b_val"]
+    original = _candidate(routine, [Instruction("LDA", "abs", b)])
+    through_x = _candidate(routine, [Instruction("LDX", "abs", b), Instruction("TXA", "imp")])
+    free = Prover(routine, 1, ())
+    assert free.prove(original, routine.entry_address).passed and free.prove(through_x, routine.entry_address).passed
+    kept = Prover(routine, 1, (), preserved_ports(("X",)))
+    assert kept.prove(original, routine.entry_address).passed  # the first proof: the original, what is kept
+    assert not kept.prove(through_x, routine.entry_address).passed
+
+
 def test_a_wrong_routine_from_the_search_is_never_reported(monkeypatch):
     """Sabotage the proof's reference answers: the search must then keep nothing (the original
     itself fails: an error, never a routine)."""
