@@ -135,6 +135,19 @@ def test_a_wrong_routine_from_the_search_is_never_reported(monkeypatch):
         optimize(broken, Options(budget=1))
 
 
+def test_with_a_tiny_sample_the_proofs_catch_the_wrong_candidates(monkeypatch):
+    """Four sample cases let many wrong routines through the search's own filter; the proofs must
+    stop every one (their counterexamples join the samples) and what comes back is still right."""
+    import retro.optimize.optimizer as optimizer
+    real = optimizer.sample_cases
+    monkeypatch.setattr(optimizer, "sample_cases", lambda routine, seed, memory: real(routine, seed, memory, size=4))
+    routine = load_spec(EXAMPLES / "umax.toml")
+    outcome = optimize(routine, Options(budget=8, seed=5))
+    assert outcome.failed_proofs >= 1 and outcome.counterexamples == outcome.failed_proofs
+    check = check_routine(replace(routine, program=outcome.program), exhaustive=True, search_budget=0)
+    assert not failed([check])
+
+
 # ---- results ----------------------------------------------------------------------------------------
 
 def test_the_wasteful_routine_loses_its_waste(tmp_path):
