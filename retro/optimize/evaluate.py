@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from retro.analysis.check.reference import reference_answers
+from retro.errors import InputError
 from retro.routines import cases as case_sets
 from retro.routines.entry import variant_values
 from retro.routines.places import Port
@@ -141,6 +142,9 @@ def sample_cases(routine: Routine, seed: int, memory: dict, size: int = SAMPLE) 
                 break
         if count >= size:
             break
+    if not count:
+        raise InputError(f"{routine.shown_path or routine.spec_path}: cases: no case inside the domain has an answer "
+                         "from the reference: nothing to search against")
     columns = [np.concatenate([t[0][k] for t in taken]) for k in range(len(routine.inputs))]
     expected = [np.concatenate([t[1][k] for t in taken]) for k in range(len(routine.outputs))]
     return Samples(columns, np.arange(count, dtype=np.int64), expected)

@@ -143,7 +143,10 @@ class Search:
         self.routine, self.options = routine, options
         self.progress = progress or (lambda line: None)
         self.seed = routine.seed if options.seed is None else options.seed
-        self.listing = read_listing(routine.program, routine.entry_address, routine.cpu)
+        try:
+            self.listing = read_listing(routine.program, routine.entry_address, routine.cpu)
+        except InputError as exc:
+            raise InputError(f"{routine.shown_path or routine.spec_path}: program: {exc}") from None
         self.size = code_bytes(self.listing)
         original = assemble(self.listing, routine.cpu)
         start = routine.entry_address - routine.program.origin

@@ -298,3 +298,16 @@ def test_sources_assemble_back_with_the_real_assembler(tmp_path, syntax, case):
                           capture_output=True, text=True, cwd=tmp_path, timeout=60)
     assert done.returncode == 0, done.stdout + done.stderr
     assert out.read_bytes() == assemble(listing)
+
+
+def test_code_that_is_not_one_block_is_one_line_exit_2(tmp_path, capsys):
+    source = tmp_path / "gap.s"
+    source.write_text("        .org $c000\ngap:    lda b_val\n        bne skip\n        .byte $ff\nskip:   rts\n"
+                      "b_val:  .byte 0\n")
+    spec = tmp_path / "gap.toml"
+    spec.write_text((EXAMPLES / "copy_b.toml").read_text().replace('file = "copy_b.s"', 'file = "gap.s"')
+                    .replace('entry = "copy_b"', 'entry = "gap"')
+                    .replace('"refs.py:copy_b"', f'"{EXAMPLES / "refs.py"}:copy_b"'))
+    code = cli_main(["optimize", str(spec), "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "gap.toml: program:" in err and "not one block" in err and "\n" not in err
