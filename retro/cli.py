@@ -12,12 +12,13 @@ import argparse
 import sys
 
 from retro import __version__, interrupts
-from retro.commands import advise, asm, chart, check, cycles, demo, nes, parry, profile, run, stability, vic
+from retro.commands import advise, asm, chart, check, cycles, demo, nes, optimize, parry, profile, run, stability, vic
 from retro.errors import RetroError
 
 # In the order `retro --help` lists them.
 COMMANDS = {"demo": demo, "asm": asm, "run": run, "vic": vic, "nes": nes, "check": check, "cycles": cycles,
-            "chart": chart, "stability": stability, "advise": advise, "parry": parry, "profile": profile}
+            "chart": chart, "stability": stability, "advise": advise, "parry": parry, "profile": profile,
+            "optimize": optimize}
 
 
 def one_line(text: str) -> str:

@@ -365,6 +365,17 @@ MUTANTS = [
            "    if high >= 0xA0:", "    if high > 0xA0:", COMPILED_TESTS),
     Mutant("compiled-store-into-code-trusted", "retro/cpu/translate.py",
            'self.put("bad |= code_map[t]")', 'self.put("bad |= 0")', COMPILED_TESTS),
+    # ---- the superoptimiser (retro/optimize/) ------------------------------------------------------
+    Mutant("optimize-free-registers-zero", "retro/optimize/evaluate.py",
+           "                entry = (registers, bits, state.free_mask)", "                entry = None",
+           ("tests/optimize/test_optimize.py::test_a_candidate_relying_on_x_zero_at_entry_is_rejected",)),
+    Mutant("optimize-proof-ignores-cycles", "retro/optimize/evaluate.py",
+           " & (base.cycles == varied.cycles)", "",
+           ("tests/optimize/test_optimize.py::test_a_candidate_whose_cycles_depend_on_the_free_carry_is_rejected",)),
+    Mutant("optimize-rts-keeps-everything-live", "retro/optimize/effects.py",
+           "            if name == \"RTS\":\n                incoming = out\n",
+           "            if name == \"RTS\":\n                incoming = everything\n",
+           ("tests/optimize/test_optimize.py::test_liveness_frees_what_the_routine_overwrites_and_keeps_the_outputs",)),
 ]
 
 

@@ -18,7 +18,8 @@ from retro.commands import advise, asm, chart, demo, nes, parry, run, stability,
 from retro.errors import InputError
 from retro.paths import ASM_DIR, EXAMPLES_DIR
 
-COMMANDS = ("demo", "asm", "run", "vic", "nes", "check", "cycles", "chart", "stability", "advise", "parry", "profile")
+COMMANDS = ("demo", "asm", "run", "vic", "nes", "check", "cycles", "chart", "stability", "advise", "parry", "profile",
+            "optimize")
 
 
 def subparsers() -> dict:

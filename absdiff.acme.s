@@ -1,0 +1,10 @@
+m = $FB
+        * = $C000
+absdiff
+        sec
+        sbc m
+        bcs done
+        eor #$FF
+        adc #$01
+done
+        rts

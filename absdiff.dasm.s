@@ -1,0 +1,11 @@
+m equ $FB
+        processor 6502
+        org $C000
+absdiff
+        sec
+        sbc m
+        bcs done
+        eor #$FF
+        adc #$01
+done
+        rts

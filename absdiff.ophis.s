@@ -1,0 +1,10 @@
+.alias m $FB
+        .org $C000
+absdiff:
+        sec
+        sbc m
+        bcs done
+        eor #$FF
+        adc #$01
+done:
+        rts

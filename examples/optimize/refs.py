@@ -1,0 +1,25 @@
+"""References of the superoptimiser's examples (docs/optimize.md): what each routine must compute."""
+
+
+def umax(a, m):
+    return max(a, m)
+
+
+def absdiff(a, m):
+    return abs(a - m)
+
+
+def clamp(a):
+    return min(a, 199)
+
+
+def overlap8(a, b):
+    return int(abs(a - b) >= 8)  # the carry: set when two 8-pixel spans miss
+
+
+def sum_x(a, b):
+    return (a + b) & 0xFF
+
+
+def copy_b(b):
+    return b

@@ -1,0 +1,19 @@
+sum_lo equ $10
+sum_hi equ $13
+dif_lo equ $15
+dif_hi equ $17
+        processor 6502
+        org $C000
+mul8
+        sta sum_lo
+        sta sum_hi
+        eor #$FF
+        sta dif_lo
+        sta dif_hi
+        sec
+        lda (sum_lo),y
+        sbc (dif_lo),y
+        tax
+        lda (sum_hi),y
+        sbc (dif_hi),y
+        rts

@@ -1,0 +1,10 @@
+.label b_val = $C00C
+.label temp = $C00D
+        * = $C000
+wasteful:
+        stx temp
+        lda temp
+        clc
+        clc
+        adc b_val
+        rts

@@ -1,0 +1,10 @@
+.alias b_val $C00C
+.alias temp $C00D
+        .org $C000
+wasteful:
+        stx temp
+        lda temp
+        clc
+        clc
+        adc b_val
+        rts
