@@ -193,3 +193,14 @@ def test_profile_of_a_specs_cases_on_a_nes_scene_counts_oam_dma(tmp_path, capsys
     assert report["stolen"] == 3 * 514
     # each call from scanline 10: 526 cycles x 3 dots = 1,578 dots, scanlines 10-14
     assert routine["lines"] == [[10, 14]]
+
+
+def test_profile_of_a_specs_cases_counts_each_calls_lines_from_its_own_start(capsys):
+    # the same rule on a C64 scene: 50 calls of aabb8 (20-34 cycles, none stolen), each restarted at
+    # raster line 250 cycle 1, all end within that 63-cycle line (the beam was once read from the first
+    # call's start: the later calls' lines ran on from it, 0-20)
+    code = main(["profile", "aabb8", "--cases", "50", "--scene", str(ROOT / "examples" / "vic_two_balls.toml"),
+                 "--at-line", "250", "--json"])
+    (routine,) = json.loads(capsys.readouterr().out)["routines"]
+    assert code == 0 and routine["calls"] == 50 and routine["max"] <= 34 and routine["stolen"] == 0
+    assert routine["lines"] == [[250, 250]]
