@@ -76,6 +76,20 @@ def test_an_nmi_handlers_vblank_budget_is_the_ntsc_vblank_less_the_flags_dot(tmp
     assert code == 0 and row["vblank"]["budget"] == 2273 and row["max"] == row["min"] == 540
 
 
+def test_on_pal_the_vblank_is_70_scanlines_at_3_2_dots_a_cycle(tmp_path, capsys):
+    # PAL (2C07): 312 scanlines, pre-render 311, 3.2 dots a CPU cycle. The sequence begins at the first
+    # cycle at or after the handler's (82,182 + 7 x 3.2 = 82,204.4 dots -> cycle 25,689) less 7: 25,682,
+    # dot floor(82,182.4) = 82,182, scanline 241 dot 1. To dot 311 x 341 = 106,051: 23,869 dots / 3.2 =
+    # 7,459 cycles. The write in call cycle 15 is frame cycle 25,697, odd: 514; 540 in all, 6,919 left.
+    spec = _spec(tmp_path, "nmi", NMI_HANDLER, extra='interrupt = "nmi"\n')
+    scene = tmp_path / "pal.toml"
+    scene.write_text('chip = "nes"\nvideo = "pal"\n[[oam]]\ny = 100\ntile = 0\nx = 100\n')
+    code, (record,) = _json(capsys, "cycles", spec, "--scene", str(scene), "--in-nmi", *FAST)
+    assert code == 0 and record["vblank"] == {"budget": 7459, "best_left": 6919, "worst_left": 6919,
+                                              "oam_dma_max": 514}
+    assert (record["raster"]["scene"]["start_line"], record["raster"]["scene"]["start_dot"]) == (241, 1)
+
+
 def test_a_handler_called_by_jsr_in_the_nmi_has_the_sequences_cycles_less(tmp_path, capsys):
     # Called as by JSR (as `retro run --in-nmi` does) its first cycle follows the sequence: 27,401,
     # scanline 241 dot 22; 89,001 - 82,203 = 6,798 dots = 2,266 cycles. CLC/ADC #1/RTS: 2 + 2 + 6 = 10.
