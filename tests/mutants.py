@@ -47,6 +47,7 @@ CHECK_TESTS = ("tests/routines/test_user_specs.py", "tests/routines/test_routine
                "tests/routines/test_routines_exhaustive.py")
 TIMELINE_TESTS = ("tests/vic", "tests/cpu/test_machine.py")
 NES_TESTS = ("tests/cpu/test_machine.py", "tests/nes")
+NES_SCENE_TESTS = ("tests/nes/test_nes_scene_check.py",)
 BUDGET_TESTS = ("tests/vic", "tests/test_machines.py", "tests/test_commands.py")
 STABILITY_TESTS = ("tests/study/test_stability_pinned.py", "tests/study/test_stability_report_pinned.py",
                    "tests/study/test_study_cli.py")
@@ -290,6 +291,23 @@ MUTANTS = [
            "if self.vblank and value & CTRL_NMI and not enabled:", "if False:", NES_TESTS),
     Mutant("nes-nmi-edge-seen-by-the-writes-own-poll", "retro/chips/ppu/device.py",
            "self.nmi_next = self.nmi_edge_cycle  #", "self.nmi_next = -NEVER  #", NES_TESTS),
+    # ---- NES scenes in check/cycles/run/profile (retro/machines/nes.py, retro/routines/chip_access.py) --
+    Mutant("nes-dma-parity-of-the-machine-clock", "retro/chips/ppu/device.py",
+           "(OAM_DMA_ODD_EXTRA if (cycle - self.origin) % 2 else 0)", "(OAM_DMA_ODD_EXTRA if cycle % 2 else 0)",
+           NES_SCENE_TESTS),
+    Mutant("nes-nmi-entry-without-the-sequence", "retro/machines/nes.py",
+           "handler.cycle - (INTERRUPT_CYCLES if sequence_counted else 0)", "handler.cycle", NES_SCENE_TESTS),
+    Mutant("nes-batch-ignores-the-nmi", "retro/routines/chip_access.py",
+           "if to_nmi is not None and limit >= to_nmi:", "if False:", NES_SCENE_TESTS),
+    Mutant("nes-entry-frame-not-drawn", "retro/machines/nes.py",
+           "    ppu.advance(ppu.dot_of(machine.cycle))\n    ppu.nmi_pending = False",
+           "    ppu.nmi_pending = False", NES_SCENE_TESTS),
+    Mutant("nes-budget-from-the-frame-start", "retro/machines/nes.py",
+           "(rendering - begins) * ratio.denominator // ratio.numerator, in_nmi)",
+           "rendering * ratio.denominator // ratio.numerator, in_nmi)", NES_SCENE_TESTS),
+    Mutant("nes-calls-not-restarted", "retro/routines/chip_access.py",
+           "        self.ppu.restore(self._snapshot, self.machine.cycle - self.entry.cycle)", "        pass",
+           NES_SCENE_TESTS),
     # ---- the raster budget (retro/machines/c64.py) -------------------------------------------------
     Mutant("budget-end-a-cycle-late", "retro/machines/c64.py",
            "position(video, device.time(start + cycles - 1))", "position(video, device.time(start + cycles))",

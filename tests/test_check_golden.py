@@ -23,7 +23,7 @@ CASES = golden.cases()
 # fails the test unless it is named here; every recorded key must still be there with its value).
 ADDED_KEYS: set[str] = {"code_coverage", "search", "bounds_reached", "engine_note", "entry_dependence", "random_draw",
                         "engine_reason", "compile_seconds", "compiled_fallbacks", "table_blocks", "cpu_min", "cpu_max",
-                        "static_modified"}
+                        "static_modified", "vblank"}
 
 
 def test_every_case_has_a_golden_file_and_no_file_is_stale():

@@ -7,7 +7,7 @@ import inspect
 import math
 from pathlib import Path
 
-from retro.analysis.check import RoutineCheck, SceneStart, inputs_by_name, run_checks
+from retro.analysis.check import RoutineCheck, inputs_by_name, run_checks
 from retro.analysis.check.coverage import coverage_line, coverage_record, summary
 from retro.analysis.check.entry_runs import VARIANTS
 from retro.analysis.check.results import describe_case, describe_outputs, entry_needs
@@ -16,7 +16,7 @@ from retro.analysis.junit import junit_xml
 from retro.analysis.raster import format_raster, raster_figures
 from retro.analysis.row_check import rows_lines, rows_record
 from retro.errors import InputError
-from retro.fileio import command_files, file_option, output_folder, read_text, write_all_atomic, write_atomic
+from retro.fileio import command_files, output_folder, read_text, write_all_atomic, write_atomic
 from retro.loaders.source_lines import has_line_information, read_source_map
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
@@ -26,7 +26,9 @@ from retro.reports.lcov import lcov_text
 from retro.reports.listing import listing_text
 from retro.routines import cases as case_sets
 from retro.routines.entry import EntryState
-from retro.routines.chip_access import FREE_REASON
+from retro.chips.ppu.constants import DOTS_PER_LINE
+from retro.machines.nes import position_after
+from retro.routines.chip_access import FREE_REASON, NesStart
 from retro.workers import MAX_WORKERS
 import argparse
 from retro.analysis.check import AGREEMENT_PER_PART, AUTO_BATCH_CASES
@@ -38,8 +40,6 @@ from retro.routines.spec import MAX_SEARCH
 
 MAX_RANDOM = 10 ** 9
 MAX_JOBS = MAX_WORKERS
-MAX_AT_LINE = 1000  # above every chip's line count: the scene's chip gives the exact range
-MAX_AT_CYCLE = 100
 JSON_EXACT = 1 << 53  # larger whole numbers lose digits in JSON readers that use doubles
 
 
@@ -47,27 +47,20 @@ def check(routines: list[str] | None = None, *, exhaustive: bool = False, seed: 
           random: int | str | None = None, jobs: int | str | None = None, scene: str | Path | None = None,
           at_line: int | str | None = None, at_cycle: int | str | None = None, engine: str = "auto",
           progress: Progress = quiet, bounded_product: int = case_sets.BOUNDED_PRODUCT,
-          search: int | str | None = None) -> list[RoutineCheck]:
+          search: int | str | None = None, at_dot: int | str | None = None, in_nmi: bool = False
+          ) -> list[RoutineCheck]:
     """Check each routine (all built-ins when none is named). `random`: random cases per routine
     (default: the spec's count, bounded without `exhaustive`); `scene` runs every call on a C64 with
-    that VIC-II scene from `at_line`/`at_cycle` (default: the scene's [cpu] start); `search`: candidates
+    that VIC-II scene from `at_line`/`at_cycle` (default: the scene's [cpu] start), or on a NES with that
+    NES scene from scanline `at_line`, dot `at_dot` (default 0, 0), or `in_nmi` as the NMI handler; `search`: candidates
     of the coverage-guided search (default: the spec's `[cases] search`, else 4,096; 0: none)."""
     return run_checks(
         routines, exhaustive=exhaustive,
         seed=None if seed is None else parse_int(seed, field="--seed", lo=0, hi=2 ** 63 - 1),
         random_count=None if random is None else parse_int(random, field="--random", lo=0, hi=MAX_RANDOM),
         jobs=None if jobs is None else parse_int(jobs, field="--jobs", lo=1, hi=MAX_JOBS),
-        progress=progress, start=scene_start(scene, at_line, at_cycle), bounded_product=bounded_product, engine=engine,
+        progress=progress, start=options.scene_start(scene, at_line, at_cycle, at_dot, in_nmi), bounded_product=bounded_product, engine=engine,
         search_budget=None if search is None else parse_int(search, field="--search", lo=0, hi=MAX_SEARCH))
-
-
-def scene_start(scene: str | Path | None, at_line: int | str | None, at_cycle: int | str | None) -> SceneStart | None:
-    if file_option(scene, "--scene") is None:
-        if at_line is not None or at_cycle is not None:
-            raise InputError("--at-line and --at-cycle go with --scene")
-        return None
-    return SceneStart(str(scene), None if at_line is None else parse_int(at_line, field="--at-line", lo=0, hi=MAX_AT_LINE),
-                      None if at_cycle is None else parse_int(at_cycle, field="--at-cycle", lo=1, hi=MAX_AT_CYCLE))
 
 
 def failed(checks: list[RoutineCheck]) -> bool:
@@ -108,7 +101,7 @@ def cycle_figures(check: RoutineCheck) -> dict:
             "static_max": check.static.worst if check.static else None,
             "min_inputs": inputs_by_name(routine, t.min_case) if t.min_case is not None else None,
             "max_inputs": inputs_by_name(routine, t.max_case) if t.max_case is not None else None,
-            "budget": routine.budget,
+            "budget": routine.budget, "vblank": vblank_record(check),
             "raster": {**raster_figures(routine.machine, t.cycles_min, check.mean if t.cycles_count else None,
                                         t.cycles_max), **scene_raster(check)}}
 
@@ -120,6 +113,8 @@ def scene_raster(check: RoutineCheck) -> dict:
     t = check.totals
     if start is None or not t.cycles_count:
         return {}
+    if isinstance(start, NesStart):
+        return {"scene": nes_scene_raster(check)}
     video = start.scene.state.video
     per_line = video.cycles_per_line
     last = start.line * per_line + start.cycle - 1 + t.cycles_max - 1
@@ -129,6 +124,33 @@ def scene_raster(check: RoutineCheck) -> dict:
                       "min_lines": round(t.cycles_min / per_line, 3), "mean_lines": round(check.mean / per_line, 3),
                       "max_lines": round(t.cycles_max / per_line, 3), "stolen_max": t.stolen_max,
                       "slowest_end_line": end_line, "slowest_end_cycle": end_cycle + 1, "frames_crossed": frames}}
+
+
+def nes_scene_raster(check: RoutineCheck) -> dict:
+    """The calls on a NES scene's frame: where they start (scanline, dot, or the NMI), scanlines taken
+    (341 dots each), the most cycles OAM DMA held the CPU, and where the slowest returned."""
+    start, t = check.start, check.totals
+    video = start.scene.video
+    entry = start.entry(check.routine.world.enter)
+    per_line = DOTS_PER_LINE / video.dots_per_cpu_cycle
+    end_line, end_dot, frames = position_after(video, entry, t.cycles_max)
+    return {"chip": "ppu", "video": video.name, "start_line": entry.line, "start_dot": entry.dot,
+            "in_nmi": entry.in_nmi, "min_lines": round(float(t.cycles_min / per_line), 3),
+            "mean_lines": round(float(check.mean / per_line), 3), "max_lines": round(float(t.cycles_max / per_line), 3),
+            "stolen_max": t.stolen_max, "slowest_end_line": end_line, "slowest_end_dot": end_dot,
+            "frames_crossed": frames}
+
+
+def vblank_record(check: RoutineCheck) -> dict | None:
+    """With a NES scene: the CPU cycles from the calls' start to the pre-render line (where rendering
+    starts: the vblank budget of a call entered in vblank) and what the fastest and slowest call
+    leave of them (negative: it ran into rendering), OAM DMA counted. None otherwise."""
+    start, t = check.start, check.totals
+    if not isinstance(start, NesStart) or not t.cycles_count:
+        return None
+    budget = start.entry(check.routine.world.enter).rendering_cycles
+    return {"budget": budget, "best_left": budget - t.cycles_min, "worst_left": budget - t.cycles_max,
+            "oam_dma_max": t.stolen_max}
 
 
 def check_record(check: RoutineCheck) -> dict:
@@ -386,12 +408,26 @@ def _cycle_lines(check: RoutineCheck) -> list[str]:
     if raster:
         lines.append(f"  raster (CPU never stalled): {raster}")
     scene = scene_raster(check).get("scene")
-    if scene:
+    if scene and scene["chip"] == "ppu":
+        lines += _nes_scene_lines(check, scene)
+    elif scene:
         lines.append(f"  on the scene from line {scene['start_line']} cycle {scene['start_cycle']} ({scene['chip']}): "
                      f"{scene['min_lines']:.2f}-{scene['max_lines']:.2f} lines, up to {scene['stolen_max']} cycles "
                      f"stolen; the slowest ends at line {scene['slowest_end_line']} cycle {scene['slowest_end_cycle']}"
                      + (f" {scene['frames_crossed']} frame(s) later" if scene["frames_crossed"] else ""))
     return lines
+
+
+def _nes_scene_lines(check: RoutineCheck, scene: dict) -> list[str]:
+    where = ("the NMI handler's start, " if scene["in_nmi"] else "") + f"scanline {scene['start_line']} dot {scene['start_dot']}"
+    v = vblank_record(check)
+    return [f"  on the NES scene ({scene['video'].upper()}) from {where}: {scene['min_lines']:.2f}-{scene['max_lines']:.2f} "
+            f"scanlines, up to {scene['stolen_max']} cycles of OAM DMA; the slowest returns at scanline "
+            f"{scene['slowest_end_line']} dot {scene['slowest_end_dot']}"
+            + (f" {scene['frames_crossed']} frame(s) later" if scene["frames_crossed"] else ""),
+            f"  vblank budget: {v['budget']} cycles from the start to the pre-render line (rendering starts); the "
+            f"fastest call leaves {v['best_left']}, the slowest {v['worst_left']}"
+            + (" (it runs into rendering)" if v["worst_left"] < 0 else "")]
 
 
 def bounds_reached(check: RoutineCheck) -> dict | None:
@@ -560,11 +596,10 @@ def routine_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--random", metavar="N",
                    help="random cases per routine (default: the spec's count, at most 2,000 without --exhaustive)")
     options.jobs(p, None)
-    p.add_argument("--scene", metavar="SCENE.toml", help="run every call on a C64 with this VIC-II scene: the CPU "
-                   "stalls on Bad Lines and sprite DMA, and the report gives raster lines from the start line")
-    p.add_argument("--at-line", metavar="L", help="with --scene: the raster line each call starts at "
-                   "(default: the scene's [cpu] start_line)")
-    p.add_argument("--at-cycle", metavar="C", help="with --scene: the cycle in that line (default: the scene's)")
+    p.add_argument("--scene", metavar="SCENE.toml", help="run every call on a C64 with this VIC-II scene (the CPU "
+                   "stalls on Bad Lines and sprite DMA) or on a NES with this NES scene (OAM DMA stalls it; the report "
+                   "gives the cycles left before rendering starts); the report gives the lines from the start")
+    options.scene_entry(p)
     options.engine(p, f"; scalar is the reference and the timing model checks every call, batch and compiled are "
                       f"checked against Machine on the first {AGREEMENT_PER_PART:,} cases of each part, auto takes "
                       f"batch from {AUTO_BATCH_CASES:,} cases and compiled from {AUTO_COMPILED_CASES:,}")
@@ -580,7 +615,8 @@ def routine_options(p: argparse.ArgumentParser) -> None:
 def checks_of(args: argparse.Namespace) -> list[RoutineCheck]:
     """The run `retro check` and `retro cycles` both show, from the options `routine_options` defines."""
     return check(args.routines, exhaustive=args.exhaustive, seed=args.seed, random=args.random, jobs=args.jobs,
-                 scene=args.scene, at_line=args.at_line, at_cycle=args.at_cycle, engine=args.engine,
+                 scene=args.scene, at_line=args.at_line, at_cycle=args.at_cycle, at_dot=args.at_dot,
+                 in_nmi=args.in_nmi, engine=args.engine,
                  progress=progress_printer(args.quiet), search=args.search)
 
 

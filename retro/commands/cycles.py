@@ -28,7 +28,7 @@ def lines(checks: list[RoutineCheck]) -> list[str]:
 # ---- the cost table: bytes, measured and static cycles, cases and mismatches ------------------------
 
 COST_FIELDS = ("routine", "code_bytes", "table_bytes", "table_blocks", "min", "mean", "max", "static_min", "static_max",
-               "cases", "mismatches", "min_inputs", "max_inputs", "budget", "raster")
+               "cases", "mismatches", "min_inputs", "max_inputs", "budget", "vblank", "raster")
 
 # Issue 5's targets: (statistic, cycles). The statistic is "max" (worst case) or "mean".
 TARGETS: dict[str, tuple[str, int]] = {"aabb8": ("max", 30), "aabb_sprite": ("max", 45), "circle": ("max", 65),

@@ -8,10 +8,14 @@ from __future__ import annotations
 import argparse
 import json
 from collections.abc import Callable, Iterable
+from pathlib import Path
 
 from retro.analysis.c64_run import DEFAULT_C64_FRAMES
-from retro.analysis.check import ENGINES
+from retro.analysis.check import ENGINES, SceneStart
 from retro.analysis.console_run import DEFAULT_FRAMES, MAX_FRAMES
+from retro.errors import InputError
+from retro.fileio import file_option
+from retro.numbers import parse_int
 from retro.workers import MAX_WORKERS
 
 
@@ -82,3 +86,57 @@ def program_run(p: argparse.ArgumentParser) -> None:
                        f"halts (JMP * with no interrupt to come)")
     group.add_argument("--until", metavar="LABEL|ADDR", help="program run: stop when the PC reaches this address")
     group.add_argument("--until-value", metavar="TARGET=V", help="program run: stop when this byte holds V")
+def scene_entry(p: argparse.ArgumentParser, what: str = "each call") -> None:
+    """Where `what` starts on a --scene's frame: --at-line with --at-cycle (a VIC-II scene) or --at-dot
+    (a NES scene), or --in-nmi (a NES scene: as the NMI handler); checked against the scene's chip."""
+    p.add_argument("--at-line", metavar="L", help=f"with --scene: the raster line (a NES scene: the scanline) {what} "
+                   "starts at (default: a VIC-II scene's [cpu] start_line; a NES scene's line 0)")
+    p.add_argument("--at-cycle", metavar="C", help="with a VIC-II --scene: the cycle in that line (default: the scene's)")
+    p.add_argument("--at-dot", metavar="D", help="with a NES --scene: the dot in that scanline, 0-340 (default 0); "
+                   f"{what} starts at the first CPU cycle beginning at or after it")
+    p.add_argument("--in-nmi", action="store_true", help=f"with a NES --scene: {what} is the NMI handler, entered at "
+                   "the start of vblank (scanline 241, the vblank flag set), and the report gives the vblank cycles "
+                   "left before rendering starts (OAM DMA counted)")
+
+
+MAX_AT = 1000  # above every chip's line, cycle and dot count: the scene's chip gives the exact range
+NEEDS_NES = "needs a NES scene (--scene with chip = \"nes\")"
+
+
+def scene_start(scene: str | Path | None, at_line: int | str | None = None, at_cycle: int | str | None = None,
+                at_dot: int | str | None = None, in_nmi: bool = False) -> SceneStart | None:
+    """--scene and the `scene_entry` options as a SceneStart (None without a scene), every option
+    checked against the scene's chip before any work starts (one-line errors)."""
+    nes_only = [name for name, given in (("--at-dot", at_dot is not None), ("--in-nmi", in_nmi)) if given]
+    if file_option(scene, "--scene") is None:
+        if nes_only:
+            raise InputError(f"{nes_only[0]}: {NEEDS_NES}")
+        if at_line is not None or at_cycle is not None:
+            raise InputError("--at-line and --at-cycle go with --scene")
+        return None
+    start = SceneStart(str(scene), None if at_line is None else parse_int(at_line, field="--at-line", lo=0, hi=MAX_AT),
+                       None if at_cycle is None else parse_int(at_cycle, field="--at-cycle", lo=1, hi=MAX_AT),
+                       None if at_dot is None else parse_int(at_dot, field="--at-dot", lo=0, hi=MAX_AT), in_nmi)
+    start.raster_start()
+    return start
+
+
+def call_machine(start: SceneStart | None, cpu: str | None):
+    """The machine one call runs on (`retro run --entry`, `retro profile --entry`): a bare CPU without
+    a scene; with one, its chip where `start` puts the call: a VIC-II's beam at --at-line/--at-cycle
+    (default: the scene's [cpu] start), a NES's PPU at --at-line/--at-dot or the NMI handler's start
+    with the frame drawn so far. Returns (machine, the RasterStart/NesStart or None)."""
+    from dataclasses import replace
+
+    from retro.machines import build_machine
+    from retro.machines.nes import enter_frame
+    from retro.routines.chip_access import NesStart
+
+    if start is None:
+        return build_machine(None, cpu=cpu), None
+    where = start.raster_start()
+    if isinstance(where, NesStart):
+        machine = build_machine(where.scene, cpu=cpu)
+        enter_frame(machine, where.entry("jsr"))
+        return machine, where
+    return build_machine(replace(where.scene, start_line=where.line, start_cycle=where.cycle), cpu=cpu), where

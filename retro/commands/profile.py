@@ -47,10 +47,15 @@ class ProfileReport:
         return options.png_of(profile_image(self.profile))
 
 
+def _beam_of(machine):
+    """The machine's beam as its chip's clock stands now (None without a chip)."""
+    vic, ppu = vic_of(machine), ppu_of(machine)
+    return vic_beam(vic) if vic is not None else ppu_beam(ppu) if ppu is not None else None
+
+
 def _profiler_for(machine, inner=None) -> Profiler:
     vic, ppu = vic_of(machine), ppu_of(machine)
-    beam = vic_beam(vic) if vic is not None else ppu_beam(ppu) if ppu is not None else None
-    return Profiler(machine.mpu, beam=beam, inner=inner, nes=ppu is not None,
+    return Profiler(machine.mpu, beam=_beam_of(machine), inner=inner, nes=ppu is not None,
                     stubs=frozenset({KERNAL_IRQ_ENTRY}) if vic is not None else frozenset())
 
 
@@ -92,14 +97,12 @@ def _program_run(target, *, entry, frames, until, until_value, labels, load, sce
     return ProfileReport(profile, ran)
 
 
-def _call(target, *, entry, labels, load, scene, budget) -> ProfileReport:
+def _call(target, *, entry, labels, load, start, budget) -> ProfileReport:
     """A handler or routine called as by JSR (retro run --entry's machine), profiled."""
     from retro.loaders import load_program
-    from retro.machines import build_machine
-    from retro.scenes import load_scene
 
     program = load_program(target, symbols=file_option(labels, "--labels"), load=load)
-    machine = build_machine(None if scene is None else load_scene(scene), cpu=program.cpu)
+    machine, _ = options.call_machine(start, program.cpu)
     machine.load(program)
     address = machine.resolve(entry, "--entry")
     profiler = _profiler_for(machine)
@@ -110,15 +113,14 @@ def _call(target, *, entry, labels, load, scene, budget) -> ProfileReport:
     return ProfileReport(profile, result)
 
 
-def _cases(target, *, scene, at_line, at_cycle, cases, seed) -> ProfileReport:
+def _cases(target, *, start, cases, seed) -> ProfileReport:
     """The first `cases` planned cases of a routine spec, each called on Machine, profiled together."""
-    from retro.analysis.check.engines import SceneStart
     from retro.routines import cases as case_sets
     from retro.routines.registry import get
     from retro.routines.runner import RoutineRunner
 
     routine = get(str(target))
-    start = None if scene is None else SceneStart(str(scene), at_line, at_cycle).raster_start()
+    start = None if start is None else start.raster_start()
     seed = routine.seed if seed is None else parse_int(seed, field="--seed", lo=0, hi=2**32 - 1)
     runner = RoutineRunner(routine, seed, start)
     machine = runner.machine
@@ -129,8 +131,9 @@ def _cases(target, *, scene, at_line, at_cycle, cases, seed) -> ProfileReport:
             if done >= cases:
                 break
             writes, registers, p = runner.inputs_for_call(case)
-            if runner.vic is not None:
+            if runner.start is not None:
                 runner.restart_beam()
+                profiler.beam = _beam_of(machine)  # each call's own start on the frame
             profiler.enter(runner.entry, sp=CALL_STACK_TOP)
             machine.call(runner.entry, **registers, p=p, memory={address: [v] for address, v in writes},
                          budget=runner.limit, observer=profiler)
@@ -145,8 +148,8 @@ def profile(target: str | Path, *, entry: str | None = None, frames: int | str |
             until: str | None = None, until_value: str | None = None, labels: str | Path | None = None,
             load: str | None = None, scene: str | Path | None = None, at_line: int | str | None = None,
             at_cycle: int | str | None = None, cases: int | str = DEFAULT_CASES, seed: int | str | None = None,
-            budget: int | str = DEFAULT_BUDGET, png: str | Path | None = None, frame: int | str | None = None
-            ) -> ProfileReport:
+            budget: int | str = DEFAULT_BUDGET, png: str | Path | None = None, frame: int | str | None = None,
+            at_dot: int | str | None = None, in_nmi: bool = False) -> ProfileReport:
     """Profile `target` (module docstring); `png` writes the picture of frame `frame` (default: the
     last frame the run covered whole)."""
     file_option(png, "--png")
@@ -157,14 +160,16 @@ def profile(target: str | Path, *, entry: str | None = None, frames: int | str |
         if any(v is not None for v in (entry, frames, until, until_value, labels, load)):
             raise InputError("--entry, --frames, --until, --until-value, --labels, --load: not for a routine spec "
                              "(its cases are called as the spec says)")
-        line = None if at_line is None else parse_int(at_line, field="--at-line", lo=0, hi=999)
-        cycle = None if at_cycle is None else parse_int(at_cycle, field="--at-cycle", lo=1, hi=100)
-        if scene is None and (line is not None or cycle is not None):
-            raise InputError("--at-line and --at-cycle go with --scene")
-        report = _cases(target, scene=scene, at_line=line, at_cycle=cycle, cases=cases, seed=seed)
+        report = _cases(target, start=options.scene_start(scene, at_line, at_cycle, at_dot, in_nmi), cases=cases,
+                        seed=seed)
     elif entry is not None and frames is None and until is None and until_value is None:
-        report = _call(target, entry=entry, labels=labels, load=load, scene=scene, budget=budget)
+        report = _call(target, entry=entry, labels=labels, load=load, budget=budget,
+                       start=options.scene_start(scene, at_line, at_cycle, at_dot, in_nmi))
     else:
+        given = [name for name, value in (("--at-line", at_line), ("--at-cycle", at_cycle), ("--at-dot", at_dot),
+                                          ("--in-nmi", in_nmi or None)) if value is not None]
+        if given:
+            raise InputError(f"{', '.join(given)}: where a spec's cases or a call (--entry) start, not for a program run")
         report = _program_run(target, entry=entry, frames=frames, until=until, until_value=until_value,
                               labels=labels, load=load, scene=scene)
     if png is not None:
@@ -227,9 +232,9 @@ def add_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--entry", metavar="LABEL|ADDR", help="call this routine or handler (as by JSR); with --frames, "
                    "--until or --until-value: run a C64 program from here")
     options.program_run(p)
-    p.add_argument("--scene", metavar="SCENE.toml", help="a VIC-II scene (a C64 program run, a call, a spec's cases)")
-    p.add_argument("--at-line", metavar="L", help="spec: the raster line every call starts at (with --scene)")
-    p.add_argument("--at-cycle", metavar="C", help="spec: the cycle in that line (with --scene)")
+    p.add_argument("--scene", metavar="SCENE.toml", help="a VIC-II scene (a C64 program run, a call, a spec's cases) "
+                   "or a NES scene (a call, a spec's cases)")
+    options.scene_entry(p, "a call (a spec: every call)")
     p.add_argument("--cases", default=str(DEFAULT_CASES), metavar="N",
                    help=f"spec: how many of its planned cases to run (default {DEFAULT_CASES:,})")
     p.add_argument("--seed", metavar="S", help="spec: the seed of its random cases")
@@ -242,7 +247,8 @@ def add_options(p: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     report = profile(args.target, entry=args.entry, frames=args.frames, until=args.until,
                      until_value=args.until_value, labels=args.labels, load=args.load, scene=args.scene,
-                     at_line=args.at_line, at_cycle=args.at_cycle, cases=args.cases, seed=args.seed,
+                     at_line=args.at_line, at_cycle=args.at_cycle, at_dot=args.at_dot, in_nmi=args.in_nmi,
+                     cases=args.cases, seed=args.seed,
                      budget=args.budget, png=args.png, frame=args.frame)
     options.show(lines, as_json if args.json else None, report)
     return 0

@@ -23,9 +23,8 @@ from retro.fileio import file_option, read_bytes
 from retro.loaders import load_program
 from retro.loaders.basic_stub import sys_line
 from retro.numbers import parse_int
-from retro.machines import build_machine
 from retro.machines.c64 import RasterBudget, call_budget, vic_of
-from retro.machines.nes import enter_nmi, ppu_of, vblank_budget
+from retro.machines.nes import ppu_of, vblank_budget
 from retro.program import Program
 from retro.scenes import load_scene
 from retro.scenes.vic import VicScene
@@ -46,7 +45,7 @@ class RunReport:
     machine: Machine
     raster: RasterBudget | None  # where on the beam the call ran, with a VIC-II scene
     tracer: object = None  # with --trace-json or --watch: the retro.analysis.trace.Tracer of the call
-    vblank: dict | None = None  # with --in-nmi: the NMI handler's vblank budget (retro.machines.nes.vblank_budget)
+    vblank: dict | None = None  # with a NES scene: the call's vblank budget (retro.machines.nes.vblank_budget)
 
     def _repr_html_(self) -> str:  # in a notebook: the report, the trace listing first when traced
         return options.pre_html(lines(self))
@@ -284,15 +283,18 @@ def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None,
         a: int | str = 0, x: int | str = 0, y: int | str = 0, flags: dict[str, int | str] | None = None,
         sets: list[str] = (), peeks: list[str] = (), budget: int | str = DEFAULT_BUDGET,
         scene: str | Path | None = None, trace: bool = False, cpu: str | None = None, wrap=None,
-        in_nmi: bool = False) -> RunReport:
+        in_nmi: bool = False, at_line: int | str | None = None, at_cycle: int | str | None = None,
+        at_dot: int | str | None = None) -> RunReport:
     """Call `entry` of the program at `path` (as by JSR, through its RTS). `sets` are TARGET=V[,V...]
-    stores before the call, `peeks` TARGET[:N] reads after it; `scene` attaches a VIC-II or NES scene;
+    stores before the call, `peeks` TARGET[:N] reads after it; `scene` attaches a VIC-II or NES scene,
+    the call entered at `at_line`/`at_cycle` (VIC-II) or `at_line`/`at_dot` or `in_nmi` (NES);
     `cpu` ("6510", "2a03", "65c02") is the CPU to run on (default: the file's own, else the 6510)."""
     registers = {name: parse_int(value, field=f"--{name}", lo=0, hi=0xFF) for name, value in (("a", a), ("x", x), ("y", y))}
     budget = parse_int(budget, field="--budget", lo=1, hi=MAX_BUDGET)
     status = status_with_flags(flags)
     program = _call_program(path, entry, labels, load, cpu)
-    machine = _call_machine(path, program, scene, cpu)
+    start = options.scene_start(scene, at_line, at_cycle, at_dot, in_nmi)
+    machine = _call_machine(path, program, start, cpu)
     memory = dict(parse_assignment(s) for s in sets)
     for target in memory:
         machine.resolve(target, f"--set {target}")
@@ -300,14 +302,10 @@ def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None,
     entry_address = machine.resolve(entry, "--entry")
     observer = None if wrap is None else wrap(machine, None)  # --trace-json / --watch (retro.analysis.trace)
     ppu = ppu_of(machine)
-    if in_nmi:
-        if ppu is None:
-            raise InputError("--in-nmi: needs a NES scene (--scene with chip = \"nes\")")
-        enter_nmi(machine)
     start, dma_before = machine.cycle, ppu.dma_stalled if ppu is not None else 0
     result = machine.call(entry_address, **registers, p=status, memory=memory, budget=budget, trace=trace,
                           observer=observer)
-    vblank = vblank_budget(machine, start, result.cycles, dma_before) if in_nmi else None
+    vblank = vblank_budget(machine, start, result.cycles, dma_before) if ppu is not None else None
     values = {target: machine.peek(target, count) for target, count in peek_counts.items()}
     return RunReport(program=program, entry=entry_address, result=result, peeks=values, machine=machine,
                      raster=call_budget(machine, result), vblank=vblank)
@@ -325,13 +323,14 @@ def _call_program(path: str | Path, entry: str | int, labels, load, cpu: str | N
     return program
 
 
-def _call_machine(path: str | Path, program: Program, scene: str | Path | None, cpu: str | None) -> Machine:
-    """The machine a call runs on (with the scene's chip, for the program's CPU), the program loaded."""
-    loaded_scene = None if scene is None else load_scene(scene)
-    if loaded_scene is not None and program.cpu and loaded_scene.cpu_variant != program.cpu:
-        raise InputError(f"--scene {scene}: a scene for the {loaded_scene.cpu_variant.upper()}, "
+def _call_machine(path: str | Path, program: Program, start, cpu: str | None) -> Machine:
+    """The machine a call runs on (with the scene's chip where `start` puts the call, for the program's
+    CPU), the program loaded."""
+    scene_cpu = None if start is None else start.raster_start().scene.cpu_variant
+    if scene_cpu is not None and program.cpu and scene_cpu != program.cpu:
+        raise InputError(f"--scene {start.scene}: a scene for the {scene_cpu.upper()}, "
                          f"but {path} is a program for the {program.cpu.upper()}")
-    machine = build_machine(loaded_scene, cpu=_cpu(cpu, program, path))
+    machine, _ = options.call_machine(start, _cpu(cpu, program, path))
     machine.load(program)
     return machine
 
@@ -495,7 +494,7 @@ def lines(report: RunReport | ConsoleRun | C64Run) -> list[str]:
                    f"{'; crosses a frame end' if budget.frames else ''})")
     v = report.vblank
     if v is not None:
-        out.append(f"vblank: the NMI handler ran from scanline {v['start_line']} dot {v['start_dot']} to scanline "
+        out.append(f"vblank: the call ran from scanline {v['start_line']} dot {v['start_dot']} to scanline "
                    f"{v['end_line']} dot {v['end_dot']}: {v['cycles']} cycles ({v['oam_dma_cycles']} of them OAM DMA), "
                    f"{v['vblank_cycles_left']} cycles of vblank left before rendering starts (pre-render line)")
     out += [f"{target}: " + " ".join(f"${v:02X}" for v in values) for target, values in report.peeks.items()]
@@ -529,8 +528,7 @@ def add_options(p: argparse.ArgumentParser) -> None:
                    help=f"stop the routine after this many cycles (default {DEFAULT_BUDGET:,}, at most {MAX_BUDGET:,})")
     p.add_argument("--scene", metavar="SCENE.toml", help="attach a VIC-II or NES PPU scene to the machine")
     p.add_argument("--cpu", metavar="CPU", help="the CPU: 6510 (default), 2a03 (an iNES image's) or 65c02 (WDC)")
-    p.add_argument("--in-nmi", action="store_true", help="with a NES scene: call the routine as the NMI handler, "
-                   "at the start of vblank, and report the vblank cycles it leaves (OAM DMA counted)")
+    options.scene_entry(p, "the call")
     output = p.add_mutually_exclusive_group()  # the JSON object's keys are fixed: no room for a trace
     output.add_argument("--trace", action="store_true", help="print every instruction executed (a program run: with "
                         "registers, flags, memory read and written and the beam position; needs a bound below)")
@@ -566,6 +564,12 @@ def main(args: argparse.Namespace) -> int:
 def _program_run_main(args: argparse.Namespace, console: dict) -> int:
     """`retro run` of a whole program (a cartridge from reset, a C64 program from SYS or --entry):
     exit 1 on a test ROM's failed verdict."""
+    entry_options = [name for name, given in (("--at-line", args.at_line), ("--at-cycle", args.at_cycle),
+                                              ("--at-dot", args.at_dot), ("--in-nmi", args.in_nmi or None))
+                     if given is not None]
+    if entry_options:
+        raise InputError(f"{', '.join(entry_options)}: where a call (--entry) starts on the scene's frame, "
+                         f"not for a program run")
     report = run_console_or_refuse(args.program, labels=args.labels, peeks=args.peeks, load=args.load,
                                    scene=args.scene, trace=args.trace, cpu=args.cpu, entry=args.entry,
                                    trace_json=args.trace_json, trace_limit=args.trace_limit,
@@ -590,7 +594,8 @@ def _call_main(args: argparse.Namespace) -> int:
     flags = {flag: getattr(args, flag) for flag in SETTABLE_FLAGS if getattr(args, flag) is not None}
     report = run(args.program, args.entry, labels=args.labels, load=args.load, a=args.a, x=args.x, y=args.y,
                  flags=flags, sets=args.sets, peeks=args.peeks, budget=args.budget, scene=args.scene,
-                 trace=args.trace, cpu=args.cpu, wrap=wrap, in_nmi=args.in_nmi)
+                 trace=args.trace, cpu=args.cpu, wrap=wrap, in_nmi=args.in_nmi, at_line=args.at_line,
+                 at_cycle=args.at_cycle, at_dot=args.at_dot)
     if wrap is not None:
         report.tracer = wrap.made[0]
         if args.trace_json:

@@ -12,10 +12,10 @@ the address; nesdev wiki "APU", "Standard controller", "Open bus behavior").
 
 from __future__ import annotations
 
-import math
+from dataclasses import dataclass
 
 from retro.chips.cartridge import PRG_START, NromCartridge
-from retro.chips.ppu.constants import DOTS_PER_LINE, OAMDMA, PPU_REGISTER_BASE, PPU_REGISTER_END, VBLANK_DOT, VBLANK_LINE
+from retro.chips.ppu.constants import CTRL_NMI, DOTS_PER_LINE, OAMDMA, PPU_REGISTER_BASE, PPU_REGISTER_END, VBLANK_DOT, VBLANK_LINE, VideoStandard
 from retro.chips.ppu.device import PpuDevice
 from retro.chips.ppu.state import PpuState
 from retro.cpu.machine import Machine
@@ -132,23 +132,85 @@ def ppu_of(machine: Machine) -> PpuDevice | None:
 VBLANK_START_DOT = VBLANK_LINE * DOTS_PER_LINE + VBLANK_DOT
 
 
-def enter_nmi(machine: Machine) -> int:
-    """Put the NES's PPU where an NMI handler starts: the clock so that the machine's next cycle is
-    the handler's first (VBLANK_START_DOT + the sequence, on a CPU cycle boundary), the vblank flag set and this
-    frame's NMI edge taken. Returns the dot of that cycle in the frame."""
+@dataclass(frozen=True)
+class FrameEntry:
+    """Where in the frame a call starts: its first CPU cycle, counted from line 0, dot 0 (the first
+    cycle beginning at or after the dot asked for), the line and dot that cycle begins at, and the
+    CPU cycles from it to the pre-render line, where rendering starts (the vblank budget of a call
+    entered in vblank)."""
+
+    cycle: int
+    line: int
+    dot: int
+    rendering_cycles: int
+    in_nmi: bool = False
+
+
+def frame_entry(video: VideoStandard, line: int, dot: int, in_nmi: bool = False) -> FrameEntry:
+    """The call's start at the first CPU cycle beginning at or after (`line`, `dot`) of a frame."""
+    ratio = video.dots_per_cpu_cycle
+    return entry_at_cycle(video, -(-(line * DOTS_PER_LINE + dot) * ratio.denominator // ratio.numerator), in_nmi)
+
+
+def entry_at_cycle(video: VideoStandard, cycle: int, in_nmi: bool = False) -> FrameEntry:
+    """The call's start at CPU cycle `cycle` of a frame (`retro.chips.ppu.clock`: it begins at dot
+    floor(cycle x dots per cycle))."""
+    ratio = video.dots_per_cpu_cycle
+    begins = cycle * ratio.numerator // ratio.denominator
+    rendering = video.pre_render_line * DOTS_PER_LINE
+    return FrameEntry(cycle, begins // DOTS_PER_LINE, begins % DOTS_PER_LINE,
+                      (rendering - begins) * ratio.denominator // ratio.numerator, in_nmi)
+
+
+def nmi_entry(video: VideoStandard, sequence_counted: bool = False) -> FrameEntry:
+    """An NMI handler's start: its first instruction the cycle after the 7-cycle sequence begun at
+    the vblank flag (`VBLANK_START_DOT`); `sequence_counted` (a spec entered as "nmi", whose cycles
+    count the sequence): the sequence's first cycle."""
+    handler = frame_entry(video, 0, VBLANK_START_DOT + INTERRUPT_CYCLES * video.dots_per_cpu_cycle)
+    return entry_at_cycle(video, handler.cycle - (INTERRUPT_CYCLES if sequence_counted else 0), in_nmi=True)
+
+
+def position_after(video: VideoStandard, entry: FrameEntry, cycles: int) -> tuple[int, int, int]:
+    """(line, dot, frames crossed) where a call entered at `entry` returns after `cycles` cycles (the
+    dot its next cycle begins at; frames of full length: frame 0 is even, it never skips a dot)."""
+    ratio = video.dots_per_cpu_cycle
+    frames, within = divmod((entry.cycle + cycles) * ratio.numerator // ratio.denominator, video.dots_per_frame)
+    return within // DOTS_PER_LINE, within % DOTS_PER_LINE, frames
+
+
+def enter_frame(machine: Machine, entry: FrameEntry) -> int:
+    """Put the NES's PPU where a call entered at `entry` starts: the clock so that the machine's next
+    cycle is entry.cycle of frame 0, the frame drawn so far (vblank, sprite-0 hit and overflow flags
+    as set by then) and an NMI edge of this frame's vblank taken already (the NMI came before the
+    call, or is the call). Returns the absolute dot of that cycle."""
     ppu = ppu_of(machine)
-    ratio = ppu.video.dots_per_cpu_cycle
-    entry_dot = VBLANK_START_DOT + INTERRUPT_CYCLES * ratio
-    cycles = math.ceil(entry_dot / ratio)  # the first CPU cycle at or after that dot
-    ppu.start_clock(machine.cycle - cycles)
+    ppu.start_clock(machine.cycle - entry.cycle)
     ppu.advance(ppu.dot_of(machine.cycle))
-    ppu.nmi_pending = False  # the edge of this vblank is the one being handled
+    ppu.nmi_pending = False
     ppu._refresh_nmi_next()
     return ppu.dot_of(machine.cycle)
 
 
+def enter_nmi(machine: Machine) -> int:
+    """`enter_frame` at an NMI handler's first instruction (`nmi_entry`)."""
+    return enter_frame(machine, nmi_entry(ppu_of(machine).video))
+
+
+def cycles_to_nmi(ppu: PpuDevice, entry: FrameEntry) -> int | None:
+    """CPU cycles from a call's start at `entry` to the next NMI edge the CPU could see, with the
+    scene's $2000 (None: the NMI is off)."""
+    if not ppu.ctrl & CTRL_NMI:
+        return None
+    video = ppu.video
+    entered = entry.line * DOTS_PER_LINE + entry.dot
+    # the next vblank flag, one dot early at most (the odd-frame skip of the frame before it)
+    vblank = VBLANK_START_DOT + (video.dots_per_frame - 1 if entered >= VBLANK_START_DOT else 0)
+    ratio = video.dots_per_cpu_cycle
+    return max(0, vblank * ratio.denominator // ratio.numerator - entry.cycle)
+
+
 def vblank_budget(machine: Machine, start: int, cycles: int, dma_before: int) -> dict:
-    """A call that began at machine cycle `start` (after `enter_nmi`) and took `cycles`: where it began
+    """A call that began at machine cycle `start` (after `enter_frame`) and took `cycles`: where it began
     and ended (line, dot), the CPU cycles of vblank left when it returned (before the pre-render line,
     where rendering starts; negative: it ran into it), and the cycles OAM DMA held the CPU."""
     ppu = ppu_of(machine)

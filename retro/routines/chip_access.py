@@ -17,15 +17,24 @@ when unsure, the answer is no (Machine runs the calls):
 - more pushes (PHA, PHP) than pulls, or TXS, could make an RTS jump where the decoder did not look;
 - with interrupt sources enabled in the scene, an IRQ could come unless I is set on entry and no
   CLI, PLP or RTI is in the code.
+
+On a NES scene (`NesStart`, `NesCalls`) the PPU steals cycles only through OAM DMA, which takes a
+write to $4014, a chip register: a routine that touches none runs on the batched core with no stall
+at all. The NMI cannot be masked: with $2000 bit 7 set in the scene, a call that could run until the
+next vblank flag (its cycle limit reaches it) stays on Machine.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
 from retro.cpu.flow import decode
 from retro.cpu.timing import timing_of
 from retro.errors import InputError
+from retro.machines.nes import FrameEntry, cycles_to_nmi, enter_frame, frame_entry, nmi_entry, ppu_of
+from retro.scenes.nes import NesScene
 
 PAGE_SHIFT = 8
 INDEXED_REACH = 0xFF  # abs,X / abs,Y reach up to 255 bytes past the base
@@ -37,6 +46,7 @@ PUSHES, PULLS = frozenset({"PHA", "PHP", "PHX", "PHY"}), frozenset({"PLA", "PLP"
 FREE_REASON = "the routine touches no chip register"
 CLEARS_I = frozenset({"CLI", "PLP", "RTI"})
 FLOW_MNEMONICS = frozenset({"JMP", "JSR"})
+OPCODE_JSR = 0x20
 
 
 def chip_free(read, entry: int, program: tuple[int, int], chip_pages: frozenset[int], cpu: str,
@@ -45,6 +55,22 @@ def chip_free(read, entry: int, program: tuple[int, int], chip_pages: frozenset[
     `program` is (first, end) of the program's bytes, `chip_pages` the pages chips own,
     `interrupts` whether the chip has an interrupt source enabled (the caller has checked that I
     is set on entry)."""
+    code, unknown = _reachable_code(read, entry, program, cpu)
+    if unknown:
+        return False, unknown
+    mnemonics: set[str] = set()
+    for pc in sorted(code):
+        op = timing_of(read(pc), cpu)
+        mnemonics.add(op.mnemonic)
+        reason = _access_problem(read, pc, op, code, chip_pages)
+        if reason:
+            return False, reason
+    return _stack_and_interrupts(read, code, cpu, interrupts, mnemonics)
+
+
+def _reachable_code(read, entry: int, program: tuple[int, int], cpu: str) -> tuple[dict[int, int], str]:
+    """{address: length} of every instruction reachable from `entry` (JSR callees included), or why
+    the code cannot be followed statically."""
     outside: list[int] = []
 
     def note_call(pc: int, target: int) -> tuple[int, int]:
@@ -59,36 +85,41 @@ def chip_free(read, entry: int, program: tuple[int, int], chip_pages: frozenset[
         if start in seen:
             continue
         seen.add(start)
-        before = len(outside)
         try:
             nodes = decode(read, start, note_call, cpu)
         except (InputError, KeyError, ValueError) as exc:
-            return False, f"the code is not followed statically ({exc})"
-        if len(outside) > before:
-            return False, f"a JSR leaves the program (to ${outside[-1]:04X})"
+            return code, f"the code is not followed statically ({exc})"
+        if outside:
+            return code, f"a JSR leaves the program (to ${outside[-1]:04X})"
         for pc in nodes:
             code[pc] = timing_of(read(pc), cpu).length
-            if read(pc) == 0x20:  # JSR: the callee is code too
+            if read(pc) == OPCODE_JSR:  # the callee is code too
                 pending.append(read(pc + 1) | read(pc + 2) << 8)
-    pushes = pulls = 0
-    mnemonics = set()
-    for pc, length in sorted(code.items()):
-        op = timing_of(read(pc), cpu)
-        mnemonics.add(op.mnemonic)
-        pushes += op.mnemonic in PUSHES
-        pulls += op.mnemonic in PULLS
-        if op.mnemonic == "TXS":
-            return False, f"TXS at ${pc:04X} (the stack is moved: returns are not followed)"
-        if op.mode in INDIRECT_MODES:
-            return False, f"an indirect access at ${pc:04X} might reach a chip register"
-        if op.mode not in ABSOLUTE_MODES or op.mnemonic in FLOW_MNEMONICS:
-            continue
-        base = read(pc + 1) | read(pc + 2) << 8
-        last = base + (INDEXED_REACH if op.mode != "abs" else 0)
-        if any(page & 0xFF in chip_pages for page in range(base >> PAGE_SHIFT, (last >> PAGE_SHIFT) + 1)):
-            return False, f"the access at ${pc:04X} reaches a chip register"
-        if op.mnemonic in STORE_MNEMONICS and any(base <= p + k <= last for p, n in code.items() for k in range(n)):
-            return False, f"the store at ${pc:04X} may rewrite the routine's own code"
+    return code, ""
+
+
+def _access_problem(read, pc: int, op, code: dict[int, int], chip_pages: frozenset[int]) -> str:
+    """Why the instruction at `pc` keeps the calls off the batched core ('' when it does not)."""
+    if op.mnemonic == "TXS":
+        return f"TXS at ${pc:04X} (the stack is moved: returns are not followed)"
+    if op.mode in INDIRECT_MODES:
+        return f"an indirect access at ${pc:04X} might reach a chip register"
+    if op.mode not in ABSOLUTE_MODES or op.mnemonic in FLOW_MNEMONICS:
+        return ""
+    base = read(pc + 1) | read(pc + 2) << 8
+    last = base + (INDEXED_REACH if op.mode != "abs" else 0)
+    if any(page & 0xFF in chip_pages for page in range(base >> PAGE_SHIFT, (last >> PAGE_SHIFT) + 1)):
+        return f"the access at ${pc:04X} reaches a chip register"
+    if op.mnemonic in STORE_MNEMONICS and any(base <= p + k <= last for p, n in code.items() for k in range(n)):
+        return f"the store at ${pc:04X} may rewrite the routine's own code"
+    return ""
+
+
+def _stack_and_interrupts(read, code: dict[int, int], cpu: str, interrupts: bool,
+                          mnemonics: set[str]) -> tuple[bool, str]:
+    """The verdict once no single instruction was a problem: pushes against pulls, interrupts."""
+    pushes = sum(timing_of(read(pc), cpu).mnemonic in PUSHES for pc in code)
+    pulls = sum(timing_of(read(pc), cpu).mnemonic in PULLS for pc in code)
     if pushes > pulls:
         return False, "more pushes than pulls: an RTS may jump where the decoder did not look"
     if interrupts and mnemonics & CLEARS_I:
@@ -134,3 +165,57 @@ class BusStalls:
             chosen = spent == cycles
             out[chosen] = self._table(int(cycles), mask)[at[chosen]]
         return out
+
+
+@dataclass(frozen=True)
+class NesStart:
+    """Run every call with a NES scene's PPU on the bus, entered at `line` and `dot` of the frame, or
+    (`in_nmi`) where an NMI handler starts (retro.machines.nes.nmi_entry); the frame drawn so far in
+    the PPU's flags (vblank, sprite-0 hit, overflow), as the hardware has them then."""
+
+    scene: NesScene
+    line: int = 0
+    dot: int = 0
+    in_nmi: bool = False
+
+    def entry(self, enter: str) -> FrameEntry:
+        """Where a call starts; `enter` is the routine's ("nmi": its cycles count the interrupt sequence,
+        which then begins at the vblank flag)."""
+        if self.in_nmi:
+            return nmi_entry(self.scene.video, sequence_counted=enter == "nmi")
+        return frame_entry(self.scene.video, self.line, self.dot)
+
+
+class NesCalls:
+    """The PPU side of a routine's calls on a NES scene: each call from the same beam position and the
+    same PPU state (what earlier calls wrote, read or copied by DMA is forgotten), and the cycles OAM
+    DMA held the CPU in the last one."""
+
+    def __init__(self, machine, start: NesStart, enter: str) -> None:
+        self.machine = machine
+        self.ppu = ppu_of(machine)
+        self.entry = start.entry(enter)
+        enter_frame(machine, self.entry)
+        self.ppu.dma_stalled = 0
+        self._snapshot = self.ppu.snapshot()
+
+    def restart(self) -> None:
+        """The PPU as the call's entry finds it, its clock set so that the machine's next cycle is the entry's."""
+        self.ppu.restore(self._snapshot, self.machine.cycle - self.entry.cycle)
+
+    @property
+    def dma_cycles(self) -> int:
+        """Cycles OAM DMA held the CPU since the last `restart`."""
+        return self.ppu.dma_stalled
+
+    def verdict(self, read, entry: int, program: tuple[int, int], cpu: str, limit: int) -> tuple[bool, str]:
+        """Whether the batched core may run the calls (no stall can happen) and why (module docstring)."""
+        pages = frozenset(page for page, device in enumerate(self.machine.bus.page_devices) if device is not None)
+        free, why = chip_free(read, entry, program, pages, cpu, False)
+        if not free:
+            return False, why
+        to_nmi = cycles_to_nmi(self.ppu, self.entry)
+        if to_nmi is not None and limit >= to_nmi:
+            return False, (f"the scene enables the NMI ($2000 bit 7) and a call may run {limit:,} cycles, past the "
+                           f"next vblank flag {to_nmi:,} cycles after its start")
+        return True, why

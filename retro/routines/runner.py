@@ -34,7 +34,7 @@ from retro.machines import build_machine
 from retro.machines.c64 import vic_of
 from retro.routines import batch_runs
 from retro.routines.batch_runs import BatchOutcome
-from retro.routines.chip_access import BusStalls, chip_free
+from retro.routines.chip_access import BusStalls, NesCalls, NesStart, chip_free
 from retro.routines.entry import EntryState, variant_memory, variant_stack
 from retro.routines.input_plan import InputPlan, case_byte
 from retro.routines.outputs import port_values
@@ -85,17 +85,21 @@ class RasterStart:
     cycle: int = 1
 
 
-def _machine_for(routine: Routine, start: RasterStart | None):
-    """(the machine a routine runs on, its VIC-II or None): a bare CPU, or the scene's C64."""
+def _machine_for(routine: Routine, start: RasterStart | NesStart | None):
+    """(the machine a routine runs on, its VIC-II or None, the PPU's side of every call or None): a bare
+    CPU, the scene's C64 or the scene's NES."""
     if start is None:
-        return build_machine(cpu=routine.cpu), None
+        return build_machine(cpu=routine.cpu), None, None
     if start.scene.cpu_variant != routine.cpu:
         raise InputError(f"--scene: a {start.scene.cpu_variant} scene cannot run the {routine.cpu} routine "
                          f"{routine.name}")
+    if isinstance(start, NesStart):
+        machine = build_machine(start.scene)
+        return machine, None, NesCalls(machine, start, routine.world.enter)
     if not isinstance(start.scene, VicScene):
         raise InputError(NEEDS_A_VIC_SCENE)
     machine = build_machine(start.scene)
-    return machine, vic_of(machine)
+    return machine, vic_of(machine), None
 
 
 def _pointer_pcs(routine: Routine) -> frozenset[int]:
@@ -118,7 +122,7 @@ def _written_kept(routine: Routine) -> dict[str, int]:
 
 
 class RoutineRunner:
-    def __init__(self, routine: Routine, seed: int = 0, start: RasterStart | None = None,
+    def __init__(self, routine: Routine, seed: int = 0, start: RasterStart | NesStart | None = None,
                  fill: str | None = None) -> None:
         """`fill`: an entry-state variant ("ones", "random": retro.routines.entry) whose bytes every
         address holds that the machine, the program, the `[memory]` blocks and `init` leave alone;
@@ -129,7 +133,7 @@ class RoutineRunner:
         self.fill = fill
         self.entry_state = EntryState.of(routine.entry_state, routine.inputs, vary_interrupt=start is None)
         self.program = routine.program  # read once, by the spec
-        self.machine, self.vic = _machine_for(routine, start)
+        self.machine, self.vic, self.nes = _machine_for(routine, start)
         if fill is not None:  # before anything is loaded: what stays untouched keeps the variant's bytes
             memory = np.asarray(self.machine.memory, dtype=np.uint8)
             self.machine.memory[:] = np.where(memory == 0, variant_memory(fill, seed), memory).tolist()
@@ -190,7 +194,7 @@ class RoutineRunner:
         world, `record` leaves out the traps (mocks, exits) and `last_extra_cycles` says what the timing
         model must add for them and for an interrupt entry; `last_calls` holds the recorded mocks' calls."""
         writes, registers, p = self.inputs_for_call(case, entry)
-        if self.vic is not None:
+        if self.start is not None:
             self.restart_beam()
             stolen = self.machine.mpu.stolen
         located = self.plan.vias.outputs(case) if self.plan.vias is not None else None
@@ -203,8 +207,8 @@ class RoutineRunner:
             cycles, a, x, y, p = self.machine.call_fast(self.entry, writes, **registers, p=self._entry_p(p),
                                                         budget=self.limit, record=record, pointer_pcs=self.pointer_pcs,
                                                         enter=self.routine.world.enter)
-        if self.vic is not None:
-            self.last_stolen = self.machine.mpu.stolen - stolen
+        if self.start is not None:  # the VIC-II's stalls, or OAM DMA's (the PPU's `stall`, not counted in mpu.stolen)
+            self.last_stolen = self.machine.mpu.stolen - stolen if self.nes is None else self.nes.dma_cycles
         if world is not None:
             if record is not None:
                 traps = world.actions
@@ -221,6 +225,10 @@ class RoutineRunner:
         return p & ~FLAG_I if self.routine.world.enter == "irq" else p
 
     def restart_beam(self) -> None:
+        """The scene's chip as every call finds it: the beam at the start, the frame drawn so far."""
+        if self.nes is not None:
+            self.nes.restart()
+            return
         self.vic.restart(self.machine.cycle, self.start.line, self.start.cycle, drawn=True)
         self.machine.mpu.ba_high_until = -1  # the CPU's note of how long BA stays high was for the old beam
 
@@ -247,7 +255,7 @@ class RoutineRunner:
     @property
     def engine_reason(self) -> str | None:
         """Why the batched core may or may not run the calls with the scene (None without a scene)."""
-        return None if self.vic is None else self.chip_verdict[1]
+        return None if self.start is None else self.chip_verdict[1]
 
     @functools.cached_property
     def bus_stalls(self) -> BusStalls:
@@ -258,9 +266,12 @@ class RoutineRunner:
 
     @functools.cached_property
     def chip_verdict(self) -> tuple[bool, str]:
+        memory = self.machine.memory
+        if self.nes is not None:
+            return self.nes.verdict(memory.__getitem__, self.entry, (self.program.origin, self.program.end),
+                                    self.routine.cpu, self.limit)
         if self.vic is None:
             return True, ""
-        memory = self.machine.memory
         pages = frozenset(page for page, device in enumerate(self.machine.bus.page_devices) if device is not None)
         interrupts = bool(self.vic.registers[REG_IRQ_ENABLE] & IRQ_SOURCES)
         if interrupts and (not self.plan.base_flags & FLAG_I or any(bit == FLAG_I for _, bit in self.plan.flags)):
@@ -302,7 +313,7 @@ class RoutineRunner:
     def traced(self, case: Sequence) -> CallResult:
         """The same call with the instruction trace (for the report of a failing case)."""
         writes, registers, p = self.inputs_for_call(case)
-        if self.vic is not None:
+        if self.start is not None:
             self.restart_beam()
         if self.world is not None:
             self.world.reset(self.machine.cycle)

@@ -15,6 +15,7 @@ from retro.analysis.check.results import describe_outputs
 from retro.analysis.coverage_model import CodeCoverage
 from retro.errors import InputError, RunError
 from retro.routines import cases as case_sets
+from retro.routines.chip_access import NesStart
 from retro.routines.outputs import row_of
 from retro.routines.runner import RasterStart, RoutineRunner
 from retro.routines.spec import Routine, load_spec
@@ -50,20 +51,25 @@ def routine_of(key: str) -> Routine:
 
 @dataclass(frozen=True)
 class SceneStart:
-    """`--scene S --at-line L --at-cycle C`, as plain data that crosses to worker processes."""
+    """`--scene S --at-line L --at-cycle C` (a VIC-II scene) or `--at-line L --at-dot D` / `--in-nmi`
+    (a NES scene), as plain data that crosses to worker processes."""
 
     scene: str
-    line: int | None = None  # None: the scene's own [cpu] start_line / start_cycle
+    line: int | None = None  # None: the scene's own [cpu] start_line / start_cycle (a NES scene: line 0)
     cycle: int | None = None
+    dot: int | None = None  # a NES scene: the dot in that scanline (default 0)
+    in_nmi: bool = False  # a NES scene: every call is the NMI handler, from the start of vblank
 
-    def raster_start(self) -> RasterStart:
+    def raster_start(self) -> RasterStart | NesStart:
         from retro.scenes import load_scene
         from retro.scenes.vic import VicScene
 
         scene = load_scene(self.scene)
         if not isinstance(scene, VicScene):
-            raise InputError(f"--scene {self.scene}: a spec's cases run on a VIC-II scene's timeline only (a NES "
-                             f"scene goes with one call: retro run FILE --entry E --scene S, or retro profile)")
+            return nes_start(scene, self.line, self.dot, self.in_nmi, self.cycle)
+        if self.dot is not None or self.in_nmi:
+            raise InputError(f"{'--in-nmi' if self.in_nmi else '--at-dot'}: needs a NES scene; {self.scene} is a "
+                             f"VIC-II scene (--at-line and --at-cycle)")
         line = scene.start_line if self.line is None else self.line
         cycle = scene.start_cycle if self.cycle is None else self.cycle
         video = scene.state.video
@@ -71,6 +77,23 @@ class SceneStart:
             raise InputError(f"--at-line/--at-cycle: the {video.chip} has lines 0-{video.lines - 1} and cycles "
                              f"1-{video.cycles_per_line}, got line {line} cycle {cycle}")
         return RasterStart(scene, line, cycle)
+
+
+def nes_start(scene, line: int | None, dot: int | None, in_nmi: bool, cycle: int | None) -> NesStart:
+    """A NES scene's entry, every option checked against the scene's video standard (one-line errors)."""
+    from retro.chips.ppu.constants import DOTS_PER_LINE
+
+    if cycle is not None:
+        raise InputError(f"--at-cycle: a VIC-II option; {scene.source} is a NES scene: give the scanline's dot "
+                         f"(--at-dot 0-{DOTS_PER_LINE - 1})")
+    if in_nmi and (line is not None or dot is not None):
+        raise InputError("--in-nmi enters at the start of vblank: not with --at-line/--at-dot")
+    video = scene.video
+    line, dot = line or 0, dot or 0
+    if not 0 <= line <= video.pre_render_line or not 0 <= dot < DOTS_PER_LINE:
+        raise InputError(f"--at-line/--at-dot: the {video.name.upper()} PPU has scanlines 0-{video.pre_render_line} "
+                         f"and dots 0-{DOTS_PER_LINE - 1}, got scanline {line} dot {dot}")
+    return NesStart(scene, line, dot, in_nmi)
 
 
 def runner_for(spec: str, seed: int, start: SceneStart | None = None, fill: str | None = None) -> RoutineRunner:

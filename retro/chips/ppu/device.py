@@ -266,6 +266,23 @@ class PpuDevice:
         self.origin = cycle
         self._refresh_nmi_next()
 
+    # fields a snapshot leaves shared: the bus's callbacks, and arrays the device replaces, never mutates
+    _SHARED = frozenset({"read_memory", "stall", "_candidates", "_fixed_events", "video"})
+
+    def snapshot(self) -> dict:
+        """Everything the device holds now, as a copy `restore` can go back to (any number of times)."""
+        return {name: (value.copy() if name not in self._SHARED and isinstance(value, (bytearray, list)) else value)
+                for name, value in vars(self).items() if name != "_fixed_events"}
+
+    def restore(self, snapshot: dict, origin: int) -> None:
+        """Back to `snapshot` with the clock's origin moved to machine cycle `origin` (every position in
+        the snapshot counts dots from its origin, so the beam stands where it stood relative to it)."""
+        for name, value in snapshot.items():
+            setattr(self, name, value.copy() if name not in self._SHARED and isinstance(value, (bytearray, list))
+                    else value)
+        self.nmi_edge_cycle += origin - snapshot["origin"]  # the one field counted in machine cycles
+        self.start_clock(origin)
+
     def _refresh_nmi_next(self) -> None:
         """The first CPU cycle whose poll can see an NMI edge: a pending edge's own cycle, else a lower
         bound on the next vblank flag's."""
@@ -461,6 +478,8 @@ class PpuDevice:
         base = page * PAGE_SIZE
         for i in range(OAM_SIZE):
             self.oam[(self.oam_addr + i) & 0xFF] = self.read_memory(base + i)
-        stalled = OAM_DMA_CYCLES + (OAM_DMA_ODD_EXTRA if cycle % 2 else 0)
+        # odd or even counted from the clock's origin (retro.chips.ppu.clock): a call entered at a
+        # given dot of the frame always meets the same parity
+        stalled = OAM_DMA_CYCLES + (OAM_DMA_ODD_EXTRA if (cycle - self.origin) % 2 else 0)
         self.dma_stalled += stalled
         self.stall(stalled)
