@@ -26,18 +26,22 @@ BRK through the KERNAL's $FE66).
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 
 from retro.analysis.console_run import FRAMES_DONE, HALTED, INTERRUPTED, MAX_FRAMES, REACHED, VALUE_SEEN, StopRun, \
     run_frames
 from retro.chips.vic.constants import PAL, REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT, VIC_BASE
+from retro.chips.vic.constants import CHAR_ROM_BYTES
 from retro.chips.vic.device import VicDevice
+from retro.chips.vic.fetch import CHARGEN_ENV, memory_parts
 from retro.chips.vic.graphics import VicMemory
 from retro.chips.vic.model import VicState
 from retro.cpu.bus import NEVER
 from retro.cpu.machine import CALL_STACK_TOP, RETURN_TRAP, Machine, push_return_trap
 from retro.cpu.mpu import FLAG_I, FLAG_U
 from retro.errors import InputError, RunError
+from retro.fileio import read_bytes
 from retro.machines.c64 import (
     KERNAL_IRQ_ENTRY,
     KERNAL_IRQ_ENTRY_CODE,
@@ -166,13 +170,29 @@ class _C64Watch:
             raise StopRun(VALUE_SEEN)
 
 
+def char_rom_image() -> bytes | None:
+    """The character ROM image the user names in $RETRO_C64_CHARGEN (4096 bytes), or None."""
+    path = os.environ.get(CHARGEN_ENV)
+    if not path:
+        return None
+    image = read_bytes(path, "character ROM image", CHAR_ROM_BYTES)
+    if len(image) != CHAR_ROM_BYTES:
+        raise InputError(f"{path} (${CHARGEN_ENV}): a character ROM image is {CHAR_ROM_BYTES} bytes, not {len(image)}")
+    return image
+
+
 def c64_for(program: Program, scene: VicScene | None) -> Machine:
     """A C64 as after RUN (module docstring) with `program` loaded and the scene's VIC-II (else the
-    KERNAL's), its beam where the scene says (else line 0, cycle 1)."""
+    KERNAL's), its beam where the scene says (else line 0, cycle 1). The VIC-II reads its memory
+    (retro.chips.vic.fetch); a scene's screen, colour RAM, character set, bitmap and sprite data are
+    put where it fetches them (fetch.memory_parts), and the program may not load over them."""
+    char_rom = char_rom_image()
     if scene is None:
-        machine = build_c64(kernal_vic_state())
+        machine = build_c64(kernal_vic_state(), reads_memory=True, char_rom=char_rom)
     else:
-        machine = build_c64(scene.state, start_line=scene.start_line, start_cycle=scene.start_cycle)
+        machine = build_c64(scene.state, start_line=scene.start_line, start_cycle=scene.start_cycle,
+                            reads_memory=True, char_rom=char_rom)
+        _fill_scene_memory(machine, scene, program)
     install_kernal_irq_entry(machine)  # the KERNAL is mapped in: its vector at $FFFE is the hardware's
     memory = machine.bus.memory
     memory[PORT_DIRECTION], memory[PORT_DATA] = POWER_ON_PORT
@@ -181,6 +201,19 @@ def c64_for(program: Program, scene: VicScene | None) -> Machine:
     machine.load(program)
     machine.mpu.stop_on_brk = False  # BRK goes through the vector, as on the machine
     return machine
+
+
+def _fill_scene_memory(machine: Machine, scene: VicScene, program: Program) -> None:
+    try:
+        parts = memory_parts(scene.state, vic_of(machine).fetcher.bank_port.bank)
+    except InputError as exc:
+        raise InputError(f"{scene.source}: {exc}") from None
+    loaded = (program.origin, program.origin + len(program.code))
+    for name, at, values in parts:
+        if at < loaded[1] and loaded[0] < at + len(values):
+            raise InputError(f"{scene.source}: the scene's {name} (${at:04X}-${at + len(values) - 1:04X}, where the "
+                             f"VIC-II reads it) overlaps the program (${loaded[0]:04X}-${loaded[1] - 1:04X})")
+        machine.bus.load(at, bytes(values))
 
 
 def run_c64(program: Program, entry: int, *, frames: int, scene: VicScene | None = None,

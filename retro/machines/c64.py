@@ -15,8 +15,9 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 from retro.chips.vic.beam import position
-from retro.chips.vic.constants import VIC_BASE, VIC_LAST
+from retro.chips.vic.constants import CIA2_BASE, CIA2_LAST, VIC_BASE, VIC_LAST
 from retro.chips.vic.device import VicDevice
+from retro.chips.vic.fetch import VicBankPort, VicFetcher
 from retro.chips.vic.model import VicState
 from retro.cpu.bus import Device
 from retro.cpu.machine import Machine
@@ -34,17 +35,26 @@ KERNAL_IRQ_EXIT_CODE = bytes([0x68, 0xA8, 0x68, 0xAA, 0x68, 0x40])  # PLA / TAY 
 
 
 def build_c64(state: VicState | None = None, *, start_line: int = 0, start_cycle: int = 1,
-              irq_vector: str = IRQ_VECTOR_HARDWARE, vic: Device | None = None) -> Machine:
+              irq_vector: str = IRQ_VECTOR_HARDWARE, vic: Device | None = None, reads_memory: bool = False,
+              char_rom: bytes | None = None) -> Machine:
     """A fresh C64: a 6510 with a VIC-II holding `state` at $D000-$D3FF, driving the CPU's BA and IRQ
     lines, its beam at line `start_line`, cycle `start_cycle` now, the frame drawn so far in its
     latches ($D01E, $D01F, $D019: `VicDevice.at_beam` with `drawn`); with `irq_vector` "$0314" the
     KERNAL's IRQ entry is in RAM. `vic`: a device of the caller's at the VIC-II's registers instead
-    (the latch study's, which answers reads of one case's frame and leaves the CPU's lines alone)."""
+    (the latch study's, which answers reads of one case's frame and leaves the CPU's lines alone).
+
+    With `reads_memory` the VIC-II fetches sprite data, screen, character set and colour RAM from
+    the machine's RAM (retro.chips.vic.fetch; `char_rom` the character ROM image, if the user has
+    one) and CIA 2's port A at $DD00 picks its bank; otherwise `state` holds what it sees."""
     machine = Machine(CPU)
     if vic is None:
         if state is None:
             raise ValueError("build_c64 needs a VIC-II state or a device")
-        vic = VicDevice.at_beam(state, machine.cycle, start_line, start_cycle, drawn=True)
+        fetcher = None
+        if reads_memory:
+            port = machine.attach(VicBankPort(), CIA2_BASE, CIA2_LAST)
+            fetcher = VicFetcher(machine.bus.memory, port, char_rom)
+        vic = VicDevice.at_beam(state, machine.cycle, start_line, start_cycle, drawn=True, fetcher=fetcher)
     machine.attach(vic, VIC_BASE, VIC_LAST)
     if irq_vector == IRQ_VECTOR_KERNAL:
         install_kernal_irq_entry(machine)
