@@ -29,8 +29,8 @@ import math
 import os
 from dataclasses import dataclass, field
 
-from retro.analysis.console_run import FRAMES_DONE, HALTED, INTERRUPTED, MAX_FRAMES, REACHED, VALUE_SEEN, StopRun, \
-    run_frames
+from retro.analysis.console_run import FRAMES_DONE, HALTED, INTERRUPTED, MAX_FRAMES, REACHED, REPORTED, VALUE_SEEN, \
+    StopRun, Verdict, run_frames
 from retro.chips.vic.constants import PAL, REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT, VIC_BASE
 from retro.chips.vic.constants import CHAR_ROM_BYTES
 from retro.chips.vic.device import VicDevice
@@ -47,8 +47,11 @@ from retro.machines.c64 import (
     KERNAL_IRQ_ENTRY_CODE,
     KERNAL_IRQ_EXIT,
     KERNAL_IRQ_EXIT_CODE,
+    KERNAL_IRQ_HANDLER,
+    KERNAL_IRQ_HANDLER_STUB,
     build_c64,
     install_kernal_irq_entry,
+    install_kernal_irq_handler_stub,
     vic_of,
 )
 from retro.program import Program
@@ -77,11 +80,12 @@ SYS_REGISTERS = 0x030C  # A, X, Y, P that SYS loads (0 after power-on)
 KERNAL_NAMES = {0xFFD2: "CHROUT", 0xFFE4: "GETIN", 0xFFCF: "CHRIN", 0xFFF0: "PLOT", 0xFF9F: "SCNKEY",
                 0xFFE1: "STOP", 0xFFBA: "SETLFS", 0xFFBD: "SETNAM", 0xFFD5: "LOAD", 0xFFD8: "SAVE",
                 0xFFC0: "OPEN", 0xFFC3: "CLOSE", 0xFFCC: "CLRCHN", 0xFF81: "CINT", 0xFF84: "IOINIT",
-                0xE544: "clear screen", 0xEA31: "the KERNAL's IRQ handler (keyboard, clock)",
+                0xE544: "clear screen",
                 0xEA7E: "the KERNAL's IRQ handler (after the keyboard scan)",
                 0xFE66: "the KERNAL's BRK handler (BASIC warm start)", 0xFE47: "the KERNAL's NMI handler"}
 STUB_RANGES = ((KERNAL_IRQ_ENTRY, KERNAL_IRQ_ENTRY + len(KERNAL_IRQ_ENTRY_CODE)),
-               (KERNAL_IRQ_EXIT, KERNAL_IRQ_EXIT + len(KERNAL_IRQ_EXIT_CODE)))
+               (KERNAL_IRQ_EXIT, KERNAL_IRQ_EXIT + len(KERNAL_IRQ_EXIT_CODE)),
+               (KERNAL_IRQ_HANDLER, KERNAL_IRQ_HANDLER + len(KERNAL_IRQ_HANDLER_STUB)))
 MAX_C64_FRAMES = MAX_FRAMES
 
 
@@ -103,6 +107,7 @@ class C64Run:
     notes: tuple[str, ...] = ()
     peeks: dict[str, list[int]] = field(default_factory=dict)  # filled by the command
     tracer: object = None  # a retro.analysis.trace.Tracer that observed the run (--trace, --watch)
+    verdict: Verdict | None = None  # with result_at: the test program's result (debug_cart_verdict)
 
     @property
     def vic(self) -> VicDevice:
@@ -133,11 +138,49 @@ def rom_error(machine: Machine, pc: int, came_from: int | None) -> RunError:
                     f"this C64 has no BASIC or KERNAL ROM (docs/vic.md \"Running a C64 program\")")
 
 
+# VICE's testbench (testbench/*-hooks.sh of the VICE test programs; x64sc's -debugcart): a test
+# program ends by writing its result to $D7FF, $00 passed and $FF failed; the first write ends the run.
+DEBUG_CART = 0xD7FF
+DEBUG_CART_PASSED, DEBUG_CART_FAILED = 0x00, 0xFF
+
+
+class ResultPort:
+    """RAM at a test program's result address that remembers the first value written there."""
+
+    def __init__(self, memory: list[int]) -> None:
+        self.memory = memory
+        self.written: int | None = None
+
+    def read(self, address: int, cycle: int) -> int:
+        return self.memory[address]
+
+    def write(self, address: int, value: int, cycle: int) -> None:
+        self.memory[address] = value
+        if self.written is None:
+            self.written = value
+
+    def peek(self, address: int) -> int:
+        return self.memory[address]
+
+
+def debug_cart_verdict(address: int, written: int | None) -> Verdict:
+    """The verdict of VICE's testbench protocol from the first byte written at `address` (None: none)."""
+    protocol = f"result byte ${address:04X} (VICE testbench: $00 passed, $FF failed)"
+    if written is None:
+        return Verdict(protocol, None, None, "nothing written there yet")
+    if written == DEBUG_CART_PASSED:
+        return Verdict(protocol, written, True, "passed")
+    return Verdict(protocol, written, False, "failed" if written == DEBUG_CART_FAILED
+                   else f"${written:02X} written: the protocol knows $00 and $FF only")
+
+
 class _C64Watch:
     """Observer of the run loop: the stop conditions (module docstring) and the ROM check."""
 
-    def __init__(self, machine: Machine, until: int | None, until_value: tuple[int, int] | None) -> None:
+    def __init__(self, machine: Machine, until: int | None, until_value: tuple[int, int] | None,
+                 result: ResultPort | None = None) -> None:
         self.machine = machine
+        self.result = result
         self.memory = machine.bus.memory
         self.peek = machine.bus.peek
         self.vic = vic_of(machine)
@@ -159,6 +202,8 @@ class _C64Watch:
         pc = mpu.pc
         if self.pc >= 0:
             self.last = self.pc
+        if self.result is not None and self.result.written is not None:
+            raise StopRun(REPORTED)
         if pc == self.pc and (mpu.p & FLAG_I or self.vic.irq_next >= NEVER):
             self.halt_pc = pc
             raise StopRun(HALTED)
@@ -193,6 +238,7 @@ def c64_for(program: Program, scene: VicScene | None) -> Machine:
         machine = build_c64(scene.state, start_line=scene.start_line, start_cycle=scene.start_cycle,
                             reads_memory=True, char_rom=char_rom)
         _fill_scene_memory(machine, scene, program)
+    install_kernal_irq_handler_stub(machine)  # a handler hooked at $0314 may end with JMP $EA31
     install_kernal_irq_entry(machine)  # the KERNAL is mapped in: its vector at $FFFE is the hardware's
     memory = machine.bus.memory
     memory[PORT_DIRECTION], memory[PORT_DATA] = POWER_ON_PORT
@@ -218,10 +264,12 @@ def _fill_scene_memory(machine: Machine, scene: VicScene, program: Program) -> N
 
 def run_c64(program: Program, entry: int, *, frames: int, scene: VicScene | None = None,
             until: int | None = None, until_value: tuple[int, int] | None = None,
-            sys_line: int | None = None, notes: tuple[str, ...] = (), wrap=None) -> C64Run:
+            sys_line: int | None = None, notes: tuple[str, ...] = (), wrap=None,
+            result_at: int | None = None) -> C64Run:
     """Run `program` on a C64 from `entry` (module docstring) for up to `frames` frames. `wrap(machine,
     watch)`, if given, returns the observer to run with instead of the stop conditions' own (a
-    profiler that tells them in turn)."""
+    profiler that tells them in turn). `result_at`: a test program's result address (DEBUG_CART):
+    the run stops at the first write there and carries the verdict."""
     if not 1 <= frames <= MAX_C64_FRAMES:
         raise InputError(f"--frames: {frames:,} is not a frame count in 1..{MAX_C64_FRAMES:,}")
     machine = c64_for(program, scene)
@@ -232,7 +280,14 @@ def run_c64(program: Program, entry: int, *, frames: int, scene: VicScene | None
     mpu.sp = push_return_trap(memory)  # an RTS from the SYS'd code comes back here (RETURNED)
     mpu.pc = entry
     mpu.pending_interrupt = None
-    watch = _C64Watch(machine, until, until_value)
+    result = None
+    if result_at is not None:
+        result = ResultPort(memory)
+        try:
+            machine.attach(result, result_at, result_at)
+        except InputError as exc:
+            raise InputError(f"--result ${result_at:04X}: {exc}") from None
+    watch = _C64Watch(machine, until, until_value, result)
     observer = watch if wrap is None else wrap(machine, watch)
     frame_cycles = vic_of(machine).video.frame_cycles
     start = machine.cycle
@@ -240,7 +295,7 @@ def run_c64(program: Program, entry: int, *, frames: int, scene: VicScene | None
     vic_of(machine).catch_up(machine.cycle)  # the latches and $D019 as they stand at the end of the run
     return C64Run(machine=machine, entry=entry, frames_asked=frames, cycles=machine.cycle - start,
                   instructions=instructions, stopped=stopped, halt_pc=watch.halt_pc, sys_line=sys_line,
-                  notes=notes)
+                  notes=notes, verdict=None if result is None else debug_cart_verdict(result_at, result.written))
 
 
 def vic_registers(vic: VicDevice) -> dict:

@@ -32,6 +32,11 @@ KERNAL_IRQ_ENTRY_CODE = bytes([0x48, 0x8A, 0x48, 0x98, 0x48, 0xBA, 0xBD, 0x04, 0
                                0xF0, 0x03, 0x6C, 0x16, 0x03, 0x6C, 0x14, 0x03])
 KERNAL_IRQ_EXIT = 0xEA81
 KERNAL_IRQ_EXIT_CODE = bytes([0x68, 0xA8, 0x68, 0xAA, 0x68, 0x40])  # PLA / TAY / PLA / TAX / PLA / RTI
+# The KERNAL's IRQ handler ($EA31: clock, cursor blink, keyboard scan, CIA 1 acknowledge, then the
+# exit at $EA81) stood in for by a JMP to its exit: what it does touches only the KERNAL's work
+# area and CIA 1, which a program run does not model; it takes fewer cycles than the ROM's.
+KERNAL_IRQ_HANDLER = 0xEA31
+KERNAL_IRQ_HANDLER_STUB = bytes([0x4C, KERNAL_IRQ_EXIT & 0xFF, KERNAL_IRQ_EXIT >> 8])  # JMP $EA81
 
 
 def build_c64(state: VicState | None = None, *, start_line: int = 0, start_cycle: int = 1,
@@ -72,6 +77,11 @@ def install_kernal_irq_entry(machine: Machine) -> None:
     machine.bus.load(KERNAL_IRQ_ENTRY, KERNAL_IRQ_ENTRY_CODE)
     machine.bus.load(KERNAL_IRQ_EXIT, KERNAL_IRQ_EXIT_CODE)
     machine.bus.load(CPU_IRQ_VECTOR, bytes([KERNAL_IRQ_ENTRY & 0xFF, KERNAL_IRQ_ENTRY >> 8]))
+
+
+def install_kernal_irq_handler_stub(machine: Machine) -> None:
+    """Put the stand-in for the KERNAL's IRQ handler (KERNAL_IRQ_HANDLER_STUB) at $EA31."""
+    machine.bus.load(KERNAL_IRQ_HANDLER, KERNAL_IRQ_HANDLER_STUB)
 
 
 @dataclass(frozen=True)
