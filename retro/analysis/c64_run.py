@@ -49,6 +49,7 @@ from retro.machines.c64 import (
     KERNAL_IRQ_EXIT_CODE,
     KERNAL_IRQ_HANDLER,
     KERNAL_IRQ_HANDLER_STUB,
+    KERNAL_NMI_EXIT,
     build_c64,
     install_kernal_irq_entry,
     install_kernal_irq_handler_stub,
@@ -85,7 +86,8 @@ KERNAL_NAMES = {0xFFD2: "CHROUT", 0xFFE4: "GETIN", 0xFFCF: "CHRIN", 0xFFF0: "PLO
                 0xFE66: "the KERNAL's BRK handler (BASIC warm start)", 0xFE47: "the KERNAL's NMI handler"}
 STUB_RANGES = ((KERNAL_IRQ_ENTRY, KERNAL_IRQ_ENTRY + len(KERNAL_IRQ_ENTRY_CODE)),
                (KERNAL_IRQ_EXIT, KERNAL_IRQ_EXIT + len(KERNAL_IRQ_EXIT_CODE)),
-               (KERNAL_IRQ_HANDLER, KERNAL_IRQ_HANDLER + len(KERNAL_IRQ_HANDLER_STUB)))
+               (KERNAL_IRQ_HANDLER, KERNAL_IRQ_HANDLER + len(KERNAL_IRQ_HANDLER_STUB)),
+               (KERNAL_NMI_EXIT, KERNAL_NMI_EXIT + len(KERNAL_IRQ_EXIT_CODE)))
 MAX_C64_FRAMES = MAX_FRAMES
 
 

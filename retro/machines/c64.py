@@ -37,6 +37,9 @@ KERNAL_IRQ_EXIT_CODE = bytes([0x68, 0xA8, 0x68, 0xAA, 0x68, 0x40])  # PLA / TAY 
 # area and CIA 1, which a program run does not model; it takes fewer cycles than the ROM's.
 KERNAL_IRQ_HANDLER = 0xEA31
 KERNAL_IRQ_HANDLER_STUB = bytes([0x4C, KERNAL_IRQ_EXIT & 0xFF, KERNAL_IRQ_EXIT >> 8])  # JMP $EA81
+# $FEBC, the end of the KERNAL's NMI handler, is the same register restore and RTI as $EA81 [Mapping
+# the Commodore 64, $FEBC]; IRQ handlers end with JMP $FEBC to skip the keyboard scan.
+KERNAL_NMI_EXIT = 0xFEBC
 
 
 def build_c64(state: VicState | None = None, *, start_line: int = 0, start_cycle: int = 1,
@@ -80,8 +83,10 @@ def install_kernal_irq_entry(machine: Machine) -> None:
 
 
 def install_kernal_irq_handler_stub(machine: Machine) -> None:
-    """Put the stand-in for the KERNAL's IRQ handler (KERNAL_IRQ_HANDLER_STUB) at $EA31."""
+    """Put the stand-in for the KERNAL's IRQ handler (KERNAL_IRQ_HANDLER_STUB) at $EA31, and the
+    KERNAL's register restore at $FEBC."""
     machine.bus.load(KERNAL_IRQ_HANDLER, KERNAL_IRQ_HANDLER_STUB)
+    machine.bus.load(KERNAL_NMI_EXIT, KERNAL_IRQ_EXIT_CODE)
 
 
 @dataclass(frozen=True)
