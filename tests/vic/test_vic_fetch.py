@@ -185,3 +185,30 @@ def test_text_after_the_sys_number_ends_the_expression_unless_an_operator_follow
         return
     found = sys_line(program)
     assert found.address == address and any("/T.L.R/" in note for note in found.notes)
+
+
+def test_a_run_with_a_scene_collides_through_memory(tmp_path):
+    """`retro run --scene`: the scene's sprites are put in memory and collide there; a program
+    that clears sprite 1's data makes them stop colliding."""
+    from retro.commands import run
+
+    scene_file = tmp_path / "two.toml"
+    scene_file.write_text('chip = "vic-ii"\n[registers]\n"$d011" = 0x1b\n"$d018" = 0x14\n'
+                          '[[sprite]]\nindex = 0\nx = 100\ny = 100\ndata = "' + "ff" * 63 + '"\n'
+                          '[[sprite]]\nindex = 1\nx = 110\ny = 100\ndata = "' + "ff" * 63 + '"\n')
+    stub = bytes([0x0B, 0x08, 0x0A, 0x00, 0x9E]) + b"2061" + bytes([0, 0, 0])
+    prg = tmp_path / "p.prg"
+
+    def collisions_seen(before: list[int]) -> int:
+        """Run `before`, then OR every $D01E read into $C000 for two frames."""
+        at = 0x080D + len(before)
+        loop = [0xAD, 0x1E, 0xD0, 0x0D, 0x00, 0xC0, 0x8D, 0x00, 0xC0, 0x4C, at & 0xFF, at >> 8]
+        prg.write_bytes(bytes([0x01, 0x08]) + stub + bytes(before + loop))
+        report = run.run_c64_program(prg, frames=2, scene=scene_file, peeks=["$C000"])
+        return report.peeks["$C000"][0], report.machine.bus.memory[0x07F9]
+
+    seen, pointer = collisions_seen([])
+    assert seen == 0x03
+    block = pointer * 64
+    clear = [0xA9, 0x00, 0xA2, 0x3F, 0x9D, block & 0xFF, block >> 8, 0xCA, 0x10, 0xFA]  # zero sprite 1's block
+    assert collisions_seen(clear)[0] == 0x00
