@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from retro.chips.vic.constants import PAL, REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT
-from retro.chips.vic.fetch import VicBankPort, VicFetcher, memory_parts, sprites_drawn_between, vic_bases
+from retro.chips.vic.fetch import VicBankPort, VicFetcher, memory_parts, sprite_line_counts, sprites_drawn_between, \
+    vic_bases
 from retro.chips.vic.graphics import VicMemory
 from retro.chips.vic.model import VicState, run_frames
 from retro.errors import InputError, RunError
@@ -162,14 +163,18 @@ def test_a_scene_whose_parts_overlap_is_refused_naming_d018():
 def test_memory_is_read_only_where_a_sprite_can_draw():
     registers = bytearray(REGISTER_COUNT)
     registers[0x15], registers[0x01] = 1, 100  # sprite 0 on lines 101-121
+    counts = sprite_line_counts(PAL, bytes(registers))
     cycles = PAL.cycles_per_line
-    assert not sprites_drawn_between(PAL, bytes(registers), 0, 90 * cycles)
-    assert sprites_drawn_between(PAL, bytes(registers), 100 * cycles, 101 * cycles)
-    assert sprites_drawn_between(PAL, bytes(registers), 90 * cycles, 130 * cycles)
-    assert sprites_drawn_between(PAL, bytes(registers), FRAME + 110 * cycles, FRAME + 110 * cycles + 1)
-    assert not sprites_drawn_between(PAL, bytes(registers), 200 * cycles, 300 * cycles)
+    assert not sprites_drawn_between(PAL, counts, 0, 90 * cycles)
+    assert sprites_drawn_between(PAL, counts, 100 * cycles, 101 * cycles)
+    assert sprites_drawn_between(PAL, counts, 90 * cycles, 130 * cycles)
+    assert sprites_drawn_between(PAL, counts, FRAME + 110 * cycles, FRAME + 110 * cycles + 1)
+    assert not sprites_drawn_between(PAL, counts, 200 * cycles, 300 * cycles)
+    assert not sprites_drawn_between(PAL, counts, 300 * cycles, FRAME + 90 * cycles)
+    assert sprites_drawn_between(PAL, counts, 300 * cycles, FRAME + 100 * cycles)  # across the frame's end
     registers[0x15] = 0
-    assert not sprites_drawn_between(PAL, bytes(registers), 0, 3 * FRAME)
+    assert sprite_line_counts(PAL, bytes(registers)) is None
+    assert not sprites_drawn_between(PAL, None, 0, 3 * FRAME)
 
 
 @pytest.mark.parametrize("text, address, refused", [(b"\x9e2069 /T.L.R/", 2069, False),

@@ -53,7 +53,6 @@ from retro.chips.vic.constants import (
     Y_COMPARE_MASK,
 )
 from retro.chips.vic.dma import DMA_REGISTERS, bus_schedule
-from retro.chips.vic.fetch import sprites_drawn_between
 from retro.chips.vic.model import (
     COLLISION_REGISTERS,
     FrameCollisions,
@@ -180,7 +179,7 @@ class VicDevice:
         lo = self.synced
         if until <= lo:
             return
-        if self.fetcher is not None and sprites_drawn_between(self.video, self.registers, lo, until):
+        if self.fetcher is not None and self.fetcher.sprites_drawn_between(self.video, self.registers, lo, until):
             self._fetch()  # elsewhere what the VIC-II fetches changes nothing
         frame_cycles = self.video.frame_cycles
         events = self._schedule

@@ -146,6 +146,13 @@ class VicFetcher:
         self._built: tuple = ((bytes(SPRITE_BYTES),) * SPRITE_COUNT, VicMemory.blank())
         self.missing_sprites = 0  # bit n: sprite n's data came from the absent character ROM
         self.missing_graphics = False  # the screen, character set or bitmap did
+        self._counts: tuple | None = None  # (registers, sprite_line_counts) of the last registers asked about
+
+    def sprites_drawn_between(self, video: Video, registers: bytearray, lo: int, hi: int) -> bool:
+        """sprites_drawn_between for the device's registers (the line counts kept while they hold)."""
+        if self._counts is None or self._counts[0] != registers:
+            self._counts = (bytes(registers), sprite_line_counts(video, registers))
+        return sprites_drawn_between(video, self._counts[1], lo, hi)
 
     def _read(self, address: int, length: int) -> tuple[list[int], bool]:
         """`length` bytes of the VIC-II's view from `address` (within one bank), and whether any came
@@ -291,16 +298,26 @@ def _sprite_line_counts(video: Video, enabled: int, ys: bytes, expand_y: int) ->
     return counts
 
 
-def sprites_drawn_between(video: Video, registers: bytes, lo: int, hi: int) -> bool:
-    """Whether an enabled sprite may draw a pixel in frame time [lo, hi) (times counted from a frame's
-    start, repeating every frame): outside those times what the VIC-II fetches changes no collision."""
+def sprite_line_counts(video: Video, registers: bytes) -> np.ndarray | None:
+    """Cumulative count of the lines (two frames long) where an enabled sprite may draw, or None
+    when no sprite is enabled."""
     enabled = registers[REG_SPRITE_ENABLE]
-    if not enabled or hi <= lo:
+    if not enabled:
+        return None
+    return _sprite_line_counts(video, enabled, bytes(registers[REG_SPRITE_Y0:REG_SPRITE_X_MSB:2]),
+                               registers[REG_SPRITE_EXPAND_Y])
+
+
+def sprites_drawn_between(video: Video, counts: np.ndarray | None, lo: int, hi: int) -> bool:
+    """Whether an enabled sprite may draw a pixel in frame time [lo, hi) (times counted from a frame's
+    start, repeating every frame; `counts` from sprite_line_counts): outside those times what the
+    VIC-II fetches changes no collision."""
+    if counts is None or hi <= lo:
         return False
-    if hi - lo >= video.frame_cycles:
+    frame_cycles = video.frame_cycles
+    if hi - lo >= frame_cycles:
         return True
-    counts = _sprite_line_counts(video, enabled, bytes(registers[REG_SPRITE_Y0:REG_SPRITE_X_MSB:2]),
-                                 registers[REG_SPRITE_EXPAND_Y])
-    first = lo % video.frame_cycles // video.cycles_per_line
-    last = first + (hi - 1 - lo + lo % video.frame_cycles % video.cycles_per_line) // video.cycles_per_line
-    return bool(counts[last + 1] - counts[first])
+    within = lo % frame_cycles
+    first = within // video.cycles_per_line
+    last = first + (hi - 1 - lo + within % video.cycles_per_line) // video.cycles_per_line
+    return counts[last + 1] != counts[first]
