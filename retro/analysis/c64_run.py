@@ -252,8 +252,11 @@ def c64_for(program: Program, scene: VicScene | None) -> Machine:
 
 
 def _fill_scene_memory(machine: Machine, scene: VicScene, program: Program) -> None:
+    port = vic_of(machine).fetcher.bank_port
+    if scene.bank:
+        port.set_bank(scene.bank)
     try:
-        parts = memory_parts(scene.state, vic_of(machine).fetcher.bank_port.bank)
+        parts = memory_parts(scene.state, port.bank)
     except InputError as exc:
         raise InputError(f"{scene.source}: {exc}") from None
     loaded = (program.origin, program.origin + len(program.code))

@@ -217,3 +217,18 @@ def test_a_run_with_a_scene_collides_through_memory(tmp_path):
     block = pointer * 64
     clear = [0xA9, 0x00, 0xA2, 0x3F, 0x9D, block & 0xFF, block >> 8, 0xCA, 0x10, 0xFA]  # zero sprite 1's block
     assert collisions_seen(clear)[0] == 0x00
+
+
+def test_a_scene_names_the_bank_its_memory_goes_to(tmp_path):
+    from retro.analysis.c64_run import c64_for
+    from retro.scenes.vic import load
+
+    scene_file = tmp_path / "b.toml"
+    scene_file.write_text('chip = "vic-ii"\n[registers]\n"$d018" = 0x14\n[memory]\nbank = 2\n'
+                          'screen = { fill = 7 }\n')
+    machine = c64_for(Program(code=b"\x60", origin=0xC000, source="p"), load(scene_file))
+    assert machine.bus.memory[0x8400:0x8400 + 1000] == [7] * 1000 and machine.bus.memory[0x0400] == 0
+    assert vic_of(machine).fetcher.bank_port.bank == 2
+    scene_file.write_text('chip = "vic-ii"\n[memory]\nbank = 4\n')
+    with pytest.raises(InputError, match="memory.bank"):
+        load(scene_file)
