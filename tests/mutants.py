@@ -78,7 +78,7 @@ MUTANTS = [
     Mutant("vic-no-char-rom-window", "retro/chips/vic/constants.py",
            "CHAR_ROM_BANKS = (0, 2)", "CHAR_ROM_BANKS = ()", ("tests/vic/test_vic_fetch.py",)),
     Mutant("vic-memory-read-nowhere", "retro/chips/vic/device.py",
-           "if self.fetcher is not None and self.fetcher.sprites_drawn_between(self.video, self.registers, lo, until):",
+           "if self.fetcher is not None and self.fetcher.due(self.video, self.registers, lo, until):",
            "if False:", ("tests/vic/test_vic_fetch.py",)),
     # ---- CPU -------------------------------------------------------------------------------------
     Mutant("branch-taken-costs-nothing", "retro/cpu/timing.py",

@@ -179,7 +179,7 @@ class VicDevice:
         lo = self.synced
         if until <= lo:
             return
-        if self.fetcher is not None and self.fetcher.sprites_drawn_between(self.video, self.registers, lo, until):
+        if self.fetcher is not None and self.fetcher.due(self.video, self.registers, lo, until):
             self._fetch()  # elsewhere what the VIC-II fetches changes nothing
         frame_cycles = self.video.frame_cycles
         events = self._schedule

@@ -49,6 +49,7 @@ from retro.chips.vic.constants import (
     COLOR_RAM,
     CONTROL1_BMM,
     CONTROL1_ECM,
+    CONTROL2_MCM,
     IDLE_ADDRESS,
     IDLE_ADDRESS_ECM,
     MEMORY_BITMAP_BIT,
@@ -56,6 +57,7 @@ from retro.chips.vic.constants import (
     MEMORY_SCREEN_MASK,
     MEMORY_SCREEN_SHIFT,
     REG_CONTROL1,
+    REG_CONTROL2,
     REG_MEMORY_POINTERS,
     REG_SPRITE_ENABLE,
     REG_SPRITE_EXPAND_Y,
@@ -74,6 +76,7 @@ from retro.chips.vic.model import VicState, sprite_rows
 from retro.errors import InputError, RunError
 
 CHARGEN_ENV = "RETRO_C64_CHARGEN"
+_NOTHING_READ = [0] * SCREEN_CELLS  # what stands for bytes the chip's collisions do not depend on
 BANK_MASK = BANK_SIZE - 1
 ROM_MISSING_HINT = (f"retro has no character ROM (it is Commodore's): set {CHARGEN_ENV} to a 4096-byte image of "
                     f"it (docs/vic.md \"The VIC-II reads memory\")")
@@ -147,12 +150,21 @@ class VicFetcher:
         self.missing_sprites = 0  # bit n: sprite n's data came from the absent character ROM
         self.missing_graphics = False  # the screen, character set or bitmap did
         self._counts: tuple | None = None  # (registers, sprite_line_counts) of the last registers asked about
+        self._line = -1  # the raster line (counted from the device's start) in which `due` last said yes
 
-    def sprites_drawn_between(self, video: Video, registers: bytearray, lo: int, hi: int) -> bool:
-        """sprites_drawn_between for the device's registers (the line counts kept while they hold)."""
+    def due(self, video: Video, registers: bytearray, lo: int, hi: int) -> bool:
+        """Whether the device drawing frame time [lo, hi) reads memory first: an enabled sprite may
+        draw in it (sprites_drawn_between) and memory was not read yet in the raster line of `hi`
+        (the VIC-II fetches a sprite's row once a line, in the line before it is shown)."""
+        line = hi // video.cycles_per_line
+        if line == self._line:
+            return False
         if self._counts is None or self._counts[0] != registers:
             self._counts = (bytes(registers), sprite_line_counts(video, registers))
-        return sprites_drawn_between(video, self._counts[1], lo, hi)
+        if not sprites_drawn_between(video, self._counts[1], lo, hi):
+            return False
+        self._line = line
+        return True
 
     def _read(self, address: int, length: int) -> tuple[list[int], bool]:
         """`length` bytes of the VIC-II's view from `address` (within one bank), and whether any came
@@ -174,16 +186,22 @@ class VicFetcher:
         bank = self.bank_port.bank
         screen_at, charset_at, bitmap_at = vic_bases(registers, bank)
         control1 = registers[REG_CONTROL1]
+        enabled = registers[REG_SPRITE_ENABLE]
         pointers, missing_pointers = self._read(screen_at + SPRITE_POINTERS, SPRITE_COUNT)
         sprites = []
         missing_sprites = 0
-        for n, pointer in enumerate(pointers):
-            data, missing = self._read(bank * BANK_SIZE + pointer * SPRITE_BLOCK, SPRITE_BYTES)
+        for n, pointer in enumerate(pointers):  # a disabled sprite collides with nothing: not read
+            data, missing = (self._read(bank * BANK_SIZE + pointer * SPRITE_BLOCK, SPRITE_BYTES) if enabled >> n & 1
+                             else (_NOTHING_READ[:SPRITE_BYTES], False))
             sprites.append(data)
             missing_sprites |= (1 << n) if missing or missing_pointers else 0
-        screen, missing_screen = self._read(screen_at, SCREEN_CELLS)
-        colour = self.ram[COLOR_RAM:COLOR_RAM + SCREEN_CELLS]
+        # only what decides the foreground is read: no video matrix in bitmap modes, no colour RAM
+        # unless multicolor text (its bit 3) [graphics.py]
         bitmap_mode = bool(control1 & CONTROL1_BMM)
+        screen, missing_screen = (_NOTHING_READ[:SCREEN_CELLS], False) if bitmap_mode else self._read(screen_at,
+                                                                                                    SCREEN_CELLS)
+        colour = (self.ram[COLOR_RAM:COLOR_RAM + SCREEN_CELLS] if registers[REG_CONTROL2] & CONTROL2_MCM
+                  and not bitmap_mode else _NOTHING_READ[:SCREEN_CELLS])
         shapes, missing_shapes = self._read(bitmap_at, BITMAP_BYTES) if bitmap_mode else self._read(charset_at,
                                                                                                    CHARSET_BYTES)
         idle, missing_idle = self._read(bank * BANK_SIZE + (IDLE_ADDRESS_ECM if control1 & CONTROL1_ECM
