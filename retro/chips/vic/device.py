@@ -198,7 +198,7 @@ class VicDevice:
 
     def _fetch(self) -> None:
         """Take what the VIC-II fetches from memory as it stands now (docs/vic.md, "The VIC-II reads
-        memory": memory is read at every synchronisation, and holds since the one before)."""
+        memory": once per raster line where sprites draw, and after every register write)."""
         state = self.fetcher.state_for(self.state, self.registers)
         if state is not self.state:
             self.state = state
