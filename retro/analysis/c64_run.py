@@ -31,10 +31,10 @@ from dataclasses import dataclass, field
 
 from retro.analysis.console_run import FRAMES_DONE, HALTED, INTERRUPTED, MAX_FRAMES, REACHED, REPORTED, VALUE_SEEN, \
     StopRun, Verdict, run_frames
-from retro.chips.vic.constants import PAL, REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT, VIC_BASE
-from retro.chips.vic.constants import CHAR_ROM_BYTES
+from retro.chips.vic.constants import CHAR_ROM_BYTES, PAL, REG_SPRITE_ENABLE, REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT, \
+    VIC_BASE
 from retro.chips.vic.device import VicDevice
-from retro.chips.vic.fetch import CHARGEN_ENV, memory_parts
+from retro.chips.vic.fetch import CHARGEN_ENV, ROM_MISSING_HINT, memory_parts
 from retro.chips.vic.graphics import VicMemory
 from retro.chips.vic.model import VicState
 from retro.cpu.bus import NEVER
@@ -298,6 +298,10 @@ def run_c64(program: Program, entry: int, *, frames: int, scene: VicScene | None
     start = machine.cycle
     stopped, instructions = run_frames(machine, start + math.ceil(frames * frame_cycles), frame_cycles, observer)
     vic_of(machine).catch_up(machine.cycle)  # the latches and $D019 as they stand at the end of the run
+    unknown = vic_of(machine).fetcher.unknown_latches(vic_of(machine).registers[REG_SPRITE_ENABLE])
+    if unknown:
+        notes = notes + (f"{' and '.join(unknown)} at the end of the run count the character ROM's bytes as 0: "
+                         f"{ROM_MISSING_HINT}",)
     return C64Run(machine=machine, entry=entry, frames_asked=frames, cycles=machine.cycle - start,
                   instructions=instructions, stopped=stopped, halt_pc=watch.halt_pc, sys_line=sys_line,
                   notes=notes, verdict=None if result is None else debug_cart_verdict(result_at, result.written))

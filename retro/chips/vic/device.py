@@ -265,8 +265,7 @@ class VicDevice:
         self._advance(t)
         register = address % MIRROR_SIZE
         if self.fetcher is not None and register in READ_ONLY_LATCHES:
-            self.fetcher.check_latch(f"${VIC_BASE + register:04X}", self.registers[REG_SPRITE_ENABLE],
-                                     graphics=register == REG_SPRITE_BACKGROUND)
+            self.fetcher.check_latch(VIC_BASE + register, self.registers[REG_SPRITE_ENABLE])
         if register == REG_SPRITE_SPRITE:
             value, self.sprite_sprite = self.sprite_sprite, 0
             self._refresh_irq_next()

@@ -39,7 +39,6 @@ from retro.chips.vic.constants import (
     CHARSET_BYTES,
     CHARSET_STEP,
     CIA2_BANK_BITS,
-    CIA2_BASE,
     CIA2_DDR_A,
     CIA2_KERNAL_DDR_A,
     CIA2_KERNAL_PORT_A,
@@ -59,8 +58,10 @@ from retro.chips.vic.constants import (
     REG_CONTROL1,
     REG_CONTROL2,
     REG_MEMORY_POINTERS,
+    REG_SPRITE_BACKGROUND,
     REG_SPRITE_ENABLE,
     REG_SPRITE_EXPAND_Y,
+    REG_SPRITE_SPRITE,
     REG_SPRITE_X_MSB,
     REG_SPRITE_Y0,
     SCREEN_CELLS,
@@ -69,6 +70,7 @@ from retro.chips.vic.constants import (
     SPRITE_BYTES,
     SPRITE_COUNT,
     SPRITE_POINTERS,
+    VIC_BASE,
     Video,
 )
 from retro.chips.vic.graphics import VicMemory
@@ -77,7 +79,8 @@ from retro.errors import InputError, RunError
 
 CHARGEN_ENV = "RETRO_C64_CHARGEN"
 _NOTHING_READ = [0] * SCREEN_CELLS  # what stands for bytes the chip's collisions do not depend on
-BANK_MASK = BANK_SIZE - 1
+LATCH_SPRITE_SPRITE = VIC_BASE + REG_SPRITE_SPRITE  # $D01E
+LATCH_SPRITE_BACKGROUND = VIC_BASE + REG_SPRITE_BACKGROUND  # $D01F
 ROM_MISSING_HINT = (f"retro has no character ROM (it is Commodore's): set {CHARGEN_ENV} to a 4096-byte image of "
                     f"it (docs/vic.md \"The VIC-II reads memory\")")
 
@@ -93,8 +96,11 @@ class VicBankPort:
     @property
     def bank(self) -> int:
         """The VIC-II's bank 0-3: the pins of port A bits 0-1 inverted; an input pin reads 1."""
-        pins = (self.registers[CIA2_PORT_A] | ~self.registers[CIA2_DDR_A]) & CIA2_BANK_BITS
-        return CIA2_BANK_BITS - pins
+        return CIA2_BANK_BITS - (self._pins() & CIA2_BANK_BITS)
+
+    def _pins(self) -> int:
+        """Port A's pins: the outputs as written, the inputs pulled up to 1."""
+        return (self.registers[CIA2_PORT_A] | ~self.registers[CIA2_DDR_A]) & 0xFF
 
     def set_bank(self, bank: int) -> None:
         """Program bits 0-1 as outputs selecting `bank` (what `lda #$3x; sta $dd00` does)."""
@@ -104,7 +110,7 @@ class VicBankPort:
     def read(self, address: int, cycle: int) -> int:
         register = address % CIA2_REGISTERS
         if register == CIA2_PORT_A:
-            return (self.registers[CIA2_PORT_A] | ~self.registers[CIA2_DDR_A]) & 0xFF
+            return self._pins()
         if register == CIA2_DDR_A:
             return self.registers[CIA2_DDR_A]
         raise RunError(f"the program read CIA 2 at ${address:04X}: retro models only CIA 2's port A and its data "
@@ -115,8 +121,6 @@ class VicBankPort:
 
     def peek(self, address: int) -> int:
         return self.registers[address % CIA2_REGISTERS]
-
-
 
 
 def vic_bases(registers: bytes, bank: int) -> tuple[int, int, int]:
@@ -226,17 +230,23 @@ class VicFetcher:
         sprite_data, memory = self._built
         return replace(state, sprite_data=sprite_data, memory=memory, view_key=self._key)
 
-    def check_latch(self, what: str, sprites: int, graphics: bool) -> None:
-        """RunError when reading a latch whose value depends on bytes of the absent character ROM:
-        `sprites` the enabled sprites; `graphics` whether the foreground counts ($D01F)."""
-        from_rom = []
+    def unknown_latches(self, sprites: int) -> list[str]:
+        """The latches whose value, with `sprites` enabled, depends on the absent character ROM."""
+        unknown = []
         if self.missing_sprites & sprites:
-            from_rom.append("sprite data")
-        if graphics and self.missing_graphics and sprites:
-            from_rom.append("the screen, character set or bitmap")
-        if from_rom:
-            raise RunError(f"the program read {what}, whose value depends on {' and '.join(from_rom)} the VIC-II "
-                           f"fetches from the character ROM ($1000-$1FFF of bank 0 or 2): {ROM_MISSING_HINT}")
+            unknown.append(f"${LATCH_SPRITE_SPRITE:04X}")
+        if sprites and (self.missing_graphics or self.missing_sprites & sprites):
+            unknown.append(f"${LATCH_SPRITE_BACKGROUND:04X}")
+        return unknown
+
+    def check_latch(self, register: int, sprites: int) -> None:
+        """RunError when the program reads a latch ($D01E, $D01F: `register`) whose value, with
+        `sprites` enabled, depends on bytes of the absent character ROM."""
+        what = f"${register:04X}"
+        if what in self.unknown_latches(sprites):
+            fetched = "sprite data" if register == LATCH_SPRITE_SPRITE else "sprite data, screen, character set or bitmap"
+            raise RunError(f"the program read {what}, whose value depends on {fetched} the VIC-II fetches from the "
+                           f"character ROM ($1000-$1FFF of bank 0 or 2): {ROM_MISSING_HINT}")
 
 
 FIRST_FREE_ADDRESS = 0x0200  # zero page and stack are the CPU's: nothing the VIC-II shows is put there
