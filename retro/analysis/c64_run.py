@@ -26,25 +26,33 @@ BRK through the KERNAL's $FE66).
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 
-from retro.analysis.console_run import FRAMES_DONE, HALTED, INTERRUPTED, MAX_FRAMES, REACHED, VALUE_SEEN, StopRun, \
-    run_frames
-from retro.chips.vic.constants import PAL, REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT, VIC_BASE
+from retro.analysis.console_run import FRAMES_DONE, HALTED, INTERRUPTED, MAX_FRAMES, REACHED, REPORTED, VALUE_SEEN, \
+    StopRun, Verdict, run_frames
+from retro.chips.vic.constants import CHAR_ROM_BYTES, PAL, REG_SPRITE_ENABLE, REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT, \
+    VIC_BASE
 from retro.chips.vic.device import VicDevice
+from retro.chips.vic.fetch import CHARGEN_ENV, ROM_MISSING_HINT, memory_parts
 from retro.chips.vic.graphics import VicMemory
 from retro.chips.vic.model import VicState
 from retro.cpu.bus import NEVER
 from retro.cpu.machine import CALL_STACK_TOP, RETURN_TRAP, Machine, push_return_trap
 from retro.cpu.mpu import FLAG_I, FLAG_U
 from retro.errors import InputError, RunError
+from retro.fileio import read_bytes
 from retro.machines.c64 import (
     KERNAL_IRQ_ENTRY,
     KERNAL_IRQ_ENTRY_CODE,
     KERNAL_IRQ_EXIT,
     KERNAL_IRQ_EXIT_CODE,
+    KERNAL_IRQ_HANDLER,
+    KERNAL_IRQ_HANDLER_STUB,
+    KERNAL_NMI_EXIT,
     build_c64,
     install_kernal_irq_entry,
+    install_kernal_irq_handler_stub,
     vic_of,
 )
 from retro.program import Program
@@ -74,11 +82,13 @@ SYS_REGISTERS = 0x030C  # A, X, Y, P that SYS loads (0 after power-on)
 KERNAL_NAMES = {0xFFD2: "CHROUT", 0xFFE4: "GETIN", 0xFFCF: "CHRIN", 0xFFF0: "PLOT", 0xFF9F: "SCNKEY",
                 0xFFE1: "STOP", 0xFFBA: "SETLFS", 0xFFBD: "SETNAM", 0xFFD5: "LOAD", 0xFFD8: "SAVE",
                 0xFFC0: "OPEN", 0xFFC3: "CLOSE", 0xFFCC: "CLRCHN", 0xFF81: "CINT", 0xFF84: "IOINIT",
-                0xE544: "clear screen", 0xEA31: "the KERNAL's IRQ handler (keyboard, clock)",
+                0xE544: "clear screen",
                 0xEA7E: "the KERNAL's IRQ handler (after the keyboard scan)",
                 0xFE66: "the KERNAL's BRK handler (BASIC warm start)", 0xFE47: "the KERNAL's NMI handler"}
 STUB_RANGES = ((KERNAL_IRQ_ENTRY, KERNAL_IRQ_ENTRY + len(KERNAL_IRQ_ENTRY_CODE)),
-               (KERNAL_IRQ_EXIT, KERNAL_IRQ_EXIT + len(KERNAL_IRQ_EXIT_CODE)))
+               (KERNAL_IRQ_EXIT, KERNAL_IRQ_EXIT + len(KERNAL_IRQ_EXIT_CODE)),
+               (KERNAL_IRQ_HANDLER, KERNAL_IRQ_HANDLER + len(KERNAL_IRQ_HANDLER_STUB)),
+               (KERNAL_NMI_EXIT, KERNAL_NMI_EXIT + len(KERNAL_IRQ_EXIT_CODE)))
 MAX_C64_FRAMES = MAX_FRAMES
 
 
@@ -100,6 +110,7 @@ class C64Run:
     notes: tuple[str, ...] = ()
     peeks: dict[str, list[int]] = field(default_factory=dict)  # filled by the command
     tracer: object = None  # a retro.analysis.trace.Tracer that observed the run (--trace, --watch)
+    verdict: Verdict | None = None  # with result_at: the test program's result (debug_cart_verdict)
 
     @property
     def vic(self) -> VicDevice:
@@ -130,11 +141,49 @@ def rom_error(machine: Machine, pc: int, came_from: int | None) -> RunError:
                     f"this C64 has no BASIC or KERNAL ROM (docs/vic.md \"Running a C64 program\")")
 
 
+# VICE's testbench (testbench/*-hooks.sh of the VICE test programs; x64sc's -debugcart): a test
+# program ends by writing its result to $D7FF, $00 passed and $FF failed; the first write ends the run.
+DEBUG_CART = 0xD7FF
+DEBUG_CART_PASSED, DEBUG_CART_FAILED = 0x00, 0xFF
+
+
+class ResultPort:
+    """RAM at a test program's result address that remembers the first value written there."""
+
+    def __init__(self, memory: list[int]) -> None:
+        self.memory = memory
+        self.written: int | None = None
+
+    def read(self, address: int, cycle: int) -> int:
+        return self.memory[address]
+
+    def write(self, address: int, value: int, cycle: int) -> None:
+        self.memory[address] = value
+        if self.written is None:
+            self.written = value
+
+    def peek(self, address: int) -> int:
+        return self.memory[address]
+
+
+def debug_cart_verdict(address: int, written: int | None) -> Verdict:
+    """The verdict of VICE's testbench protocol from the first byte written at `address` (None: none)."""
+    protocol = f"result byte ${address:04X} (VICE testbench: $00 passed, $FF failed)"
+    if written is None:
+        return Verdict(protocol, None, None, "nothing written there yet")
+    if written == DEBUG_CART_PASSED:
+        return Verdict(protocol, written, True, "passed")
+    return Verdict(protocol, written, False, "failed" if written == DEBUG_CART_FAILED
+                   else f"${written:02X} written: the protocol knows $00 and $FF only")
+
+
 class _C64Watch:
     """Observer of the run loop: the stop conditions (module docstring) and the ROM check."""
 
-    def __init__(self, machine: Machine, until: int | None, until_value: tuple[int, int] | None) -> None:
+    def __init__(self, machine: Machine, until: int | None, until_value: tuple[int, int] | None,
+                 result: ResultPort | None = None) -> None:
         self.machine = machine
+        self.result = result
         self.memory = machine.bus.memory
         self.peek = machine.bus.peek
         self.vic = vic_of(machine)
@@ -156,6 +205,8 @@ class _C64Watch:
         pc = mpu.pc
         if self.pc >= 0:
             self.last = self.pc
+        if self.result is not None and self.result.written is not None:
+            raise StopRun(REPORTED)
         if pc == self.pc and (mpu.p & FLAG_I or self.vic.irq_next >= NEVER):
             self.halt_pc = pc
             raise StopRun(HALTED)
@@ -167,13 +218,30 @@ class _C64Watch:
             raise StopRun(VALUE_SEEN)
 
 
+def char_rom_image() -> bytes | None:
+    """The character ROM image the user names in $RETRO_C64_CHARGEN (4096 bytes), or None."""
+    path = os.environ.get(CHARGEN_ENV)
+    if not path:
+        return None
+    image = read_bytes(path, "character ROM image", CHAR_ROM_BYTES)
+    if len(image) != CHAR_ROM_BYTES:
+        raise InputError(f"{path} (${CHARGEN_ENV}): a character ROM image is {CHAR_ROM_BYTES} bytes, not {len(image)}")
+    return image
+
+
 def c64_for(program: Program, scene: VicScene | None) -> Machine:
     """A C64 as after RUN (module docstring) with `program` loaded and the scene's VIC-II (else the
-    KERNAL's), its beam where the scene says (else line 0, cycle 1)."""
+    KERNAL's), its beam where the scene says (else line 0, cycle 1). The VIC-II reads its memory
+    (retro.chips.vic.fetch); a scene's screen, colour RAM, character set, bitmap and sprite data are
+    put where it fetches them (fetch.memory_parts), and the program may not load over them."""
+    char_rom = char_rom_image()
     if scene is None:
-        machine = build_c64(kernal_vic_state())
+        machine = build_c64(kernal_vic_state(), reads_memory=True, char_rom=char_rom)
     else:
-        machine = build_c64(scene.state, start_line=scene.start_line, start_cycle=scene.start_cycle)
+        machine = build_c64(scene.state, start_line=scene.start_line, start_cycle=scene.start_cycle,
+                            reads_memory=True, char_rom=char_rom)
+        _fill_scene_memory(machine, scene, program)
+    install_kernal_irq_handler_stub(machine)  # a handler hooked at $0314 may end with JMP $EA31
     install_kernal_irq_entry(machine)  # the KERNAL is mapped in: its vector at $FFFE is the hardware's
     memory = machine.bus.memory
     memory[PORT_DIRECTION], memory[PORT_DATA] = POWER_ON_PORT
@@ -184,12 +252,30 @@ def c64_for(program: Program, scene: VicScene | None) -> Machine:
     return machine
 
 
+def _fill_scene_memory(machine: Machine, scene: VicScene, program: Program) -> None:
+    port = vic_of(machine).fetcher.bank_port
+    if scene.bank:
+        port.set_bank(scene.bank)
+    try:
+        parts = memory_parts(scene.state, port.bank)
+    except InputError as exc:
+        raise InputError(f"{scene.source}: {exc}") from None
+    loaded = (program.origin, program.origin + len(program.code))
+    for name, at, values in parts:
+        if at < loaded[1] and loaded[0] < at + len(values):
+            raise InputError(f"{scene.source}: the scene's {name} (${at:04X}-${at + len(values) - 1:04X}, where the "
+                             f"VIC-II reads it) overlaps the program (${loaded[0]:04X}-${loaded[1] - 1:04X})")
+        machine.bus.load(at, bytes(values))
+
+
 def run_c64(program: Program, entry: int, *, frames: int, scene: VicScene | None = None,
             until: int | None = None, until_value: tuple[int, int] | None = None,
-            sys_line: int | None = None, notes: tuple[str, ...] = (), wrap=None) -> C64Run:
+            sys_line: int | None = None, notes: tuple[str, ...] = (), wrap=None,
+            result_at: int | None = None) -> C64Run:
     """Run `program` on a C64 from `entry` (module docstring) for up to `frames` frames. `wrap(machine,
     watch)`, if given, returns the observer to run with instead of the stop conditions' own (a
-    profiler that tells them in turn)."""
+    profiler that tells them in turn). `result_at`: a test program's result address (DEBUG_CART):
+    the run stops at the first write there and carries the verdict."""
     if not 1 <= frames <= MAX_C64_FRAMES:
         raise InputError(f"--frames: {frames:,} is not a frame count in 1..{MAX_C64_FRAMES:,}")
     machine = c64_for(program, scene)
@@ -200,15 +286,26 @@ def run_c64(program: Program, entry: int, *, frames: int, scene: VicScene | None
     mpu.sp = push_return_trap(memory)  # an RTS from the SYS'd code comes back here (RETURNED)
     mpu.pc = entry
     mpu.pending_interrupt = None
-    watch = _C64Watch(machine, until, until_value)
+    result = None
+    if result_at is not None:
+        result = ResultPort(memory)
+        try:
+            machine.attach(result, result_at, result_at)
+        except InputError as exc:
+            raise InputError(f"--result ${result_at:04X}: {exc}") from None
+    watch = _C64Watch(machine, until, until_value, result)
     observer = watch if wrap is None else wrap(machine, watch)
     frame_cycles = vic_of(machine).video.frame_cycles
     start = machine.cycle
     stopped, instructions = run_frames(machine, start + math.ceil(frames * frame_cycles), frame_cycles, observer)
     vic_of(machine).catch_up(machine.cycle)  # the latches and $D019 as they stand at the end of the run
+    unknown = vic_of(machine).fetcher.unknown_latches(vic_of(machine).registers[REG_SPRITE_ENABLE])
+    if unknown:
+        notes = notes + (f"{' and '.join(unknown)} at the end of the run count the character ROM's bytes as 0: "
+                         f"{ROM_MISSING_HINT}",)
     return C64Run(machine=machine, entry=entry, frames_asked=frames, cycles=machine.cycle - start,
                   instructions=instructions, stopped=stopped, halt_pc=watch.halt_pc, sys_line=sys_line,
-                  notes=notes)
+                  notes=notes, verdict=None if result is None else debug_cart_verdict(result_at, result.written))
 
 
 def vic_registers(vic: VicDevice) -> dict:

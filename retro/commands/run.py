@@ -150,9 +150,10 @@ def run_console(path: str | Path, *, frames: int | str = DEFAULT_FRAMES, until: 
 def run_c64_program(path: str | Path, *, entry: str | int | None = None, frames: int | str = DEFAULT_C64_FRAMES,
                     until: str | int | None = None, until_value: str | None = None,
                     labels: str | Path | None = None, load: int | str | None = None, scene: str | Path | None = None,
-                    peeks: list[str] = (), cpu: str | None = None, wrap=None) -> C64Run:
+                    peeks: list[str] = (), cpu: str | None = None, wrap=None, result: str | int | None = None) -> C64Run:
     """Run the program at `path` on a C64 from its BASIC SYS line (or `entry`) for `frames` frames or
-    until a condition (as `run_console`), with `scene`'s VIC-II if given."""
+    until a condition (as `run_console`), with `scene`'s VIC-II if given; `result`: a test program's
+    result address (VICE's testbench: $D7FF), the run stops at its first write."""
     frames = parse_int(frames, field="--frames", lo=1, hi=MAX_FRAMES)
     if cpu is not None and variant_named(cpu, "--cpu") != "6510":
         raise InputError(f"--cpu {cpu}: a C64 program runs on the 6510")
@@ -166,13 +167,14 @@ def run_c64_program(path: str | Path, *, entry: str | int | None = None, frames:
     resolver.load(program)
     stop_pc, value = _stop_conditions(resolver, until, until_value)
     peek_counts = _checked_peeks(resolver, peeks)
+    result_at = None if result is None else resolver.resolve(result, "--result")
     if entry is None:
         basic = sys_line(program)
         start, line, notes = basic.address, basic.line_number, basic.notes
     else:
         start, line, notes = resolver.resolve(entry, "--entry"), None, ()
     report = run_c64(program, start, frames=frames, scene=loaded_scene, until=stop_pc, until_value=value,
-                     sys_line=line, notes=notes + tuple(program.notes), wrap=wrap)
+                     sys_line=line, notes=notes + tuple(program.notes), wrap=wrap, result_at=result_at)
     report.peeks = {target: report.machine.peek(target, count) for target, count in peek_counts.items()}
     return report
 
@@ -252,9 +254,6 @@ def run_console_or_refuse(path: str | Path, *, load=None, scene=None, trace: boo
     wrap = trace_wrapper(path, trace=trace, trace_json=trace_json, trace_limit=trace_limit, trace_cycles=trace_cycles,
                          trace_pc=trace_pc, watches=list(watches), labels=options.get("labels"), load=load)
     if not is_cartridge(path):
-        if options.get("result") is not None:
-            raise InputError("--result: only for an iNES image (a test ROM's result byte)")
-        options.pop("result", None)
         report = run_c64_program(path, entry=entry, load=load, scene=scene, cpu=cpu, wrap=wrap, **options)
     else:
         for name, value in (("--load", load), ("--scene", scene), ("--entry", entry)):
@@ -406,6 +405,7 @@ def c64_json(report: C64Run) -> dict:
             "frames": round(report.frames_run, 3), "cycles": report.cycles, "instructions": report.instructions,
             "halt_pc": report.halt_pc, "cpu": _cpu_state(report.machine.mpu), "vic": vic_registers(report.vic),
             "ram": bytes(report.machine.memory).hex(), "peek": report.peeks, "notes": list(report.notes),
+            "verdict": report.verdict.as_dict() if report.verdict else None,
             **_watch_json(report)}
 
 
@@ -431,6 +431,8 @@ def c64_lines(report: C64Run) -> list[str]:
         f"$D019=${vic['d019']:02X} $D01A=${report.vic.peek(0xD01A):02X} $D01E=${vic['d01e']:02X} "
         f"$D01F=${vic['d01f']:02X}")
     out += [f"note: {note}" for note in report.notes]
+    if report.verdict is not None:
+        out.append(f"verdict: {report.verdict.summary()}")
     return out + watch_lines(report)
 
 
@@ -514,8 +516,10 @@ def add_options(p: argparse.ArgumentParser) -> None:
                    "the program runs as the machine would (--frames, --until, --until-value): an iNES image from its "
                    "reset vector, a C64 program from its BASIC SYS line; with those options, a C64 program from here")
     options.program_run(p)
-    p.add_argument("--result", metavar="ADDR", help="iNES image from reset: a test ROM's result byte (blargg's 2005 "
-                   "ROMs: $F8, 1 = passed); the $6000 protocol is read without it; exit 1 on a failed verdict")
+    p.add_argument("--result", metavar="ADDR", help="a test program's result byte: an iNES image's (blargg's 2005 "
+                   "ROMs: $F8, 1 = passed; the $6000 protocol is read without it), a C64 program's (VICE's test "
+                   "programs: $D7FF, the run stops at its first write, $00 = passed, $FF = failed); exit 1 on a "
+                   "failed verdict")
     for register in ("a", "x", "y"):
         p.add_argument(f"--{register}", default="0", metavar="V", help=f"{register.upper()} on entry (default 0)")
     for flag in SETTABLE_FLAGS:

@@ -4,7 +4,10 @@ A C64 `.prg` that starts with `10 SYS 2061` is loaded at $0801 (BASIC's program 
 tokenised BASIC lines [Mapping the Commodore 64, $0801 and $A000 token table; C64 Programmer's
 Reference Guide, "BASIC tokens"]: each line is a 2-byte pointer to the next line (0: the end of the
 program), a 2-byte line number, the text with keywords as tokens (SYS = $9E, REM = $8F), and a
-$00 byte. `SYS` takes a number 0-65535; BASIC ignores spaces inside it.
+$00 byte. `SYS` takes a number 0-65535; BASIC ignores spaces inside it. The expression ends at the first byte
+that is not part of it: an operator is a token ($AA-$B3: + - * / ^ AND OR > = <), so untokenised text
+after the number (`SYS2069 /T.L.R/`, as some test programs sign their line) is never read by BASIC
+while the SYS'd code runs (a note says so).
 
 `sys_line(program)` finds the first `SYS` that RUN would reach, without a BASIC interpreter:
 statements before it are not run (a note says so); an expression retro cannot evaluate
@@ -26,6 +29,8 @@ SPACE = 0x20
 COLON = 0x3A
 OPEN_PAREN, CLOSE_PAREN = 0x28, 0x29
 DIGITS = range(0x30, 0x3A)
+NUMBER_PARTS = b".E("  # a decimal point, an exponent, a bracket: still the expression
+OPERATOR_TOKENS = range(0xAA, 0xB4)  # + - * / ^ AND OR > = < [Mapping the Commodore 64, $A09E token table]
 LINE_HEADER = 4  # next-line pointer + line number
 MAX_LINES = 10_000  # a stub is a line or two; this bounds a walk over a malformed chain
 
@@ -60,8 +65,12 @@ def sys_line(program: Program) -> SysLine:
             address, before = found
             if before:
                 skipped.append(f"line {number}")
+            address, trailing = address
             notes = ((f"BASIC statements before the SYS ({', '.join(skipped)}) are not run: retro has no "
                       f"BASIC interpreter",) if skipped else ())
+            if trailing:
+                notes += (f"line {number}: the text after SYS {address} ({trailing!r}) ends BASIC's expression "
+                          f"(it holds no operator token) and is not run",)
             return SysLine(number, address, notes)
         skipped.append(f"line {number}")
         following = link - BASIC_START
@@ -88,7 +97,7 @@ def _sys_in(text: bytes, number: int, source: str) -> tuple[int, bool] | None:
     return None
 
 
-def _number_after(rest: bytes, number: int, source: str) -> int:
+def _number_after(rest: bytes, number: int, source: str) -> tuple[int, str]:
     digits = ""
     i = 0
     while i < len(rest) and rest[i] in (SPACE, OPEN_PAREN):
@@ -100,10 +109,15 @@ def _number_after(rest: bytes, number: int, source: str) -> int:
         i += 1
     while i < len(rest) and rest[i] in (SPACE, CLOSE_PAREN) and parenthesised:
         i += 1
+    trailing = ""
+    if digits and i < len(rest) and rest[i] != COLON and rest[i] not in OPERATOR_TOKENS \
+            and rest[i] not in NUMBER_PARTS:
+        trailing = rest[i:].decode("latin-1")
+        i = len(rest)
     if not digits or (i < len(rest) and rest[i] != COLON):
         raise InputError(f"{source}: BASIC line {number}: the SYS is not followed by a plain number retro can "
                          f"read (no BASIC interpreter); give the start address with --entry")
     address = int(digits)
     if address > 0xFFFF:
         raise InputError(f"{source}: BASIC line {number}: SYS {address} is not an address (0-65535)")
-    return address
+    return address, trailing

@@ -15,8 +15,9 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 from retro.chips.vic.beam import position
-from retro.chips.vic.constants import VIC_BASE, VIC_LAST
+from retro.chips.vic.constants import CIA2_BASE, CIA2_LAST, VIC_BASE, VIC_LAST
 from retro.chips.vic.device import VicDevice
+from retro.chips.vic.fetch import VicBankPort, VicFetcher
 from retro.chips.vic.model import VicState
 from retro.cpu.bus import Device
 from retro.cpu.machine import Machine
@@ -31,20 +32,37 @@ KERNAL_IRQ_ENTRY_CODE = bytes([0x48, 0x8A, 0x48, 0x98, 0x48, 0xBA, 0xBD, 0x04, 0
                                0xF0, 0x03, 0x6C, 0x16, 0x03, 0x6C, 0x14, 0x03])
 KERNAL_IRQ_EXIT = 0xEA81
 KERNAL_IRQ_EXIT_CODE = bytes([0x68, 0xA8, 0x68, 0xAA, 0x68, 0x40])  # PLA / TAY / PLA / TAX / PLA / RTI
+# The KERNAL's IRQ handler ($EA31: clock, cursor blink, keyboard scan, CIA 1 acknowledge, then the
+# exit at $EA81) stood in for by a JMP to its exit: what it does touches only the KERNAL's work
+# area and CIA 1, which a program run does not model; it takes fewer cycles than the ROM's.
+KERNAL_IRQ_HANDLER = 0xEA31
+KERNAL_IRQ_HANDLER_STUB = bytes([0x4C, KERNAL_IRQ_EXIT & 0xFF, KERNAL_IRQ_EXIT >> 8])  # JMP $EA81
+# $FEBC, the end of the KERNAL's NMI handler, is the same register restore and RTI as $EA81 [Mapping
+# the Commodore 64, $FEBC]; IRQ handlers end with JMP $FEBC to skip the keyboard scan.
+KERNAL_NMI_EXIT = 0xFEBC
 
 
 def build_c64(state: VicState | None = None, *, start_line: int = 0, start_cycle: int = 1,
-              irq_vector: str = IRQ_VECTOR_HARDWARE, vic: Device | None = None) -> Machine:
+              irq_vector: str = IRQ_VECTOR_HARDWARE, vic: Device | None = None, reads_memory: bool = False,
+              char_rom: bytes | None = None) -> Machine:
     """A fresh C64: a 6510 with a VIC-II holding `state` at $D000-$D3FF, driving the CPU's BA and IRQ
     lines, its beam at line `start_line`, cycle `start_cycle` now, the frame drawn so far in its
     latches ($D01E, $D01F, $D019: `VicDevice.at_beam` with `drawn`); with `irq_vector` "$0314" the
     KERNAL's IRQ entry is in RAM. `vic`: a device of the caller's at the VIC-II's registers instead
-    (the latch study's, which answers reads of one case's frame and leaves the CPU's lines alone)."""
+    (the latch study's, which answers reads of one case's frame and leaves the CPU's lines alone).
+
+    With `reads_memory` the VIC-II fetches sprite data, screen, character set and colour RAM from
+    the machine's RAM (retro.chips.vic.fetch; `char_rom` the character ROM image, if the user has
+    one) and CIA 2's port A at $DD00 picks its bank; otherwise `state` holds what it sees."""
     machine = Machine(CPU)
     if vic is None:
         if state is None:
             raise ValueError("build_c64 needs a VIC-II state or a device")
-        vic = VicDevice.at_beam(state, machine.cycle, start_line, start_cycle, drawn=True)
+        fetcher = None
+        if reads_memory:
+            port = machine.attach(VicBankPort(), CIA2_BASE, CIA2_LAST)
+            fetcher = VicFetcher(machine.bus.memory, port, char_rom)
+        vic = VicDevice.at_beam(state, machine.cycle, start_line, start_cycle, drawn=True, fetcher=fetcher)
     machine.attach(vic, VIC_BASE, VIC_LAST)
     if irq_vector == IRQ_VECTOR_KERNAL:
         install_kernal_irq_entry(machine)
@@ -62,6 +80,13 @@ def install_kernal_irq_entry(machine: Machine) -> None:
     machine.bus.load(KERNAL_IRQ_ENTRY, KERNAL_IRQ_ENTRY_CODE)
     machine.bus.load(KERNAL_IRQ_EXIT, KERNAL_IRQ_EXIT_CODE)
     machine.bus.load(CPU_IRQ_VECTOR, bytes([KERNAL_IRQ_ENTRY & 0xFF, KERNAL_IRQ_ENTRY >> 8]))
+
+
+def install_kernal_irq_handler_stub(machine: Machine) -> None:
+    """Put the stand-in for the KERNAL's IRQ handler (KERNAL_IRQ_HANDLER_STUB) at $EA31, and the
+    KERNAL's register restore at $FEBC."""
+    machine.bus.load(KERNAL_IRQ_HANDLER, KERNAL_IRQ_HANDLER_STUB)
+    machine.bus.load(KERNAL_NMI_EXIT, KERNAL_IRQ_EXIT_CODE)
 
 
 @dataclass(frozen=True)

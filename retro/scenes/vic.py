@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from retro.chips.vic.constants import (
+    BANK_COUNT,
     CHAR_HEIGHT,
     COLOR_MASK,
     READ_ONLY_LATCHES,
@@ -55,7 +56,7 @@ IRQ_VECTOR_HARDWARE = "$fffe"  # the program puts its handler's address at $FFFE
 IRQ_VECTOR_KERNAL = "$0314"  # the program puts it at $0314/$0315; the KERNAL entry saves A, X, Y first
 IRQ_VECTORS = (IRQ_VECTOR_HARDWARE, IRQ_VECTOR_KERNAL)
 MAX_SPEED = 255  # pixels a frame, either axis: faster than anything on screen
-MEMORY_KEYS = {"screen", "color", "charset", "bitmap", "idle", "charpad", "koala"}
+MEMORY_KEYS = {"screen", "color", "charset", "bitmap", "idle", "charpad", "koala", "bank"}
 FILL_KEYS = {"fill", "cells", "file"}
 # keys that read one file into several parts of memory (retro/loaders/gfx_screen.py)
 WHOLE_FILE_PARTS = {"charpad": ("charset", "screen", "color"), "koala": ("bitmap", "screen", "color")}
@@ -90,6 +91,7 @@ class VicScene:
     start_line: int = 0  # [cpu] start_line / start_cycle: the beam when the routine is entered
     start_cycle: int = 1
     irq_vector: str = IRQ_VECTOR_HARDWARE  # or IRQ_VECTOR_KERNAL (retro.machines.c64 puts the KERNAL's entry in RAM)
+    bank: int = 0  # [memory] bank: the VIC-II's 16K bank (CIA 2 $DD00 bits 0-1 inverted) in a program run
 
 
 def register_offset(key: str, where: Fields) -> int:
@@ -318,7 +320,9 @@ def parse(doc: dict, source: str) -> VicScene:
     start_line = where.integer(cpu.get("start_line", 0), "cpu.start_line", 0, VIDEOS[video].lines - 1)
     start_cycle = where.integer(cpu.get("start_cycle", 1), "cpu.start_cycle", 1, VIDEOS[video].cycles_per_line)
     irq_vector = where.choice(cpu.get("irq_vector", IRQ_VECTORS[0]), "cpu.irq_vector", IRQ_VECTORS, fold_case=True)
-    return VicScene(source, video, bytes(registers), tuple(specs), memory, state, start_line=start_line,
+    bank = where.integer(where.table(doc.get("memory", {}), "memory", MEMORY_KEYS).get("bank", 0), "memory.bank", 0,
+                         BANK_COUNT - 1)
+    return VicScene(source, video, bytes(registers), tuple(specs), memory, state, bank=bank, start_line=start_line,
                     start_cycle=start_cycle, irq_vector=irq_vector)
 
 

@@ -216,3 +216,31 @@ SPRITE_DMA_CYCLES = 2  # two s-accesses fall in the CPU's half of the cycles tak
 # Bad Line condition [Bauer 3.5]: a line in GRAPHICS_FIRST_LINE ($30) .. BAD_LINE_LAST ($F7) whose
 # low 3 bits equal YSCROLL, while DEN was set in some cycle of line $30 (the device samples it there:
 # device.VicDevice._latch; dma.ba_low takes the DEN it is given).
+
+
+# ---- what the VIC-II fetches from the C64's memory [Bauer 2.4.2, 3.6; PRG p.102 "Memory management";
+# Mapping the Commodore 64, $D018 and $DD00] --------------------------------------------------------
+BANK_SIZE = 0x4000  # the VIC-II sees 16K at a time (14 address bits)
+BANK_COUNT = 4
+CIA2_BASE = 0xDD00  # CIA 2: port A bits 0-1 are VIC address bits 14-15, inverted
+CIA2_LAST = 0xDDFF  # its 16 registers repeat through $DD00-$DDFF
+CIA2_REGISTERS = 16
+CIA2_PORT_A = 0x00  # $DD00
+CIA2_DDR_A = 0x02  # $DD02: 1 = output
+CIA2_BANK_BITS = 0x03
+CIA2_KERNAL_PORT_A = 0x97  # $DD00 after the KERNAL's IOINIT: bank 0 [Mapping the Commodore 64, $FDA3]
+CIA2_KERNAL_DDR_A = 0x3F
+MEMORY_SCREEN_SHIFT = 4  # $D018 bits 4-7: video matrix at 1K * value within the bank
+MEMORY_SCREEN_MASK = 0xF0
+MEMORY_CHARSET_MASK = 0x0E  # $D018 bits 1-3: character generator at 2K * (value >> 1)
+MEMORY_BITMAP_BIT = 0x08  # $D018 bit 3: bitmap at 8K * bit
+SCREEN_STEP = 0x0400
+CHARSET_STEP = 0x0800  # $D018 bits 1-3 times 2K: (d018 & $0E) << 10
+BITMAP_STEP = 0x2000
+SPRITE_POINTERS = 0x03F8  # the 8 sprite pointers follow the video matrix (screen + $3F8) [Bauer 3.8]
+COLOR_RAM = 0xD800  # colour RAM: 1000 nybbles, fixed, outside the bank [Bauer 2.4.2]
+IDLE_ADDRESS = 0x3FFF  # the idle-state g-access (bank + $3FFF; $39FF with ECM) [Bauer 3.7.3.9]
+IDLE_ADDRESS_ECM = 0x39FF
+CHAR_ROM_BANKS = (0, 2)  # banks whose $1000-$1FFF the VIC-II reads from the character ROM [Bauer 2.4.2]
+CHAR_ROM_OFFSET = 0x1000
+CHAR_ROM_BYTES = 0x1000

@@ -40,6 +40,7 @@ from retro.chips.vic.constants import (
     IRQ_SPRITE_SPRITE,
     MIRROR_SIZE,
     RASTER_IRQ_LINE0_DELAY,
+    READ_ONLY_LATCHES,
     REG_CONTROL1,
     REG_IRQ_ENABLE,
     REG_IRQ_LATCH,
@@ -57,6 +58,7 @@ from retro.chips.vic.constants import (
     UNUSED_BITS,
     UNUSED_READ,
     WINDOW_LINES,
+    VIC_BASE,
     Y_COMPARE_MASK,
 )
 from retro.chips.vic.dma import DMA_REGISTERS, bus_schedule
@@ -130,19 +132,20 @@ class VicDevice:
 
     @classmethod
     def at_beam(cls, state: VicState, cycle: int, line: int = 0, line_cycle: int = 1, *,
-                drawn: bool = False) -> "VicDevice":
+                drawn: bool = False, fetcher=None) -> "VicDevice":
         """A device whose beam is at `line`, cycle `line_cycle` (1-based) at machine cycle `cycle`.
 
         With `drawn`, the frame so far has been drawn with this state since its line 0, cycle 1: its
         collisions are in $D01E/$D01F (unread since) and its raster compare and collision events in
         $D019 (unacknowledged), as the machine would have them. Without it nothing is taken to have
-        happened earlier in that frame (no raster compare, no collision).
+        happened earlier in that frame (no raster compare, no collision). `fetcher`: a
+        retro.chips.vic.fetch.VicFetcher when the chip reads its memory (else `state` holds it).
         """
         video = state.video
         if not 0 <= line < video.lines or not 1 <= line_cycle <= video.cycles_per_line:
             raise ValueError(f"no line {line}, cycle {line_cycle} on the {video.chip}")
         offset = line * video.cycles_per_line + line_cycle - 1
-        device = cls(state, start_cycle=cycle - offset)
+        device = cls(state, start_cycle=cycle - offset, fetcher=fetcher)
         if drawn:
             device._advance(offset)
         else:
@@ -155,11 +158,14 @@ class VicDevice:
         as `at_beam` makes it (for runs of many calls that each start at the same raster position).
         The bus keeps this object, so its state is replaced in place; the collision cache is kept."""
         schedules = self._schedules
-        fresh = type(self).at_beam(self.state, cycle, line, line_cycle, drawn=drawn)
+        fresh = type(self).at_beam(self.state, cycle, line, line_cycle, drawn=drawn, fetcher=self.fetcher)
         self.__dict__.update(fresh.__dict__)
         self._schedules.update(schedules)
 
-    def __init__(self, state: VicState, start_cycle: int = 0) -> None:
+    def __init__(self, state: VicState, start_cycle: int = 0, fetcher=None) -> None:
+        self.fetcher = fetcher
+        if fetcher is not None:
+            state = fetcher.state_for(state, state.registers)
         self.state = state
         self.video = state.video
         self.start_cycle = start_cycle
@@ -306,6 +312,8 @@ class VicDevice:
         lo = self.synced
         if until <= lo:
             return
+        if self.fetcher is not None and self.fetcher.due(self.video, self.registers, lo, until):
+            self._fetch()  # elsewhere what the VIC-II fetches changes nothing
         frame_cycles = self.video.frame_cycles
         events = self._schedule
         new_ss = _bits_between(events.ss_times, events.ss_bits, lo, until, frame_cycles)
@@ -323,6 +331,14 @@ class VicDevice:
             self._raster_match_at = None
         self.synced = until
         self._refresh_irq_next()
+
+    def _fetch(self) -> None:
+        """Take what the VIC-II fetches from memory as it stands now (docs/vic.md, "The VIC-II reads
+        memory": once per raster line where sprites draw, and after every register write)."""
+        state = self.fetcher.state_for(self.state, self.registers)
+        if state is not self.state:
+            self.state = state
+            self._schedule = self._schedule_for(state)
 
     # ---- the CPU's lines ---------------------------------------------------------------------
 
@@ -395,6 +411,8 @@ class VicDevice:
         t = self.time(cycle)
         self._advance(t)
         register = address % MIRROR_SIZE
+        if self.fetcher is not None and register in READ_ONLY_LATCHES:
+            self.fetcher.check_latch(VIC_BASE + register, self.registers[REG_SPRITE_ENABLE])
         if register == REG_SPRITE_SPRITE:
             value, self.sprite_sprite = self.sprite_sprite, 0
             self._refresh_irq_next()
@@ -454,6 +472,8 @@ class VicDevice:
                 self._schedule = self._schedule_for(self.state)
             if register in _DMA_SET:
                 self._bus = bus_schedule(self.video, self.registers)
+        if self.fetcher is not None:
+            self._fetch()  # $D018, the mode bits and the enabled sprites change what it fetches
         self._refresh_irq_next()
 
     def peek(self, address: int) -> int:

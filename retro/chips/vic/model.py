@@ -87,6 +87,8 @@ class VicState:
     registers: bytes  # REGISTER_COUNT values as last written
     sprite_data: tuple[bytes, ...]  # SPRITE_COUNT x 63 bytes
     memory: VicMemory = field(default_factory=VicMemory.blank)
+    # what the sprite data and memory were fetched from (retro.chips.vic.fetch); b"": given directly
+    view_key: bytes = b""
 
     def __post_init__(self) -> None:
         if len(self.registers) != REGISTER_COUNT or len(self.sprite_data) != SPRITE_COUNT:
@@ -96,7 +98,7 @@ class VicState:
         return replace(self, registers=bytes(registers))
 
     def collision_key(self) -> bytes:
-        return bytes(self.registers[r] for r in COLLISION_REGISTERS)
+        return bytes(self.registers[r] for r in COLLISION_REGISTERS) + self.view_key
 
     def sprite_x(self, n: int) -> int:
         return sprite_x(self.registers, n)
