@@ -1,5 +1,5 @@
 """What the command modules share at the command line: the options several commands have, defined
-once so each means the same everywhere (--jobs, --engine, --method, --quiet, --out, --scale), and how a
+once so each means the same everywhere (--jobs, --scheduler, --engine, --method, --quiet, --out, --scale), and how a
 command's result is printed (its module's `lines` or `as_json`)."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import json
 from collections.abc import Callable, Iterable
 
 from retro.analysis.check import ENGINES
-from retro.workers import MAX_WORKERS
+from retro.workers import MAX_WORKERS, SCHEDULER_ENV
 
 
 def show(lines: Callable[..., Iterable[str]], to_json: Callable | None, result, indent: int | None = None) -> None:
@@ -42,6 +42,13 @@ def jobs(p: argparse.ArgumentParser, default: int | None) -> None:
     """--jobs; default None leaves the count to the command (the checker: up to 2)."""
     p.add_argument("--jobs", default=default, metavar="N",
                    help=f"worker processes (default: {'up to 2' if default is None else default}; at most {MAX_WORKERS})")
+
+
+def scheduler(p: argparse.ArgumentParser) -> None:
+    """--scheduler, beside --jobs: the run's parallel work on an existing Dask cluster (docs/dask.md)."""
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help=f"run the parallel work on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786) "
+                        f"instead of local worker processes (default: ${SCHEDULER_ENV} when set; docs/dask.md)")
 
 
 def quiet(p: argparse.ArgumentParser) -> None:

@@ -3,11 +3,8 @@ picks, the engine agreement, the totals and the verdicts of bounds and budget.""
 
 from __future__ import annotations
 
-import os
 import time
-from collections import deque
 from collections.abc import Callable, Iterator
-from concurrent.futures import Future
 from itertools import chain, islice
 
 from retro.analysis.check.engines import (
@@ -45,9 +42,12 @@ from retro.routines.registry import select
 from retro.routines.runner import PROBE_CASES, RoutineRunner
 from retro.routines.spec import Routine
 from retro.routines.where import require_inside
-from retro.workers import worker_pool
+from retro.workers import Workers, as_workers, only, run_in_order, session
 
 PROGRESS_SECONDS = 1.0  # at most one progress line a second
+PARALLEL_CALLS = {"scalar": 200_000, "batch": 2_000_000, "compiled": 2_000_000}  # planned calls from which a check
+# runs on workers: at Machine's ~50,000 and the array engines' 1-10 million calls per CPU-second, seconds of work,
+# well above a local cluster's start (about 1 CPU-second); a sweep (uncounted, --exhaustive) always does
 
 
 # ---- what a worker does: one block of calls, tallied ------------------------------------------------
@@ -117,29 +117,18 @@ def agreement_chunk(spec: str, seed: int, cases: list[tuple], engine: str = "bat
 
 # ---- a whole check ------------------------------------------------------------------------------------
 
-def _run_work(work: Iterator[tuple], jobs: int, report: Callable[[Tally], None],
+def _run_work(work: Iterator[tuple], workers: Workers | int, report: Callable[[Tally], None],
               stop: Callable[[], int]) -> None:
-    """Run (function, arguments) items in order, over `jobs` worker processes when more than one,
-    with at most 2 * jobs items in flight; stop early once `stop()` is true (a run error)."""
-    if jobs <= 1:
-        for function, arguments in work:
-            report(function(*arguments))
-            if stop():
-                return
-        return
-    pool = worker_pool(jobs)
-    pending: deque[Future] = deque()
-    try:
-        for function, arguments in work:
-            pending.append(pool.submit(function, *arguments))
-            if len(pending) >= 2 * jobs:  # bounded: cases are made as workers take them
-                report(pending.popleft().result())  # in order: ties (first fastest case) do not depend on timing
-            if stop():
-                break
-        while pending:
-            report(pending.popleft().result())
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+    """Run (function, arguments) items in order, on `workers` (retro.workers: this process, or Dask tasks
+    with a bounded number in flight); stop early once `stop()` is true (a run error)."""
+    def merged(result: Tally) -> bool:
+        report(result)
+        return bool(stop())
+    run_in_order(_call, work, workers, merged)
+
+
+def _call(function: Callable, arguments: tuple) -> Tally:
+    return function(*arguments)
 
 
 def _chunks(parts: list[case_sets.Part]) -> Iterator[tuple[list[tuple], int]]:
@@ -201,7 +190,7 @@ def _part_runs(parts: list[case_sets.Part], totals: Tally, unknown: bool, rows: 
 
 
 def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | None = None,
-                  random_count: int | None = None, jobs: int = 1, progress: Callable[[str], None] | None = None,
+                  random_count: int | None = None, jobs: Workers | int = 1, progress: Callable[[str], None] | None = None,
                   start: SceneStart | None = None, bounded_product: int = case_sets.BOUNDED_PRODUCT,
                   engine: str = "auto", search_budget: int | None = None, entry_state: bool = True) -> RoutineCheck:
     """Check one routine: a spec path, or a Routine built in Python (then in this process only).
@@ -258,7 +247,7 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     work = (((batch_chunk, (spec, seed, block, first, every, used, start)) for block, first in _blocks(parts))
             if on_batch else
             ((machine_chunk, (spec, seed, chunk, start, first, every)) for chunk, first in _chunks(parts)))
-    _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
+    _run_work(work, only(jobs, unknown or known >= PARALLEL_CALLS[used]), report, lambda: totals.run_errors)
     searched = _search(spec, seed, runner, on_batch, totals, search_budget)
     if searched.found:  # the search's cases, checked like every other case
         found = case_sets.cases_to_columns(routine, searched.found)
@@ -314,20 +303,17 @@ def _search(spec: str, seed: int, runner, on_batch: bool, totals: Tally, budget:
                   fastest=None if totals.min_case is None else (totals.cycles_min, totals.min_case))
 
 
-def default_jobs() -> int:
-    return max(1, min(2, os.cpu_count() or 1))
-
-
 def run_checks(names: list[str] | None, *, exhaustive: bool = False, seed: int | None = None,
-               random_count: int | None = None, jobs: int | None = None,
+               random_count: int | None = None, jobs: Workers | int | None = None,
                progress: Callable[[str], None] | None = None, start: SceneStart | None = None,
                bounded_product: int = case_sets.BOUNDED_PRODUCT, engine: str = "auto",
                search_budget: int | None = None) -> list[RoutineCheck]:
     """Check the named routines (built-in names or spec paths; all built-ins when none are named);
     every name is loaded and validated before any work starts."""
     specs = select(names)
-    workers = default_jobs() if jobs is None else jobs
-    return [check_routine(spec, exhaustive=exhaustive, seed=seed, random_count=random_count, jobs=workers,
-                          progress=progress, start=start, bounded_product=bounded_product, engine=engine,
-                          search_budget=search_budget)
-            for spec in specs]
+    workers = as_workers(jobs)
+    with session():  # the routines share one cluster, started by the first that needs it
+        return [check_routine(spec, exhaustive=exhaustive, seed=seed, random_count=random_count, jobs=workers,
+                              progress=progress, start=start, bounded_product=bounded_product, engine=engine,
+                              search_budget=search_budget)
+                for spec in specs]
