@@ -161,6 +161,18 @@ def test_a_two_worker_cluster_gives_the_same_json_as_one_process(monkeypatch, en
     assert json.dumps(two, sort_keys=True) == json.dumps(one, sort_keys=True)
 
 
+def test_a_sweep_of_unknown_length_in_many_tasks_gives_the_same_json(monkeypatch):
+    """mul8's sweep function does not say how many cases it makes: tasks go out until one comes back
+    short; the workers make the cases themselves (dropping those of the other worker's tasks)."""
+    from retro.analysis.check import run
+
+    one = _records(run.run_checks(["mul8"], exhaustive=True, jobs=1, engine="batch", search_budget=0))
+    monkeypatch.setattr(run, "TASK_BLOCKS", 1)  # 3 tasks and more
+    two = _records(run.run_checks(["mul8"], exhaustive=True, jobs=2, engine="batch", search_budget=0))
+    assert one[0]["cases"] > 2 * 65_536
+    assert json.dumps(two, sort_keys=True) == json.dumps(one, sort_keys=True)
+
+
 def test_a_sweep_runs_on_an_existing_cluster_given_by_its_address(monkeypatch):
     from distributed import LocalCluster
 
