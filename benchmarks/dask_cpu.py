@@ -2,7 +2,7 @@
 (retro/workers.py), side by side, with the cluster's start apart; and the start time of the small runs
 that must not pay for Dask (`retro demo`, `retro check mul8`).
 
-    python benchmarks/dask_cpu.py [ROUTINE ...] [--engine batch] [--skip-small]
+    python benchmarks/dask_cpu.py [ROUTINE ...] [--engine batch] [--skip-small] [--before DIR]
 
 Default: mul8 and aabb8 with --exhaustive on the batched core. The workers' CPU is read from the workers
 themselves (time.process_time in each, at the cluster's start and before it closes), the parent's from
@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import time
@@ -65,17 +66,29 @@ def two_workers(name: str, engine: str) -> tuple[float, float, float, float, str
             _records(checks))
 
 
-def start_seconds(argv: list[str]) -> tuple[float, float]:
-    """Wall and CPU seconds of a command in a fresh process."""
+START = """
+import sys
+from retro.entry import main
+code = main(sys.argv[1:])
+print("dask imported:", any(m.split(".")[0] in ("dask", "distributed") for m in sys.modules), file=sys.stderr)
+raise SystemExit(code)
+"""
+
+
+def start_seconds(root: Path, argv: list[str]) -> tuple[float, float, str]:
+    """Wall and CPU seconds of a command in a fresh process run from `root`, and whether it imported Dask."""
     import resource
 
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     began = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "retro", *argv], cwd=ROOT, stdout=subprocess.DEVNULL,
-                   stderr=subprocess.DEVNULL, check=False)
+    done = subprocess.run([sys.executable, "-c", START, *argv], cwd=root, stdout=subprocess.DEVNULL,
+                          stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(root)})
     wall = time.perf_counter() - began
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    if done.returncode:
+        raise SystemExit(f"retro {' '.join(argv)} in {root}: exit {done.returncode}: {done.stderr[-300:]}")
+    said = done.stderr.strip().splitlines()[-1].split(": ")[-1]
+    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), said
 
 
 def main() -> int:
@@ -83,11 +96,19 @@ def main() -> int:
     parser.add_argument("routines", nargs="*", default=["mul8", "aabb8"])
     parser.add_argument("--engine", default="batch")
     parser.add_argument("--skip-small", action="store_true")
+    parser.add_argument("--before", metavar="DIR", help="a checkout of the code before Dask, timed beside this one")
     args = parser.parse_args()
     if not args.skip_small:
-        for argv in (["demo", "--quiet"], ["check", "mul8", "--quiet"]):
-            wall, cpu = start_seconds(argv)
-            print(f"retro {' '.join(argv):<22} {wall:6.2f} s wall  {cpu:6.2f} CPU-s (Dask imported: no)")
+        import tempfile
+
+        with tempfile.TemporaryDirectory() as out:
+            for argv in (["demo", "--out", out], ["check", "mul8", "--quiet"]):
+                shown = " ".join(argv[:2])
+                for label, root in (("before", args.before), ("now", ROOT)):
+                    if root is None:
+                        continue
+                    wall, cpu, dask = start_seconds(Path(root), argv)
+                    print(f"retro {shown:<12} {label:<7} {wall:6.2f} s wall {cpu:6.2f} CPU-s  Dask imported: {dask}")
     print(f"{'check --exhaustive':<22} {'1 process':>10} {'2 workers':>10} {'(start)':>9} {'ratio':>7} "
           f"{'beyond start':>13}")
     for name in args.routines:
