@@ -26,15 +26,17 @@ def main(argv: list[str] | None = None) -> int:
             stream.flush()
         except (OSError, ValueError, KeyboardInterrupt):
             pass
-    if interrupts.stopping() and not _resource_tracker_running():
-        # Cleanup has run (temp files, workers): skip the interpreter's teardown of numpy and
-        # matplotlib, most of a second of the stop. Not with a multiprocessing resource tracker
-        # (spawn/forkserver pools), which would report the skipped semaphores as leaked.
+    if interrupts.stopping():
+        # Cleanup has run (temp files, workers): skip the interpreter's teardown of numpy, matplotlib
+        # and Dask, a second or more of the stop. The semaphores of multiprocessing (Dask's worker
+        # processes) are released first, else its resource tracker reports them as leaked.
+        _release_semaphores()
         os._exit(code)
     interrupts.exit_now_on_signal()
     return code
 
 
-def _resource_tracker_running() -> bool:
-    tracker = sys.modules.get("multiprocessing.resource_tracker")
-    return tracker is not None and getattr(getattr(tracker, "_resource_tracker", None), "_pid", None) is not None
+def _release_semaphores() -> None:
+    util = sys.modules.get("multiprocessing.util")
+    if util is not None:
+        util._run_finalizers(0)  # what multiprocessing's own exit handler runs first: semaphores unlinked

@@ -1,77 +1,198 @@
-"""Worker processes for the long commands (check, chart, stability, advise): one pool maker for all.
+"""Where the long commands' parallel work runs (check, chart, advise): in this process, or as Dask tasks.
 
-A worker ignores Ctrl-C (the parent stops the pool and reports one line) and, on Linux, dies with its
-parent: when `retro chart` is killed, its workers get SIGTERM from the kernel instead of running on
-(prctl PR_SET_PDEATHSIG, Linux man page prctl(2)).
+A run small enough for one process runs its tasks here, in order, and never imports Dask. A larger one
+runs them on a Dask cluster: an embedded `LocalCluster` of `count` worker processes on this machine
+(nothing to start or configure), or the existing cluster whose scheduler is at `--scheduler ADDRESS` or
+in the environment variable RETRO_SCHEDULER. Either way the results come back in task order, whatever
+the order the tasks finish in, with at most IN_FLIGHT tasks per worker thread submitted at once (memory
+stays bounded whatever the run's size). On Ctrl-C (or SIGTERM) the pending tasks are cancelled and the
+embedded cluster's workers are stopped; they ignore Ctrl-C themselves (the parent stops them) and exit
+when their parent dies (distributed's worker processes watch a pipe from it).
 """
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
+import logging
+import os
 import signal
-import sys
-import time
-from concurrent.futures import ProcessPoolExecutor
+from collections import deque
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import ExitStack, contextmanager
+from dataclasses import dataclass
+from typing import Any
 
 from retro import interrupts
 
-PR_SET_PDEATHSIG = 1  # prctl(2): the signal the calling process gets when its parent dies
 MAX_WORKERS = 2  # each worker holds its own emulator, case blocks and study corpus (70-320 MB): 2 keep a command's
 # whole process tree under 1 GiB (benchmarks/peak_memory.py, docs/limits.md)
+SCHEDULER_ENV = "RETRO_SCHEDULER"  # the address of an existing Dask scheduler, when --scheduler is not given
+IN_FLIGHT = 2  # tasks submitted per worker thread: one running, one ready (results are merged in order)
+CONNECT_SECONDS = 10  # how long a scheduler address may take to answer
+CLOSE_SECONDS = 20  # and this long after a run (then its workers are killed)
 
 
-def _prepare_worker() -> None:
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    for name in ("SIGTERM", "SIGHUP"):  # the parent's handlers raise; a worker just ends
-        if hasattr(signal, name):
-            signal.signal(getattr(signal, name), signal.SIG_DFL)
-    if sys.platform.startswith("linux"):
+@dataclass(frozen=True)
+class Workers:
+    """Where a run's tasks go: `count` local worker processes, or the cluster at `scheduler`."""
+
+    count: int = 1
+    scheduler: str | None = None
+
+    @property
+    def parallel(self) -> bool:
+        return self.scheduler is not None or self.count > 1
+
+
+def default_count() -> int:
+    return max(1, min(MAX_WORKERS, os.cpu_count() or 1))
+
+
+def configured(jobs: int | None, scheduler: str | None) -> Workers:
+    """The workers of a command: its --jobs (None: up to MAX_WORKERS) and --scheduler, which when absent
+    comes from RETRO_SCHEDULER (an empty value: none)."""
+    address = scheduler if scheduler is not None else os.environ.get(SCHEDULER_ENV)
+    return Workers(default_count() if jobs is None else jobs, address.strip() or None if address else None)
+
+
+def as_workers(workers: Workers | int | None) -> Workers:
+    """A plain count (the library's `jobs`/`workers` arguments) as local workers; None: the default."""
+    if isinstance(workers, Workers):
+        return workers
+    return Workers(default_count() if workers is None else workers)
+
+
+def only(workers: Workers | int | None, needed: bool) -> Workers:
+    """`workers` when the run is big enough to need them, else this process alone (no cluster, no import)."""
+    return as_workers(workers) if needed else Workers(1)
+
+
+def run_in_order(function: Callable, tasks: Iterable[tuple], workers: Workers | int | None,
+                 report: Callable[[Any], bool | None]) -> None:
+    """`report(function(*task))` for each task, in task order; a `report` returning True ends the run
+    (the tasks still pending are cancelled). With one local worker (and no scheduler) the tasks run in
+    this process; else as Dask tasks, at most IN_FLIGHT per worker thread at once."""
+    workers = as_workers(workers)
+    if not workers.parallel:
+        for task in tasks:
+            interrupts.raise_if_stopping()
+            if report(function(*task)):
+                return
+        return
+    if _session is not None:  # one cluster for the whole command (`session`)
+        if workers not in _session:
+            _session[workers] = _session_stack.enter_context(_client(workers))
+        _run_on(_session[workers], function, tasks, report)
+        return
+    with _client(workers) as client:
+        _run_on(client, function, tasks, report)
+
+
+_session: dict | None = None
+_session_stack = ExitStack()
+
+
+@contextmanager
+def session() -> Iterator[None]:
+    """The runs inside share their cluster: started by the first that needs one, closed on leaving (a
+    command's several parallel steps, or its several routines, pay for one start)."""
+    global _session
+    if _session is not None:  # already inside one
+        yield
+        return
+    _session = {}
+    try:
+        yield
+    finally:
+        _session = None
+        _session_stack.close()
+
+
+def _run_on(client, function: Callable, tasks: Iterable[tuple], report: Callable[[Any], bool | None]) -> None:
+    limit = IN_FLIGHT * max(1, sum(client.nthreads().values()))
+    pending: deque = deque()
+    iterator: Iterator[tuple] = iter(tasks)
+    try:
+        while True:
+            while len(pending) < limit:
+                task = next(iterator, None)
+                if task is None:
+                    break
+                interrupts.raise_if_stopping()
+                pending.append(client.submit(function, *task, pure=False))
+            if not pending:
+                return
+            if report(pending.popleft().result()):  # in order: ties (the first fastest case) do not depend on timing
+                return
+    finally:
+        # an embedded cluster's workers are killed on a stop (cancelling first would hold up its closing)
+        if pending and not (interrupts.stopping() and getattr(client, "cluster", None) is not None):
+            client.cancel(list(pending))
+
+
+@contextmanager
+def _client(workers: Workers) -> Iterator[Any]:
+    """A Dask client of the scheduler at `workers.scheduler`, else of an embedded local cluster of
+    `workers.count` single-threaded worker processes (closed, its workers stopped, on leaving)."""
+    from retro.errors import InputError
+
+    import dask
+    from distributed import Client, LocalCluster
+
+    if workers.scheduler is not None:
         try:
-            libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
-            libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
-        except (OSError, AttributeError):  # no libc to ask: the worker just lacks the safeguard
+            client = Client(workers.scheduler, timeout=CONNECT_SECONDS, set_as_default=False)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise InputError(f"--scheduler {workers.scheduler}: no Dask scheduler answers there ({exc})") from None
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    # for this process's clusters: workers forked from a server process (a fraction of spawn's start, which
+    # imports everything again per worker); their logs only when critical (errors reach us as exceptions)
+    dask.config.set({"distributed.worker.multiprocessing-method": "forkserver",
+                     "distributed.logging.distributed": "critical"})
+    cluster = LocalCluster(n_workers=workers.count, threads_per_worker=1, processes=True, dashboard_address=":0",
+                           preload=[__name__], silence_logs=logging.CRITICAL, memory_limit=0)
+    client = Client(cluster, set_as_default=False)
+    pids = list(client.run(os.getpid).values())
+    try:
+        yield client
+    finally:
+        _close(client, cluster, pids)
+
+
+def _close(client, cluster, pids: list[int]) -> None:
+    """Close the client and the embedded cluster (its workers killed when they do not end within
+    CLOSE_SECONDS). On a stop the workers are killed at once (they hold nothing to save) and nothing
+    waits: the process is ending, and a cluster closed under a stop can wait on workers already gone."""
+    if interrupts.stopping():
+        from distributed.core import Status
+
+        for nanny in cluster.workers.values():
+            nanny.status = Status.closing  # a nanny restarts a worker that dies, unless it is closing
+        _kill(pids)
+        cluster.shutdown_on_close = False  # nor is the cluster closed at exit (distributed's atexit would wait)
+        return
+    try:
+        client.close(timeout=CLOSE_SECONDS)
+        cluster.close(timeout=CLOSE_SECONDS)
+    except (TimeoutError, OSError, RuntimeError):
+        _kill(pids)
+
+
+def _kill(pids: list[int]) -> None:
+    for pid in pids:
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except OSError:  # already gone
             pass
 
 
-class _Pool(ProcessPoolExecutor):
-    """Stopped, not drained, on a stop signal: `shutdown` after Ctrl-C or SIGTERM (and leaving a
-    `with` block on KeyboardInterrupt) cancels what is queued and ends the workers at once, instead
-    of waiting for their tasks (up to 30 s for a chart's)."""
-
-    def submit(self, *args, **kwargs):
-        interrupts.raise_if_stopping()  # a stop the handler's exception did not carry out
-        return super().submit(*args, **kwargs)
-
-    def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
-        if interrupts.stopping():
-            self.stop_workers()
-        else:
-            super().shutdown(wait=wait, cancel_futures=cancel_futures)
-
-    def __exit__(self, exc_type, exc, tb):
-        if exc_type is not None and issubclass(exc_type, KeyboardInterrupt):
-            self.stop_workers()
-            return False
-        return super().__exit__(exc_type, exc, tb)
-
-    def stop_workers(self) -> None:
-        processes = list((self._processes or {}).values())  # the pool's own list: no public one before 3.14
-        super().shutdown(wait=False, cancel_futures=True)
-        for process in processes:
-            process.terminate()
-        deadline = time.monotonic() + WORKER_STOP_SECONDS
-        for process in processes:
-            process.join(max(0.0, deadline - time.monotonic()))
-            if process.is_alive():
-                process.kill()
-                process.join(1)
-
-
-WORKER_STOP_SECONDS = 1.0  # SIGTERM ends a worker at once (it has no handler); SIGKILL after this
-
-
-def worker_pool(workers: int) -> ProcessPoolExecutor:
-    """A process pool whose workers ignore Ctrl-C, die with their parent, and are stopped at once
-    when the command is."""
-    return _Pool(max_workers=workers, initializer=_prepare_worker)
+def dask_setup(worker) -> None:
+    """Run by each worker of the embedded cluster as it starts (its `preload`): Ctrl-C in the terminal
+    reaches the whole process group, and the parent, not the worker, decides what stops."""
+    try:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except ValueError:  # not the worker process's main thread: it keeps the default
+        pass

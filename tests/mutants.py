@@ -53,6 +53,8 @@ STABILITY_TESTS = ("tests/study/test_stability_pinned.py", "tests/study/test_sta
                    "tests/study/test_study_cli.py")
 FIELD_TESTS = ("tests/test_fields.py",)
 COMPILED_TESTS = ("tests/cpu/test_compiled.py",)
+WORKER_TESTS = ("tests/test_workers.py",)
+STREAM_TESTS = ("tests/routines/test_case_stream.py",)
 FLOW_TESTS = ("tests/cpu/test_flow_values.py", "tests/routines/test_static_smc.py")
 COMMAND_TESTS = ("tests/test_commands.py", "tests/test_cli_foundation.py", "tests/routines/test_routines_cli.py")
 
@@ -198,7 +200,22 @@ MUTANTS = [
            "found += self.agreement.engine_mismatches + self.agreement.cycle_mismatches", "found += 0",
            BATCH_TESTS),
     Mutant("agreement-run-skipped", "retro/analysis/check/run.py",
-           "agreement.merge(agreement_chunk(spec, seed, chunk))", "pass", BATCH_TESTS),
+           "agreement.merge(agreement_chunk(spec, seed, chunk, engine, start))", "pass", BATCH_TESTS),
+    # ---- the parallel work (retro/workers.py) and a task's cases (retro/routines/cases.py) ------------
+    Mutant("results-merged-in-finishing-order", "retro/workers.py",
+           "if report(pending.popleft().result()):", "if report(pending.pop().result()):", WORKER_TESTS),
+    Mutant("workers-take-ctrl-c", "retro/workers.py",
+           "signal.signal(signal.SIGINT, signal.SIG_IGN)", "pass", WORKER_TESTS),
+    Mutant("small-check-starts-a-cluster", "retro/analysis/check/run.py",
+           "needed = plan.unknown or plan.known >= PARALLEL_CALLS[sweep.engine]", "needed = True", WORKER_TESTS),
+    Mutant("stream-cuts-a-block-one-late", "retro/routines/cases.py",
+           "yield block if seen >= skip else [column[skip - seen:] for column in block]",
+           "yield block if seen >= skip else [column[skip - seen + 1:] for column in block]", STREAM_TESTS),
+    Mutant("stream-seeks-a-product-of-drawn-inputs", "retro/routines/cases.py",
+           "if any(port.name not in routine.exhaustive for port in routine.part_inputs(\"exhaustive\")):",
+           "if False:", STREAM_TESTS),
+    Mutant("stream-reaches-any-case", "retro/routines/cases.py",
+           "return first == done or part.seek is not None", "return True", STREAM_TESTS),
     # ---- the CPU's timeline on a C64: sprite DMA, Bad Lines, BA (retro/chips/vic) ------------------
     Mutant("sprite-dma-retriggers-while-on", "retro/chips/vic/model.py",
            "if (line % video.lines) & Y_COMPARE_MASK == y and line >= free_from:",

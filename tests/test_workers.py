@@ -1,22 +1,36 @@
-"""Worker processes die with their parent and leave Ctrl-C to it."""
+"""The long commands' parallel work on Dask (retro/workers.py): results in task order whatever order the
+tasks finish in, workers that leave Ctrl-C to their parent and die with it, no worker left after
+Ctrl-C, the same check JSON on a two-worker cluster as in one process, and small runs that never
+import Dask."""
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
+from retro import workers
+from retro.workers import Workers, run_in_order
+
+ROOT = Path(__file__).resolve().parent.parent
+ENV = {**os.environ, "PYTHONPATH": str(ROOT)}
+ENV.pop(workers.SCHEDULER_ENV, None)
+
 PARENT = """
-import os, sys, time
-from retro.workers import worker_pool
-pool = worker_pool(1)
-print(pool.submit(os.getpid).result(), flush=True)
-pool.submit(time.sleep, 60)
-time.sleep(60)
+import os, time
+from retro.workers import Workers, run_in_order
+
+def report(pid):
+    print(pid, flush=True)
+    time.sleep(60)
+
+run_in_order(os.getpid, [()], Workers(2), report)
 """
 
 
@@ -32,22 +46,171 @@ def _alive(pid: int) -> bool:
         return False
 
 
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG is Linux's")
-def test_a_killed_parent_takes_its_workers_with_it():
-    parent = subprocess.Popen([sys.executable, "-c", PARENT], stdout=subprocess.PIPE, text=True)
-    worker = int(parent.stdout.readline())
-    assert _alive(worker)
-    parent.send_signal(signal.SIGKILL)
-    parent.wait()
-    deadline = time.monotonic() + 10
-    while _alive(worker) and time.monotonic() < deadline:
+def _descendants(pid: int) -> list[int]:
+    """Every process below `pid` (the embedded cluster's workers are the forkserver's children)."""
+    listed = subprocess.run(["ps", "-e", "-o", "pid=,ppid="], capture_output=True, text=True).stdout
+    children: dict[int, list[int]] = {}
+    for line in listed.splitlines():
+        child, parent = (int(n) for n in line.split())
+        children.setdefault(parent, []).append(child)
+    found, todo = [], [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            found.append(child)
+            todo.append(child)
+    return found
+
+
+def _gone(pids: list[int], seconds: float = 10) -> list[int]:
+    deadline = time.monotonic() + seconds
+    while any(_alive(p) for p in pids) and time.monotonic() < deadline:
         time.sleep(0.1)
-    assert not _alive(worker), "the worker outlived its killed parent"
+    return [p for p in pids if _alive(p)]
+
+
+def _slow_square(n: int, seconds: float) -> int:
+    time.sleep(seconds)
+    return n * n
+
+
+def test_results_come_in_task_order_whatever_order_tasks_finish_in():
+    got = []
+    tasks = [(n, 0.6 if n % 2 == 0 else 0.0) for n in range(6)]  # the even ones finish after the next odd one
+    run_in_order(_slow_square, tasks, Workers(2), got.append)
+    assert got == [n * n for n in range(6)]
+
+
+def test_a_report_returning_true_ends_the_run():
+    got = []
+    run_in_order(_slow_square, [(n, 0.0) for n in range(50)], Workers(2), lambda r: got.append(r) or len(got) == 3)
+    assert got == [0, 1, 4]
+
+
+def test_one_worker_runs_in_this_process():
+    assert run_in_order(os.getpid, [()], Workers(1), lambda pid: pid == os.getpid()) is None
 
 
 def test_workers_ignore_ctrl_c():
-    from retro.workers import worker_pool
+    handlers = []
+    run_in_order(signal.getsignal, [(signal.SIGINT,)] * 2, Workers(2), handlers.append)
+    assert handlers == [signal.SIG_IGN, signal.SIG_IGN]
 
-    with worker_pool(1) as pool:
-        handler = pool.submit(signal.getsignal, signal.SIGINT).result()
-    assert handler == signal.SIG_IGN
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="/proc and ps")
+def test_a_killed_parent_takes_its_workers_with_it():
+    parent = subprocess.Popen([sys.executable, "-c", PARENT], stdout=subprocess.PIPE, text=True, env=ENV)
+    try:
+        worker = int(parent.stdout.readline())
+        below = _descendants(parent.pid)
+        assert worker in below and _alive(worker)
+    finally:
+        parent.send_signal(signal.SIGKILL)
+        parent.wait()
+    assert not _gone(below), "a worker outlived its killed parent"
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="/proc and ps")
+def test_ctrl_c_cancels_the_sweep_and_leaves_no_worker():
+    """Ctrl-C in a terminal reaches the whole process group: the command ends with its one line and
+    130, and no process it started is left."""
+    child = subprocess.Popen([sys.executable, "-m", "retro", "check", "aabb8", "--exhaustive", "--engine", "batch",
+                              "--jobs", "2", "--no-search"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                             text=True, env=ENV, start_new_session=True)
+    try:
+        line = child.stderr.readline()  # the first progress line: the sweep is on the workers
+        assert "check aabb8" in line, line
+        below = _descendants(child.pid)
+        assert len(below) >= 2, below
+        os.killpg(child.pid, signal.SIGINT)
+        err = child.stderr.read()
+        child.wait(timeout=30)
+    finally:
+        if child.poll() is None:
+            os.killpg(child.pid, signal.SIGKILL)
+    assert child.returncode == 130 and err.strip().endswith("interrupted") and "Traceback" not in err, err
+    assert not _gone(below), "a worker outlived the interrupted command"
+
+
+def _records(checks) -> list[dict]:
+    from retro.commands.check import as_json
+
+    records = as_json(checks)
+    for record in records:
+        record.pop("compile_seconds", None)  # a timing
+    return records
+
+
+ROUTINES = ["mul8", "tile", str(ROOT / "examples" / "boxhit" / "boxhit.toml")]
+
+
+@pytest.mark.parametrize("engine", ["scalar", "batch"])
+def test_a_two_worker_cluster_gives_the_same_json_as_one_process(monkeypatch, engine):
+    from retro.analysis.check import run
+
+    one = _records(run.run_checks(ROUTINES, jobs=1, engine=engine, search_budget=0))
+    monkeypatch.setattr(run, "PARALLEL_CALLS", dict.fromkeys(run.PARALLEL_CALLS, 0))  # every check on the workers
+    used = []
+    real = workers._client
+
+    def counted(w):
+        used.append(w)
+        return real(w)
+    monkeypatch.setattr(workers, "_client", counted)
+    two = _records(run.run_checks(ROUTINES, jobs=2, engine=engine, search_budget=0))
+    assert used == [Workers(2)]  # one cluster for the three routines
+    assert json.dumps(two, sort_keys=True) == json.dumps(one, sort_keys=True)
+
+
+def test_a_sweep_of_unknown_length_in_many_tasks_gives_the_same_json(monkeypatch):
+    """mul8's sweep function does not say how many cases it makes: tasks go out until one comes back
+    short; the workers make the cases themselves (dropping those of the other worker's tasks)."""
+    from retro.analysis.check import run
+
+    one = _records(run.run_checks(["mul8"], exhaustive=True, jobs=1, engine="batch", search_budget=0))
+    monkeypatch.setattr(run, "TASK_BLOCKS", 1)  # 3 tasks and more
+    two = _records(run.run_checks(["mul8"], exhaustive=True, jobs=2, engine="batch", search_budget=0))
+    assert one[0]["cases"] > 2 * 65_536
+    assert json.dumps(two, sort_keys=True) == json.dumps(one, sort_keys=True)
+
+
+def test_a_sweep_runs_on_an_existing_cluster_given_by_its_address(monkeypatch):
+    from distributed import LocalCluster
+
+    from retro.analysis.check import run
+    from retro.commands.check import check
+
+    one = _records(check(["mul8"], jobs=1, search=0))
+    monkeypatch.setattr(run, "PARALLEL_CALLS", dict.fromkeys(run.PARALLEL_CALLS, 0))
+    with LocalCluster(n_workers=1, threads_per_worker=2, processes=True, dashboard_address=":0") as cluster:
+        monkeypatch.setenv(workers.SCHEDULER_ENV, cluster.scheduler_address)
+        from_env = _records(check(["mul8"], search=0))
+        monkeypatch.delenv(workers.SCHEDULER_ENV)
+        given = _records(check(["mul8"], search=0, scheduler=cluster.scheduler_address))
+    assert from_env == one and given == one
+
+
+def test_a_scheduler_that_does_not_answer_is_one_line(monkeypatch):
+    from retro.analysis.check import run
+    from retro.commands.check import check
+    from retro.errors import InputError
+
+    monkeypatch.setattr(run, "PARALLEL_CALLS", dict.fromkeys(run.PARALLEL_CALLS, 0))
+    monkeypatch.setattr(workers, "CONNECT_SECONDS", 1)
+    with pytest.raises(InputError, match=r"--scheduler tcp://127.0.0.1:9: no Dask scheduler answers there"):
+        check(["mul8"], search=0, scheduler="tcp://127.0.0.1:9")
+
+
+SMALL = """
+import sys
+import retro
+from retro.commands.check import check
+check(["mul8"], jobs=2)
+heavy = sorted(m for m in sys.modules if m.split(".")[0] in ("dask", "distributed"))
+print(heavy)
+"""
+
+
+def test_a_small_check_never_imports_dask():
+    done = subprocess.run([sys.executable, "-c", SMALL], capture_output=True, text=True, env=ENV, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "[]"

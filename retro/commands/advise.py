@@ -15,6 +15,7 @@ from retro.errors import InputError
 from retro.fileio import file_option
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
+from retro.workers import configured, session
 import argparse
 from retro.commands import options
 from retro.progress import progress_printer
@@ -36,18 +37,19 @@ def accuracy_target(value: float | str) -> float:
 
 def advise(scene: str | Path, *, accuracy: float | str = DEFAULT_ACCURACY, methods: list[str] = (),
            software: bool = False, objects: int | str | None = None, jobs: int | str = DEFAULT_JOBS,
-           engine: str = "auto", progress: Progress = quiet) -> Advice:
+           engine: str = "auto", progress: Progress = quiet, scheduler: str | None = None) -> Advice:
     """Every method (built-in and the user's method files `methods`; without the hardware latch when
     `software`) measured on the scene's sprites; the cheapest one that decides at least `accuracy` of
     the cases correctly, per test or, for `objects` objects, per frame."""
     target = accuracy_target(accuracy)
     for method in methods:
         file_option(method, "--method")
-    workers = parse_int(jobs, field="--jobs", lo=1, hi=MAX_JOBS)
+    workers = configured(parse_int(jobs, field="--jobs", lo=1, hi=MAX_JOBS), scheduler)
     count = None if objects is None else parse_int(objects, field="--objects", lo=1, hi=MAX_OBJECTS)
     check_engine(engine)
-    return advise_scene(str(scene), target, workers=workers, progress=progress, methods=with_user_methods(methods),
-                        software=software, objects=count, engine=engine)
+    with session():  # its steps share one cluster
+        return advise_scene(str(scene), target, workers=workers, progress=progress, methods=with_user_methods(methods),
+                            software=software, objects=count, engine=engine)
 
 
 def lines(advice: Advice) -> list[str]:
@@ -73,11 +75,13 @@ def add_options(p: argparse.ArgumentParser) -> None:
                    help="choose by 6502 cycles per frame for N objects (1-64, the scene's sprites in turn): "
                         "preparation, the cheaper broad phase (every pair or a sort along X) and the tests")
     options.jobs(p, DEFAULT_JOBS)
+    options.scheduler(p)
     options.quiet(p)
 
 
 def main(args: argparse.Namespace) -> int:
     result = advise(args.scene, accuracy=args.accuracy, methods=args.methods, software=args.software,
-                    objects=args.objects, jobs=args.jobs, engine=args.engine, progress=progress_printer(args.quiet))
+                    objects=args.objects, jobs=args.jobs, engine=args.engine, progress=progress_printer(args.quiet),
+                    scheduler=args.scheduler)
     options.show(lines, None, result)
     return 0

@@ -11,7 +11,7 @@ from retro.analysis.study.methods import with_user_methods
 from retro.fileio import all_or_nothing
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
-from retro.workers import MAX_WORKERS
+from retro.workers import MAX_WORKERS, configured, session
 import argparse
 from retro.analysis.study.chart_run import REDUCED_COST_SAMPLES
 from retro.commands import options
@@ -35,15 +35,17 @@ def samples_count(samples: int | str | None) -> int | str | None:
 @all_or_nothing
 def chart(out: str | Path = DEFAULT_OUT, *, reduced: bool = False, methods: list[str] = (), sprites: list[str] = (),
           samples: int | str | None = "auto", per_frame: bool = False, jobs: int | str = DEFAULT_JOBS,
-          engine: str = "auto", progress: Progress = quiet, shapes: tuple[str, ...] | None = None) -> ChartOutput:
+          engine: str = "auto", progress: Progress = quiet, shapes: tuple[str, ...] | None = None,
+          scheduler: str | None = None) -> ChartOutput:
     """The speed/accuracy study of the built-in methods and the user's method files `methods` on the
     corpus (the named `shapes` of sprites/, all by default, then every sprite of the files `sprites`)."""
-    workers = parse_int(jobs, field="--jobs", lo=1, hi=MAX_JOBS)
+    workers = configured(parse_int(jobs, field="--jobs", lo=1, hi=MAX_JOBS), scheduler)
     cost_samples = samples_count(samples)
     check_engine(engine)
-    return run_chart(Path(out), reduced=reduced, workers=workers, progress=progress, shape_names=shapes,
-                     cost_samples=cost_samples, methods=with_user_methods(methods), sprite_files=tuple(sprites),
-                     per_frame=per_frame, engine=engine)
+    with session():  # its steps share one cluster
+        return run_chart(Path(out), reduced=reduced, workers=workers, progress=progress, shape_names=shapes,
+                         cost_samples=cost_samples, methods=with_user_methods(methods), sprite_files=tuple(sprites),
+                         per_frame=per_frame, engine=engine)
 
 
 def lines(output: ChartOutput) -> list[str]:
@@ -70,11 +72,13 @@ def add_options(p: argparse.ArgumentParser) -> None:
                    help="also chart 6502 cycles per frame against the number of objects (1-64) for each method, "
                         "with its preparation and a broad phase (every pair, sort along X): per_frame.png/.csv/.md")
     options.jobs(p, DEFAULT_JOBS)
+    options.scheduler(p)
     options.quiet(p)
 
 
 def main(args: argparse.Namespace) -> int:
     result = chart(args.out, reduced=args.reduced, methods=args.methods, sprites=args.sprites, samples=args.samples,
-                   per_frame=args.per_frame, jobs=args.jobs, engine=args.engine, progress=progress_printer(args.quiet))
+                   per_frame=args.per_frame, jobs=args.jobs, engine=args.engine, progress=progress_printer(args.quiet),
+                   scheduler=args.scheduler)
     options.show(lines, None, result)
     return 0

@@ -29,7 +29,7 @@ from retro.routines.entry import EntryState
 from retro.chips.ppu.constants import DOTS_PER_LINE
 from retro.machines.nes import position_after
 from retro.routines.chip_access import FREE_REASON, NesStart
-from retro.workers import MAX_WORKERS
+from retro.workers import MAX_WORKERS, configured
 import argparse
 from retro.analysis.check import AGREEMENT_PER_PART, AUTO_BATCH_CASES
 from retro.analysis.check.engines import AUTO_COMPILED_CASES
@@ -47,18 +47,19 @@ def check(routines: list[str] | None = None, *, exhaustive: bool = False, seed: 
           random: int | str | None = None, jobs: int | str | None = None, scene: str | Path | None = None,
           at_line: int | str | None = None, at_cycle: int | str | None = None, engine: str = "auto",
           progress: Progress = quiet, bounded_product: int = case_sets.BOUNDED_PRODUCT,
-          search: int | str | None = None, at_dot: int | str | None = None, in_nmi: bool = False
-          ) -> list[RoutineCheck]:
+          search: int | str | None = None, at_dot: int | str | None = None, in_nmi: bool = False,
+          scheduler: str | None = None) -> list[RoutineCheck]:
     """Check each routine (all built-ins when none is named). `random`: random cases per routine
     (default: the spec's count, bounded without `exhaustive`); `scene` runs every call on a C64 with
     that VIC-II scene from `at_line`/`at_cycle` (default: the scene's [cpu] start), or on a NES with that
     NES scene from scanline `at_line`, dot `at_dot` (default 0, 0), or `in_nmi` as the NMI handler; `search`: candidates
-    of the coverage-guided search (default: the spec's `[cases] search`, else 4,096; 0: none)."""
+    of the coverage-guided search (default: the spec's `[cases] search`, else 4,096; 0: none); `scheduler`: a
+    Dask scheduler's address for the parallel work (default: $RETRO_SCHEDULER, else local workers)."""
     return run_checks(
         routines, exhaustive=exhaustive,
         seed=None if seed is None else parse_int(seed, field="--seed", lo=0, hi=2 ** 63 - 1),
         random_count=None if random is None else parse_int(random, field="--random", lo=0, hi=MAX_RANDOM),
-        jobs=None if jobs is None else parse_int(jobs, field="--jobs", lo=1, hi=MAX_JOBS),
+        jobs=configured(None if jobs is None else parse_int(jobs, field="--jobs", lo=1, hi=MAX_JOBS), scheduler),
         progress=progress, start=options.scene_start(scene, at_line, at_cycle, at_dot, in_nmi), bounded_product=bounded_product, engine=engine,
         search_budget=None if search is None else parse_int(search, field="--search", lo=0, hi=MAX_SEARCH))
 
@@ -596,6 +597,7 @@ def routine_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--random", metavar="N",
                    help="random cases per routine (default: the spec's count, at most 2,000 without --exhaustive)")
     options.jobs(p, None)
+    options.scheduler(p)
     p.add_argument("--scene", metavar="SCENE.toml", help="run every call on a C64 with this VIC-II scene (the CPU "
                    "stalls on Bad Lines and sprite DMA) or on a NES with this NES scene (OAM DMA stalls it; the report "
                    "gives the cycles left before rendering starts); the report gives the lines from the start")
@@ -617,7 +619,7 @@ def checks_of(args: argparse.Namespace) -> list[RoutineCheck]:
     return check(args.routines, exhaustive=args.exhaustive, seed=args.seed, random=args.random, jobs=args.jobs,
                  scene=args.scene, at_line=args.at_line, at_cycle=args.at_cycle, at_dot=args.at_dot,
                  in_nmi=args.in_nmi, engine=args.engine,
-                 progress=progress_printer(args.quiet), search=args.search)
+                 progress=progress_printer(args.quiet), search=args.search, scheduler=args.scheduler)
 
 
 def add_options(p: argparse.ArgumentParser) -> None:

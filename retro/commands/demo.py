@@ -87,7 +87,7 @@ def routine_table(out: Path) -> list[str]:
 
 
 def speed_accuracy(out: Path) -> list[str]:
-    return chart.lines(chart.chart(out / "chart", shapes=CHART_SHAPES, samples=CHART_SAMPLES))
+    return chart.lines(chart.chart(out / "chart", shapes=CHART_SHAPES, samples=CHART_SAMPLES, jobs=1))
 
 
 STEPS: tuple[tuple[str, Callable[[Path], list[str]]], ...] = (

@@ -7,7 +7,6 @@ from __future__ import annotations
 import argparse
 import sys
 from dataclasses import dataclass, replace
-from pathlib import Path
 
 from retro.analysis.check import check_routine
 from retro.commands import options

@@ -1,6 +1,6 @@
 """What the command modules share at the command line: the options several commands have, defined
-once so each means the same everywhere (--jobs, --engine, --method, --quiet, --out, --scale, the program
-run's --labels, --load, --frames, --until, --until-value), and how a command's result is printed (its
+once so each means the same everywhere (--jobs, --scheduler, --engine, --method, --quiet, --out, --scale, the
+program run's --labels, --load, --frames, --until, --until-value), and how a command's result is printed (its
 module's `lines` or `as_json`)."""
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from retro.analysis.console_run import DEFAULT_FRAMES, MAX_FRAMES
 from retro.errors import InputError
 from retro.fileio import file_option
 from retro.numbers import parse_int
-from retro.workers import MAX_WORKERS
+from retro.workers import MAX_WORKERS, SCHEDULER_ENV
 
 
 def show(lines: Callable[..., Iterable[str]], to_json: Callable | None, result, indent: int | None = None) -> None:
@@ -49,6 +49,13 @@ def jobs(p: argparse.ArgumentParser, default: int | None) -> None:
     """--jobs; default None leaves the count to the command (the checker: up to 2)."""
     p.add_argument("--jobs", default=default, metavar="N",
                    help=f"worker processes (default: {'up to 2' if default is None else default}; at most {MAX_WORKERS})")
+
+
+def scheduler(p: argparse.ArgumentParser) -> None:
+    """--scheduler, beside --jobs: the run's parallel work on an existing Dask cluster (docs/dask.md)."""
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help=f"run the parallel work on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786) "
+                        f"instead of local worker processes (default: ${SCHEDULER_ENV} when set; docs/dask.md)")
 
 
 def quiet(p: argparse.ArgumentParser) -> None:

@@ -57,6 +57,8 @@ class Part:
     blocks: Callable[[], Iterator[Columns]]  # a fresh iterator of column blocks of at most CHUNK cases
     draw: "DomainDraw | None" = None  # the random part: how its cases were drawn (with a `where` domain)
     inside: int | None = None  # the exhaustive part: its combinations inside the domain, when only those run
+    seek: Callable[[int], Iterator[Columns]] | None = None  # its blocks from a case index on, without making the
+    # cases before it (None: they are made and dropped; `stream`)
 
     @property
     def cases(self) -> Iterator[tuple]:
@@ -109,7 +111,8 @@ def plan(routine: Routine, *, exhaustive: bool, seed: int | None = None, random:
             parts.append(Part("exhaustive", len(valid) if full else sample, total,
                               lambda: _product(routine, seed, sample, valid), inside=len(valid)))
         elif exhaustive or total <= bounded_product:
-            parts.append(Part("exhaustive", total, total, lambda: _product(routine, seed, None)))
+            parts.append(Part("exhaustive", total, total, lambda: _product(routine, seed, None),
+                              seek=_product_seek(routine, seed)))
         else:
             sample = min(BOUNDED_SAMPLE, bounded_product)
             parts.append(Part("exhaustive", sample, total, lambda: _product(routine, seed, sample)))
@@ -138,19 +141,58 @@ def batches(parts: list[Part], size: int) -> Iterator[Columns]:
     """The parts' cases as column blocks of `size` cases (the last one shorter), in case order; fewer
     when a case holds many values (table inputs), so that a block stays within BLOCK_BYTES. Each block
     is a fresh copy: the parts' blocks are let go as soon as they are used up."""
+    blocks = chain.from_iterable(part.blocks() for part in parts)
+    first = next(blocks, None)
+    if first is not None:
+        yield from rechunked(chain([first], blocks), block_size(first, size))
+
+
+def stream(parts: list[Part], size: int, first: int = 0) -> Iterator[Columns]:
+    """The parts' cases from case `first` on (counted over all the parts), in blocks of `size` cases
+    (the last one shorter): what a worker makes of a task's description. A part wholly before `first`
+    is passed over by its count, one it starts in is entered by its `seek` when it has one; else its
+    cases before `first` are made and dropped (a user's sweep function can only be run from its start)."""
+    return rechunked(_cases_from(parts, first), size)
+
+
+def reachable(parts: list[Part], first: int) -> bool:
+    """Whether `stream` reaches case `first` without making the cases before it."""
+    done = 0
+    for part in parts:
+        if part.count is not None and done + part.count <= first:
+            done += part.count
+            continue
+        return first == done or part.seek is not None
+    return True
+
+
+def _cases_from(parts: list[Part], first: int) -> Iterator[Columns]:
+    done = 0  # cases of the parts before this one
+    for part in parts:
+        if part.count is not None and done + part.count <= first:
+            done += part.count
+            continue
+        skip = max(0, first - done)
+        seen = skip if skip and part.seek is not None else 0  # the part's cases passed over
+        for block in part.seek(skip) if skip and part.seek is not None else part.blocks():
+            n = len(block[0])
+            if seen + n > skip:
+                yield block if seen >= skip else [column[skip - seen:] for column in block]
+            seen += n
+        done += seen
+
+
+def rechunked(blocks: Iterable[Columns], size: int) -> Iterator[Columns]:
+    """Column blocks cut and joined into blocks of `size` cases (the last one shorter), each a fresh copy."""
     pending: deque[Columns] = deque()
     offset = count = 0  # where the first pending block's unused cases start; cases pending in all
-    started = False
-    for part in parts:
-        for block in part.blocks():
-            if not started:
-                size, started = block_size(block, size), True
-            pending.append(block)
-            count += len(block[0])
-            while count >= size:
-                taken, offset = _take(pending, offset, size)
-                count -= size
-                yield taken
+    for block in blocks:
+        pending.append(block)
+        count += len(block[0])
+        while count >= size:
+            taken, offset = _take(pending, offset, size)
+            count -= size
+            yield taken
     if count:
         yield _take(pending, offset, count)[0]
 
@@ -181,9 +223,19 @@ def block_size(block: Columns, size: int) -> int:
 
 # ---- exhaustive product ----------------------------------------------------------------------------
 
-def _product(routine: Routine, seed: int, sample: int | None, valid: np.ndarray | None = None) -> Iterator[Columns]:
-    """Every combination (mixed-radix counting over the swept inputs' values), in blocks; or a seeded
-    sample of `sample` distinct combinations; `valid`: only these combinations (their indices)."""
+def _product_seek(routine: Routine, seed: int) -> Callable[[int], Iterator[Columns]] | None:
+    """The full product's blocks from a combination on, when every input is swept (else the inputs drawn
+    at random per case draw in order from the first case: no seeking)."""
+    if any(port.name not in routine.exhaustive for port in routine.part_inputs("exhaustive")):
+        return None
+    return lambda start: _product(routine, seed, None, start=start)
+
+
+def _product(routine: Routine, seed: int, sample: int | None, valid: np.ndarray | None = None,
+             start: int = 0) -> Iterator[Columns]:
+    """Every combination (mixed-radix counting over the swept inputs' values), in blocks (from
+    combination `start`); or a seeded sample of `sample` distinct combinations; `valid`: only these
+    combinations (their indices)."""
     ports = routine.part_inputs("exhaustive")
     swept = [i for i, port in enumerate(ports) if port.name in routine.exhaustive]
     radices = [ports[i].count for i in swept]
@@ -193,7 +245,7 @@ def _product(routine: Routine, seed: int, sample: int | None, valid: np.ndarray 
         chosen = valid if sample is None else valid[np.sort(rng.choice(len(valid), size=sample, replace=False))]
         indices: Iterable[np.ndarray] = (chosen[i:i + CHUNK] for i in range(0, len(chosen), CHUNK))
     elif sample is None:
-        indices = (np.arange(start, min(start + CHUNK, total), dtype=np.uint64) for start in range(0, total, CHUNK))
+        indices = (np.arange(at, min(at + CHUNK, total), dtype=np.uint64) for at in range(start, total, CHUNK))
     else:
         picked = np.sort(rng.choice(total, size=sample, replace=False).astype(np.uint64))
         indices = (picked[i:i + CHUNK] for i in range(0, sample, CHUNK))

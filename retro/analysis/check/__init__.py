@@ -7,7 +7,7 @@ shows each condition of the domain is needed, and a failure inside it is a misma
 extremes must lie within the static best/worst case (retro.cpu.flow), and both within the spec's
 cycle budget (`[cycles] max`) when it has one.
 
-Cases are made lazily (retro.routines.cases) and run in chunks over worker processes (`jobs`);
+Cases are made lazily (retro.routines.cases), by the worker that runs them (retro.workers: Dask);
 the first run failure (BRK, JAM, a runaway past `[cycles] limit`) stops the check and is reported
 with its inputs.
 

@@ -3,11 +3,10 @@ picks, the engine agreement, the totals and the verdicts of bounds and budget.""
 
 from __future__ import annotations
 
-import os
 import time
-from collections import deque
 from collections.abc import Callable, Iterator
-from concurrent.futures import Future
+from dataclasses import dataclass
+from functools import cached_property
 from itertools import chain, islice
 
 from retro.analysis.check.engines import (
@@ -45,9 +44,12 @@ from retro.routines.registry import select
 from retro.routines.runner import PROBE_CASES, RoutineRunner
 from retro.routines.spec import Routine
 from retro.routines.where import require_inside
-from retro.workers import worker_pool
+from retro.workers import Workers, as_workers, only, run_in_order, session
 
 PROGRESS_SECONDS = 1.0  # at most one progress line a second
+PARALLEL_CALLS = {"scalar": 200_000, "batch": 2_000_000, "compiled": 2_000_000}  # planned calls from which a check
+# runs on workers: at Machine's ~50,000 and the array engines' 1-10 million calls per CPU-second, seconds of work,
+# well above a local cluster's start (about 1 CPU-second); a sweep (uncounted, --exhaustive) always does
 
 
 # ---- what a worker does: one block of calls, tallied ------------------------------------------------
@@ -115,48 +117,211 @@ def agreement_chunk(spec: str, seed: int, cases: list[tuple], engine: str = "bat
                        runner.memory_values, against)  # (the array engine counts these cases' coverage)
 
 
-# ---- a whole check ------------------------------------------------------------------------------------
+# ---- a sweep's tasks: a description of their cases, made in the worker -------------------------------
 
-def _run_work(work: Iterator[tuple], jobs: int, report: Callable[[Tally], None],
-              stop: Callable[[], int]) -> None:
-    """Run (function, arguments) items in order, over `jobs` worker processes when more than one,
-    with at most 2 * jobs items in flight; stop early once `stop()` is true (a run error)."""
-    if jobs <= 1:
-        for function, arguments in work:
-            report(function(*arguments))
-            if stop():
-                return
-        return
-    pool = worker_pool(jobs)
-    pending: deque[Future] = deque()
+@dataclass(frozen=True)
+class Sweep:
+    """What every task of a check's sweep shares: the plan of its cases (spec, seed, options), the engine
+    and the entry-state sample. A task is this plus a range of case indices; the worker makes the cases
+    itself (retro.routines.cases), so no case column ever crosses a pipe or the network."""
+
+    spec: str
+    seed: int
+    exhaustive: bool
+    random: int | None
+    bounded_product: int
+    engine: str  # "scalar" (Machine), "batch" or "compiled"
+    every: int = 0  # every how many cases one is rerun with the entry state varied (0: none)
+    start: SceneStart | None = None
+
+    def parts(self) -> list[case_sets.Part]:
+        """The plan's parts, made once per process (the check's own process registers the ones it made)."""
+        if self not in _PLANS:
+            _PLANS.clear()  # one plan per worker at a time: memory stays bounded
+            _PLANS[self] = case_sets.plan(routine_of(self.spec), exhaustive=self.exhaustive, seed=self.seed,
+                                          random=self.random, bounded_product=self.bounded_product)
+        return _PLANS[self]
+
+    @cached_property
+    def block(self) -> int:
+        """Cases per block: the batched core's lanes (fewer for table inputs), a CHUNK on Machine."""
+        if self.engine == "scalar":
+            return case_sets.CHUNK
+        return case_sets.block_size(case_sets.cases_to_columns(routine_of(self.spec), []), BATCH_LANES)
+
+
+TASK_BLOCKS = 4  # blocks per task: a few seconds of work at most, many tasks for an even spread
+_PLANS: dict[Sweep, list] = {}
+_CURSORS: dict[Sweep, tuple[int, Iterator]] = {}  # where this process's last task of a sweep stopped
+
+
+def sweep_task(sweep: Sweep, first: int, count: int) -> Tally:
+    """Cases first..first+count-1 of the sweep (fewer at its end: none past it), tallied block by
+    block; stops after a block with a run error."""
+    totals = Tally()
+    blocks = _blocks_from(sweep, first)
+    position = first
+    while position < first + count:
+        block = next(blocks, None)
+        if block is None:
+            break
+        totals.merge(_block_tally(sweep, block, position))
+        position += len(block[0])
+        if totals.run_errors:
+            break
+    _CURSORS.clear()
+    _CURSORS[sweep] = (position, blocks)
+    return totals
+
+
+def _blocks_from(sweep: Sweep, first: int) -> Iterator:
+    """The sweep's blocks from case `first`: this process's cursor moved on when its cases cannot be
+    reached without making those before (a sweep function), else a fresh stream that passes over them."""
+    position, blocks = _CURSORS.pop(sweep, (None, None))
+    parts = sweep.parts()
+    if blocks is None or position > first or case_sets.reachable(parts, first):
+        return case_sets.stream(parts, sweep.block, first)
+    for _ in range((first - position) // sweep.block):  # another worker's tasks: made and dropped
+        next(blocks, None)
+    return blocks
+
+
+def _block_tally(sweep: Sweep, block: list, first: int) -> Tally:
+    if sweep.engine == "scalar":
+        return machine_chunk(sweep.spec, sweep.seed, case_sets.columns_to_cases(block), sweep.start, first,
+                             sweep.every)
+    return batch_chunk(sweep.spec, sweep.seed, block, first, sweep.every, sweep.engine, sweep.start)
+
+
+def _tasks(sweep: Sweep, known: int, unknown: bool, ended: Callable[[], bool]) -> Iterator[tuple]:
+    """(sweep, first, count) in case order: up to the planned count, or, with a sweep function whose count
+    is unknown, until a task comes back short."""
+    size = TASK_BLOCKS * sweep.block
+    first = 0
+    while (first < known) if not unknown else not ended():
+        yield sweep, first, size
+        first += size
+
+
+def _run_sweep(sweep: Sweep, plan: "_Plan", workers: Workers | int, totals: Tally,
+               report: Callable[[Tally], None]) -> None:
+    """The planned cases as tasks on `workers` (this process when the check is small), merged in order;
+    stops at the first run error."""
+    size = TASK_BLOCKS * sweep.block
+    ended = False
+
+    def merged(result: Tally) -> bool:
+        nonlocal ended
+        ended = ended or result.cases < size
+        if result.cases:
+            report(result)
+        return bool(totals.run_errors)
+    needed = plan.unknown or plan.known >= PARALLEL_CALLS[sweep.engine]
+    _PLANS[sweep] = plan.parts  # this process's tasks use the parts it made
     try:
-        for function, arguments in work:
-            pending.append(pool.submit(function, *arguments))
-            if len(pending) >= 2 * jobs:  # bounded: cases are made as workers take them
-                report(pending.popleft().result())  # in order: ties (first fastest case) do not depend on timing
-            if stop():
-                break
-        while pending:
-            report(pending.popleft().result())
+        run_in_order(sweep_task, _tasks(sweep, plan.known, plan.unknown, lambda: ended), only(workers, needed), merged)
     finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+        _PLANS.pop(sweep, None)
+        _CURSORS.pop(sweep, None)
 
 
-def _chunks(parts: list[case_sets.Part]) -> Iterator[tuple[list[tuple], int]]:
-    """The parts' cases in chunks, each with the index of its first case in the check."""
-    first = 0
+# ---- a whole check: a pipeline of steps ----------------------------------------------------------------
+
+@dataclass
+class _Plan:
+    """A check's routine and the plan of its cases."""
+
+    spec: str
+    routine: Routine
+    seed: int
+    random: int | None
+    parts: list[case_sets.Part]
+
+    @property
+    def known(self) -> int:
+        return sum(p.count for p in self.parts if p.count is not None)
+
+    @property
+    def unknown(self) -> bool:
+        return any(p.count is None for p in self.parts)
+
+    @property
+    def calls(self) -> int | None:
+        return None if self.unknown else self.known
+
+
+@dataclass(frozen=True)
+class _Engine:
+    """The engine a check runs on, and what the report says of it."""
+
+    on_batch: bool  # an array engine runs the calls (Machine agrees on the first of each part)
+    used: str  # "scalar", "batch" or "compiled"
+    reason: str
+    note: str = ""  # why Machine ran calls an array engine was asked for or would have run
+    compile_seconds: float | None = None
+
+
+def _planned(spec: str | Routine, exhaustive: bool, seed: int | None, random_count: int | None,
+             bounded_product: int) -> _Plan:
+    key = routine_key(spec)
+    routine = routine_of(key)
+    seed = routine.seed if seed is None else seed
+    if routine.reference is None:  # rows only: no answer is known for a generated case, whatever --random says
+        random_count = 0
+    parts = case_sets.plan(routine, exhaustive=exhaustive, seed=seed, random=random_count,
+                           bounded_product=bounded_product)
+    return _Plan(key, routine, seed, random_count, parts)
+
+
+def _engine_choice(plan: _Plan, runner: RoutineRunner, engine: str, start: SceneStart | None) -> _Engine:
+    """The one rule (engines.batched) applied to the plan, and why; an array engine asked for a check
+    only Machine can run is an input error."""
+    on_batch = batched(engine, plan.calls, runner.batchable, AUTO_BATCH_CASES)
+    refusal = runner.batch_refusal if runner.vic is None else None
+    note = ""
+    if refusal is not None and batched(engine, plan.calls, True, AUTO_BATCH_CASES):
+        note = f"Machine ran the calls: {refusal}"  # the batched core would have: say why not
+    elif engine in ("batch", "compiled") and not on_batch:
+        raise InputError(f"--engine {engine}: with --scene the calls of {plan.routine.name} run on Machine "
+                         f"({runner.engine_reason}); use --engine scalar or auto")
+    if not on_batch:
+        reason = (runner.engine_reason if start is not None else
+                  note or (f"{engine}: {plan.known:,} planned calls" if engine == "auto" else f"--engine {engine}"))
+        return _Engine(False, "scalar", reason, note)
+    used, reason = array_engine(engine, plan.calls)
+    if start is not None:
+        reason = runner.engine_reason
+    if used != "compiled":
+        return _Engine(True, used, reason, note)
+    refused = compiled_or_why(runner)
+    if refused is not None:
+        return _Engine(True, "batch", f"the compiled engine does not take it: {refused}", note)
+    return _Engine(True, used, reason, note, runner.compiled().compile_seconds)
+
+
+def _rows_first(plan: _Plan, start: SceneStart | None, choice: _Engine, totals: Tally,
+                report: Callable[[Tally], None]) -> RowsCheck | None:
+    """The spec's expected rows, in this process, before the cases (retro.analysis.row_check); a row's
+    call that stops stops the check (no planned case runs)."""
+    if not plan.routine.rows:
+        return None
+    rows, rows_totals = check_rows(plan.spec, plan.seed, start, choice.on_batch)
+    report(rows_totals)
+    if totals.run_errors:
+        plan.parts = []
+    return rows
+
+
+def _agreement(spec: str, seed: int, parts: list[case_sets.Part], engine: str,
+               start: SceneStart | None = None) -> Tally:
+    """Machine first: the reference engine's verdict on a prefix of every part, both engines compared."""
+    agreement = Tally()
     for part in parts:
-        for chunk in case_sets.chunks(part.cases):
-            yield chunk, first
-            first += len(chunk)
-
-
-def _blocks(parts: list[case_sets.Part]) -> Iterator[tuple[list, int]]:
-    """The parts' cases in column blocks for the batched core, each with its first case's index."""
-    first = 0
-    for block in case_sets.batches(parts, BATCH_LANES):
-        yield block, first
-        first += len(block[0])
+        for chunk in case_sets.chunks(islice(part.cases, AGREEMENT_PER_PART)):
+            agreement.merge(agreement_chunk(spec, seed, chunk, engine, start))
+            if agreement.run_errors:
+                break
+    return agreement
 
 
 def _reporter(routine: Routine, totals: Tally, known: int, unknown: bool,
@@ -177,16 +342,36 @@ def _reporter(routine: Routine, totals: Tally, known: int, unknown: bool,
     return report
 
 
-def _agreement(spec: str, seed: int, parts: list[case_sets.Part], engine: str,
-               start: SceneStart | None = None) -> Tally:
-    """Machine first: the reference engine's verdict on a prefix of every part, both engines compared."""
-    agreement = Tally()
-    for part in parts:
-        for chunk in case_sets.chunks(islice(part.cases, AGREEMENT_PER_PART)):
-            agreement.merge(agreement_chunk(spec, seed, chunk, engine, start))
-            if agreement.run_errors:
-                break
-    return agreement
+def _search(plan: _Plan, runner: RoutineRunner, on_batch: bool, totals: Tally, budget: int | None) -> SearchResult:
+    """The coverage-guided search from what the planned cases ran (none after a call that stopped,
+    nor for a spec of rows only: no answer is known for a case it would find)."""
+    routine = runner.routine
+    if budget is None:
+        budget = routine.search if routine.search is not None else DEFAULT_SEARCH
+    if routine.reference is None or totals.run_errors:
+        budget = 0
+    return search(runner, on_batch=on_batch, seed=plan.seed, budget=budget, covered=totals.code_coverage,
+                  slowest=None if totals.max_case is None else (totals.cycles_max, totals.max_case),
+                  fastest=None if totals.min_case is None else (totals.cycles_min, totals.min_case))
+
+
+def _run_found(plan: _Plan, searched: SearchResult, on_batch: bool, agreement: Tally | None,
+               start: SceneStart | None, totals: Tally, report: Callable[[Tally], None]) -> None:
+    """The search's cases, checked like every other case, as a part of their own ("search"), in this
+    process on the batched core (or Machine)."""
+    if not searched.found:
+        return
+    found = case_sets.cases_to_columns(plan.routine, searched.found)
+    part = case_sets.Part("search", len(searched.found), len(searched.found), lambda: iter([found]))
+    plan.parts.append(part)
+    if on_batch:
+        agreement.merge(_agreement(plan.spec, plan.seed, [part], "batch", start))
+    for block in (case_sets.batches([part], BATCH_LANES) if on_batch else
+                  case_sets.rechunked(part.blocks(), case_sets.CHUNK)):
+        report(batch_chunk(plan.spec, plan.seed, block, 0, 0, "batch", start) if on_batch else
+               machine_chunk(plan.spec, plan.seed, case_sets.columns_to_cases(block), start))
+        if totals.run_errors:
+            return
 
 
 def _part_runs(parts: list[case_sets.Part], totals: Tally, unknown: bool, rows: RowsCheck | None) -> list[PartRun]:
@@ -200,134 +385,88 @@ def _part_runs(parts: list[case_sets.Part], totals: Tally, unknown: bool, rows: 
     return part_runs
 
 
-def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | None = None,
-                  random_count: int | None = None, jobs: int = 1, progress: Callable[[str], None] | None = None,
-                  start: SceneStart | None = None, bounded_product: int = case_sets.BOUNDED_PRODUCT,
-                  engine: str = "auto", search_budget: int | None = None, entry_state: bool = True) -> RoutineCheck:
-    """Check one routine: a spec path, or a Routine built in Python (then in this process only).
-    `engine`: "scalar" (Machine), "batch" (the batched core, checked against Machine on the first
-    AGREEMENT_PER_PART cases of each part) or "auto" (batch from AUTO_BATCH_CASES planned cases).
-    `search_budget`: candidates the coverage-guided search may run after the planned cases (None:
-    the spec's `[cases] search`, else DEFAULT_SEARCH; 0: no search). `entry_state`: also run a sample
-    of the cases with the entry state the spec leaves arbitrary varied (retro.analysis.check.entry_runs)."""
-    began = time.monotonic()
-    check_engine(engine)
-    if isinstance(spec, Routine):
-        jobs = 1
-    spec = routine_key(spec)
-    routine = routine_of(spec)
-    seed = routine.seed if seed is None else seed
-    if routine.reference is None:  # rows only: no answer is known for a generated case, whatever --random says
-        random_count = 0
-    parts = case_sets.plan(routine, exhaustive=exhaustive, seed=seed, random=random_count,
-                           bounded_product=bounded_product)
-    known = sum(p.count for p in parts if p.count is not None)
-    unknown = any(p.count is None for p in parts)
-    runner = runner_for(spec, seed, start)  # loads and validates in this process before any worker starts
-    on_batch = batched(engine, None if unknown else known, runner.batchable, AUTO_BATCH_CASES)
-    refusal = runner.batch_refusal if runner.vic is None else None
-    engine_note = ""
-    if refusal is not None and batched(engine, None if unknown else known, True, AUTO_BATCH_CASES):
-        engine_note = f"Machine ran the calls: {refusal}"  # the batched core would have: say why not
-    elif engine in ("batch", "compiled") and not on_batch:
-        raise InputError(f"--engine {engine}: with --scene the calls of {routine.name} run on Machine "
-                         f"({runner.engine_reason}); use --engine scalar or auto")
-    used, reason = ("scalar", runner.engine_reason if start is not None else
-                    engine_note or (f"{engine}: {known:,} planned calls" if engine == "auto" else f"--engine {engine}"))
-    compile_seconds = None
-    if on_batch:
-        used, reason = array_engine(engine, None if unknown else known)
-        if start is not None:
-            reason = runner.engine_reason
-        if used == "compiled":
-            refused = compiled_or_why(runner)
-            if refused is not None:
-                used, reason = "batch", f"the compiled engine does not take it: {refused}"
-            else:
-                compile_seconds = runner.compiled().compile_seconds
-    totals = Tally()
-    report = _reporter(routine, totals, known, unknown, progress)
-    rows = None
-    if routine.rows:  # the spec's expected rows run first, in this process (retro.analysis.row_check)
-        rows, rows_totals = check_rows(spec, seed, start, on_batch)
-        report(rows_totals)
-        if totals.run_errors:  # a row's call that stopped stops the check
-            parts = []
-    agreement = _agreement(spec, seed, parts, used, start) if on_batch else None
-    every = entry_every(known, exhaustive, bounded_product, unknown) if entry_state and parts else 0
-    work = (((batch_chunk, (spec, seed, block, first, every, used, start)) for block, first in _blocks(parts))
-            if on_batch else
-            ((machine_chunk, (spec, seed, chunk, start, first, every)) for chunk, first in _chunks(parts)))
-    _run_work(work, jobs if (known > case_sets.CHUNK or unknown) else 1, report, lambda: totals.run_errors)
-    searched = _search(spec, seed, runner, on_batch, totals, search_budget)
-    if searched.found:  # the search's cases, checked like every other case
-        found = case_sets.cases_to_columns(routine, searched.found)
-        parts.append(case_sets.Part("search", len(searched.found), len(searched.found), lambda: iter([found])))
-        if on_batch:
-            agreement.merge(_agreement(spec, seed, parts[-1:], "batch", start))
-        work = (((batch_chunk, (spec, seed, block, 0, 0, "batch", start))
-                 for block in case_sets.batches(parts[-1:], BATCH_LANES))
-                if on_batch else ((machine_chunk, (spec, seed, chunk, start)) for chunk, _ in _chunks(parts[-1:])))
-        _run_work(work, 1, report, lambda: totals.run_errors)
+def _assembled(plan: _Plan, runner: RoutineRunner, choice: _Engine, totals: Tally, agreement: Tally | None,
+               rows: RowsCheck | None, searched: SearchResult, every: int, unknown: bool) -> RoutineCheck:
+    """The check's record: static bounds and the verdicts against the totals, the parts, the engine."""
+    routine = plan.routine
     require_inside(f"{routine.spec_path}: cases.where", routine.domain, totals.cases, totals.outside,
                    totals.constraint_cases)
     if routine.reference is None:  # rows only: unknown static bounds are said, not an error
         static, rows.static_note = rows_only_static(routine, runner)
     else:
         static = static_bounds(routine, runner)
-    probe = chain((row.case for row in routine.rows), *(islice(p.cases, PROBE_CASES) for p in parts))
-    check = RoutineCheck(routine, runner.size(runner.blocks_read(probe)), static, totals, bounds_violations(routine, static, totals),
-                         budget_violations(routine, static, totals), _part_runs(parts, totals, unknown, rows),
-                         start=runner.start, engine=used, agreement=agreement, rows=rows, engine_reason=reason,
-                         compile_seconds=compile_seconds, search=searched, engine_note=engine_note, entry_every=every,
-                         random_draw=next((p.draw for p in parts if p.name == "random"), None))
-    if rows is not None and rows.agreement is not None:
-        check.agreement = agreement = merged_agreement(agreement, rows)
+    probe = chain((row.case for row in routine.rows), *(islice(p.cases, PROBE_CASES) for p in plan.parts))
+    return RoutineCheck(routine, runner.size(runner.blocks_read(probe)), static, totals,
+                        bounds_violations(routine, static, totals), budget_violations(routine, static, totals),
+                        _part_runs(plan.parts, totals, unknown, rows), start=runner.start, engine=choice.used,
+                        agreement=agreement, rows=rows, engine_reason=choice.reason,
+                        compile_seconds=choice.compile_seconds, search=searched, engine_note=choice.note,
+                        entry_every=every, random_draw=next((p.draw for p in plan.parts if p.name == "random"), None))
+
+
+def _failure_and_coverage(check: RoutineCheck, plan: _Plan, runner: RoutineRunner, start: SceneStart | None) -> None:
+    """The first failure (the timing model's or the engines' disagreement too) with its trace, and the
+    code coverage (not on the compiled engine, which counts none: say so rather than show what it did not)."""
+    totals, agreement = check.totals, check.agreement
+    if check.rows is not None and check.rows.agreement is not None:
+        check.agreement = agreement = merged_agreement(agreement, check.rows)
     if agreement is not None and agreement.failure is not None and totals.failure is None:
         totals.failure = agreement.failure  # the timing model or the engines disagreed on a call
     if totals.failure is not None:
-        check.trace = failure_trace(spec, seed, totals.failure.case, start)
-    if used == "compiled":  # the compiled engine counts no coverage: say so rather than show what it did not count
-        return _finished(check, began)
+        check.trace = failure_trace(plan.spec, plan.seed, totals.failure.case, start)
+    if check.engine == "compiled":
+        return
     check.code_coverage = completed(totals.code_coverage, runner)
     if totals.max_case is not None and not totals.run_errors:
         check.code_coverage.worst_path = worst_path(runner, totals.max_case)
         check.code_coverage.worst_cycles = totals.cycles_max
-    return _finished(check, began)
 
 
-def _finished(check: RoutineCheck, began: float) -> RoutineCheck:
+def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | None = None,
+                  random_count: int | None = None, jobs: Workers | int = 1, progress: Callable[[str], None] | None = None,
+                  start: SceneStart | None = None, bounded_product: int = case_sets.BOUNDED_PRODUCT,
+                  engine: str = "auto", search_budget: int | None = None, entry_state: bool = True) -> RoutineCheck:
+    """Check one routine: a spec path, or a Routine built in Python (then in this process only).
+    `engine`: "scalar" (Machine), "batch" (the batched core, checked against Machine on the first
+    AGREEMENT_PER_PART cases of each part) or "auto" (batch from AUTO_BATCH_CASES planned cases).
+    `jobs`: where a large check's tasks run (retro.workers). `search_budget`: candidates the
+    coverage-guided search may run after the planned cases (None: the spec's `[cases] search`, else
+    DEFAULT_SEARCH; 0: no search). `entry_state`: also run a sample of the cases with the entry state
+    the spec leaves arbitrary varied (retro.analysis.check.entry_runs)."""
+    began = time.monotonic()
+    check_engine(engine)
+    workers = Workers(1) if isinstance(spec, Routine) else jobs
+    plan = _planned(spec, exhaustive, seed, random_count, bounded_product)
+    known, unknown = plan.known, plan.unknown
+    runner = runner_for(plan.spec, plan.seed, start)  # loads and validates in this process before any worker starts
+    choice = _engine_choice(plan, runner, engine, start)
+    totals = Tally()
+    report = _reporter(plan.routine, totals, known, unknown, progress)
+    rows = _rows_first(plan, start, choice, totals, report)
+    agreement = _agreement(plan.spec, plan.seed, plan.parts, choice.used, start) if choice.on_batch else None
+    every = entry_every(known, exhaustive, bounded_product, unknown) if entry_state and plan.parts else 0
+    if plan.parts:
+        sweep = Sweep(plan.spec, plan.seed, exhaustive, plan.random, bounded_product, choice.used, every, start)
+        _run_sweep(sweep, plan, workers, totals, report)
+    searched = _search(plan, runner, choice.on_batch, totals, search_budget)
+    _run_found(plan, searched, choice.on_batch, agreement, start, totals, report)
+    check = _assembled(plan, runner, choice, totals, agreement, rows, searched, every, unknown)
+    _failure_and_coverage(check, plan, runner, start)
     check.seconds = time.monotonic() - began
     return check
 
 
-def _search(spec: str, seed: int, runner, on_batch: bool, totals: Tally, budget: int | None) -> SearchResult:
-    """The coverage-guided search from what the planned cases ran (none after a call that stopped,
-    nor for a spec of rows only: no answer is known for a case it would find)."""
-    routine = runner.routine
-    if budget is None:
-        budget = routine.search if routine.search is not None else DEFAULT_SEARCH
-    if routine.reference is None or totals.run_errors:
-        budget = 0
-    return search(runner, on_batch=on_batch, seed=seed, budget=budget, covered=totals.code_coverage,
-                  slowest=None if totals.max_case is None else (totals.cycles_max, totals.max_case),
-                  fastest=None if totals.min_case is None else (totals.cycles_min, totals.min_case))
-
-
-def default_jobs() -> int:
-    return max(1, min(2, os.cpu_count() or 1))
-
-
 def run_checks(names: list[str] | None, *, exhaustive: bool = False, seed: int | None = None,
-               random_count: int | None = None, jobs: int | None = None,
+               random_count: int | None = None, jobs: Workers | int | None = None,
                progress: Callable[[str], None] | None = None, start: SceneStart | None = None,
                bounded_product: int = case_sets.BOUNDED_PRODUCT, engine: str = "auto",
                search_budget: int | None = None) -> list[RoutineCheck]:
     """Check the named routines (built-in names or spec paths; all built-ins when none are named);
     every name is loaded and validated before any work starts."""
     specs = select(names)
-    workers = default_jobs() if jobs is None else jobs
-    return [check_routine(spec, exhaustive=exhaustive, seed=seed, random_count=random_count, jobs=workers,
-                          progress=progress, start=start, bounded_product=bounded_product, engine=engine,
-                          search_budget=search_budget)
-            for spec in specs]
+    workers = as_workers(jobs)
+    with session():  # the routines share one cluster, started by the first that needs it
+        return [check_routine(spec, exhaustive=exhaustive, seed=seed, random_count=random_count, jobs=workers,
+                              progress=progress, start=start, bounded_product=bounded_product, engine=engine,
+                              search_budget=search_budget)
+                for spec in specs]

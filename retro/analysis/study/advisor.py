@@ -25,6 +25,7 @@ import math
 from dataclasses import dataclass
 from itertools import combinations
 
+from retro.workers import Workers
 from retro.analysis.study.accuracy import Confusion, pooled
 from retro.analysis.study.corpus import Shape
 from retro.analysis.study.costs import CycleStats
@@ -127,7 +128,7 @@ def _shape_key(shape: Shape) -> tuple:
     return shape.mask.shape, shape.mask.tobytes(), shape.data, shape.multicolor, shape.expand_x, shape.expand_y
 
 
-def advise(path: str, target: float, workers: int | None = None, progress: Progress = quiet,
+def advise(path: str, target: float, workers: Workers | int | None = None, progress: Progress = quiet,
            samples: int = ADVICE_COST_SAMPLES, methods: tuple[Method, ...] = METHODS, software: bool = False,
            objects: int | None = None, engine: str = "auto") -> Advice:
     """`target` in (0, 1] and `objects` in 1..MAX_OBJECTS are checked by retro.commands.advise."""

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from retro.analysis.study import report
+from retro.workers import Workers
 from retro.analysis.study.corpus import DEFAULT_SHAPES, REDUCED_SHAPES, load_shapes
 from retro.analysis.study.evaluate import evaluate
 from retro.progress import Progress, quiet
@@ -40,7 +41,7 @@ class ChartOutput:
     per_frame: object = None  # per_frame.PerFrame with --per-frame
 
 
-def run_chart(out_dir: Path, reduced: bool = False, workers: int | None = None, progress: Progress = quiet,
+def run_chart(out_dir: Path, reduced: bool = False, workers: Workers | int | None = None, progress: Progress = quiet,
               shape_names: tuple[str, ...] | None = None, cost_samples: int | None | str = AUTO,
               methods: tuple[Method, ...] = METHODS, sprite_files: tuple[str, ...] = (),
               per_frame: bool = False, engine: str = "auto") -> ChartOutput:

@@ -14,12 +14,11 @@ from itertools import combinations_with_replacement
 
 from retro.analysis.study.corpus import Pair, Shape, make_pair
 from retro.analysis.study.costs import CycleStats, MethodCost
-from retro.analysis.study.evaluate import default_workers
 from retro.progress import Progress, quiet
 from retro.analysis.study.host_timing import host_microseconds
 from retro.analysis.study.methods import METHODS, Method, sub_pair
 from retro.errors import RunError
-from retro.workers import worker_pool
+from retro.workers import Workers, only, run_in_order
 
 HOST_SAMPLES = 48  # cases per pair timed on the host (a secondary figure)
 
@@ -58,13 +57,12 @@ def _measure_pair(method: Method, a: Shape, b: Shape, samples: int | None,
     return pair.name, cycles
 
 
-def measure_costs(shapes: list[Shape], samples: int | None, workers: int | None = None, progress: Progress = quiet,
+def measure_costs(shapes: list[Shape], samples: int | None, workers: Workers | int | None = None, progress: Progress = quiet,
                   pair_list: list[tuple[Shape, Shape]] | None = None,
                   methods: tuple[Method, ...] = METHODS, engine: str = "auto") -> dict[str, MethodCost]:
     """MethodCost for every method; a host-only method gets no cycles and says so. `samples`: cases
     measured per pair (None: every case)."""
     jobs = pair_list if pair_list is not None else list(combinations_with_replacement(shapes, 2))
-    workers = default_workers() if workers is None else workers
     pairs = [make_pair(a, b) for a, b in jobs]
     measured = [m for m in methods if not m.host_only]
     tasks = [(m, a, b) for m in measured for a, b in jobs]
@@ -73,22 +71,18 @@ def measure_costs(shapes: list[Shape], samples: int | None, workers: int | None 
     return {m.key: _method_cost(m, pairs, jobs, by_method.get(m.key, []), samples) for m in methods}
 
 
-def _run_pairs(tasks: list, samples: int | None, engine: str, workers: int, per_method: int,
+def _run_pairs(tasks: list, samples: int | None, engine: str, workers: Workers | int | None, per_method: int,
                progress: Progress) -> list[tuple[str, list[int]]]:
-    """Each (method, shape, shape) measured, in order, over worker processes when more than one."""
+    """Each (method, shape, shape) measured, in order, over `workers` (retro.workers) when more than one."""
     results = []
-    if workers > 1 and len(tasks) > 1:
-        with worker_pool(workers) as pool:
-            futures = [pool.submit(_measure_pair, m, a, b, samples, engine) for m, a, b in tasks]
-            for (m, _, _), future in zip(tasks, futures):
-                results.append(future.result())
-                if len(results) % per_method == 0:
-                    progress(f"cost: {m.key} ({m.routine}) measured on {per_method} pairs")
-        return results
-    for m, a, b in tasks:
-        results.append(_measure_pair(m, a, b, samples, engine))
+
+    def report(result: tuple[str, list[int]]) -> None:
+        results.append(result)
         if len(results) % per_method == 0:
+            m = tasks[len(results) - 1][0]
             progress(f"cost: {m.key} ({m.routine}) measured on {per_method} pairs")
+    run_in_order(_measure_pair, ((m, a, b, samples, engine) for m, a, b in tasks), only(workers, len(tasks) > 1),
+                 report)
     return results
 
 

@@ -44,12 +44,11 @@ from retro.analysis.study.broad_phase import (
 )
 from retro.analysis.study.corpus import Shape
 from retro.analysis.study.costs import CycleStats
-from retro.analysis.study.evaluate import default_workers
 from retro.progress import Progress, quiet
 from retro.analysis.study.methods.base import KIND_PAIR, Method
 from retro.chips.vic import constants as vic
 from retro.errors import RunError
-from retro.workers import worker_pool
+from retro.workers import Workers, only, run_in_order
 
 BUDGET_LINES = 20  # "a typical budget of 20 raster lines"
 OBJECT_COUNTS = tuple(range(1, MAX_OBJECTS + 1))
@@ -133,27 +132,20 @@ def _sweep_task(extents: Extents, n: int, layouts: int, frames: int) -> tuple[Ex
 
 
 def measure_broad(extent_sets: Sequence[Extents], counts: Sequence[int], layouts: int = LAYOUTS, frames: int = FRAMES,
-                  workers: int | None = None, progress: Progress = quiet) -> BroadTable:
-    """Both drivers for every object count; the sweep on each distinct set of extents."""
-    workers = default_workers() if workers is None else workers
+                  workers: Workers | int | None = None, progress: Progress = quiet) -> BroadTable:
+    """Both drivers for every object count; the sweep on each distinct set of extents, over `workers`
+    (retro.workers) when more than one."""
     brute = {n: brute_sample(n) for n in counts}
     tasks = [(e, n) for e in dict.fromkeys(extent_sets) for n in counts]
     sweep: dict[tuple[Extents, int], list[BroadSample]] = {}
-    if workers > 1 and len(tasks) > 1:
-        with worker_pool(workers) as pool:
-            futures = [pool.submit(_sweep_task, e, n, layouts, frames) for e, n in tasks]
-            for i, future in enumerate(futures, 1):
-                e, n, samples = future.result()
-                sweep[(e, n)] = samples
-                if i % len(counts) == 0:
-                    progress(f"per frame: sort and sweep measured for {len(counts)} object counts "
-                             f"({i // len(counts)} of {len(tasks) // len(counts)} hitbox widths)")
-    else:
-        for i, (e, n) in enumerate(tasks, 1):
-            sweep[(e, n)] = sweep_samples(e, n, layouts, frames)
-            if i % len(counts) == 0:
-                progress(f"per frame: sort and sweep measured for {len(counts)} object counts "
-                         f"({i // len(counts)} of {len(tasks) // len(counts)} hitbox widths)")
+
+    def report(result: tuple[Extents, int, list[BroadSample]]) -> None:
+        e, n, samples = result
+        sweep[(e, n)] = samples
+        if len(sweep) % len(counts) == 0:
+            progress(f"per frame: sort and sweep measured for {len(counts)} object counts "
+                     f"({len(sweep) // len(counts)} of {len(tasks) // len(counts)} hitbox widths)")
+    run_in_order(_sweep_task, ((e, n, layouts, frames) for e, n in tasks), only(workers, len(tasks) > 1), report)
     return BroadTable(brute=brute, sweep=sweep, layouts=layouts, frames=frames)
 
 
@@ -350,7 +342,7 @@ class PerFrame:
 
 def per_frame(methods: Sequence[Method], tests: dict[str, CycleStats], shapes: Sequence[Shape],
               counts: Sequence[int] = OBJECT_COUNTS, reduced: bool = False, budget: Budget = PAL_BUDGET,
-              workers: int | None = None, progress: Progress = quiet, engine: str = "auto") -> PerFrame:
+              workers: Workers | int | None = None, progress: Progress = quiet, engine: str = "auto") -> PerFrame:
     """The model for every method with measured cycles (`tests`: cycles per test by method key)."""
     used = [m for m in methods if not m.host_only and m.key in tests and tests[m.key].samples]
     prepares = prepare_costs(used, engine)
