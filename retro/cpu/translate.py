@@ -38,7 +38,7 @@ from retro.cpu.timing import (
     branch_target,
 )
 
-TRANSLATOR_VERSION = 1  # part of every cache key: a change of the generated code's meaning bumps it
+TRANSLATOR_VERSION = 2  # part of every cache key: a change of the generated code's meaning bumps it
 # A call's status (the compiled function's per-call result): 0 returned, else why it stopped.
 RETURNED = 0
 BUDGET = 4  # the cycle budget was spent (retro.cpu.batch.LaneError.BUDGET)
@@ -50,6 +50,10 @@ NO_BLOCK = -1
 WORD = 0xFFFF
 BYTE = 0xFF
 STACK_PAGE = 0x100
+
+
+SET_A, SET_X, SET_Y, SET_P, SET_FLAG = range(5)  # what a `sets` row of `translate` does with its column
+SET_REGISTERS = "axyp"
 
 
 class Untranslatable(Exception):
@@ -66,6 +70,7 @@ class Translation:
     code_bytes: frozenset[int]  # every byte of a translated instruction (writes there fall back)
     fixed_writes: tuple[int, ...]  # addresses written at a fixed address (restored after every call)
     instructions: int
+    placed: tuple[int, ...] = ()  # addresses the function puts the case columns' bytes at (`places`)
 
 
 def tables_for(cpu: str) -> dict[int, Op]:
@@ -576,11 +581,24 @@ def _inlined(starts: list[int], instructions: dict, entry: int, return_pc: int, 
             if start != entry and start not in returned_to and len(sources) == 1 and sources[0] < start}
 
 
+def _placing(places: tuple, sets: tuple) -> str:
+    """The lines that put a lane's inputs in place: `places` rows (column, shift, address) put the byte
+    (column >> shift) & 255 at address; `sets` rows (column, shift, what) OR that byte into A, X, Y or P
+    (SET_A..SET_P), or set P's bit `shift` when the column is not 0 (SET_FLAG)."""
+    lines = [f"mem[{address}] = (cols[{column}][lane] >> {shift}) & 255" for column, shift, address in places]
+    for column, shift, what in sets:
+        if what == SET_FLAG:
+            lines.append(f"p |= {shift} if cols[{column}][lane] != 0 else 0")
+        else:
+            lines.append(f"{SET_REGISTERS[what]} |= (cols[{column}][lane] >> {shift}) & 255")
+    return "\n".join(" " * 8 + line for line in lines)
+
+
 def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
-              inputs_at: Iterable[int] = ()) -> Translation:
+              inputs_at: Iterable[int] = (), places: tuple = (), sets: tuple = ()) -> Translation:
     """The routine at entry (its bytes as `read` gives them: the memory every call starts from) as
-    the source of one function (see the module docstring); Untranslatable when it certainly modifies
-    its own code."""
+    the source of one function (see the module docstring; `places` and `sets`: where the case
+    columns go, `_placing`); Untranslatable when it certainly modifies its own code."""
     starts, instructions = find_blocks(read, entry, cpu, return_pc)
     code_bytes = frozenset((pc + k) & WORD for pc, op in instructions.items()
                            for k in range(MODE_LENGTH[op.mode] if op is not None else 1))
@@ -620,25 +638,31 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
     name = "run_calls"
     restore = "\n".join(f"        mem[{address}] = image[{address}]" for address in sorted(e.fixed_writes))
     source = _FUNCTION.format(name=name, entry_block=blocks[entry], body="\n".join(e.lines), budget_status=BUDGET,
-                              fallback_write=FALLBACK_WRITE, z_bit=_Z_BIT, restore=restore)
-    return Translation(source, name, blocks, code_bytes, tuple(sorted(e.fixed_writes)), len(instructions))
+                              fallback_write=FALLBACK_WRITE, z_bit=_Z_BIT, restore=restore,
+                              placing=_placing(places, sets))
+    return Translation(source, name, blocks, code_bytes, tuple(sorted(e.fixed_writes)), len(instructions),
+                       tuple(address for _, _, address in places))
 
 
-# The function around the blocks: one call per lane, inputs placed, outputs read, memory restored.
+# The function around the blocks: one call per lane, inputs placed from the case columns (`cols`, a
+# tuple: `placing`, the lines `_placing` makes), results written straight into the caller's arrays,
+# memory restored. `lane_bytes`: bytes per lane made beforehand (table inputs), one row per `lane_addr`.
+# `base`: A, X, Y, P before the inputs. `out` rows: A, X, Y, P, cycles, status.
 _FUNCTION = '''
 LOG_MASK = 65535
 
 
-def {name}(mem, image, log, code_map, addr_block, in_addr, in_bytes, reg_a, reg_x, reg_y, reg_p,
-           start_sp, budget, return_pc, return_sp, out_addr, out_a, out_x, out_y, out_p, out_cycles,
-           out_status, out_bytes):
-    for lane in range(reg_a.shape[0]):
-        for k in range(in_addr.shape[0]):
-            mem[in_addr[k]] = in_bytes[k, lane]
-        a = np.int64(reg_a[lane])
-        x = np.int64(reg_x[lane])
-        y = np.int64(reg_y[lane])
-        p = np.int64(reg_p[lane])
+def {name}(mem, image, log, code_map, addr_block, cols, lane_addr, lane_bytes, base, start_sp, budget, return_pc,
+           return_sp, out_addr, out, out_bytes):
+    for lane in range(out.shape[1]):
+        for k in range(lane_addr.shape[0]):
+            mem[lane_addr[k]] = lane_bytes[k, lane]
+        a = base[0]
+        x = base[1]
+        y = base[2]
+        p = base[3]
+{placing}
+        p = (p | 32) & 239
         nv = p & 128
         fv = (p >> 6) & 1
         fd = (p >> 3) & 1
@@ -666,12 +690,12 @@ def {name}(mem, image, log, code_map, addr_block, in_addr, in_bytes, reg_a, reg_
             status = {fallback_write}
         if status == 0 and cycles > budget:
             status = {budget_status}
-        out_a[lane] = a
-        out_x[lane] = x
-        out_y[lane] = y
-        out_p[lane] = (nv & 128) | (fv << 6) | 32 | (fd << 3) | (fi << 2) | {z_bit} | fc
-        out_cycles[lane] = cycles
-        out_status[lane] = status
+        out[0, lane] = a
+        out[1, lane] = x
+        out[2, lane] = y
+        out[3, lane] = (nv & 128) | (fv << 6) | 32 | (fd << 3) | (fi << 2) | {z_bit} | fc
+        out[4, lane] = cycles
+        out[5, lane] = status
         for k in range(out_addr.shape[0]):
             out_bytes[k, lane] = mem[out_addr[k]]
         if nlog > LOG_MASK + 1:  # more writes than the log holds: the whole memory
@@ -682,4 +706,3 @@ def {name}(mem, image, log, code_map, addr_block, in_addr, in_bytes, reg_a, reg_
                 mem[t] = image[t]
 {restore}
 '''
-

@@ -580,7 +580,7 @@ class RoutineRunner:
     def compiled(self):
         """The routine compiled (`retro.cpu.compiled`), made on first use and again when the code bytes
         changed (set_memory); Untranslatable when the compiled engine does not take it."""
-        from retro.cpu.compiled import compile_routine
+        from retro.cpu.compiled import SET_FLAG, SET_REGISTERS, compile_routine
 
         image = bytes(self.call_image)
         held = getattr(self, "_compiled", None)
@@ -590,34 +590,41 @@ class RoutineRunner:
                                                                       for a in addresses]
         trapped = bytearray(image)
         push_return_trap(trapped)
-        routine = compile_routine(bytes(trapped), self.entry, self.routine.cpu, RETURN_TRAP, inputs_at)
+        plan = self.plan
+        places = ()  # memory inputs go through lane_bytes (numpy casts them to bytes in one pass)
+        sets = tuple([(index, shift, SET_REGISTERS.index(register)) for index, register, shift in plan.registers]
+                     + [(index, bit, SET_FLAG) for index, bit in plan.flags])
+        routine = compile_routine(bytes(trapped), self.entry, self.routine.cpu, RETURN_TRAP, inputs_at,
+                                  len(self.routine.inputs), places, sets)
         self._compiled = (routine, [(a, image[a]) for a in sorted(routine.translation.code_bytes)], image)
         return routine
 
     def run_compiled(self, columns: list) -> "BatchOutcome":
         """Run every case of a column block on the compiled engine; calls it leaves (`fallbacks`, by
         reason) run on the batched core."""
-        from retro.cpu.compiled import FALLBACK
+        from retro.cpu import compiled as engine
 
         compiled = self.compiled()
         n = len(columns[0])
-        placed: list[tuple[int, np.ndarray]] = []
-        registers, p = self.plan.place(columns, _column_byte, lambda address, lanes: placed.append((address, lanes)))
-        in_addr = np.asarray([address for address, _ in placed], dtype=np.int64)
-        in_bytes = np.empty((len(placed), n), dtype=np.uint8)
-        for k, (_, lanes) in enumerate(placed):
-            in_bytes[k] = lanes
+        plan = self.plan
+        tables: list[tuple[int, np.ndarray]] = [(address, columns[index] >> shift if shift else columns[index])
+                                                for index, address, shift in plan.bytes]
+        for index, addresses in plan.tables:
+            tables += [(address, columns[index][:, k]) for k, address in enumerate(addresses)]
+        lane_addr = np.asarray([address for address, _ in tables], dtype=np.int64)
+        lane_bytes = np.empty((len(tables), n), dtype=np.uint8)
+        for k, (_, lanes) in enumerate(tables):
+            lane_bytes[k] = lanes
+        flat = tuple(np.ascontiguousarray(c if c.ndim == 1 else c[:, 0], dtype=np.int64) for c in columns)
+        start = dict(plan.base_registers)
+        base = np.asarray([start["a"], start["x"], start["y"], plan.base_flags], dtype=np.int64)
         image = bytearray(self.call_image)
         s = self.machine.entry_s if self.routine.entry_s == ENTRY_S else self.routine.entry_s
         stack_pointer = push_return_trap(image, s)
-        registers.pop("s", None)
-        lanes = {name: np.broadcast_to(np.asarray(value, dtype=np.int64), (n,)).copy() for name, value in registers.items()}
-        flags = np.broadcast_to(np.asarray((p | FLAG_U) & ~FLAG_B, dtype=np.int64), (n,)).copy()
         out_addr = np.asarray(sorted({place.address for port in self.routine.outputs for place in port.places
                                       if place.kind == "memory"}), dtype=np.int64)
-        done = compiled.run(bytes(image), in_addr, in_bytes, lanes["a"],
-                            lanes["x"], lanes["y"], flags, stack_pointer, self.limit, RETURN_TRAP, return_s(s),
-                            out_addr)
+        done = compiled.run(bytes(image), flat, base, stack_pointer, self.limit, RETURN_TRAP, return_s(s), out_addr,
+                            lane_addr, lane_bytes)
         column_of = {int(address): k for k, address in enumerate(out_addr)}
         out_bytes = done["bytes"]
         outputs = port_values(self.routine.outputs, {"a": done["a"], "x": done["x"], "y": done["y"]}, done["p"],
@@ -627,7 +634,7 @@ class RoutineRunner:
         status = done["status"]
         error = np.where(status == LaneError.BUDGET, LaneError.BUDGET, 0).astype(np.int8)
         cycles = done["cycles"]
-        left = np.flatnonzero(status >= FALLBACK)
+        left = np.flatnonzero(status >= engine.FALLBACK) if n and status.max() >= engine.FALLBACK else ()
         if len(left):
             for code, count in zip(*np.unique(status[left], return_counts=True)):
                 self.fallbacks[int(code)] = self.fallbacks.get(int(code), 0) + int(count)
