@@ -323,6 +323,16 @@ MUTANTS = [
            "    if high >= 0xA0:", "    if high > 0xA0:", COMPILED_TESTS),
     Mutant("compiled-store-into-code-trusted", "retro/cpu/translate.py",
            'self.put("bad |= code_map[t]")', 'self.put("bad |= 0")', COMPILED_TESTS),
+    Mutant("compiled-65c02-decimal-cycle-dropped", "retro/cpu/translate.py",
+           '                self.put("cycles += fd")', '                pass', COMPILED_TESTS),
+    Mutant("compiled-binary-sbc-not-complemented", "retro/cpu/translate.py",
+           'operand = f"{value} ^ 255" if name == "sbc" else value', 'operand = value', COMPILED_TESTS),
+    Mutant("compiled-flag-input-ignored", "retro/cpu/translate.py",
+           'lines.append(f"p |= {shift} if cols[{column}][lane] != 0 else 0")', 'pass', COMPILED_TESTS),
+    Mutant("compiled-register-input-shift-dropped", "retro/cpu/translate.py",
+           'lines.append(f"{SET_REGISTERS[what]} |= (cols[{column}][lane] >> {shift}) & 255")',
+           'lines.append(f"{SET_REGISTERS[what]} |= cols[{column}][lane] & 255")',
+           COMPILED_TESTS + ("tests/routines/test_compiled_check.py",)),
 ]
 
 

@@ -38,7 +38,7 @@ from retro.cpu.timing import (
     branch_target,
 )
 
-TRANSLATOR_VERSION = 2  # part of every cache key: a change of the generated code's meaning bumps it
+TRANSLATOR_VERSION = 3  # part of every cache key: a change of the generated code's meaning bumps it
 # A call's status (the compiled function's per-call result): 0 returned, else why it stopped.
 RETURNED = 0
 BUDGET = 4  # the cycle budget was spent (retro.cpu.batch.LaneError.BUDGET)
@@ -229,44 +229,17 @@ class _Emitter:
         self.put(f"nv = {value}")
         self.put(f"zv = {value}")
 
-    def adc(self, value: str) -> None:
-        if self.cmos:
-            self.put("if fd:")
-            self.put(f"    a, nv, zv, fv, fc = adc_decimal_cmos(a, {value}, fc)")
-            self.put("    cycles += 1")
-            self.put("else:")
-        elif self.decimal:
-            self.put("if fd:")
-            self.put(f"    a, nv, zv, fv, fc = adc_decimal_nmos(a, {value}, fc)")
-            self.put("else:")
+    def add(self, name: str, value: str) -> None:
+        """ADC (or SBC: `name` "sbc") of value: one call of the helper for this CPU's decimal mode
+        (retro.cpu.compiled_ops); the 2A03 has none, the 65C02 takes a cycle more with D set."""
+        if self.decimal or self.cmos:
+            family = "cmos" if self.cmos else "nmos"
+            self.put(f"a, nv, zv, fv, fc = {name}_{family}(a, {value}, fc, fd)")
+            if self.cmos:
+                self.put("cycles += fd")
         else:
-            self.put("if True:")
-        self.put(f"    t = a + {value} + fc")
-        self.put(f"    fv = (((a ^ t) & ({value} ^ t)) >> 7) & 1")
-        self.put("    fc = t >> 8")
-        self.put("    a = t & 255")
-        self.put("    nv = a")
-        self.put("    zv = a")
-
-    def sbc(self, value: str) -> None:
-        if self.cmos:
-            self.put("if fd:")
-            self.put(f"    a, nv, zv, fv, fc = sbc_decimal_cmos(a, {value}, fc)")
-            self.put("    cycles += 1")
-            self.put("else:")
-        elif self.decimal:
-            self.put("if fd:")
-            self.put(f"    a, nv, zv, fv, fc = sbc_decimal_nmos(a, {value}, fc)")
-            self.put("else:")
-        else:
-            self.put("if True:")
-        self.put(f"    u = {value} ^ 255")
-        self.put("    t = a + u + fc")
-        self.put("    fv = (((a ^ t) & (u ^ t)) >> 7) & 1")
-        self.put("    fc = t >> 8")
-        self.put("    a = t & 255")
-        self.put("    nv = a")
-        self.put("    zv = a")
+            operand = f"{value} ^ 255" if name == "sbc" else value
+            self.put(f"a, nv, zv, fv, fc = adc_binary(a, {operand}, fc)")
 
     def compare(self, register: str, value: str) -> None:
         self.put(f"t = {register} - {value}")
@@ -311,9 +284,9 @@ class _Emitter:
             self.put(f"a = a {symbol} {value}")
             self.nz("a")
         elif name == "ADC":
-            self.adc(value)
+            self.add("adc", value)
         elif name in ("SBC", "USBC"):
-            self.sbc(value)
+            self.add("sbc", value)
         elif name in ("CMP", "CPX", "CPY"):
             self.compare({"CMP": "a", "CPX": "x", "CPY": "y"}[name], value)
         elif name == "BIT":
