@@ -420,6 +420,16 @@ MUTANTS = [
            "            if name == \"RTS\":\n                incoming = out\n",
            "            if name == \"RTS\":\n                incoming = everything\n",
            ("tests/optimize/test_optimize.py::test_liveness_frees_what_the_routine_overwrites_and_keeps_the_outputs",)),
+    Mutant("compiled-65c02-decimal-cycle-dropped", "retro/cpu/translate.py",
+           '                self.put("cycles += fd")', '                pass', COMPILED_TESTS),
+    Mutant("compiled-binary-sbc-not-complemented", "retro/cpu/translate.py",
+           'operand = f"{value} ^ 255" if name == "sbc" else value', 'operand = value', COMPILED_TESTS),
+    Mutant("compiled-flag-input-ignored", "retro/cpu/translate.py",
+           'lines.append(f"p |= {shift} if cols[{column}][lane] != 0 else 0")', 'pass', COMPILED_TESTS),
+    Mutant("compiled-register-input-shift-dropped", "retro/cpu/translate.py",
+           'lines.append(f"{SET_REGISTERS[what]} |= (cols[{column}][lane] >> {shift}) & 255")',
+           'lines.append(f"{SET_REGISTERS[what]} |= cols[{column}][lane] & 255")',
+           COMPILED_TESTS + ("tests/routines/test_compiled_check.py",)),
 ]
 
 

@@ -1,15 +1,51 @@
-"""The rare paths of the compiled engine's generated code, as plain Python functions of ints that the
-generated module compiles with numba (`retro.cpu.compiled`): decimal-mode ADC and SBC, and ARR.
+"""ADC, SBC and ARR for the compiled engine's generated code (`retro.cpu.translate`): functions of ints
+compiled by numba once per process, which a routine's generated code calls (one line, one call site for
+numba to type) rather than repeating them: a routine's compile time grows with its lines and far faster
+with its branches. (Not in numba's own disk cache: only the engine's checked entries are ever loaded;
+a cached routine carries the code it calls.) And `Pipeline`, numba's compiler without its SSA pass,
+whose cost grows with the square of a function's branches (measured: 30% of a 200-branch function).
 
 Each returns (A, nv, zv, V, C): N is bit 7 of nv, Z is set when zv == 0 (the generated code's lazy
-flags, `retro.cpu.translate`). The rules are those of the batched core (`retro.cpu.batch`,
+flags, `retro.cpu.translate`). Without numba they stay plain Python (the engine is then off and says
+why: `retro.cpu.compiled.numba_problem`). The rules are those of the batched core (`retro.cpu.batch`,
 `retro.cpu.batch65c02`) for one call: Bruce Clark, "Decimal Mode", appendix A (the NMOS 6502's A, C,
 N, V and Z; the 65C02's valid N and Z), and "NMOS 6510 Unintended Opcodes - No More Secrets" for ARR.
 """
 
 from __future__ import annotations
 
+try:
+    from numba import njit
+    from numba.core.compiler import CompilerBase, DefaultPassBuilder
+except Exception:  # noqa: BLE001 - an unsupported Python or numpy fails at import in many ways
+    def njit(*args, **kwargs):
+        return lambda function: function
+    CompilerBase = object
+    DefaultPassBuilder = None
 
+
+class Pipeline(CompilerBase):
+    """numba's nopython pipeline without SSA reconstruction: the generated functions assign every
+    variable an int64 (their types need no SSA to unify), and the pass is quadratic in their branches."""
+
+    def define_pipelines(self):
+        self.state.flags.enable_ssa = False
+        return [DefaultPassBuilder.define_nopython_pipeline(self.state)]
+
+
+def _jit(function):
+    return njit(function)
+
+
+@_jit
+def adc_binary(a, value, carry):
+    """ADC without decimal mode (and SBC, given the operand's complement)."""
+    total = a + value + carry
+    result = total & 0xFF
+    return result, result, result, (((a ^ total) & (value ^ total)) >> 7) & 1, total >> 8
+
+
+@_jit
 def adc_decimal_nmos(a, value, carry):
     """NMOS ADC with D set: Clark's sequences 1 and 2; Z from the binary sum."""
     total = a + value + carry
@@ -24,6 +60,7 @@ def adc_decimal_nmos(a, value, carry):
     return high & 0xFF, signed & 0x80, total & 0xFF, overflow, 1 if high > 0xFF else 0
 
 
+@_jit
 def sbc_decimal_nmos(a, value, carry):
     """NMOS SBC with D set: flags from the binary difference, A by Clark's sequence 3."""
     binary = a + (value ^ 0xFF) + carry
@@ -38,6 +75,7 @@ def sbc_decimal_nmos(a, value, carry):
     return high & 0xFF, result, result, overflow, binary >> 8
 
 
+@_jit
 def adc_decimal_cmos(a, value, carry):
     """65C02 ADC with D set: A and C by Clark's sequence 1, V by sequence 2, N and Z from A."""
     low = (a & 0x0F) + (value & 0x0F) + carry
@@ -52,6 +90,7 @@ def adc_decimal_cmos(a, value, carry):
     return result, result, result, overflow, 1 if total > 0xFF else 0
 
 
+@_jit
 def sbc_decimal_cmos(a, value, carry):
     """65C02 SBC with D set: C and V from the binary difference, A by Clark's sequence 4, N and Z from A."""
     binary = a + (value ^ 0xFF) + carry
@@ -67,6 +106,7 @@ def sbc_decimal_cmos(a, value, carry):
     return result, result, result, overflow, binary >> 8
 
 
+@_jit
 def arr(value, carry, decimal):
     """ARR on A AND the operand (`value`): ROR with its own flags; in decimal mode (NMOS) as 64doc."""
     result = (value >> 1) | (carry << 7)
@@ -84,4 +124,25 @@ def arr(value, carry, decimal):
     return adjusted, carry << 7, result, overflow, high_carry
 
 
-HELPERS = ("adc_decimal_nmos", "sbc_decimal_nmos", "adc_decimal_cmos", "sbc_decimal_cmos", "arr")
+@_jit
+def adc_nmos(a, value, carry, decimal):
+    return adc_decimal_nmos(a, value, carry) if decimal else adc_binary(a, value, carry)
+
+
+@_jit
+def sbc_nmos(a, value, carry, decimal):
+    return sbc_decimal_nmos(a, value, carry) if decimal else adc_binary(a, value ^ 0xFF, carry)
+
+
+@_jit
+def adc_cmos(a, value, carry, decimal):
+    """(The 65C02 takes a cycle more in decimal mode: the caller adds D to the cycles.)"""
+    return adc_decimal_cmos(a, value, carry) if decimal else adc_binary(a, value, carry)
+
+
+@_jit
+def sbc_cmos(a, value, carry, decimal):
+    return sbc_decimal_cmos(a, value, carry) if decimal else adc_binary(a, value ^ 0xFF, carry)
+
+
+HELPERS = ("adc_binary", "adc_nmos", "sbc_nmos", "adc_cmos", "sbc_cmos", "arr", "Pipeline")  # what generated code uses

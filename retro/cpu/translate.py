@@ -38,7 +38,7 @@ from retro.cpu.timing import (
     branch_target,
 )
 
-TRANSLATOR_VERSION = 1  # part of every cache key: a change of the generated code's meaning bumps it
+TRANSLATOR_VERSION = 3  # part of every cache key: a change of the generated code's meaning bumps it
 # A call's status (the compiled function's per-call result): 0 returned, else why it stopped.
 RETURNED = 0
 BUDGET = 4  # the cycle budget was spent (retro.cpu.batch.LaneError.BUDGET)
@@ -50,6 +50,10 @@ NO_BLOCK = -1
 WORD = 0xFFFF
 BYTE = 0xFF
 STACK_PAGE = 0x100
+
+
+SET_A, SET_X, SET_Y, SET_P, SET_FLAG = range(5)  # what a `sets` row of `translate` does with its column
+SET_REGISTERS = "axyp"
 
 
 class Untranslatable(Exception):
@@ -66,6 +70,7 @@ class Translation:
     code_bytes: frozenset[int]  # every byte of a translated instruction (writes there fall back)
     fixed_writes: tuple[int, ...]  # addresses written at a fixed address (restored after every call)
     instructions: int
+    placed: tuple[int, ...] = ()  # addresses the function puts the case columns' bytes at (`places`)
 
 
 def tables_for(cpu: str) -> dict[int, Op]:
@@ -224,44 +229,17 @@ class _Emitter:
         self.put(f"nv = {value}")
         self.put(f"zv = {value}")
 
-    def adc(self, value: str) -> None:
-        if self.cmos:
-            self.put("if fd:")
-            self.put(f"    a, nv, zv, fv, fc = adc_decimal_cmos(a, {value}, fc)")
-            self.put("    cycles += 1")
-            self.put("else:")
-        elif self.decimal:
-            self.put("if fd:")
-            self.put(f"    a, nv, zv, fv, fc = adc_decimal_nmos(a, {value}, fc)")
-            self.put("else:")
+    def add(self, name: str, value: str) -> None:
+        """ADC (or SBC: `name` "sbc") of value: one call of the helper for this CPU's decimal mode
+        (retro.cpu.compiled_ops); the 2A03 has none, the 65C02 takes a cycle more with D set."""
+        if self.decimal or self.cmos:
+            family = "cmos" if self.cmos else "nmos"
+            self.put(f"a, nv, zv, fv, fc = {name}_{family}(a, {value}, fc, fd)")
+            if self.cmos:
+                self.put("cycles += fd")
         else:
-            self.put("if True:")
-        self.put(f"    t = a + {value} + fc")
-        self.put(f"    fv = (((a ^ t) & ({value} ^ t)) >> 7) & 1")
-        self.put("    fc = t >> 8")
-        self.put("    a = t & 255")
-        self.put("    nv = a")
-        self.put("    zv = a")
-
-    def sbc(self, value: str) -> None:
-        if self.cmos:
-            self.put("if fd:")
-            self.put(f"    a, nv, zv, fv, fc = sbc_decimal_cmos(a, {value}, fc)")
-            self.put("    cycles += 1")
-            self.put("else:")
-        elif self.decimal:
-            self.put("if fd:")
-            self.put(f"    a, nv, zv, fv, fc = sbc_decimal_nmos(a, {value}, fc)")
-            self.put("else:")
-        else:
-            self.put("if True:")
-        self.put(f"    u = {value} ^ 255")
-        self.put("    t = a + u + fc")
-        self.put("    fv = (((a ^ t) & (u ^ t)) >> 7) & 1")
-        self.put("    fc = t >> 8")
-        self.put("    a = t & 255")
-        self.put("    nv = a")
-        self.put("    zv = a")
+            operand = f"{value} ^ 255" if name == "sbc" else value
+            self.put(f"a, nv, zv, fv, fc = adc_binary(a, {operand}, fc)")
 
     def compare(self, register: str, value: str) -> None:
         self.put(f"t = {register} - {value}")
@@ -306,9 +284,9 @@ class _Emitter:
             self.put(f"a = a {symbol} {value}")
             self.nz("a")
         elif name == "ADC":
-            self.adc(value)
+            self.add("adc", value)
         elif name in ("SBC", "USBC"):
-            self.sbc(value)
+            self.add("sbc", value)
         elif name in ("CMP", "CPX", "CPY"):
             self.compare({"CMP": "a", "CPX": "x", "CPY": "y"}[name], value)
         elif name == "BIT":
@@ -403,148 +381,205 @@ BRANCH_TESTS = {0x80: ("nv >= 128", "nv < 128"), 0x40: ("fv", "fv == 0"), 0x01: 
                 0x02: ("zv == 0", "zv != 0")}
 
 
+# One function per kind of instruction, each emitting it and returning True when it ends the block
+# (control went elsewhere); `_instruction` picks it by mnemonic (HANDLERS, built below from the tables).
+
+def _emit_stop(e: _Emitter, pc: int, op: Op | None, blocks: dict[int, int], return_pc: int) -> bool:
+    e.put(f"status = {FALLBACK_STOP}")
+    e.put("break")
+    return True
+
+
+def _emit_branch(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
+    e.put(f"cycles += {op.cycles}")
+    offset = e.read((pc + 1) & WORD)
+    if op.mnemonic == "BRA":
+        _branch(e, "True", pc, 2, offset, blocks, return_pc)
+    else:
+        flag, wanted = BRANCH_CONDITIONS[e.read(pc)]
+        _branch(e, BRANCH_TESTS[flag][0 if wanted else 1], pc, 2, offset, blocks, return_pc)
+    return True
+
+
+def _emit_bit_branch(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
+    """BBRn / BBSn zp, offset (65C02)."""
+    name = op.mnemonic
+    e.put(f"cycles += {op.cycles}")
+    test = f"({_read(e.read((pc + 1) & WORD))} >> {int(name[3])}) & 1"
+    _branch(e, f"{test} == {1 if name[2] == 'S' else 0}", pc, 3, e.read((pc + 2) & WORD), blocks, return_pc)
+    return True
+
+
+def _emit_jmp(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
+    e.put(f"cycles += {op.cycles}")
+    pointer = e.read((pc + 1) & WORD) | e.read((pc + 2) & WORD) << 8
+    if op.mode == "abs":
+        _go(e, pointer, blocks, return_pc)
+        return True
+    if op.mode == "iax":
+        e.put(f"t = ({pointer} + x) & 65535")
+        e.put(f"t = {_read('t')} | ({_read('(t + 1) & 65535')} << 8)")
+    elif e.cmos:
+        e.put(f"t = {_read(pointer)} | ({_read((pointer + 1) & WORD)} << 8)")
+    else:  # NMOS: the high byte from the start of the pointer's page when the pointer ends one
+        e.put(f"t = {_read(pointer)} | ({_read((pointer & PAGE_MASK) | ((pointer + 1) & BYTE))} << 8)")
+    _jump_to(e, "t", blocks)
+    return True
+
+
+def _emit_jsr(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
+    back = (pc + 2) & WORD
+    e.push(str(back >> 8))
+    e.push(str(back & BYTE))
+    e.put(f"cycles += {op.cycles}")
+    _go(e, e.read((pc + 1) & WORD) | e.read((pc + 2) & WORD) << 8, blocks, return_pc)
+    return True
+
+
+def _emit_rts(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
+    e.pull("t")
+    e.pull("u")
+    e.put(f"cycles += {op.cycles}")
+    e.put("t = ((u << 8 | t) + 1) & 65535")
+    _jump_to(e, "t", blocks)
+    return True
+
+
+def _store_to(e: _Emitter, pc: int, address: str | int, value: str) -> None:
+    if isinstance(address, int):
+        e.write_fixed(pc, address, value)
+    else:
+        e.write_at(address, value)
+
+
+def _emit_store(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
+    address, _ = e.address(pc, op)
+    _store_to(e, pc, address, STORES[op.mnemonic])
+    e.put(f"cycles += {op.cycles}")
+    return False
+
+
+def _emit_read(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
+    if op.mode == "imp":  # the undocumented one-byte NOPs
+        e.put(f"cycles += {op.cycles}")
+    elif e.cmos and op.mnemonic == "BIT" and op.mode == "imm":  # 65C02 BIT #imm: Z only
+        e.put(f"zv = a & {e.read((pc + 1) & WORD)}")
+        e.put(f"cycles += {op.cycles}")
+    else:
+        value, crossed = e.operand(pc, op)
+        e.operate(op.mnemonic, value)
+        e.cycles(op.cycles, crossed, op.page_penalty)
+    return False
+
+
+def _emit_modify(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
+    """A shift or step of A or memory, and the undocumented ones that then read the result (SLO...)."""
+    shift, then = COMBINED.get(op.mnemonic, (op.mnemonic, None))
+    if op.mode == "acc":
+        e.shift(shift, "a", "a")
+        e.put(f"cycles += {op.cycles}")
+        return False
+    address, crossed = e.address(pc, op)
+    if not isinstance(address, int) and address != "ea":
+        e.put(f"ea = {address}")
+        address = "ea"
+    e.put(f"v = {_read(address)}")
+    e.shift(shift, "v", "v")
+    _store_to(e, pc, address, "v")
+    if then is not None:
+        e.operate(then, "v")
+    e.cycles(op.cycles, crossed, op.page_penalty)  # the 65C02's shifts abs,X: +1 across a page
+    return False
+
+
+def _emit_test_bits(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
+    """TSB, TRB, RMBn, SMBn (65C02)."""
+    name = op.mnemonic
+    address, _ = e.address(pc, op)
+    e.put(f"v = {_read(address)}")
+    if name in ("TSB", "TRB"):
+        e.put("zv = a & v")
+        result = "(v | a)" if name == "TSB" else "(v & (a ^ 255))"
+    else:
+        mask = 1 << int(name[3])
+        result = f"(v | {mask})" if name[0] == "S" else f"(v & {BYTE ^ mask})"
+    _store_to(e, pc, address, result)
+    e.put(f"cycles += {op.cycles}")
+    return False
+
+
+def _implied(emit: Callable[[_Emitter, str], None]):
+    """A one-byte instruction's handler: its effect (`emit(e, mnemonic)`), then its cycles."""
+    def handler(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
+        emit(e, op.mnemonic)
+        e.put(f"cycles += {op.cycles}")
+        return False
+    return handler
+
+
+def _set_flag(e: _Emitter, name: str) -> None:
+    flag, value = FLAG_SETTERS[name]
+    e.put(f"{flag} = {value}")
+
+
+def _transfer(e: _Emitter, name: str) -> None:
+    target, source = TRANSFERS[name]
+    e.put(f"{target} = {source}")
+    e.nz(target)
+
+
+def _step(e: _Emitter, name: str) -> None:
+    register, step = STEPS[name]
+    e.put(f"{register} = ({register} + {step}) & 255")
+    e.nz(register)
+
+
+def _pull_register(e: _Emitter, name: str) -> None:
+    register = name[2].lower()
+    e.pull(register)
+    e.nz(register)
+
+
+def _pull_p(e: _Emitter, name: str) -> None:
+    e.pull("t")
+    e.unpack_p("t")
+
+
+def _mnemonics(mode: str) -> set[str]:
+    return {op.mnemonic for table in (OPCODE_TABLE, OPCODE_TABLE_65C02) for op in table.values() if op.mode == mode}
+
+
+HANDLERS: dict[str, Callable[..., bool]] = {
+    **{name: _emit_stop for name in STOPS},
+    **{name: _emit_branch for name in _mnemonics("rel")},
+    **{name: _emit_bit_branch for name in _mnemonics("zpr")},
+    "JMP": _emit_jmp, "JSR": _emit_jsr, "RTS": _emit_rts,
+    **{name: _emit_store for name in STORES},
+    **{name: _emit_read for name in READS},
+    **{name: _emit_modify for name in (*SHIFTS, *COMBINED)},
+    **{name: _emit_test_bits for name in ("TSB", "TRB", *(f"{kind}MB{bit}" for kind in "RS" for bit in range(8)))},
+    **{name: _implied(_set_flag) for name in FLAG_SETTERS},
+    **{name: _implied(_transfer) for name in TRANSFERS},
+    **{name: _implied(_step) for name in STEPS},
+    "TXS": _implied(lambda e, name: e.put("sp = x")),
+    **{name: _implied(lambda e, name: e.push(name[2].lower())) for name in ("PHA", "PHX", "PHY")},
+    "PHP": _implied(lambda e, name: e.push(e.pack_p())),
+    **{name: _implied(_pull_register) for name in ("PLA", "PLX", "PLY")},
+    "PLP": _implied(_pull_p),
+}
+
+
 def _instruction(e: _Emitter, pc: int, op: Op | None, blocks: dict[int, int], return_pc: int) -> bool:
     """Emit one instruction; True when it ends the block (control went elsewhere)."""
-    read = e.read
-    if op is None or op.mnemonic in STOPS:
-        e.put(f"status = {FALLBACK_STOP}")
-        e.put("break")
-        return True
-    name, mode, base = op.mnemonic, op.mode, op.cycles
-    length = MODE_LENGTH[mode]
-    lo = read((pc + 1) & WORD)
-    if e.cmos and op.kind == RESERVED:
-        e.put(f"cycles += {base}")
+    if op is None:
+        return _emit_stop(e, pc, op, blocks, return_pc)
+    if e.cmos and op.kind == RESERVED:  # the 65C02's NOPs of every length
+        e.put(f"cycles += {op.cycles}")
         return False
-    if mode == "rel":
-        e.put(f"cycles += {base}")
-        if name == "BRA":
-            _branch(e, "True", pc, 2, lo, blocks, return_pc)
-        else:
-            flag, wanted = BRANCH_CONDITIONS[read(pc)]
-            _branch(e, BRANCH_TESTS[flag][0 if wanted else 1], pc, 2, lo, blocks, return_pc)
-        return True
-    if mode == "zpr":  # BBRn / BBSn zp, offset
-        bit = int(name[3])
-        e.put(f"cycles += {base}")
-        test = f"({_read(lo)} >> {bit}) & 1"
-        _branch(e, f"{test} == {1 if name[2] == 'S' else 0}", pc, 3, read((pc + 2) & WORD), blocks, return_pc)
-        return True
-    if name == "JMP":
-        e.put(f"cycles += {base}")
-        pointer = lo | read((pc + 2) & WORD) << 8
-        if mode == "abs":
-            _go(e, pointer, blocks, return_pc)
-            return True
-        if mode == "iax":
-            e.put(f"t = ({pointer} + x) & 65535")
-            e.put(f"t = {_read('t')} | ({_read('(t + 1) & 65535')} << 8)")
-        elif e.cmos:
-            e.put(f"t = {_read(pointer)} | ({_read((pointer + 1) & WORD)} << 8)")
-        else:  # NMOS: the high byte from the start of the pointer's page when the pointer ends one
-            e.put(f"t = {_read(pointer)} | ({_read((pointer & PAGE_MASK) | ((pointer + 1) & BYTE))} << 8)")
-        _jump_to(e, "t", blocks)
-        return True
-    if name == "JSR":
-        back = (pc + 2) & WORD
-        e.push(str(back >> 8))
-        e.push(str(back & BYTE))
-        e.put(f"cycles += {base}")
-        _go(e, lo | read((pc + 2) & WORD) << 8, blocks, return_pc)
-        return True
-    if name == "RTS":
-        e.pull("t")
-        e.pull("u")
-        e.put(f"cycles += {base}")
-        e.put("t = ((u << 8 | t) + 1) & 65535")
-        _jump_to(e, "t", blocks)
-        return True
-    if name in STORES:
-        address, _ = e.address(pc, op)
-        if isinstance(address, int):
-            e.write_fixed(pc, address, STORES[name])
-        else:
-            e.write_at(address, STORES[name])
-        e.put(f"cycles += {base}")
-        return False
-    if name in READS and not (e.cmos and name == "BIT" and mode == "imm"):
-        if mode == "imp":  # the undocumented one-byte NOPs
-            e.put(f"cycles += {base}")
-            return False
-        value, crossed = e.operand(pc, op)
-        e.operate(name, value)
-        e.cycles(base, crossed, op.page_penalty)
-        return False
-    if name == "BIT":  # 65C02 BIT #imm: Z only
-        e.put(f"zv = a & {lo}")
-        e.put(f"cycles += {base}")
-        return False
-    shift, then = COMBINED.get(name, (name, None))
-    if shift in SHIFTS:
-        if mode == "acc":
-            e.shift(shift, "a", "a")
-            e.put(f"cycles += {base}")
-            return False
-        address, crossed = e.address(pc, op)
-        fixed = isinstance(address, int)
-        if not fixed and address != "ea":
-            e.put(f"ea = {address}")
-            address = "ea"
-        e.put(f"v = {_read(address)}")
-        e.shift(shift, "v", "v")
-        if fixed:
-            e.write_fixed(pc, address, "v")
-        else:
-            e.write_at(address, "v")
-        if then is not None:
-            e.operate(then, "v")
-        e.cycles(base, crossed, op.page_penalty)  # the 65C02's shifts abs,X: +1 across a page
-        return False
-    if name in ("TSB", "TRB") or name[:3] in ("RMB", "SMB"):
-        address, _ = e.address(pc, op)
-        e.put(f"v = {_read(address)}")
-        if name == "TSB":
-            e.put("zv = a & v")
-            result = "(v | a)"
-        elif name == "TRB":
-            e.put("zv = a & v")
-            result = "(v & (a ^ 255))"
-        else:
-            mask = 1 << int(name[3])
-            result = f"(v | {mask})" if name[0] == "S" else f"(v & {BYTE ^ mask})"
-        e.write_fixed(pc, address, result) if isinstance(address, int) else e.write_at(address, result)
-        e.put(f"cycles += {base}")
-        return False
-    if name in FLAG_SETTERS:
-        flag, value = FLAG_SETTERS[name]
-        e.put(f"{flag} = {value}")
-    elif name in TRANSFERS:
-        target, source = TRANSFERS[name]
-        e.put(f"{target} = {source}")
-        e.nz(target)
-    elif name == "TXS":
-        e.put("sp = x")
-    elif name in STEPS:
-        register, step = STEPS[name]
-        e.put(f"{register} = ({register} + {step}) & 255")
-        e.nz(register)
-    elif name in ("PHA", "PHX", "PHY"):
-        e.push(name[2].lower())
-    elif name == "PHP":
-        e.push(e.pack_p())
-    elif name in ("PLA", "PLX", "PLY"):
-        register = name[2].lower()
-        e.pull(register)
-        e.nz(register)
-    elif name == "PLP":
-        e.pull("t")
-        e.unpack_p("t")
-    elif name == "NOP":
-        pass
-    else:  # pragma: no cover - a new table row needs its translation here
-        raise AssertionError(f"no translation for {name} ({mode})")
-    e.put(f"cycles += {base}")
-    return False
+    handler = HANDLERS.get(op.mnemonic)
+    if handler is None:  # pragma: no cover - a new table row needs its translation here
+        raise AssertionError(f"no translation for {op.mnemonic} ({op.mode})")
+    return handler(e, pc, op, blocks, return_pc)
 
 
 def _exits(start: int, instructions: dict, leaders: set[int], return_pc: int, read) -> tuple[list[int], list[int]]:
@@ -576,11 +611,24 @@ def _inlined(starts: list[int], instructions: dict, entry: int, return_pc: int, 
             if start != entry and start not in returned_to and len(sources) == 1 and sources[0] < start}
 
 
+def _placing(places: tuple, sets: tuple) -> str:
+    """The lines that put a lane's inputs in place: `places` rows (column, shift, address) put the byte
+    (column >> shift) & 255 at address; `sets` rows (column, shift, what) OR that byte into A, X, Y or P
+    (SET_A..SET_P), or set P's bit `shift` when the column is not 0 (SET_FLAG)."""
+    lines = [f"mem[{address}] = (cols[{column}][lane] >> {shift}) & 255" for column, shift, address in places]
+    for column, shift, what in sets:
+        if what == SET_FLAG:
+            lines.append(f"p |= {shift} if cols[{column}][lane] != 0 else 0")
+        else:
+            lines.append(f"{SET_REGISTERS[what]} |= (cols[{column}][lane] >> {shift}) & 255")
+    return "\n".join(" " * 8 + line for line in lines)
+
+
 def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
-              inputs_at: Iterable[int] = ()) -> Translation:
+              inputs_at: Iterable[int] = (), places: tuple = (), sets: tuple = ()) -> Translation:
     """The routine at entry (its bytes as `read` gives them: the memory every call starts from) as
-    the source of one function (see the module docstring); Untranslatable when it certainly modifies
-    its own code."""
+    the source of one function (see the module docstring; `places` and `sets`: where the case
+    columns go, `_placing`); Untranslatable when it certainly modifies its own code."""
     starts, instructions = find_blocks(read, entry, cpu, return_pc)
     code_bytes = frozenset((pc + k) & WORD for pc, op in instructions.items()
                            for k in range(MODE_LENGTH[op.mode] if op is not None else 1))
@@ -620,25 +668,31 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
     name = "run_calls"
     restore = "\n".join(f"        mem[{address}] = image[{address}]" for address in sorted(e.fixed_writes))
     source = _FUNCTION.format(name=name, entry_block=blocks[entry], body="\n".join(e.lines), budget_status=BUDGET,
-                              fallback_write=FALLBACK_WRITE, z_bit=_Z_BIT, restore=restore)
-    return Translation(source, name, blocks, code_bytes, tuple(sorted(e.fixed_writes)), len(instructions))
+                              fallback_write=FALLBACK_WRITE, z_bit=_Z_BIT, restore=restore,
+                              placing=_placing(places, sets))
+    return Translation(source, name, blocks, code_bytes, tuple(sorted(e.fixed_writes)), len(instructions),
+                       tuple(address for _, _, address in places))
 
 
-# The function around the blocks: one call per lane, inputs placed, outputs read, memory restored.
+# The function around the blocks: one call per lane, inputs placed from the case columns (`cols`, a
+# tuple: `placing`, the lines `_placing` makes), results written straight into the caller's arrays,
+# memory restored. `lane_bytes`: bytes per lane made beforehand (table inputs), one row per `lane_addr`.
+# `base`: A, X, Y, P before the inputs. `out` rows: A, X, Y, P, cycles, status.
 _FUNCTION = '''
 LOG_MASK = 65535
 
 
-def {name}(mem, image, log, code_map, addr_block, in_addr, in_bytes, reg_a, reg_x, reg_y, reg_p,
-           start_sp, budget, return_pc, return_sp, out_addr, out_a, out_x, out_y, out_p, out_cycles,
-           out_status, out_bytes):
-    for lane in range(reg_a.shape[0]):
-        for k in range(in_addr.shape[0]):
-            mem[in_addr[k]] = in_bytes[k, lane]
-        a = np.int64(reg_a[lane])
-        x = np.int64(reg_x[lane])
-        y = np.int64(reg_y[lane])
-        p = np.int64(reg_p[lane])
+def {name}(mem, image, log, code_map, addr_block, cols, lane_addr, lane_bytes, base, start_sp, budget, return_pc,
+           return_sp, out_addr, out, out_bytes):
+    for lane in range(out.shape[1]):
+        for k in range(lane_addr.shape[0]):
+            mem[lane_addr[k]] = lane_bytes[k, lane]
+        a = base[0]
+        x = base[1]
+        y = base[2]
+        p = base[3]
+{placing}
+        p = (p | 32) & 239
         nv = p & 128
         fv = (p >> 6) & 1
         fd = (p >> 3) & 1
@@ -666,12 +720,12 @@ def {name}(mem, image, log, code_map, addr_block, in_addr, in_bytes, reg_a, reg_
             status = {fallback_write}
         if status == 0 and cycles > budget:
             status = {budget_status}
-        out_a[lane] = a
-        out_x[lane] = x
-        out_y[lane] = y
-        out_p[lane] = (nv & 128) | (fv << 6) | 32 | (fd << 3) | (fi << 2) | {z_bit} | fc
-        out_cycles[lane] = cycles
-        out_status[lane] = status
+        out[0, lane] = a
+        out[1, lane] = x
+        out[2, lane] = y
+        out[3, lane] = (nv & 128) | (fv << 6) | 32 | (fd << 3) | (fi << 2) | {z_bit} | fc
+        out[4, lane] = cycles
+        out[5, lane] = status
         for k in range(out_addr.shape[0]):
             out_bytes[k, lane] = mem[out_addr[k]]
         if nlog > LOG_MASK + 1:  # more writes than the log holds: the whole memory
@@ -682,4 +736,3 @@ def {name}(mem, image, log, code_map, addr_block, in_addr, in_bytes, reg_a, reg_
                 mem[t] = image[t]
 {restore}
 '''
-

@@ -147,7 +147,7 @@ def _fact_watches(runner: RoutineRunner) -> dict:
 def compiled_routine(runner: RoutineRunner):
     """The routine compiled (`retro.cpu.compiled`), made on first use and again when the code bytes
     changed (set_memory); Untranslatable when the compiled engine does not take it."""
-    from retro.cpu.compiled import compile_routine
+    from retro.cpu.compiled import SET_FLAG, SET_REGISTERS, compile_routine
 
     image = bytes(runner.call_image)
     held = runner._compiled
@@ -157,9 +157,27 @@ def compiled_routine(runner: RoutineRunner):
     inputs_at = [address for _, address, _ in plan.bytes] + [a for _, addresses in plan.tables for a in addresses]
     trapped = bytearray(image)
     push_return_trap(trapped)
-    routine = compile_routine(bytes(trapped), runner.entry, runner.routine.cpu, RETURN_TRAP, inputs_at)
+    places = ()  # memory inputs go through lane_bytes (numpy casts them to bytes in one pass)
+    sets = tuple([(index, shift, SET_REGISTERS.index(register)) for index, register, shift in plan.registers]
+                 + [(index, bit, SET_FLAG) for index, bit in plan.flags])
+    routine = compile_routine(bytes(trapped), runner.entry, runner.routine.cpu, RETURN_TRAP, inputs_at,
+                              len(runner.routine.inputs), places, sets)
     runner._compiled = (routine, [(a, image[a]) for a in sorted(routine.translation.code_bytes)], image)
     return routine
+
+
+def _lane_bytes(plan, columns: list, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The memory inputs as (addresses, one row of bytes per address): numpy casts each column to
+    bytes in one pass (the kernel reads registers and flags from the columns itself)."""
+    tables: list[tuple[int, np.ndarray]] = [(address, columns[index] >> shift if shift else columns[index])
+                                            for index, address, shift in plan.bytes]
+    for index, addresses in plan.tables:
+        tables += [(address, columns[index][:, k]) for k, address in enumerate(addresses)]
+    lane_addr = np.asarray([address for address, _ in tables], dtype=np.int64)
+    lane_bytes = np.empty((len(tables), n), dtype=np.uint8)
+    for k, (_, lanes) in enumerate(tables):
+        lane_bytes[k] = lanes
+    return lane_addr, lane_bytes
 
 
 def run_compiled(runner: RoutineRunner, columns: list) -> BatchOutcome:
@@ -167,21 +185,17 @@ def run_compiled(runner: RoutineRunner, columns: list) -> BatchOutcome:
     reason) run on the batched core."""
     compiled = runner.compiled()
     n = len(columns[0])
-    placed: list[tuple[int, np.ndarray]] = []
-    registers, p = runner.plan.place(columns, column_byte, lambda address, lanes: placed.append((address, lanes)))
-    in_addr = np.asarray([address for address, _ in placed], dtype=np.int64)
-    in_bytes = np.empty((len(placed), n), dtype=np.uint8)
-    for k, (_, lanes) in enumerate(placed):
-        in_bytes[k] = lanes
+    plan = runner.plan
+    lane_addr, lane_bytes = _lane_bytes(plan, columns, n)
+    flat = tuple(np.ascontiguousarray(c if c.ndim == 1 else c[:, 0], dtype=np.int64) for c in columns)
+    start = dict(plan.base_registers)
+    base = np.asarray([start["a"], start["x"], start["y"], plan.base_flags], dtype=np.int64)
     image = bytearray(runner.call_image)
     s = runner.fixed_entry_s
     stack_pointer = push_return_trap(image, s)
-    registers.pop("s", None)
-    lanes = {name: np.broadcast_to(np.asarray(value, dtype=np.int64), (n,)).copy() for name, value in registers.items()}
-    flags = np.broadcast_to(np.asarray((p | FLAG_U) & ~FLAG_B, dtype=np.int64), (n,)).copy()
-    out_addr = np.asarray(runner.plan.output_addresses, dtype=np.int64)
-    done = compiled.run(bytes(image), in_addr, in_bytes, lanes["a"], lanes["x"], lanes["y"], flags, stack_pointer,
-                        runner.limit, RETURN_TRAP, return_s(s), out_addr)
+    out_addr = np.asarray(plan.output_addresses, dtype=np.int64)
+    done = compiled.run(bytes(image), flat, base, stack_pointer, runner.limit, RETURN_TRAP, return_s(s), out_addr,
+                        lane_addr, lane_bytes)
     column_of = {int(address): k for k, address in enumerate(out_addr)}
     out_bytes = done["bytes"]
     outputs = port_values(runner.routine.outputs, {"a": done["a"], "x": done["x"], "y": done["y"]}, done["p"],
@@ -199,6 +213,8 @@ def _rerun_fallbacks(runner: RoutineRunner, columns: list, status: np.ndarray, o
     batched core, their results written over the compiled block's."""
     from retro.cpu.compiled import FALLBACK
 
+    if not len(status) or status.max() < FALLBACK:  # the common case: no scan for the calls left
+        return
     left = np.flatnonzero(status >= FALLBACK)
     if not len(left):
         return

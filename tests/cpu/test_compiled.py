@@ -14,7 +14,7 @@ import pytest
 
 from retro.cpu import compiled as compiled_module
 from retro.cpu.batch import BatchCpu, LaneError
-from retro.cpu.compiled import compile_routine, numba_problem
+from retro.cpu.compiled import SET_A, SET_FLAG, SET_P, SET_X, SET_Y, compile_routine, numba_problem
 from retro.cpu.machine import CALL_STACK_TOP, RETURN_TRAP, push_return_trap
 from retro.cpu.opcodes import DOCUMENTED, MODE_LENGTH, RESERVED, STABLE
 from retro.cpu.translate import FALLBACK, Untranslatable, tables_for
@@ -169,11 +169,12 @@ def on_compiled(cpu: str, code: bytes, registers, memory, watched=WATCHED) -> tu
     """(results, calls left to the batched core); a call stopped by the budget is None."""
     image = image_with(code)
     sp = push_return_trap(image)
-    routine = compile_routine(bytes(image), CODE, cpu, RETURN_TRAP)
+    routine = compile_routine(bytes(image), CODE, cpu, RETURN_TRAP, columns=4,
+                              sets=((0, 0, SET_A), (1, 0, SET_X), (2, 0, SET_Y), (3, 0, SET_P)))
     flags = ((registers[:, 3] | 0x20) & ~0x10).astype(np.int64)
-    done = routine.run(bytes(image), PLACED, np.ascontiguousarray(memory.T.astype(np.uint8)), registers[:, 0].astype(np.int64),
-                       registers[:, 1].astype(np.int64), registers[:, 2].astype(np.int64), flags, sp, BUDGET,
-                       RETURN_TRAP, CALL_STACK_TOP, np.asarray(watched, dtype=np.int64))
+    columns = (*(np.ascontiguousarray(registers[:, k], dtype=np.int64) for k in range(3)), flags)
+    done = routine.run(bytes(image), columns, np.zeros(4, dtype=np.int64), sp, BUDGET, RETURN_TRAP, CALL_STACK_TOP,
+                       np.asarray(watched, dtype=np.int64), PLACED, np.ascontiguousarray(memory.T.astype(np.uint8)))
     results, left = [], 0
     for i in range(len(registers)):
         status = int(done["status"][i])
@@ -291,9 +292,8 @@ def test_a_taken_branch_into_the_next_page_costs_two_cycles_more(compiled_cache)
     image = bytearray(0x10000)
     image[start:start + len(code)] = code
     sp = push_return_trap(image)
-    routine = compile_routine(bytes(image), start, "6510", RETURN_TRAP)
-    flags = np.array([0x20, 0x21], dtype=np.int64)  # carry clear, carry set
-    zeros = np.zeros(2, dtype=np.int64)
-    done = routine.run(bytes(image), np.zeros(0, dtype=np.int64), np.zeros((0, 2), dtype=np.uint8), zeros, zeros,
-                       zeros, flags, sp, BUDGET, RETURN_TRAP, CALL_STACK_TOP, np.zeros(0, dtype=np.int64))
+    routine = compile_routine(bytes(image), start, "6510", RETURN_TRAP, columns=1, sets=((0, 1, SET_FLAG),))
+    carry = np.array([0, 1], dtype=np.int64)  # carry clear, carry set
+    done = routine.run(bytes(image), (carry,), np.asarray([0, 0, 0, 0x20], dtype=np.int64), sp, BUDGET, RETURN_TRAP,
+                       CALL_STACK_TOP, np.zeros(0, dtype=np.int64))
     assert done["cycles"].tolist() == [22, 18] and done["status"].tolist() == [0, 0]

@@ -73,3 +73,22 @@ def test_auto_takes_the_compiled_engine_for_a_sweep_or_millions_of_calls():
     assert engines.array_engine("auto", None) == ("compiled", "auto: a sweep")
     assert engines.array_engine("auto", 20_000_000) == ("compiled", "auto: 20,000,000 planned calls")
     assert engines.array_engine("batch", None) == ("batch", "--engine batch")
+
+
+def test_when_numba_fails_to_import_auto_runs_the_batched_core_and_says_so_once():
+    """The import itself fails (sys.modules["numba"] = None makes `import numba` raise ImportError), in a
+    fresh process: the engine modules still import, auto picks the batched core, one line on stderr."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = ("import sys\nsys.modules['numba'] = None\n"
+              "from retro.analysis.check import engines\n"
+              "print(engines.array_engine('auto', None))\nprint(engines.array_engine('auto', 10 ** 9))\n")
+    root = str(Path(__file__).resolve().parents[2])
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONPATH": root})
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.count("('batch', 'numba cannot be imported (ModuleNotFoundError") == 2
+    assert done.stderr.count("the compiled engine is off: numba cannot be imported") == 1

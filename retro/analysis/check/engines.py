@@ -26,8 +26,9 @@ BATCH_LANES = 65_536  # cases the batched core runs at once (memory stays bounde
 AUTO_BATCH_CASES = 20_000  # planned cases from which engine="auto" takes the batched core for a check
 # (it then also runs AGREEMENT_PER_PART cases of each part on Machine: below this it would not pay)
 AUTO_COMPILED_CASES = 16_000_000  # planned cases from which "auto" takes the compiled engine (numba importable):
-# a routine's first compile costs 0.9-19 s of CPU, won back against the batched core after 0.6-63 million
-# calls (benchmarks/compiled_speed.py, "pays from": 12-19 million for mul8, tile and circle)
+# a routine's first compile costs 0.7-4.9 s of CPU, won back against the batched core after 0.4-61 million
+# calls (benchmarks/compiled_speed.py, "pays from", load 16: 5-12 million for mul8, tile, circle and the
+# edges routines; aabb8's 61 million include numba's own start, the process's first compile)
 AGREEMENT_PER_PART = 2_000  # cases of each part also run on Machine when the batched core runs the check
 TRACE_SHOWN = 400  # instructions of the first failing case's trace in the report
 
