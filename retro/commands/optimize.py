@@ -13,7 +13,7 @@ from retro.commands import options
 from retro.commands.check import failed
 from retro.errors import InputError, RunError
 from retro.fileio import all_or_nothing, output_folder, write_all_atomic
-from retro.optimize.code import Listing, code_bytes
+from retro.optimize.code import Listing, address_names, code_bytes
 from retro.optimize.evaluate import PROOF_SPACE
 from retro.optimize.optimizer import DEFAULT_WINDOW, OBJECTIVES, Options, Outcome, check_options, optimize as search
 from retro.optimize.report import cost_row, cost_table, listing_diff, new_spec, toml_text
@@ -47,13 +47,6 @@ def _labels(listing: Listing) -> dict[str, int]:
     return {name: at[i] for name, i in listing.labels}
 
 
-def _names(routine) -> dict[int, str]:
-    names: dict[int, str] = {}
-    for name, value in sorted(routine.program.symbols.items()):
-        names.setdefault(value, name)
-    return names
-
-
 @all_or_nothing
 def optimize(spec: str, *, objective: str = "worst", no_slower: bool = False, budget: float = 30.0,
              window: int = DEFAULT_WINDOW, seed: int | None = None, preserve: tuple[str, ...] = (),
@@ -82,11 +75,12 @@ def optimize(spec: str, *, objective: str = "worst", no_slower: bool = False, bu
                       routine.machine)
     after = cost_row(best.cycles["max"], best.cycles["mean"], best.cycles["min"], code_bytes(outcome.best),
                      routine.machine)
-    names = _names(routine)
+    original_names = address_names(routine.program.symbols)
+    names = dict(original_names)
     for name, address in _labels(outcome.best).items():
         names[address] = name
     source = format_source(outcome.best, syntax, names, f"{routine.name}, optimised by retro optimize ({opts.objective})")
-    diff = listing_diff(plain_lines(outcome.original, _names(routine)), plain_lines(outcome.best, names), routine.name)
+    diff = listing_diff(plain_lines(outcome.original, original_names), plain_lines(outcome.best, names), routine.name)
     symbols = {n: a for n, a in routine.program.symbols.items()
                if not outcome.original.origin <= a < outcome.original.origin + code_bytes(outcome.original)
                or n in dict(outcome.original.labels) and n in dict(outcome.best.labels)}

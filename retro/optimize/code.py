@@ -104,37 +104,44 @@ def code_bytes(listing: Listing) -> int:
     return sum(i.length for i in listing.instructions)
 
 
-def read_listing(program: Program, entry: int, cpu: str = "6510") -> Listing:
-    """The routine at `entry` as a listing: every instruction reachable from the entry (branches,
-    JSR and the next instruction followed; RTS, RTI, JMP and BRK end a path), which must form one
-    block of code from the entry (data inside it, or a jump into the middle of an instruction, is
-    refused). Branch targets inside the block get the program's label for their address, else
-    `L_XXXX`; JMP/JSR targets and targets outside keep their address."""
+def _successors(decoded, address: int, entry: int) -> list[int]:
+    """Where the routine may go on after the instruction at `address` (branches back before the
+    entry are left out: they are refused as a whole)."""
+    following = []
+    if decoded.mode == "rel" and decoded.target >= entry:
+        following.append(decoded.target)
+    if decoded.mnemonic == "BRA":
+        following.append(decoded.target)
+    elif decoded.mnemonic not in ENDS:
+        following.append(address + decoded.length)
+    return following
+
+
+def _decode_reachable(program: Program, entry: int, cpu: str) -> dict:
+    """Address -> decoded instruction for every instruction reachable from the entry inside the program."""
     code = program.code
-    end_of_program = program.origin + len(code)
 
     def read(address: int) -> int:
-        return code[address - program.origin] if program.origin <= address < end_of_program else 0
+        return code[address - program.origin] if program.origin <= address < program.end else 0
 
-    if not program.origin <= entry < end_of_program:
+    if not program.origin <= entry < program.end:
         raise InputError(f"the routine's entry ${entry:04X} is outside its program")
     decoded, pending = {}, [entry]
     while pending:
         address = pending.pop()
-        if address in decoded or not program.origin <= address < end_of_program:
+        if address in decoded or not program.origin <= address < program.end:
             continue
         if address - entry > MAX_ROUTINE_BYTES:
             raise InputError(f"the routine's code from ${entry:04X} runs past {MAX_ROUTINE_BYTES} bytes")
-        instruction = decode_at(read, address, cpu)
-        decoded[address] = instruction
-        if instruction.mode in ("zpr",):
+        instruction = decoded[address] = decode_at(read, address, cpu)
+        if instruction.mode == "zpr":
             raise InputError(f"${address:04X}: {instruction.text}: the 65C02's BBR/BBS are not optimised")
-        if instruction.mode == "rel" and instruction.target >= entry:
-            pending.append(instruction.target)
-        if instruction.mnemonic not in ENDS and instruction.mnemonic != "BRA":
-            pending.append(address + instruction.length)
-        elif instruction.mnemonic == "BRA":
-            pending.append(instruction.target)
+        pending += _successors(instruction, address, entry)
+    return decoded
+
+
+def _end_of_block(decoded: dict, entry: int) -> int:
+    """The address just past the decoded instructions, which must tile one block from the entry."""
     ordered = sorted(decoded)
     if ordered[0] != entry:
         raise InputError(f"the routine branches before its entry ${entry:04X}: not one block of code")
@@ -144,31 +151,49 @@ def read_listing(program: Program, entry: int, cpu: str = "6510") -> Listing:
             raise InputError(f"the routine's code from ${entry:04X} is not one block (${address:04X}: "
                              f"{'data or a gap' if start > address else 'an instruction inside another'})")
         address = start + decoded[start].length
-    end = address
-    names = {}
-    for name, value in sorted(program.symbols.items()):
+    return address
+
+
+def _operand(decoded) -> int | None:
+    """The byte or little-endian word after the opcode."""
+    if decoded.length == 1:
+        return None
+    return decoded.data[1] if decoded.length == 2 else decoded.data[1] | decoded.data[2] << 8
+
+
+def _has_target(decoded) -> bool:
+    return decoded.mode == "rel" or (decoded.mnemonic in ("JMP", "JSR") and decoded.mode == "abs")
+
+
+def address_names(symbols: dict[str, int]) -> dict[int, str]:
+    """Address -> the name a listing gives it: the first of its symbols in sorted order."""
+    names: dict[int, str] = {}
+    for name, value in sorted(symbols.items()):
         names.setdefault(value, name)
-    index_of = {a: k for k, a in enumerate(ordered)}
-    index_of[end] = len(ordered)
+    return names
+
+
+def read_listing(program: Program, entry: int, cpu: str = "6510") -> Listing:
+    """The routine at `entry` as a listing: every instruction reachable from the entry (branches,
+    JSR and the next instruction followed; RTS, RTI, JMP and BRK end a path), which must form one
+    block of code from the entry (data inside it, or a jump into the middle of an instruction, is
+    refused). Branch targets inside the block get the program's label for their address, else
+    `L_XXXX`; JMP/JSR targets and targets outside keep their address."""
+    decoded = _decode_reachable(program, entry, cpu)
+    ordered = sorted(decoded)
+    index_of = {address: k for k, address in enumerate(ordered)}
+    index_of[_end_of_block(decoded, entry)] = len(ordered)
+    names = address_names(program.symbols)
     labels: dict[str, int] = {}
     instructions = []
-    for address in ordered:
-        d = decoded[address]
-        lo = d.data[1] if d.length > 1 else 0
-        hi = d.data[2] if d.length > 2 else 0
-        operand = None if d.length == 1 else lo if d.length == 2 else lo | hi << 8
-        target = None
-        if d.mode == "rel" or (d.mnemonic in ("JMP", "JSR") and d.mode == "abs"):
-            where = d.target
-            target = where
-            if d.mode == "rel" and where in index_of:
-                target = names.get(where) or f"L_{where:04X}"
-                labels[target] = index_of[where]
-            operand = None
-        instructions.append(Instruction(d.mnemonic, d.mode, operand, target))
-    entry_name = names.get(entry)
-    if entry_name is not None:
-        labels.setdefault(entry_name, 0)
+    for d in (decoded[address] for address in ordered):
+        target = d.target if _has_target(d) else None
+        if d.mode == "rel" and target in index_of:
+            target, at = names.get(target) or f"L_{target:04X}", index_of[target]
+            labels[target] = at
+        instructions.append(Instruction(d.mnemonic, d.mode, None if _has_target(d) else _operand(d), target))
+    if entry in names:
+        labels.setdefault(names[entry], 0)
     return Listing(entry, tuple(instructions), tuple(sorted(labels.items(), key=lambda kv: (kv[1], kv[0]))))
 
 

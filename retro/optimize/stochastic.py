@@ -21,37 +21,75 @@ TEMPERATURE = 2.0
 RESTART_EVERY = 400  # moves from the best routine found so far
 
 
+def _pick(rng: np.random.Generator, items: list):
+    return items[int(rng.integers(len(items)))]
+
+
+def _editable(listing: Listing) -> list[int]:
+    """Indices of the instructions a move may change (those a window may hold)."""
+    return [k for k, i in enumerate(listing.instructions) if windowable(i)]
+
+
+def _replace_one(listing: Listing, pool: list[Instruction], rng: np.random.Generator) -> Listing | None:
+    editable = _editable(listing)
+    if not editable:
+        return None
+    k = _pick(rng, editable)
+    return listing.with_window(k, k + 1, (_pick(rng, pool),))
+
+
+def _insert(listing: Listing, pool: list[Instruction], rng: np.random.Generator) -> Listing | None:
+    """Before any instruction but past the last (the routine's last instruction ends it)."""
+    k = int(rng.integers(len(listing.instructions)))
+    return listing.with_window(k, k, (_pick(rng, pool),))
+
+
+def _delete(listing: Listing, pool: list[Instruction], rng: np.random.Generator) -> Listing | None:
+    editable = _editable(listing)
+    if not editable:
+        return None
+    k = _pick(rng, editable)
+    return listing.with_window(k, k + 1, ())
+
+
+def _swap_neighbours(listing: Listing, pool: list[Instruction], rng: np.random.Generator) -> Listing | None:
+    instructions, editable = listing.instructions, _editable(listing)
+    if len(editable) < 2:
+        return None
+    k = _pick(rng, editable)
+    if k + 1 < len(instructions) and windowable(instructions[k + 1]):
+        return listing.with_window(k, k + 2, (instructions[k + 1], instructions[k]))
+    return None
+
+
+def _other_operand(listing: Listing, pool: list[Instruction], rng: np.random.Generator) -> Listing | None:
+    """The same operation on another operand of the pool."""
+    editable = _editable(listing)
+    if not editable:
+        return None
+    k = _pick(rng, editable)
+    old = listing.instructions[k]
+    same = [i for i in pool if i.mnemonic == old.mnemonic and i != old]
+    return listing.with_window(k, k + 1, (_pick(rng, same),)) if same else None
+
+
+def _other_target(listing: Listing, pool: list[Instruction], rng: np.random.Generator) -> Listing | None:
+    """A branch's target moved to another label of the routine."""
+    instructions = listing.instructions
+    branches = [k for k, i in enumerate(instructions) if i.is_branch and isinstance(i.target, str)]
+    names = [name for name, _ in listing.labels]
+    if not branches or len(names) < 2:
+        return None
+    k = _pick(rng, branches)
+    return listing.with_window(k, k + 1, (replace(instructions[k], target=_pick(rng, names)),))
+
+
+MOVES = (_replace_one, _insert, _delete, _swap_neighbours, _other_operand, _other_target)
+
+
 def moves(listing: Listing, pool: list[Instruction], rng: np.random.Generator) -> Listing | None:
     """One random move; None when it does not apply (the caller draws again)."""
-    instructions = listing.instructions
-    editable = [k for k, i in enumerate(instructions) if windowable(i)]
-    kind = int(rng.integers(6))
-    if kind == 0 and editable:  # replace
-        k = editable[int(rng.integers(len(editable)))]
-        return listing.with_window(k, k + 1, (pool[int(rng.integers(len(pool)))],))
-    if kind == 1:  # insert before any instruction but past the last
-        k = int(rng.integers(len(instructions)))
-        return listing.with_window(k, k, (pool[int(rng.integers(len(pool)))],))
-    if kind == 2 and editable:  # delete
-        k = editable[int(rng.integers(len(editable)))]
-        return listing.with_window(k, k + 1, ())
-    if kind == 3 and len(editable) > 1:  # swap two neighbours
-        k = editable[int(rng.integers(len(editable)))]
-        if k + 1 < len(instructions) and windowable(instructions[k + 1]):
-            return listing.with_window(k, k + 2, (instructions[k + 1], instructions[k]))
-        return None
-    if kind == 4 and editable:  # operand: the same operation on another operand of the pool
-        k = editable[int(rng.integers(len(editable)))]
-        same = [i for i in pool if i.mnemonic == instructions[k].mnemonic and i != instructions[k]]
-        return listing.with_window(k, k + 1, (same[int(rng.integers(len(same)))],)) if same else None
-    if kind == 5:  # a branch's target: another label of the routine
-        branches = [k for k, i in enumerate(instructions) if i.is_branch and isinstance(i.target, str)]
-        names = [name for name, _ in listing.labels]
-        if branches and len(names) > 1:
-            k = branches[int(rng.integers(len(branches)))]
-            target = names[int(rng.integers(len(names)))]
-            return listing.with_window(k, k + 1, (replace(instructions[k], target=target),))
-    return None
+    return _pick(rng, MOVES)(listing, pool, rng)
 
 
 def rewrite(start: Listing, cost: Callable[[bytes], tuple | None], pool: list[Instruction], cpu: str,
