@@ -29,7 +29,7 @@ import math
 import os
 from dataclasses import dataclass, field
 
-from retro.analysis.console_run import FRAMES_DONE, HALTED, INTERRUPTED, MAX_FRAMES, REACHED, REPORTED, VALUE_SEEN, \
+from retro.analysis.console_run import HALTED, MAX_FRAMES, REACHED, REPORTED, VALUE_SEEN, \
     StopRun, Verdict, run_frames
 from retro.chips.vic.constants import CHAR_ROM_BYTES, PAL, REG_SPRITE_ENABLE, REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT, \
     VIC_BASE

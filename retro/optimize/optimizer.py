@@ -296,7 +296,7 @@ class Search:
 
     def search_window(self, listing: Listing, start: int, stop: int, kind: str, deadline: float,
                       outcome: Outcome, best_score: tuple):
-        routine, cpu, objective = self.routine, self.routine.cpu, self.options.objective
+        cpu, objective = self.routine.cpu, self.options.objective
         outcome.windows += 1
         code = assemble(listing, cpu)
         addresses = [listing.origin]

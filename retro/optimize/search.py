@@ -14,7 +14,7 @@ state must equal the reference's answers."""
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -22,10 +22,9 @@ from retro.cpu.batch import BatchCpu, Lanes
 from retro.cpu.disassembly import opcode_table
 from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z
 from retro.cpu.timing import BRANCH_CONDITIONS, BRANCH_TAKEN_CYCLES
-from retro.optimize.code import Instruction, Listing, assemble, opcode_of
-from retro.optimize.effects import ALL_MEMORY, STORES, effects, windowable
+from retro.optimize.code import Instruction, Listing, opcode_of
+from retro.optimize.effects import ALL_MEMORY, STORES
 from retro.routines.places import Place, Port
-from retro.routines.spec import Routine
 
 FLAG_BITS = {"C": FLAG_C, "Z": FLAG_Z, "I": FLAG_I, "D": FLAG_D, "V": FLAG_V, "N": FLAG_N}
 BRK = 0x00

@@ -42,12 +42,13 @@ RULES: dict[str, Syntax] = {
 }
 SYNTAXES = tuple(RULES)
 
-NAMED_MODES = ("zpg", "abs", "zpx", "zpy", "abx", "aby", "inx", "iny", "ind")  # an operand that may be a label
-WORD_MODES = ("abs", "abx", "aby", "ind")
+NAMED_MODES = ("zpg", "abs", "zpx", "zpy", "abx", "aby", "inx", "iny", "ind", "zpi", "iax")  # an operand that may be a label
+WORD_MODES = ("abs", "abx", "aby", "ind", "iax")
 FORCED_WORD_MODES = ("abs", "abx", "aby")  # the modes with a zero-page twin the assembler would pick
 # mode -> its operand around the address or name (other modes: the address alone)
 OPERAND_SHAPE = {"zpx": "{},x", "abx": "{},x", "zpy": "{},y", "aby": "{},y",
-                 "inx": "({},x)", "iny": "({}),y", "ind": "({})"}
+                 "inx": "({},x)", "iny": "({}),y", "ind": "({})",
+                 "zpi": "({})", "iax": "({},x)"}  # the 65C02's (zp) and JMP (abs,X)
 
 
 def _hex(value: int) -> str:

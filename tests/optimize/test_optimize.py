@@ -300,6 +300,31 @@ def test_sources_assemble_back_with_the_real_assembler(tmp_path, syntax, case):
     assert out.read_bytes() == assemble(listing)
 
 
+_65C02 = Listing(0xC000, (Instruction("LDA", "zpi", 0xFB), Instruction("STA", "zpi", 0x20),
+                          Instruction("JMP", "iax", 0xC100)), ())
+
+
+@pytest.mark.parametrize("syntax", SYNTAXES)
+def test_the_65c02_indirect_modes_keep_their_parentheses(syntax):
+    text = format_source(_65C02, syntax, {0xFB: "ptr"}).lower()
+    assert "lda (ptr)" in text and "sta ($20)" in text and "jmp ($c100,x)" in text
+    assert "ptr" in text.split("lda (ptr)")[0]  # the name is defined before its use
+
+
+def test_the_65c02_indirect_modes_assemble_back_with_ca65(tmp_path):
+    import shutil
+    import subprocess
+    if shutil.which("cl65") is None:
+        pytest.skip("cl65 is not installed (Debian: apt-get install cc65)")
+    source, out = tmp_path / "r.s", tmp_path / "r.bin"
+    source.write_text(format_source(_65C02, "ca65", {0xFB: "ptr"}))
+    done = subprocess.run(["cl65", "--cpu", "65c02", "-t", "none", "--start-addr", "0xc000", "-o", str(out),
+                           str(source)], capture_output=True, text=True, cwd=tmp_path, timeout=60)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert out.read_bytes() == assemble(_65C02, "65c02")
+    assert out.read_bytes() == bytes([0xB2, 0xFB, 0x92, 0x20, 0x7C, 0x00, 0xC1])  # WDC W65C02S datasheet opcodes
+
+
 def test_code_that_is_not_one_block_is_one_line_exit_2(tmp_path, capsys):
     source = tmp_path / "gap.s"
     source.write_text("        .org $c000\ngap:    lda b_val\n        bne skip\n        .byte $ff\nskip:   rts\n"

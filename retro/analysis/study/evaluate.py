@@ -8,7 +8,7 @@ from retro.analysis.study.accuracy import Confusion, confusion, pooled
 from retro.analysis.study.corpus import Shape, make_pair
 from retro.analysis.study.methods import METHODS, Method
 from retro.progress import Progress, quiet
-from retro.workers import Workers, as_workers, only, run_in_order
+from retro.workers import Workers, only, run_in_order
 
 
 @dataclass(frozen=True)
