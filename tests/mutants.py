@@ -115,7 +115,7 @@ MUTANTS = [
            "(_BAD_LINE_BITS if r == REG_CONTROL1 else 0xFF)", "(CONTROL1_DEN if r == REG_CONTROL1 else 0xFF)",
            ("tests/vic/test_timing_rules_late.py",)),
     Mutant("vic-bank-not-inverted", "retro/chips/vic/fetch.py",
-           "return CIA2_BANK_BITS - pins", "return pins", ("tests/vic/test_vic_fetch.py",)),
+           "return CIA2_BANK_BITS - (self._pins() & CIA2_BANK_BITS)", "return self._pins() & CIA2_BANK_BITS", ("tests/vic/test_vic_fetch.py",)),
     Mutant("vic-pointers-after-screen-off-by-8", "retro/chips/vic/constants.py",
            "SPRITE_POINTERS = 0x03F8", "SPRITE_POINTERS = 0x03F0", ("tests/vic/test_vic_fetch.py",)),
     Mutant("vic-no-char-rom-window", "retro/chips/vic/constants.py",
