@@ -370,3 +370,19 @@ def test_call_at_line_places_the_routine_on_the_beam():
     assert (budget.start_line, budget.start_cycle, budget.end_line, budget.end_cycle) == (0x33, 1, 0x34, 46)
     with pytest.raises(InputError, match="--at-line"):
         call_at_line(scene, program, "entry", 312)
+
+
+def _sprite0_nops(y: int, written_y: int):
+    """NOPs from cycle 1 of line $40 (no Bad Lines) after `STA $D001` of `written_y`, sprite 0 on at `y`."""
+    source = (".org $c000\nentry:  lda #$%02x\n        sta $d001\n" % written_y) + "        nop\n" * 40 + "        rts\n"
+    machine, _ = machine_at(source, vic_state(PAL, {0x11: DEN_OFF, 0x15: 0x01, 0x01: y}), 0x40, 1)
+    return machine.call("entry")
+
+
+def test_a_sprite_y_write_moves_its_dma_as_if_it_had_been_there():
+    # Sprite 0's Y written to $40 in cycle 6 of line $40 makes its DMA check (cycles 55-56 on the 6569)
+    # match in that line: the CPU stalls as it does for a sprite that was at Y $40 from the start. Left
+    # at $F0 (a write that changes nothing) it steals nothing there [Bauer 3.8.1].
+    moved, there, away = _sprite0_nops(0xF0, 0x40), _sprite0_nops(0x40, 0x40), _sprite0_nops(0xF0, 0xF0)
+    assert moved.stolen == there.stolen > 0
+    assert away.stolen == 0
