@@ -363,8 +363,9 @@ class VicDevice:
                           or self.bad_lines_allowed != written_den or self.display_opened != written_den
                           or bool(self._rows_held))
         if self._latching:
-            collision_registers = self._with_held_rows(self._sampled_registers(
-                self.bad_lines_allowed and self.display_opened, self.sprite_enable & self.sprite_display))
+            collision_registers = self._with_held_rows(
+                self._sampled_registers(self.bad_lines_allowed and self.display_opened,
+                                        self.sprite_enable & self.sprite_display))
             bus_registers = self._sampled_registers(self.bad_lines_allowed, self.sprite_enable)
         else:
             collision_registers = bus_registers = self.registers
