@@ -63,3 +63,12 @@ def test_a_started_row_does_not_start_again_at_a_later_x_in_its_line():
     assert collisions_after_write(95, 205, 200, 30, read_at=at(LINE, 60)) == 0
     assert collisions_after_write(95, 205, 200, 30, pixels=((ROW + 1, 0),)) == 0x81
     assert collisions_after_write(95, 205, 200, 30, pixels=((ROW, 0),)) == 0
+
+
+def test_a_second_write_can_still_start_a_row_not_started():
+    """96 -> 95 in cycle 25 (passed: no row yet), then 95 -> 150 in cycle 30: the sequencer has not
+    reached 150, so the row starts there in that line (sprite 7's pixel at 155 is met)."""
+    vic = VicDevice(scene(sprite(0, 96, Y, FULL), sprite(7, 155, Y, rows_with([(ROW, 0)]))).state)
+    vic.write(D000, 95, at(LINE, 25))
+    vic.write(D000, 150, at(LINE, 30))
+    assert vic.read(D01E, at(LINE + 1, 40)) == 0x81

@@ -318,7 +318,9 @@ class VicDevice:
         written = bytearray(self.registers)
         written[register] = value
         slot = first_new * PIXELS_PER_CYCLE  # the first sequencer slot comparing the new X
-        shown = self.state.registers[REG_SPRITE_ENABLE]
+        shown = self.state.registers[REG_SPRITE_ENABLE]  # ... where not hidden by a hold (below)
+        for n, (_, x) in self._rows_held.items():
+            shown |= (1 << n) if x is None else 0
         for n in range(SPRITE_COUNT):
             old_x, new_x = sprite_x(self.registers, n), sprite_x(written, n)
             if old_x == new_x or not shown >> n & 1:
