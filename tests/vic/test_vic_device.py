@@ -334,12 +334,17 @@ def test_d01f_clears_on_read_and_d019_bit1_latches_only_from_zero():
 
 
 def test_a_register_write_takes_effect_in_the_next_cycle():
-    # The first common pixel of the two sprites is drawn in cycle OVERLAP_TIME (above). Moving
-    # sprite 0 away by a write in that very cycle is too late (the cycle still drew with the old X);
-    # a write one cycle earlier is in time.
+    # The first common pixel of the two sprites, sprite 1's first (X 110), is drawn in cycle
+    # OVERLAP_TIME (above). Moving sprite 1 away by a write in that very cycle is too late (the
+    # cycle still compared the old X, and a started row keeps its X: docs/vic.md, "A sprite X write
+    # within a line"); a write one cycle earlier is in time. (Sprite 0's row started at X 100 in the
+    # cycle before: moving it then no longer moves that row.)
     vic = device()
-    vic.write(0xD000, 200, OVERLAP_TIME)
+    vic.write(0xD002, 200, OVERLAP_TIME)
     assert vic.read(0xD01E, OVERLAP_TIME + 1) == 0b11
     vic = device()
-    vic.write(0xD000, 200, OVERLAP_TIME - 1)
+    vic.write(0xD002, 200, OVERLAP_TIME - 1)
     assert vic.read(0xD01E, OVERLAP_TIME + 1) == 0
+    vic = device()
+    vic.write(0xD000, 200, OVERLAP_TIME - 1)
+    assert vic.read(0xD01E, OVERLAP_TIME + 1) == 0b11

@@ -28,10 +28,7 @@ PROGRAMS = [f"VICII/spritecollisions/{name}.prg" for name in (
     "sprite-gfx-hi-hi", "sprite-gfx-hi-mc", "sprite-gfx-mc-hi", "sprite-gfx-mc-mc",
     "sprite-sprite", "sprite-sprite-collision-cycle")] + ["VICII/spritey/spritey.prg", "VICII/spritex/testsuite.prg"]
 
-NOT_YET = {
-    "VICII/spritex/testsuite.prg": "cases 2 and 8: an X write in the cycle the sprite's row starts at X 95 must leave "
-                                   "the row at its old X (the row already started); the device re-places the row",
-}
+NOT_YET: dict[str, str] = {}  # program -> why the model does not pass it (none now)
 BOUNDED = {"VICII/spritecollisions/sprite-sprite-hi-mc.prg", "VICII/spritecollisions/sprite-gfx-mc-hi.prg",
            "VICII/spritecollisions/sprite-sprite-collision-cycle.prg"}
 
@@ -39,7 +36,6 @@ BOUNDED = {"VICII/spritecollisions/sprite-sprite-hi-mc.prg", "VICII/spritecollis
 # real C64 shows it ($81: sprites 0 and 7 collide)
 SPRITEX_REFERENCE = [0x81, 0, 0x81, 0x81, 0x81, 0, 0, 0x81, 0, 0, 0, 0, 0x81, 0, 0, 0x81, 0x81, 0x81, 0x81, 0x81, 0,
                      0, 0, 0, 0, 0, 0x81, 0x81, 0x81]
-SPRITEX_DIFFERENT = {2, 8}  # 1-based case numbers the model gets wrong (NOT_YET)
 
 
 def _program(name: str) -> Path:
@@ -65,12 +61,15 @@ def test_vice_program_passes_from_its_sys_line(name):
 
 
 @pytest.mark.exhaustive
-def test_spritex_cases_agree_with_the_real_machine_but_the_two_listed():
+def test_spritex_cases_agree_with_the_real_machine():
+    """Cases 2, 5, 8, 11-13 write sprite 0's X in the cycle its row starts (X 95 -> 96 / 94, 96 -> 95,
+    97 -> 96): a started row keeps its old X, one not started starts at the new X or not at all
+    (docs/vic.md, "A sprite X write within a line")."""
     report = run.run_c64_program(_program("VICII/spritex/testsuite.prg"), frames=FRAMES, result=RESULT,
                                  peeks=[f"$4000:{len(SPRITEX_REFERENCE)}"])
     (got,) = report.peeks.values()
     wrong = {i + 1 for i, (a, b) in enumerate(zip(got, SPRITEX_REFERENCE)) if a != b}
-    assert wrong == SPRITEX_DIFFERENT, got
+    assert wrong == set(), got
 
 
 def test_the_character_rom_is_refused_when_a_latch_needs_it():

@@ -39,6 +39,7 @@ from retro.chips.vic.constants import (
     IRQ_SPRITE_BACKGROUND,
     IRQ_SPRITE_SPRITE,
     MIRROR_SIZE,
+    PIXELS_PER_CYCLE,
     RASTER_IRQ_LINE0_DELAY,
     READ_ONLY_LATCHES,
     REG_CONTROL1,
@@ -51,6 +52,8 @@ from retro.chips.vic.constants import (
     REG_SPRITE_ENABLE,
     REG_SPRITE_EXPAND_Y,
     REG_SPRITE_SPRITE,
+    REG_SPRITE_X0,
+    REG_SPRITE_X_MSB,
     REG_SPRITE_Y0,
     REGISTER_COUNT,
     SPRITE_COUNT,
@@ -68,10 +71,13 @@ from retro.chips.vic.model import (
     VicState,
     frame_collisions,
     irq_register,
+    load_period,
     raster_compare_line,
     raster_irq_time,
     sprite_rows,
+    start_in_period,
 )
+from retro.chips.vic.sprite_registers import set_sprite_x, sprite_x
 from retro.cpu.bus import NEVER
 
 SCHEDULE_CACHE_SIZE = 256
@@ -79,6 +85,7 @@ _COLLISION_SET = frozenset(COLLISION_REGISTERS)
 _READ_ONLY = frozenset({REG_SPRITE_SPRITE, REG_SPRITE_BACKGROUND, REG_LIGHTPEN_X, REG_LIGHTPEN_Y})
 _DMA_SET = frozenset(DMA_REGISTERS)
 _SAMPLED_SET = frozenset({REG_CONTROL1, REG_SPRITE_ENABLE})
+_X_SET = frozenset(range(REG_SPRITE_X0, REG_SPRITE_X_MSB, 2)) | {REG_SPRITE_X_MSB}
 # What a sample point samples (see VicDevice._latch_points): sprite n's first and second DMA check
 # and its display check are n + SPRITE_COUNT * (LATCH_DMA_FIRST, LATCH_DMA_SECOND, LATCH_SPRITE_DISPLAY)
 LATCH_DMA_FIRST, LATCH_DMA_SECOND, LATCH_SPRITE_DISPLAY = range(3)
@@ -179,6 +186,9 @@ class VicDevice:
         self._sampled_until = 0  # device time up to which (exclusive) the samples have been taken
         self._next_latch_at = NEVER  # device time of the next sample that can change something
         self._raster_match_at: int | None = None  # a compare matched by a write latches here
+        # sprite n -> (device time it ends, the X its row started at or None: no row) while an X
+        # write does not move the row of the current load period (see _hold_started_rows)
+        self._rows_held: dict[int, tuple[int, int | None]] = {}
         self.sprite_sprite = 0  # $D01E as accumulated since the last read
         self.sprite_background = 0  # $D01F
         self.irq_latch = 0  # $D019 bits 0-3
@@ -250,11 +260,13 @@ class VicDevice:
         """The first device time in [lo, hi) where a sampled bit can change."""
         frame_cycles = self.video.frame_cycles
         found = [lo + (p - lo) % frame_cycles for p, _ in self._latch_points()]
+        found += [max(lo, until) for until, _ in self._rows_held.values()]
         first = min(found, default=None)
         return first if first is not None and first < hi else None
 
     def _latch(self, t: int) -> None:
         """The chip samples the registers as written at device time t."""
+        self._rows_held = {n: held for n, held in self._rows_held.items() if held[0] > t}
         within = t % self.video.frame_cycles
         den = bool(self.registers[REG_CONTROL1] & CONTROL1_DEN)
         for point, what in self._latch_points():
@@ -291,15 +303,71 @@ class VicDevice:
         registers[REG_CONTROL1] = registers[REG_CONTROL1] & ~CONTROL1_DEN | (CONTROL1_DEN if den else 0)
         return bytes(registers)
 
+    # ---- a sprite X write within a line [VICE-src viciisc/vicii-draw-cycle.c: trigger_sprites,
+    # draw_sprites, update_sprite_xpos; the VICE test program VICII/spritex/testsuite, PAL rows]
+    # The sequencer compares X with the X written up to the cycle before (a write in cycle c counts
+    # from cycle c + 1's first pixel) and starts the sprite's shift register where they match; that
+    # register holds the row loaded at the sprite's fetch and starts at most once before the next
+    # load (model.load_period). So in the load period of the write: a row already started keeps its
+    # X to its end; one not started yet starts at the new X if the sequencer has not passed it, else
+    # not at all; from the next load on the new X holds.
+
+    def _hold_started_rows(self, register: int, value: int, first_new: int) -> None:
+        """Hold the rows an X write at device time first_new - 1 does not move (see above)."""
+        video = self.video
+        written = bytearray(self.registers)
+        written[register] = value
+        slot = first_new * PIXELS_PER_CYCLE  # the first sequencer slot comparing the new X
+        shown = self.state.registers[REG_SPRITE_ENABLE]  # ... where not hidden by a hold (below)
+        for n, (_, x) in self._rows_held.items():
+            shown |= (1 << n) if x is None else 0
+        for n in range(SPRITE_COUNT):
+            old_x, new_x = sprite_x(self.registers, n), sprite_x(written, n)
+            if old_x == new_x or not shown >> n & 1:
+                continue
+            first, end = load_period(video, n, slot)
+            # the period ends in the load's cycle: the cycle after it is all the next period's
+            until = end // PIXELS_PER_CYCLE + 1
+            held = self._rows_held.get(n)
+            if held is not None and held[0] <= first_new:
+                held = None  # from an earlier period
+            if held is not None and held[1] is not None:
+                continue  # started: the row keeps its X
+            self._latching = True  # _use_sampled sets it from the holds
+            if held is None:
+                started = start_in_period(video, n, old_x, first)
+                if started is not None and started < slot:
+                    self._rows_held[n] = (until, old_x)
+                    continue
+            started = start_in_period(video, n, new_x, first)
+            if started is not None and started < slot:
+                self._rows_held[n] = (until, None)  # passed: no row until the next load
+            else:
+                self._rows_held.pop(n, None)
+
+    def _with_held_rows(self, registers: bytes) -> bytes:
+        """Collision registers with the X (or no display) of the held rows."""
+        if not self._rows_held:
+            return registers
+        held = bytearray(registers)
+        for n, (_, x) in self._rows_held.items():
+            if x is None:
+                held[REG_SPRITE_ENABLE] &= ~(1 << n)
+            else:
+                set_sprite_x(held, n, x)
+        return bytes(held)
+
     def _use_sampled(self) -> None:
         """Switch the collision and BA schedules to what the chip acts on now."""
         written_den = bool(self.registers[REG_CONTROL1] & CONTROL1_DEN)
         written = self.registers[REG_SPRITE_ENABLE]
         self._latching = (self.sprite_enable != written or self.sprite_display != written
-                          or self.bad_lines_allowed != written_den or self.display_opened != written_den)
+                          or self.bad_lines_allowed != written_den or self.display_opened != written_den
+                          or bool(self._rows_held))
         if self._latching:
-            collision_registers = self._sampled_registers(self.bad_lines_allowed and self.display_opened,
-                                                          self.sprite_enable & self.sprite_display)
+            collision_registers = self._with_held_rows(
+                self._sampled_registers(self.bad_lines_allowed and self.display_opened,
+                                        self.sprite_enable & self.sprite_display))
             bus_registers = self._sampled_registers(self.bad_lines_allowed, self.sprite_enable)
         else:
             collision_registers = bus_registers = self.registers
@@ -453,6 +521,8 @@ class VicDevice:
             self._refresh_irq_next()
             return
         old = self.registers[register]
+        if register in _X_SET and old != value & 0xFF:
+            self._hold_started_rows(register, value & 0xFF, t + 1)
         old_compare = raster_compare_line(self.registers)
         self.registers[register] = value & 0xFF
         if old == value:

@@ -260,6 +260,22 @@ def start_slot(video: Video, n: int, x: int) -> int | None:
     return None
 
 
+def load_period(video: Video, n: int, slot: int) -> tuple[int, int]:
+    """[first, end) slots (counted like `slot`, from any frame's cycle 1) from sprite n's last row
+    load at or before `slot` to its next one. Its shift register holds that row there and starts it
+    at most once: a start while it shifts is ignored, one after it ran empty shows nothing [VICE-src
+    viciisc/vicii-draw-cycle.c: trigger_sprites, draw_sprites, update_sprite_data]."""
+    first = slot - (slot - sprite_gap(video, n).load) % video.line_slots
+    return first, first + video.line_slots
+
+
+def start_in_period(video: Video, n: int, x: int, first: int) -> int | None:
+    """The slot at which sprite n at X = x starts in the load period that begins at slot `first`,
+    or None when that X never starts it (see start_slot)."""
+    slot = start_slot(video, n, x)
+    return None if slot is None else first + (slot - first) % video.line_slots
+
+
 def shown_rows(video: Video, n: int, y: int, expand_y: bool, slot: int) -> np.ndarray:
     """Row of sprite n started at `slot` in each raster line (counted in slots from cycle 1), -1: none.
 
