@@ -106,10 +106,6 @@ class MemoryModel:
         return self.program[0] <= address < self.program[1]
 
 
-def unknown_memory(address: int) -> int:
-    return ANY
-
-
 @dataclass(frozen=True)
 class State:
     """The registers, flags, stack and stored bytes at one point; immutable (each step makes a new one)."""

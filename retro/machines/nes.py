@@ -191,11 +191,6 @@ def enter_frame(machine: Machine, entry: FrameEntry) -> int:
     return ppu.dot_of(machine.cycle)
 
 
-def enter_nmi(machine: Machine) -> int:
-    """`enter_frame` at an NMI handler's first instruction (`nmi_entry`)."""
-    return enter_frame(machine, nmi_entry(ppu_of(machine).video))
-
-
 def cycles_to_nmi(ppu: PpuDevice, entry: FrameEntry) -> int | None:
     """CPU cycles from a call's start at `entry` to the next NMI edge the CPU could see, with the
     scene's $2000 (None: the NMI is off)."""
