@@ -16,7 +16,7 @@ from retro.errors import InputError, RunError
 from retro.loaders.basic_stub import sys_line
 from retro.machines.c64 import build_c64, vic_of
 from retro.program import Program
-from tests.vic.vic_scenes import FULL, scene, sprite
+from vic_scenes import FULL, scene, sprite
 
 FRAME = PAL.frame_cycles
 BLANK_STATE = VicState(PAL, bytes(REGISTER_COUNT), (bytes(SPRITE_BYTES),) * SPRITE_COUNT)
