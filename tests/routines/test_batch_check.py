@@ -21,7 +21,8 @@ from retro.routines.registry import builtin_names, get
 from retro.routines.runner import RoutineRunner
 
 SPECS = Path(__file__).resolve().parents[1] / "data" / "specs"
-USER_SPECS = sorted(str(p) for p in SPECS.glob("boxhit_*.toml")) + [str(SPECS / "scan" / "scan.toml")]
+USER_SPECS = sorted(str(p) for p in SPECS.glob("boxhit_*.toml")) + [str(SPECS / "scan" / "scan.toml"),
+                                                                       str(SPECS / "wide" / "wide.toml")]
 ENGINE_FIELDS = {"engine", "engine_agreement", "engine_reason", "compile_seconds", "compiled_fallbacks"}
 
 
