@@ -48,6 +48,7 @@ CHECK_TESTS = ("tests/routines/test_user_specs.py", "tests/routines/test_routine
 TIMELINE_TESTS = ("tests/vic", "tests/cpu/test_machine.py")
 NES_TESTS = ("tests/cpu/test_machine.py", "tests/nes")
 NES_SCENE_TESTS = ("tests/nes/test_nes_scene_check.py",)
+APU_TESTS = ("tests/nes/test_apu_frame.py",)
 BUDGET_TESTS = ("tests/vic", "tests/test_machines.py", "tests/test_commands.py")
 STABILITY_TESTS = ("tests/study/test_stability_pinned.py", "tests/study/test_stability_report_pinned.py",
                    "tests/study/test_study_cli.py")
@@ -332,6 +333,31 @@ MUTANTS = [
            explained="equivalent since nmi_edge also refuses an edge whose cycle is after the poll: moving the "
                      "lower bound earlier changes no poll's outcome; removing both undoes the rule and "
                      "test_the_immediate_nmi_comes_after_the_next_instruction fails (checked by hand)"),
+    # ---- the APU frame counter's interrupt (retro/chips/apu_frame.py) and OAM DMA after the poll -----
+    Mutant("apu-flag-a-cycle-early", "retro/chips/apu_frame.py",
+           "FLAG_AFTER_RESTART = 29828", "FLAG_AFTER_RESTART = 29827", APU_TESTS),
+    Mutant("apu-no-jitter", "retro/chips/apu_frame.py",
+           "ODD_WRITE_DELAY = 1 ", "ODD_WRITE_DELAY = 0 ", APU_TESTS),
+    Mutant("apu-other-phase", "retro/chips/apu_frame.py",
+           "APU_CYCLE_PARITY = 1", "APU_CYCLE_PARITY = 0", APU_TESTS),
+    Mutant("apu-flag-set-once", "retro/chips/apu_frame.py",
+           "FLAG_SET_CYCLES = 3", "FLAG_SET_CYCLES = 1", APU_TESTS),
+    Mutant("apu-period-29829", "retro/chips/apu_frame.py",
+           "FOUR_STEP_PERIOD = 29830", "FOUR_STEP_PERIOD = 29829", APU_TESTS),
+    Mutant("apu-irq-line-a-cycle-late", "retro/chips/apu_frame.py",
+           "IRQ_LINE_DELAY = 0 ", "IRQ_LINE_DELAY = 1 ", APU_TESTS),
+    Mutant("apu-power-on-write-at-the-first-instruction", "retro/chips/apu_frame.py",
+           "POWER_ON_WRITE_LEAD = 10 ", "POWER_ON_WRITE_LEAD = 0 ", APU_TESTS),
+    Mutant("apu-read-clears-a-flag-set-in-its-cycle", "retro/chips/apu_frame.py",
+           "self.cleared_at = cycle - 1 if self._next_flag(cycle) == cycle else cycle", "self.cleared_at = cycle",
+           APU_TESTS),
+    Mutant("apu-restart-at-the-write", "retro/chips/apu_frame.py",
+           "self.previous = _Sequence(self.current.first_flag, restart)", "self.previous = _Sequence(None)",
+           APU_TESTS),
+    Mutant("apu-five-step-sets-the-flag", "retro/chips/apu_frame.py",
+           "first = None if value & MODE_FIVE_STEP else", "first = None if False else", APU_TESTS),
+    Mutant("dma-before-the-poll", "retro/cpu/mpu.py",
+           "            poll -= self.halted  #", "            pass  #", APU_TESTS),
     # ---- NES scenes in check/cycles/run/profile (retro/machines/nes.py, retro/routines/chip_access.py) --
     Mutant("nes-dma-parity-of-the-machine-clock", "retro/chips/ppu/device.py",
            "(OAM_DMA_ODD_EXTRA if (cycle - self.origin) % 2 else 0)", "(OAM_DMA_ODD_EXTRA if cycle % 2 else 0)",

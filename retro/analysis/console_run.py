@@ -6,8 +6,9 @@ are checked after every instruction:
 - the PC reaches an address (`until`);
 - a byte of memory has a value (`until_value`);
 - the program has halted: an instruction jumped or branched to itself (`JMP *`, `BVC *` with V
-  clear) while the NMI is off ($2000 bit 7 clear); nothing can happen any more (this console has
-  no IRQ source), so the run ends there whatever the frame count.
+  clear) while the NMI is off ($2000 bit 7 clear) and no IRQ can come (the I flag set, or the APU's
+  frame IRQ inhibited or in the 5-step mode, its flag clear: `irq_next` says never); nothing can
+  happen any more, so the run ends there whatever the frame count.
 and after every frame:
 - a test ROM that reports through $6000 has finished (below).
 
@@ -32,7 +33,8 @@ from retro.chips.cartridge import NromCartridge
 from retro.chips.ppu.constants import CTRL_NMI, NTSC, PPUSTATUS
 from retro.chips.ppu.device import PpuDevice
 from retro.cpu.machine import Machine
-from retro.cpu.mpu import BRANCH_OPCODES
+from retro.cpu.bus import NEVER
+from retro.cpu.mpu import BRANCH_OPCODES, FLAG_I
 from retro.errors import InputError
 from retro.machines.nes import build_nes, ppu_of, reset
 
@@ -190,7 +192,9 @@ def run_cartridge(cartridge: NromCartridge, *, frames: int, until: int | None = 
     machine = build_nes(cartridge=cartridge)
     entry = reset(machine)
     ppu = ppu_of(machine)
-    watch = _Watch(machine, until, until_value, lambda: not ppu.ctrl & CTRL_NMI)
+    mpu = machine.mpu
+    watch = _Watch(machine, until, until_value,
+                   lambda: not ppu.ctrl & CTRL_NMI and (mpu.p & FLAG_I or ppu.irq_next >= NEVER))
     observer = watch if wrap is None else wrap(machine, watch)
     start = machine.cycle
     verdicts: list[Verdict | None] = [None]

@@ -149,6 +149,8 @@ class MPU6510(_Py65MPU):
         self.last_stolen = 0  # of the last step_timed
         self.settled = (0, 0)  # (next cycle index, delay so far) of the instruction being executed
         self.ba_high_until = -1  # BA is known high up to (not including) this cycle
+        self.halted_at = -1  # the start of the instruction a DMA (`stall`) halted the CPU after ...
+        self.halted = 0  # ... and for how many cycles
         super().__init__(memory=memory, pc=pc)
         self.name = type(self).__name__[3:]
         # instructions that write have a fixed cycle count: their write cycles are known in advance
@@ -262,6 +264,8 @@ class MPU6510(_Py65MPU):
             return True
         # the poll: penultimate cycle; a taken branch within its page polls a cycle earlier
         poll = end - 3 if op in BRANCH_OPCODES and self.excycles == 1 else end - 2
+        if start == self.halted_at:
+            poll -= self.halted  # the DMA came after the poll (`stall`)
         masked = (i_before if op in I_CHANGED_AFTER_POLL else self.p & FLAG_I)
         if poll >= lines.nmi_next and lines.nmi_edge(poll):
             self.pending_interrupt = "NMI"
@@ -327,8 +331,12 @@ class MPU6510(_Py65MPU):
             self.executed = count
 
     def stall(self, cycles: int) -> None:
-        """Add cycles to the current instruction (the CPU halted by DMA)."""
+        """Add cycles to the current instruction (the CPU halted by DMA after it). They come after
+        its interrupt poll: an IRQ asserted during OAM DMA is taken after the instruction that follows
+        it (blargg's cpu_interrupts_v2 4-irq_and_dma)."""
         self.excycles += cycles
+        self.halted_at = self.processorCycles
+        self.halted = cycles
 
     # ---- instruction stream ------------------------------------------------------------------
     # Opcodes and operands are fetched from RAM (the bus's memory list), never from a device:

@@ -4,16 +4,18 @@
 (`retro.machines.build_machine` reads it); the program then runs from RAM. With a cartridge
 (`retro.chips.cartridge.NromCartridge`) the machine is a console: PRG ROM at $8000-$FFFF, CHR ROM or
 RAM in the PPU, the board's mirroring, the 2 KiB of RAM mirrored up to $1FFF, PRG RAM at
-$6000-$7FFF, and the APU and controller ports at $4000-$4017 reading as an idle console's (no APU is
-modelled: sound registers ignore writes; `$4015` reads $00: no channel playing, no frame or DMC
-interrupt; `$4016`/`$4017` read $40: no button pressed, the upper bits the open bus's $40 left by
-the address; nesdev wiki "APU", "Standard controller", "Open bus behavior").
+$6000-$7FFF, and the APU and controller ports at $4000-$4017 reading as an idle console's: of the
+APU only the frame counter's interrupt is modelled (`retro.chips.apu_frame`: `$4017` writes, the
+frame flag in `$4015` bit 6, the IRQ line); sound registers ignore writes, `$4015`'s other bits read
+0 (no channel playing, no DMC interrupt); `$4016`/`$4017` read $40: no button pressed, the upper bits
+the open bus's $40 left by the address (nesdev wiki "APU", "Standard controller", "Open bus behavior").
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+from retro.chips.apu_frame import FrameCounter
 from retro.chips.cartridge import PRG_START, NromCartridge
 from retro.chips.ppu.constants import CTRL_NMI, DOTS_PER_LINE, OAMDMA, PPU_REGISTER_BASE, PPU_REGISTER_END, VBLANK_DOT, VBLANK_LINE, VideoStandard
 from retro.chips.ppu.device import PpuDevice
@@ -28,8 +30,8 @@ RAM_MIRRORS_END = 0x1FFF
 IO_START = 0x4000               # APU and I/O registers $4000-$4017 (+ $4018-$401F, test mode, unused)
 IO_END = 0x401F
 APU_STATUS = 0x4015
+APU_FRAME_COUNTER = 0x4017      # written: the frame counter; read: controller 2
 CONTROLLER_PORTS = (0x4016, 0x4017)
-IDLE_APU_STATUS = 0x00          # no length counter running, no frame or DMC interrupt
 IDLE_CONTROLLER = 0x40          # no button (bit 0 = 0); bits 5-7 the open bus's $40
 OPEN_BUS_IO = 0x40              # what a write-only register at $40xx reads back
 PRG_END = 0xFFFF
@@ -53,17 +55,24 @@ class _RamMirror:
 
 
 class _IdleIo:
-    """$4000-$401F but $4014: the APU and the controller ports of a console nobody plays."""
+    """$4000-$401F but $4014: the APU (its frame counter only) and the controller ports of a console
+    nobody plays."""
+
+    def __init__(self, frame_counter: FrameCounter) -> None:
+        self.frame_counter = frame_counter
 
     def read(self, address: int, cycle: int) -> int:
+        if address == APU_STATUS:
+            return self.frame_counter.read_status(cycle)
         return self.peek(address)
 
     def write(self, address: int, value: int, cycle: int) -> None:
-        pass
+        if address == APU_FRAME_COUNTER:
+            self.frame_counter.write_mode(value, cycle)
 
     def peek(self, address: int) -> int:
         if address == APU_STATUS:
-            return IDLE_APU_STATUS
+            return self.frame_counter.peek_status()
         if address in CONTROLLER_PORTS:
             return IDLE_CONTROLLER
         return OPEN_BUS_IO
@@ -101,7 +110,9 @@ def build_nes(state: PpuState | None = None, cartridge: NromCartridge | None = N
     if cartridge is not None:
         memory = machine.bus.memory
         machine.attach(_RamMirror(memory), RAM_MIRRORS_START, RAM_MIRRORS_END)
-        io = _IdleIo()
+        # the console starts at this cycle (`reset`): power-on's implied $4017 write comes just before
+        device.irq_source = frame_counter = FrameCounter(device, device.origin, machine.cycle)
+        io = _IdleIo(frame_counter)
         machine.attach(io, IO_START, OAMDMA - 1)
         machine.attach(io, OAMDMA + 1, IO_END)
         machine.bus.load(PRG_START, cartridge.prg)

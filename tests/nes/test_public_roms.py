@@ -38,21 +38,17 @@ ROMS = {
         "08.double_height", "09.timing_basics", "10.timing_order", "11.edge_timing")},
 }
 
-NO_APU = "needs the APU (frame IRQ, DMC): not modelled"
-NOT_YET = {
-    "cpu_interrupts_v2/rom_singles/1-cli_latency.nes": NO_APU,
-    "cpu_interrupts_v2/rom_singles/3-nmi_and_irq.nes": NO_APU,
-    "cpu_interrupts_v2/rom_singles/4-irq_and_dma.nes": NO_APU,
-    "cpu_interrupts_v2/rom_singles/5-branch_delays_irq.nes": NO_APU,
-}
+NOT_YET: dict[str, str] = {}  # ROM -> why it fails (none of the ROMs above at present)
 
 
 # The bounded form CI runs (RETRO_EXHAUSTIVE=1 runs every ROM above): one ROM per rule this project
-# models (the $2002 race, NMI timing, the odd-frame skip, sprite overflow, the BRK hijack, the sprite-0 hit)
+# models (the $2002 race, NMI timing, the odd-frame skip, sprite overflow, the BRK hijack, the sprite-0 hit,
+# the APU frame IRQ against the NMI and against OAM DMA)
 BOUNDED = {
     "ppu_vbl_nmi/rom_singles/06-suppression.nes", "ppu_vbl_nmi/rom_singles/07-nmi_on_timing.nes",
     "ppu_vbl_nmi/rom_singles/10-even_odd_timing.nes", "vbl_nmi_timing/6.nmi_disable.nes",
     "sprite_overflow_tests/3.Timing.nes", "cpu_interrupts_v2/rom_singles/2-nmi_and_brk.nes",
+    "cpu_interrupts_v2/rom_singles/3-nmi_and_irq.nes", "cpu_interrupts_v2/rom_singles/4-irq_and_dma.nes",
     "sprite_hit_tests_2005.10.05/11.edge_timing.nes",
 }
 

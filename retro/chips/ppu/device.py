@@ -101,7 +101,11 @@ class PpuDevice:
 
     chip_name = "PPU"
     drives_cpu_lines = True
-    irq_next = NEVER  # the PPU has no IRQ output
+    # The PPU has no IRQ output, but it is the machine's one CpuLines: on a console the APU's frame
+    # counter (`retro.chips.apu_frame`, set as `irq_source`) drives the IRQ input through it and
+    # keeps `irq_next` (an instance attribute then); without one the line never goes low.
+    irq_next = NEVER
+    irq_source = None
 
     def __init__(self, state: PpuState | None = None, *, origin: int = 0,
                  read_memory: Callable[[int], int] | None = None,
@@ -267,7 +271,7 @@ class PpuDevice:
         self._refresh_nmi_next()
 
     # fields a snapshot leaves shared: the bus's callbacks, and arrays the device replaces, never mutates
-    _SHARED = frozenset({"read_memory", "stall", "_candidates", "_fixed_events", "video"})
+    _SHARED = frozenset({"read_memory", "stall", "irq_source", "_candidates", "_fixed_events", "video"})
 
     def snapshot(self) -> dict:
         """Everything the device holds now, as a copy `restore` can go back to (any number of times)."""
@@ -305,7 +309,8 @@ class PpuDevice:
         return True
 
     def irq_low(self, cycle: int) -> bool:
-        return False
+        source = self.irq_source
+        return source is not None and source.irq_low(cycle)
 
     def ba_wait(self, cycle: int) -> int:
         return 0
