@@ -333,6 +333,13 @@ MUTANTS = [
            explained="equivalent since nmi_edge also refuses an edge whose cycle is after the poll: moving the "
                      "lower bound earlier changes no poll's outcome; removing both undoes the rule and "
                      "test_the_immediate_nmi_comes_after_the_next_instruction fails (checked by hand)"),
+    Mutant("vic-open-border-without-bad-lines-is-border", "retro/chips/vic/device.py",
+           "self._sampled_registers(self.display_opened, self.sprite_enable & self.sprite_display)",
+           "self._sampled_registers(self.display_opened and self.bad_lines_allowed, self.sprite_enable & self.sprite_display)",
+           ("tests/vic/test_timing_rules_late.py",)),
+    Mutant("vic-frame-without-bad-lines-shows-the-characters", "retro/chips/vic/graphics.py",
+           "displayed = (offset >= 0) & (row < TEXT_ROWS) & bad_lines", "displayed = (offset >= 0) & (row < TEXT_ROWS)",
+           ("tests/vic/test_timing_rules_late.py",)),
     # ---- the APU frame counter's interrupt (retro/chips/apu_frame.py) and OAM DMA after the poll -----
     Mutant("apu-flag-a-cycle-early", "retro/chips/apu_frame.py",
            "FLAG_AFTER_RESTART = 29828", "FLAG_AFTER_RESTART = 29827", APU_TESTS),

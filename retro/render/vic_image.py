@@ -88,8 +88,9 @@ def frame_rgb(state: VicState, collisions: FrameCollisions, palette_name: str = 
     video = state.video
     rgb_table = np.array(palette(palette_name), dtype=np.uint8)
     lines, xs = frame_order(state)
-    numbers = colours(video, state.memory, state.registers, lines, xs).astype(np.int16)
-    fg = foreground_at(video, state.memory, state.registers[REG_CONTROL1], state.registers[REG_CONTROL2], lines, xs)
+    numbers = colours(video, state.memory, state.registers, lines, xs, state.bad_lines).astype(np.int16)
+    fg = foreground_at(video, state.memory, state.registers[REG_CONTROL1], state.registers[REG_CONTROL2], lines, xs,
+                       state.bad_lines)
     for n in reversed(range(SPRITE_COUNT)):  # sprite 0 ends up on top
         place = placement(state, n)
         if place is None or place.lines.size == 0:

@@ -256,3 +256,30 @@ def test_a_program_writing_the_current_line_to_d012_takes_the_irq_at_once():
     result, entries = irq_run(100, 1, "", "lda #100\n sta $d012\n nop\n nop\n nop", compare=200)
     assert DEN_OFF & 0x10 == 0  # no Bad Line moves the cycles
     assert handler_start(entries) == (100, 16)
+
+
+# ---- the idle byte in a border opened without Bad Lines ---------------------------------------------
+
+def idle_device(idle: int) -> VicDevice:
+    """DEN clear in line $30 (no Bad Line this frame), set in line 51 (RSEL 1): the border opens."""
+    memory = {**SOLID, "idle": idle}
+    vic = VicDevice(scene(sprite(0, 100, 140), registers={"$d011": 0x0B}, memory=memory).state)
+    vic.write(D011, 0x1B, at(51, 40))
+    return vic
+
+
+def test_an_open_border_without_bad_lines_shows_the_idle_byte_and_it_collides():
+    """[Bauer 3.7.1: display state comes only from a Bad Line; 3.8.2: idle graphics collide;
+    VICII/dentest howto.txt: "idle data ($3FFF)" when the border opens without Bad Lines] The solid
+    characters are never fetched: the sprite meets the idle byte, every line of the window."""
+    assert not bad_line_107(idle_device(0xFF))
+    assert sprite_background(idle_device(0xFF)) == 0x01
+    assert sprite_background(idle_device(0x00)) == 0     # an idle byte of 0: nothing to meet
+    pixel = idle_device(0x01)                             # only pixel 7 of each column is foreground
+    assert sprite_background(pixel) == 0x01
+
+
+def test_the_idle_byte_of_a_border_open_without_bad_lines_is_not_the_characters():
+    """With Bad Lines the same sprite meets the solid characters whatever the idle byte is."""
+    vic = VicDevice(scene(sprite(0, 100, 140), registers={"$d011": 0x1B}, memory={**SOLID, "idle": 0}).state)
+    assert sprite_background(vic) == 0x01

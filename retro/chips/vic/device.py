@@ -365,13 +365,13 @@ class VicDevice:
                           or self.bad_lines_allowed != written_den or self.display_opened != written_den
                           or bool(self._rows_held))
         if self._latching:
+            # graphics where the border opened: from Bad Lines, or the idle byte in a frame without any
             collision_registers = self._with_held_rows(
-                self._sampled_registers(self.bad_lines_allowed and self.display_opened,
-                                        self.sprite_enable & self.sprite_display))
+                self._sampled_registers(self.display_opened, self.sprite_enable & self.sprite_display))
             bus_registers = self._sampled_registers(self.bad_lines_allowed, self.sprite_enable)
         else:
             collision_registers = bus_registers = self.registers
-        self.state = self.state.with_registers(collision_registers)
+        self.state = self.state.with_registers(collision_registers, bad_lines=self.bad_lines_allowed)
         self._schedule = self._schedule_for(self.state)
         self._bus = bus_schedule(self.video, bus_registers)
 

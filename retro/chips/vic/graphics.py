@@ -12,6 +12,10 @@ Foreground is a matter of bit patterns, not colours [Bauer 3.7.3, 3.8.2]:
 Geometry: column c pixel k at X = 24 + 8c + k + XSCROLL; text row r on lines 48 + YSCROLL + 8r ..
 +7; lines of the display window outside any row are idle; lines outside the window (RSEL), and all
 lines when DEN=0, are vertical border where the sequencer outputs background [Bauer 3.9, 3.10].
+A frame without Bad Lines (`bad_lines` False: DEN was clear in line $30) whose border opened
+anyway (DEN set in the window's first line) never leaves idle state: every window line shows the
+idle byte, which collides like any graphics [Bauer 3.7.1: display state only from a Bad Line;
+VICE-testprogs VICII/dentest howto.txt: "idle data ($3FFF)" with the border open and no Bad Line].
 The side border (CSEL) covers graphics but does not stop collisions.
 """
 
@@ -77,8 +81,9 @@ class VicMemory:
 
 
 @lru_cache(maxsize=64)
-def line_slots(video: Video, control1: int) -> tuple[np.ndarray, np.ndarray]:
-    """Per raster line: text row (0-24), IDLE_ROW or BORDER_ROW; and the row counter RC."""
+def line_slots(video: Video, control1: int, bad_lines: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """Per raster line: text row (0-24), IDLE_ROW or BORDER_ROW; and the row counter RC. Without
+    `bad_lines` the window is all IDLE_ROW (module docstring)."""
     rows = np.full(video.lines, BORDER_ROW, dtype=np.int16)
     rcs = np.zeros(video.lines, dtype=np.int16)
     if control1 & CONTROL1_DEN:
@@ -86,7 +91,7 @@ def line_slots(video: Video, control1: int) -> tuple[np.ndarray, np.ndarray]:
         lines = np.arange(first, last + 1)
         offset = lines - GRAPHICS_FIRST_LINE - (control1 & CONTROL1_YSCROLL)
         row = offset // CHAR_HEIGHT
-        displayed = (offset >= 0) & (row < TEXT_ROWS)
+        displayed = (offset >= 0) & (row < TEXT_ROWS) & bad_lines
         rows[lines] = np.where(displayed, row, IDLE_ROW)
         rcs[lines] = np.where(displayed, offset % CHAR_HEIGHT, 0)
     rows.flags.writeable = rcs.flags.writeable = False
@@ -145,9 +150,9 @@ def foreground(memory: VicMemory, control1: int, control2: int, rows, rcs, cols,
 
 
 def foreground_at(video: Video, memory: VicMemory, control1: int, control2: int,
-                  lines: np.ndarray, xs: np.ndarray) -> np.ndarray:
+                  lines: np.ndarray, xs: np.ndarray, bad_lines: bool = True) -> np.ndarray:
     """(len(lines), len(xs)) foreground mask: decodes only the given lines and X coordinates."""
-    rows, rcs = line_slots(video, control1 & GEOMETRY_CONTROL1)
+    rows, rcs = line_slots(video, control1 & GEOMETRY_CONTROL1, bad_lines)
     cols, ks = column_slots(video, control2 & CONTROL2_XSCROLL)
     r, c = rows[lines], cols[xs]
     if not ((r < BORDER_ROW).any() and (c < OUTSIDE_COLUMN).any()):
@@ -156,17 +161,18 @@ def foreground_at(video: Video, memory: VicMemory, control1: int, control2: int,
 
 
 def foreground_points(video: Video, memory: VicMemory, control1: int, control2: int,
-                      lines: np.ndarray, xs: np.ndarray) -> np.ndarray:
+                      lines: np.ndarray, xs: np.ndarray, bad_lines: bool = True) -> np.ndarray:
     """Foreground bit of each pixel (lines[i], xs[i]): decodes only those pixels, in one pass."""
-    rows, rcs = line_slots(video, control1 & GEOMETRY_CONTROL1)
+    rows, rcs = line_slots(video, control1 & GEOMETRY_CONTROL1, bad_lines)
     cols, ks = column_slots(video, control2 & CONTROL2_XSCROLL)
     return foreground(memory, control1, control2, rows[lines], rcs[lines], cols[xs], ks[xs])
 
 
-def colours(video: Video, memory: VicMemory, registers: bytes, lines: np.ndarray, xs: np.ndarray) -> np.ndarray:
+def colours(video: Video, memory: VicMemory, registers: bytes, lines: np.ndarray, xs: np.ndarray,
+            bad_lines: bool = True) -> np.ndarray:
     """C64 colour numbers of the graphics and border at (lines x xs), sprites not included (for images)."""
     control1, control2 = registers[REG_CONTROL1], registers[REG_CONTROL2]
-    rows, rcs = line_slots(video, control1 & GEOMETRY_CONTROL1)
+    rows, rcs = line_slots(video, control1 & GEOMETRY_CONTROL1, bad_lines)
     cols, ks = column_slots(video, control2 & CONTROL2_XSCROLL)
     r, rc, c, k = rows[lines][:, None], rcs[lines][:, None], cols[xs][None, :], ks[xs][None, :]
     byte, multicolor, cell, idle = _fetch(memory, control1, control2, r, rc, c)

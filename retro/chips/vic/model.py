@@ -89,16 +89,19 @@ class VicState:
     memory: VicMemory = field(default_factory=VicMemory.blank)
     # what the sprite data and memory were fetched from (retro.chips.vic.fetch); b"": given directly
     view_key: bytes = b""
+    # False: the frame has no Bad Line (DEN clear in line $30), so an opened border shows the idle
+    # byte in every window line (graphics.line_slots); the device sets it from what it sampled
+    bad_lines: bool = True
 
     def __post_init__(self) -> None:
         if len(self.registers) != REGISTER_COUNT or len(self.sprite_data) != SPRITE_COUNT:
             raise ValueError("VicState needs 47 registers and 8 sprites")
 
-    def with_registers(self, registers: bytes) -> "VicState":
-        return replace(self, registers=bytes(registers))
+    def with_registers(self, registers: bytes, bad_lines: bool = True) -> "VicState":
+        return replace(self, registers=bytes(registers), bad_lines=bad_lines)
 
     def collision_key(self) -> bytes:
-        return bytes(self.registers[r] for r in COLLISION_REGISTERS) + self.view_key
+        return bytes(self.registers[r] for r in COLLISION_REGISTERS) + bytes([self.bad_lines]) + self.view_key
 
     def sprite_x(self, n: int) -> int:
         return sprite_x(self.registers, n)
@@ -469,7 +472,7 @@ def frame_collisions(state: VicState) -> FrameCollisions:
     ss = under != 0
     ssl, ssx, ssb = lines[ss], xs[ss], under[ss] | bits[ss]
     sb = foreground_points(video, state.memory, state.registers[REG_CONTROL1], state.registers[REG_CONTROL2],
-                           lines, xs)
+                           lines, xs, state.bad_lines)
     sbl, sbx, sbb = lines[sb], xs[sb], bits[sb]
     ss_times, ss_merged, first_ss = _events(video, ssl, ssx, ssb, places[ss])
     sb_times, sb_merged, first_sb = _events(video, sbl, sbx, sbb, places[sb])
