@@ -197,6 +197,15 @@ SPRITE_DROP_PIXEL = 2
 SPRITE_LOAD_PIXEL = 4
 SPRITE_RESUME_PIXEL = 7
 SPRITE_PENDING_PIXEL = 4
+# A $D01D or $D01C write within a row [VICE-src viciisc/vicii-draw-cycle.c draw_sprites8,
+# draw_sprites, update_sprite_mc_bits_6569; Bauer 3.8.1 does not cover it]: the sequencer takes the
+# X-expansion bits at pixel EXPAND_X_SWITCH_PIXEL and (6569, 6567: the chips with colour latency)
+# the multicolour bits at pixel MULTICOLOR_SWITCH_PIXEL of the write's cycle. The row goes on from
+# where its shift register stands: expansion decides only whether the register shifts every pixel
+# or every other one from there (a flip-flop, not a re-placement), and a multicolour change clears
+# the sprite's pair flip-flop, so the next pair starts one shift later wherever the register stands.
+EXPAND_X_SWITCH_PIXEL = 6
+MULTICOLOR_SWITCH_PIXEL = 7
 
 # Raster compare [Bauer 3.12]: the IRQ for line 0 comes one cycle later than for the other lines.
 RASTER_IRQ_LINE0_DELAY = 1

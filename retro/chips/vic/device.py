@@ -33,12 +33,14 @@ from retro.chips.vic.constants import (
     CONTROL1_DEN,
     CONTROL1_RSEL,
     CONTROL1_RST8,
+    EXPAND_X_SWITCH_PIXEL,
     GRAPHICS_FIRST_LINE,
     IRQ_RASTER,
     IRQ_SOURCES,
     IRQ_SPRITE_BACKGROUND,
     IRQ_SPRITE_SPRITE,
     MIRROR_SIZE,
+    MULTICOLOR_SWITCH_PIXEL,
     PIXELS_PER_CYCLE,
     RASTER_IRQ_LINE0_DELAY,
     READ_ONLY_LATCHES,
@@ -50,7 +52,9 @@ from retro.chips.vic.constants import (
     REG_RASTER,
     REG_SPRITE_BACKGROUND,
     REG_SPRITE_ENABLE,
+    REG_SPRITE_EXPAND_X,
     REG_SPRITE_EXPAND_Y,
+    REG_SPRITE_MULTICOLOR,
     REG_SPRITE_SPRITE,
     REG_SPRITE_X0,
     REG_SPRITE_X_MSB,
@@ -77,6 +81,7 @@ from retro.chips.vic.model import (
     sprite_rows,
     start_in_period,
 )
+from retro.chips.vic.sprite_bits import row_sources
 from retro.chips.vic.sprite_registers import set_sprite_x, sprite_x
 from retro.cpu.bus import NEVER
 
@@ -86,6 +91,7 @@ _READ_ONLY = frozenset({REG_SPRITE_SPRITE, REG_SPRITE_BACKGROUND, REG_LIGHTPEN_X
 _DMA_SET = frozenset(DMA_REGISTERS)
 _SAMPLED_SET = frozenset({REG_CONTROL1, REG_SPRITE_ENABLE})
 _X_SET = frozenset(range(REG_SPRITE_X0, REG_SPRITE_X_MSB, 2)) | {REG_SPRITE_X_MSB}
+_SWITCH_PIXEL = {REG_SPRITE_EXPAND_X: EXPAND_X_SWITCH_PIXEL, REG_SPRITE_MULTICOLOR: MULTICOLOR_SWITCH_PIXEL}
 # What a sample point samples (see VicDevice._latch_points): sprite n's first and second DMA check
 # and its display check are n + SPRITE_COUNT * (LATCH_DMA_FIRST, LATCH_DMA_SECOND, LATCH_SPRITE_DISPLAY)
 LATCH_DMA_FIRST, LATCH_DMA_SECOND, LATCH_SPRITE_DISPLAY = range(3)
@@ -189,6 +195,9 @@ class VicDevice:
         # sprite n -> (device time it ends, the X its row started at or None: no row) while an X
         # write does not move the row of the current load period (see _hold_started_rows)
         self._rows_held: dict[int, tuple[int, int | None]] = {}
+        # sprite n -> (device time it ends, expand_x and multicolor at the row's start, the switches
+        # since) while a $D01D/$D01C write changes the row being shown (see _switch_rows_in_progress)
+        self._shapes_held: dict[int, tuple[int, bool, bool, tuple]] = {}
         self.sprite_sprite = 0  # $D01E as accumulated since the last read
         self.sprite_background = 0  # $D01F
         self.irq_latch = 0  # $D019 bits 0-3
@@ -261,12 +270,14 @@ class VicDevice:
         frame_cycles = self.video.frame_cycles
         found = [lo + (p - lo) % frame_cycles for p, _ in self._latch_points()]
         found += [max(lo, until) for until, _ in self._rows_held.values()]
+        found += [max(lo, held[0]) for held in self._shapes_held.values()]
         first = min(found, default=None)
         return first if first is not None and first < hi else None
 
     def _latch(self, t: int) -> None:
         """The chip samples the registers as written at device time t."""
         self._rows_held = {n: held for n, held in self._rows_held.items() if held[0] > t}
+        self._shapes_held = {n: held for n, held in self._shapes_held.items() if held[0] > t}
         within = t % self.video.frame_cycles
         den = bool(self.registers[REG_CONTROL1] & CONTROL1_DEN)
         for point, what in self._latch_points():
@@ -345,6 +356,54 @@ class VicDevice:
             else:
                 self._rows_held.pop(n, None)
 
+    # ---- a $D01D / $D01C write within a row [VICE-src viciisc/vicii-draw-cycle.c: draw_sprites8
+    # takes the bits at pixel 6 / 7 of the write's cycle (constants.EXPAND_X_SWITCH_PIXEL), draw_sprites
+    # goes on from where the shift register stands]. A row already started in the load period of the
+    # write goes on with the new bit from that pixel (sprite_bits.row_sources), or, if it has ended,
+    # stays as it was; a row not started yet is drawn with the new bit; from the next load on the new
+    # bit holds. The device holds the row's start flags and the switches until that load, and
+    # switches states from the write's own cycle (its pixels before the switch pixel are the same in
+    # both). Not modelled: an X write and a $D01D/$D01C write to one sprite in one load period (the
+    # X write's hold wins).
+
+    def _switch_rows_in_progress(self, register: int, value: int, t: int) -> None:
+        """Hold the rows a write of `value` to $D01D or $D01C at device time t changes (see above)."""
+        video = self.video
+        switch = t * PIXELS_PER_CYCLE + _SWITCH_PIXEL[register]  # the sequencer slot that takes it
+        shown = self.state.registers[REG_SPRITE_ENABLE]
+        for n in range(SPRITE_COUNT):
+            if not (self.registers[register] ^ value) >> n & 1 or not shown >> n & 1 or n in self._rows_held:
+                continue
+            first, end = load_period(video, n, switch)
+            started = start_in_period(video, n, sprite_x(self.registers, n), first)
+            if started is None or started > switch:
+                continue  # not started yet in this period: it starts with the new bit
+            held = self._shapes_held.get(n)
+            if held is not None and held[0] <= t + 1:
+                held = None  # from an earlier period
+            expand = bool(self.registers[REG_SPRITE_EXPAND_X] >> n & 1)
+            multicolor = bool(self.registers[REG_SPRITE_MULTICOLOR] >> n & 1)
+            base_expand, base_multicolor, switches = (expand, multicolor, ()) if held is None else held[1:]
+            new_expand = bool(value >> n & 1) if register == REG_SPRITE_EXPAND_X else expand
+            new_multicolor = bool(value >> n & 1) if register == REG_SPRITE_MULTICOLOR else multicolor
+            offset = switch - started
+            if offset < len(row_sources(base_expand, base_multicolor, switches)):
+                switches = switches + ((offset, new_expand, new_multicolor),)  # in progress: it goes on switched
+            self._latching = True  # _use_sampled sets it from the holds
+            self._shapes_held[n] = (end // PIXELS_PER_CYCLE + 1, base_expand, base_multicolor, switches)
+
+    def _with_held_shapes(self, registers: bytes) -> tuple[bytes, tuple]:
+        """Collision registers with the held rows' start flags, and the switches per sprite."""
+        if not self._shapes_held:
+            return registers, ()
+        held = bytearray(registers)
+        switches = [()] * SPRITE_COUNT
+        for n, (_, expand, multicolor, changes) in self._shapes_held.items():
+            for register, bit in ((REG_SPRITE_EXPAND_X, expand), (REG_SPRITE_MULTICOLOR, multicolor)):
+                held[register] = held[register] & ~(1 << n) | (bit << n)
+            switches[n] = changes
+        return bytes(held), tuple(switches)
+
     def _with_held_rows(self, registers: bytes) -> bytes:
         """Collision registers with the X (or no display) of the held rows."""
         if not self._rows_held:
@@ -363,15 +422,17 @@ class VicDevice:
         written = self.registers[REG_SPRITE_ENABLE]
         self._latching = (self.sprite_enable != written or self.sprite_display != written
                           or self.bad_lines_allowed != written_den or self.display_opened != written_den
-                          or bool(self._rows_held))
+                          or bool(self._rows_held) or bool(self._shapes_held))
+        switches = ()
         if self._latching:
             # graphics where the border opened: from Bad Lines, or the idle byte in a frame without any
-            collision_registers = self._with_held_rows(
-                self._sampled_registers(self.display_opened, self.sprite_enable & self.sprite_display))
+            collision_registers, switches = self._with_held_shapes(self._with_held_rows(
+                self._sampled_registers(self.display_opened, self.sprite_enable & self.sprite_display)))
             bus_registers = self._sampled_registers(self.bad_lines_allowed, self.sprite_enable)
         else:
             collision_registers = bus_registers = self.registers
-        self.state = self.state.with_registers(collision_registers, bad_lines=self.bad_lines_allowed)
+        self.state = self.state.with_registers(collision_registers, bad_lines=self.bad_lines_allowed,
+                                               sprite_switches=switches)
         self._schedule = self._schedule_for(self.state)
         self._bus = bus_schedule(self.video, bus_registers)
 
@@ -512,8 +573,10 @@ class VicDevice:
 
     def write(self, address: int, value: int, cycle: int) -> None:
         t = self.time(cycle)
-        self._advance(t + 1)  # what is drawn up to and including this cycle used the old value
         register = address % MIRROR_SIZE
+        # what is drawn up to and including this cycle used the old value; but $D01D/$D01C are taken
+        # within the cycle: its first pixels are the old setting's in the switched rows (below)
+        self._advance(t if register in _SWITCH_PIXEL else t + 1)
         if register >= REGISTER_COUNT or register in _READ_ONLY:
             return
         if register == REG_IRQ_LATCH:
@@ -523,6 +586,8 @@ class VicDevice:
         old = self.registers[register]
         if register in _X_SET and old != value & 0xFF:
             self._hold_started_rows(register, value & 0xFF, t + 1)
+        if register in _SWITCH_PIXEL and old != value & 0xFF:
+            self._switch_rows_in_progress(register, value & 0xFF, t)
         old_compare = raster_compare_line(self.registers)
         self.registers[register] = value & 0xFF
         if old == value:

@@ -68,7 +68,7 @@ from retro.chips.vic.constants import (
     Video,
 )
 from retro.chips.vic.graphics import VicMemory, foreground_points
-from retro.chips.vic.sprite_bits import opaque_mask
+from retro.chips.vic.sprite_bits import opaque_mask, row_sources, switched_mask
 from retro.chips.vic.sprite_registers import sprite_x
 
 # Registers whose value changes what collides (the device recomputes its schedule when they change)
@@ -92,16 +92,20 @@ class VicState:
     # False: the frame has no Bad Line (DEN clear in line $30), so an opened border shows the idle
     # byte in every window line (graphics.line_slots); the device sets it from what it sampled
     bad_lines: bool = True
+    # per sprite: the (pixel from the row's start, expand_x, multicolor) switches of a $D01D/$D01C
+    # write within the row being shown (sprite_bits.row_sources); () or all empty: none
+    sprite_switches: tuple[tuple[tuple[int, bool, bool], ...], ...] = ()
 
     def __post_init__(self) -> None:
         if len(self.registers) != REGISTER_COUNT or len(self.sprite_data) != SPRITE_COUNT:
             raise ValueError("VicState needs 47 registers and 8 sprites")
 
-    def with_registers(self, registers: bytes, bad_lines: bool = True) -> "VicState":
-        return replace(self, registers=bytes(registers), bad_lines=bad_lines)
+    def with_registers(self, registers: bytes, bad_lines: bool = True, sprite_switches: tuple = ()) -> "VicState":
+        return replace(self, registers=bytes(registers), bad_lines=bad_lines, sprite_switches=sprite_switches)
 
     def collision_key(self) -> bytes:
-        return bytes(self.registers[r] for r in COLLISION_REGISTERS) + bytes([self.bad_lines]) + self.view_key
+        switched = repr(self.sprite_switches).encode() if any(self.sprite_switches) else b""
+        return bytes(self.registers[r] for r in COLLISION_REGISTERS) + bytes([self.bad_lines]) + switched + self.view_key
 
     def sprite_x(self, n: int) -> int:
         return sprite_x(self.registers, n)
@@ -202,7 +206,9 @@ def sprite_rows(video: Video, y: int, expand_y: bool) -> np.ndarray:
 
 
 @lru_cache(maxsize=512)
-def _sprite_shape(data: bytes, multicolor: bool, expand_x: bool) -> np.ndarray:
+def _sprite_shape(data: bytes, multicolor: bool, expand_x: bool, switches: tuple = ()) -> np.ndarray:
+    if switches:  # a $D01D/$D01C write within the row: as the sequencer goes on drawing it
+        return switched_mask(data, row_sources(expand_x, multicolor, switches))
     mask = opaque_mask(data, multicolor)
     return np.repeat(mask, 2, axis=1) if expand_x else mask
 
@@ -338,12 +344,13 @@ def _columns(video: Video, n: int, slot: int, width: int) -> _Columns:
     return made
 
 
-def _pixels(video: Video, n: int, x: int, y: int, expand_y: bool, data: bytes, multicolor: bool, expand_x: bool):
+def _pixels(video: Video, n: int, x: int, y: int, expand_y: bool, data: bytes, multicolor: bool, expand_x: bool,
+            switches: tuple = ()):
     """(lines with a row, their rows, the columns, line index and column index of each opaque pixel)."""
     slot = start_slot(video, n, x)
     if slot is None:
         return None
-    shape = _sprite_shape(data, multicolor, expand_x)
+    shape = _sprite_shape(data, multicolor, expand_x, switches)
     rows = shown_rows(video, n, y, expand_y, slot)
     row = _columns(video, n, slot, shape.shape[1])
     lines = np.flatnonzero(rows >= 0)
@@ -365,8 +372,8 @@ class _Placed:
 # (or returns it to a place) pays for its placement once.
 @lru_cache(maxsize=4096)
 def _placed(video: Video, n: int, x: int, y: int, expand_y: bool, data: bytes, multicolor: bool,
-            expand_x: bool) -> _Placed | None:
-    found = _pixels(video, n, x, y, expand_y, data, multicolor, expand_x)
+            expand_x: bool, switches: tuple = ()) -> _Placed | None:
+    found = _pixels(video, n, x, y, expand_y, data, multicolor, expand_x, switches)
     if found is None:
         return None
     lines, _, row, i, k = found
@@ -389,7 +396,7 @@ def _sprite_key(state: VicState, n: int) -> tuple | None:
         return None
     return (state.video, n, state.sprite_x(n), state.sprite_y(n), state.sprite_flag(REG_SPRITE_EXPAND_Y, n),
             bytes(state.sprite_data[n][:SPRITE_BYTES]), state.sprite_flag(REG_SPRITE_MULTICOLOR, n),
-            state.sprite_flag(REG_SPRITE_EXPAND_X, n))
+            state.sprite_flag(REG_SPRITE_EXPAND_X, n), state.sprite_switches[n] if state.sprite_switches else ())
 
 
 def _placed_sprite(state: VicState, n: int) -> _Placed | None:
