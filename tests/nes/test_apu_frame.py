@@ -1,7 +1,8 @@
 """The APU frame counter's interrupt (retro/chips/apu_frame.py), each rule against the numbers of its
 source (nesdev wiki "APU Frame Counter", "APU"; blargg's blargg_apu_2005.07.30 readme.txt and
 tests.txt), written here as literals so that changing a constant fails a test; and OAM DMA coming
-after the interrupt poll of the `$4014` write (retro/cpu/mpu.py `stall`; cpu_interrupts_v2 4-irq_and_dma).
+after the interrupt poll of the `$4014` write (retro/cpu/mpu.py `stall`; cpu_interrupts_v2 4-irq_and_dma),
+on a console: the frame IRQ through the I/O ports and the PPU's lines, the PPU's own OAM DMA.
 
 Cycles are machine cycles; the counter's origin is 0, so odd cycles begin an APU cycle (writes there
 restart the sequence 3 cycles later, writes on even cycles 4).
@@ -10,7 +11,9 @@ restart the sequence 3 cycles later, writes on even cycles 4).
 from __future__ import annotations
 
 from retro.chips.apu_frame import FrameCounter
-from retro.cpu import Machine
+from retro.chips.cartridge import read_nrom
+from retro.chips.ines import nrom_image
+from retro.machines.nes import build_nes, ppu_of
 
 NEVER = 1 << 62
 ON_APU_CYCLE = 100_001     # odd: "during an APU cycle"
@@ -103,57 +106,43 @@ def test_power_on_acts_as_a_00_write_10_cycles_before_the_first_instruction():
     assert lines.irq_next == 2 + 29832
 
 
-class _IrqAndDma:
-    """An IRQ line low from `irq_at`; a write to $4014 halts the CPU 513 cycles (OAM DMA)."""
-
-    drives_cpu_lines = True
-    nmi_next = NEVER
-
-    def __init__(self, machine: Machine, irq_at: int) -> None:
-        self.machine, self.irq_next = machine, irq_at
-
-    def irq_low(self, cycle):
-        return cycle >= self.irq_next
-
-    def nmi_edge(self, cycle):
-        return False
-
-    def ba_wait(self, cycle):
-        return 0
-
-    def ba_free(self, cycle):
-        return NEVER
-
-    def read(self, address, cycle):
-        return 0
-
-    def write(self, address, value, cycle):
-        self.machine.mpu.stall(513)
-
-    def peek(self, address):
-        return 0
-
-
-def _return_address_of_irq(irq_at: int) -> int:
-    """STA $4014 (cycles 0-3 of the call, then the DMA), NOP, NOP, RTS; the IRQ handler keeps the
+def _console(body: list[int]):
+    """A console whose NROM PRG holds `body` at $C000 and the IRQ handler at $C100: it keeps the
     pushed PC's low byte at $10 and returns with I set (TSX, LDA $0102,X, STA $10, LDA $0101,X,
-    ORA #$04, STA $0101,X, RTI). `irq_at`: the line low from that cycle of the call."""
-    m = Machine("2a03")
-    device = _IrqAndDma(m, NEVER)
-    m.attach(device, 0x4000, 0x40FF)
-    m.poke(0xC000, [0x8D, 0x14, 0x40, 0xEA, 0xEA, 0x60])
-    m.poke(0xC100, [0xBA, 0xBD, 0x02, 0x01, 0x85, 0x10, 0xBD, 0x01, 0x01, 0x09, 0x04, 0x9D, 0x01, 0x01, 0x40])
-    m.poke(0xFFFE, [0x00, 0xC1])
-    device.irq_next = m.cycle + irq_at
-    m.call(0xC000, p=0x20, budget=2_000)
-    return m.bus.peek(0x10)
+    ORA #$04, STA $0101,X, RTI)."""
+    prg = bytearray([0xEA] * 0x4000)
+    prg[:len(body)] = bytes(body)
+    prg[0x100:0x10F] = bytes([0xBA, 0xBD, 0x02, 0x01, 0x85, 0x10, 0xBD, 0x01, 0x01, 0x09, 0x04, 0x9D, 0x01, 0x01, 0x40])
+    prg[0x3FFE:0x4000] = bytes([0x00, 0xC1])
+    return build_nes(cartridge=read_nrom(nrom_image(bytes(prg), bytes(0x2000), "horizontal"), "test.nes"))
+
+
+def _irq_from(machine, cycle: int) -> bool:
+    """Set the frame flag from machine cycle `cycle` with a $4017 = $00 write 29831 cycles before it,
+    if that write lands on an APU cycle (else no write can: the flag starts only on every other cycle)."""
+    frame_counter = ppu_of(machine).irq_source
+    frame_counter.write_mode(0x00, cycle - 29831)
+    return frame_counter.lines.irq_next == cycle
+
+
+def _return_address_of_irq(irq_at: int) -> tuple[int, int]:
+    """LDA #$02, STA $4014 (OAM DMA; the STA's cycles 0-3 counted from 0), NOP, NOP, RTS on a console
+    with the frame flag set from cycle `irq_at`, after a BIT $10 (3 cycles) where that puts the STA on
+    a cycle the flag can start at: (the pushed PC's low byte counted from the LDA, DMA cycles)."""
+    body = [0xA9, 0x02, 0x8D, 0x14, 0x40, 0xEA, 0xEA, 0x60]
+    for prefix, cycles in (([], 0), ([0x24, 0x10], 3)):
+        machine = _console(prefix + body)
+        if _irq_from(machine, machine.cycle + cycles + 2 + irq_at):
+            machine.call(0xC000, p=0x20, budget=2_000)
+            return machine.bus.peek(0x10) - len(prefix), ppu_of(machine).dma_stalled
+    raise AssertionError(f"no start puts the flag at {irq_at}")
 
 
 def test_an_irq_asserted_during_oam_dma_is_taken_after_the_next_instruction():
-    # the STA polls in its cycle 2; its write (cycle 3) starts the DMA (cycles 4-516); the NOP at
-    # $C003 polls in its first cycle, 517
-    assert _return_address_of_irq(2) == 0x03      # seen by the STA's poll: taken right after it
-    assert _return_address_of_irq(3) == 0x04      # in its write cycle: after the NOP
-    assert _return_address_of_irq(500) == 0x04    # during the DMA: after the NOP, not before it
-    assert _return_address_of_irq(517) == 0x04
-    assert _return_address_of_irq(518) == 0x05
+    # the STA polls in its cycle 2; its write (cycle 3) starts the DMA (cycles 4 .. 3 + dma); the NOP
+    # after it polls in its first cycle, 4 + dma. Pushed PC: 5 (after the STA), 6 (after the NOP), 7.
+    for irq_at in (0, 1, 2, 3, 4, 300, *range(510, 520)):  # the second NOP polls at 6 + dma
+        pushed, dma = _return_address_of_irq(irq_at)
+        assert dma in (513, 514)
+        expected = 0x05 if irq_at <= 2 else 0x06 if irq_at <= 4 + dma else 0x07
+        assert pushed == expected, (irq_at, dma)
