@@ -456,6 +456,65 @@ def _huge_integer(text: str, shown: str) -> str | None:
     return f"{shown}:{line}:{key} an integer of {digits} digits (Python reads at most 4300)"
 
 
+def toml_text(doc: dict, tables: int | None = None) -> str:
+    """`doc` as TOML text that `parse_toml` reads back equal: strings, integers, floats, booleans,
+    dates and times, arrays and tables. A table nested at most `tables` deep is a [section] (an
+    array of them [[sections]]), a deeper one inline ({ k = v }) as specs write their inputs; None:
+    every table a section."""
+    sections: list[str] = []
+    _toml_section(doc, (), tables, sections)
+    return "\n\n".join(sections) + "\n" if sections else ""
+
+
+def toml_value(value) -> str:
+    """One value as inline TOML (a table as { k = v }, an array as [a, b])."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(value)  # inf, -inf, nan and 1e+16 are TOML floats too
+    if isinstance(value, str):
+        return _toml_string(value)
+    if isinstance(value, list):
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{_toml_key(k)} = {toml_value(v)}" for k, v in value.items()) + " }" if value else "{}"
+    if hasattr(value, "isoformat"):  # datetime, date, time as tomllib gives them
+        return value.isoformat()
+    raise TypeError(f"no TOML for {type(value).__name__}")
+
+
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+_TOML_ESCAPES = {"\b": "\\b", "\t": "\\t", "\n": "\\n", "\f": "\\f", "\r": "\\r", '"': '\\"', "\\": "\\\\"}
+_TOML_UNSAFE = re.compile(r'[\x00-\x1f\x7f"\\]')  # what a basic string may not hold as it is
+
+
+def _toml_string(text: str) -> str:
+    return '"' + _TOML_UNSAFE.sub(lambda m: _TOML_ESCAPES.get(m[0], f"\\u{ord(m[0]):04x}"), text) + '"'
+
+
+def _toml_key(key: str) -> str:
+    return key if _BARE_KEY.fullmatch(key) else _toml_string(key)
+
+
+def _toml_section(table: dict, path: tuple[str, ...], tables: int | None, out: list[str],
+                  header: str | None = None) -> None:
+    """`table`'s own keys under `header`, then each of its sections (arrays of tables element by element)."""
+    as_section = tables is None or len(path) < tables
+    nested = {key: value for key, value in table.items() if as_section and (
+        isinstance(value, dict) or isinstance(value, list) and value and all(isinstance(v, dict) for v in value))}
+    lines = [] if header is None else [header]
+    lines += [f"{_toml_key(key)} = {toml_value(value)}" for key, value in table.items() if key not in nested]
+    if lines:
+        out.append("\n".join(lines))
+    for key, value in nested.items():
+        name = ".".join(_toml_key(step) for step in (*path, key))
+        if isinstance(value, dict):
+            _toml_section(value, (*path, key), tables, out, f"[{name}]")
+        else:
+            for item in value:
+                _toml_section(item, (*path, key), tables, out, f"[[{name}]]")
+
+
 def _staged_or(path: str | os.PathLike) -> Path:
     """The temp file of an output the current command has staged but not yet put in place (the demo
     runs the PRG it has just assembled), else the path itself."""
