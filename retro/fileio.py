@@ -93,7 +93,7 @@ class _Session:
 
 
 _session: _Session | None = None
-_recorders: list[set] = []  # reads collected for `cached_reads`
+_recorders: list[set] = []  # reads collected for `cached_reads` and `recording_reads`: (key, shown, stamp)
 
 
 @contextmanager
@@ -134,35 +134,70 @@ def note_input(path: str | os.PathLike, what: str = "file") -> None:
         status = os.stat(path)
     except (OSError, ValueError):
         return
-    _record((status.st_dev, status.st_ino), f"{what} {path}")
+    _record((status.st_dev, status.st_ino), f"{what} {path}", _stamp(path, status))
 
 
-def _record(key: tuple[int, int], shown: str) -> None:
+def _stamp(path: str | os.PathLike, status: os.stat_result) -> tuple:
+    """A file as it was read: its path, size, modification time and inode (an edit or a replacement
+    changes one of them)."""
+    return os.path.abspath(path), status.st_size, status.st_mtime_ns, status.st_ino
+
+
+def _record(key: tuple[int, int], shown: str, stamp: tuple | None = None) -> None:
     if _session is not None:
         _session.inputs.setdefault(key, shown)
     for recorder in _recorders:
-        recorder.add((key, shown))
+        recorder.add((key, shown, stamp))
+
+
+@contextmanager
+def recording_reads() -> Iterator[set]:
+    """The files read through this module inside the block (a cached answer's files too), for
+    `reads_unchanged` to tell later whether anything built from them is stale."""
+    reads: set = set()
+    _recorders.append(reads)
+    try:
+        yield reads
+    finally:
+        _recorders.remove(reads)
+
+
+def reads_unchanged(reads: Iterable[tuple]) -> bool:
+    """Whether every file in `reads` (recording_reads) still has the path, size, modification time
+    and inode it was read with."""
+    for _, _, stamp in reads:
+        if stamp is None:
+            continue
+        try:
+            status = os.stat(stamp[0])
+        except OSError:
+            return False
+        if (status.st_size, status.st_mtime_ns, status.st_ino) != stamp[1:]:
+            return False
+    return True
 
 
 def cached_reads(maxsize: int | None = 128) -> Callable:
-    """functools.lru_cache for a function that reads files: a cached answer records the files the
-    first call read as inputs of the current command again, so a cache never hides an input."""
+    """functools.lru_cache for a function that reads files: an answer is kept while every file the
+    call read is unchanged (path, size, modification time, inode), and a cached answer records those
+    files as inputs of the current command again, so a cache never hides an input."""
     def decorate(function: Callable) -> Callable:
+        stale: dict[tuple, int] = {}  # args whose answer was read again: how often
+
         @functools.lru_cache(maxsize=maxsize)
-        def remembered(*args):
-            reads: set = set()
-            _recorders.append(reads)
-            try:
+        def remembered(generation: int, *args):
+            with recording_reads() as reads:
                 result = function(*args)
-            finally:
-                _recorders.remove(reads)
             return result, tuple(reads)
 
         @functools.wraps(function)
         def cached(*args):
-            result, reads = remembered(*args)
-            for key, shown in reads:
-                _record(key, shown)
+            result, reads = remembered(stale.get(args, 0), *args)
+            if not reads_unchanged(reads):
+                stale[args] = stale.get(args, 0) + 1
+                result, reads = remembered(stale[args], *args)
+            for read in reads:
+                _record(*read)
             return result
 
         cached.cache_clear = remembered.cache_clear
@@ -391,7 +426,7 @@ def read_bytes(path: str | os.PathLike, what: str = "file", limit: int = MAX_INP
     try:
         with open(source, "rb") as stream:
             status = os.fstat(stream.fileno())
-            _record((status.st_dev, status.st_ino), f"{what} {path}")
+            _record((status.st_dev, status.st_ino), f"{what} {path}", _stamp(source, status))
             data = stream.read(limit + 1)  # the file may have grown since it was measured
     except (OSError, ValueError) as exc:
         raise InputError(f"{str(path)[:200]}: cannot read {what}: {getattr(exc, 'strerror', None) or exc}") from None
