@@ -93,7 +93,7 @@ class _Session:
 
 
 _session: _Session | None = None
-_recorders: list[set] = []  # reads collected for `cached_reads`
+_recorders: list[set] = []  # reads collected for `cached_reads` and `recording_reads`: (key, shown, stamp)
 
 
 @contextmanager
@@ -134,35 +134,70 @@ def note_input(path: str | os.PathLike, what: str = "file") -> None:
         status = os.stat(path)
     except (OSError, ValueError):
         return
-    _record((status.st_dev, status.st_ino), f"{what} {path}")
+    _record((status.st_dev, status.st_ino), f"{what} {path}", _stamp(path, status))
 
 
-def _record(key: tuple[int, int], shown: str) -> None:
+def _stamp(path: str | os.PathLike, status: os.stat_result) -> tuple:
+    """A file as it was read: its path, size, modification time and inode (an edit or a replacement
+    changes one of them)."""
+    return os.path.abspath(path), status.st_size, status.st_mtime_ns, status.st_ino
+
+
+def _record(key: tuple[int, int], shown: str, stamp: tuple | None = None) -> None:
     if _session is not None:
         _session.inputs.setdefault(key, shown)
     for recorder in _recorders:
-        recorder.add((key, shown))
+        recorder.add((key, shown, stamp))
+
+
+@contextmanager
+def recording_reads() -> Iterator[set]:
+    """The files read through this module inside the block (a cached answer's files too), for
+    `reads_unchanged` to tell later whether anything built from them is stale."""
+    reads: set = set()
+    _recorders.append(reads)
+    try:
+        yield reads
+    finally:
+        _recorders.remove(reads)
+
+
+def reads_unchanged(reads: Iterable[tuple]) -> bool:
+    """Whether every file in `reads` (recording_reads) still has the path, size, modification time
+    and inode it was read with."""
+    for _, _, stamp in reads:
+        if stamp is None:
+            continue
+        try:
+            status = os.stat(stamp[0])
+        except OSError:
+            return False
+        if (status.st_size, status.st_mtime_ns, status.st_ino) != stamp[1:]:
+            return False
+    return True
 
 
 def cached_reads(maxsize: int | None = 128) -> Callable:
-    """functools.lru_cache for a function that reads files: a cached answer records the files the
-    first call read as inputs of the current command again, so a cache never hides an input."""
+    """functools.lru_cache for a function that reads files: an answer is kept while every file the
+    call read is unchanged (path, size, modification time, inode), and a cached answer records those
+    files as inputs of the current command again, so a cache never hides an input."""
     def decorate(function: Callable) -> Callable:
+        stale: dict[tuple, int] = {}  # args whose answer was read again: how often
+
         @functools.lru_cache(maxsize=maxsize)
-        def remembered(*args):
-            reads: set = set()
-            _recorders.append(reads)
-            try:
+        def remembered(generation: int, *args):
+            with recording_reads() as reads:
                 result = function(*args)
-            finally:
-                _recorders.remove(reads)
             return result, tuple(reads)
 
         @functools.wraps(function)
         def cached(*args):
-            result, reads = remembered(*args)
-            for key, shown in reads:
-                _record(key, shown)
+            result, reads = remembered(stale.get(args, 0), *args)
+            if not reads_unchanged(reads):
+                stale[args] = stale.get(args, 0) + 1
+                result, reads = remembered(stale[args], *args)
+            for read in reads:
+                _record(*read)
             return result
 
         cached.cache_clear = remembered.cache_clear
@@ -391,7 +426,7 @@ def read_bytes(path: str | os.PathLike, what: str = "file", limit: int = MAX_INP
     try:
         with open(source, "rb") as stream:
             status = os.fstat(stream.fileno())
-            _record((status.st_dev, status.st_ino), f"{what} {path}")
+            _record((status.st_dev, status.st_ino), f"{what} {path}", _stamp(source, status))
             data = stream.read(limit + 1)  # the file may have grown since it was measured
     except (OSError, ValueError) as exc:
         raise InputError(f"{str(path)[:200]}: cannot read {what}: {getattr(exc, 'strerror', None) or exc}") from None
@@ -454,6 +489,65 @@ def _huge_integer(text: str, shown: str) -> str | None:
     key = f" {match.group('key').strip(chr(34) + chr(39))}:" if match.group("key") else ""
     digits = sum(c.isdigit() for c in match.group().split("=")[-1])
     return f"{shown}:{line}:{key} an integer of {digits} digits (Python reads at most 4300)"
+
+
+def toml_text(doc: dict, tables: int | None = None) -> str:
+    """`doc` as TOML text that `parse_toml` reads back equal: strings, integers, floats, booleans,
+    dates and times, arrays and tables. A table nested at most `tables` deep is a [section] (an
+    array of them [[sections]]), a deeper one inline ({ k = v }) as specs write their inputs; None:
+    every table a section."""
+    sections: list[str] = []
+    _toml_section(doc, (), tables, sections)
+    return "\n\n".join(sections) + "\n" if sections else ""
+
+
+def toml_value(value) -> str:
+    """One value as inline TOML (a table as { k = v }, an array as [a, b])."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(value)  # inf, -inf, nan and 1e+16 are TOML floats too
+    if isinstance(value, str):
+        return _toml_string(value)
+    if isinstance(value, list):
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{_toml_key(k)} = {toml_value(v)}" for k, v in value.items()) + " }" if value else "{}"
+    if hasattr(value, "isoformat"):  # datetime, date, time as tomllib gives them
+        return value.isoformat()
+    raise TypeError(f"no TOML for {type(value).__name__}")
+
+
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+_TOML_ESCAPES = {"\b": "\\b", "\t": "\\t", "\n": "\\n", "\f": "\\f", "\r": "\\r", '"': '\\"', "\\": "\\\\"}
+_TOML_UNSAFE = re.compile(r'[\x00-\x1f\x7f"\\]')  # what a basic string may not hold as it is
+
+
+def _toml_string(text: str) -> str:
+    return '"' + _TOML_UNSAFE.sub(lambda m: _TOML_ESCAPES.get(m[0], f"\\u{ord(m[0]):04x}"), text) + '"'
+
+
+def _toml_key(key: str) -> str:
+    return key if _BARE_KEY.fullmatch(key) else _toml_string(key)
+
+
+def _toml_section(table: dict, path: tuple[str, ...], tables: int | None, out: list[str],
+                  header: str | None = None) -> None:
+    """`table`'s own keys under `header`, then each of its sections (arrays of tables element by element)."""
+    as_section = tables is None or len(path) < tables
+    nested = {key: value for key, value in table.items() if as_section and (
+        isinstance(value, dict) or isinstance(value, list) and value and all(isinstance(v, dict) for v in value))}
+    lines = [] if header is None else [header]
+    lines += [f"{_toml_key(key)} = {toml_value(value)}" for key, value in table.items() if key not in nested]
+    if lines:
+        out.append("\n".join(lines))
+    for key, value in nested.items():
+        name = ".".join(_toml_key(step) for step in (*path, key))
+        if isinstance(value, dict):
+            _toml_section(value, (*path, key), tables, out, f"[{name}]")
+        else:
+            for item in value:
+                _toml_section(item, (*path, key), tables, out, f"[[{name}]]")
 
 
 def _staged_or(path: str | os.PathLike) -> Path:

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import contextlib
 import io
-import json
 import random
 import shutil
 from pathlib import Path
@@ -14,6 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from retro.cli import main
+from retro.fileio import toml_text
 from retro.paths import SPRITES_DIR
 
 SCALARS = [0, 1, 2, 7, 8, 24, 63, 100, 255, 256, 511, 512, 65535, -1, 10 ** 30, 1.5, True, "x", "$d000", "",
@@ -61,18 +61,6 @@ def _scene(rng: random.Random) -> dict:
     return doc
 
 
-def _toml(value) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, (int, float)):
-        return repr(value)
-    if isinstance(value, str):
-        return json.dumps(value)
-    if isinstance(value, list):
-        return "[" + ", ".join(_toml(v) for v in value) + "]"
-    return "{" + ", ".join(f"{json.dumps(k)} = {_toml(v)}" for k, v in value.items()) + "}"
-
-
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(st.integers(0, 2 ** 32))
 def test_random_scenes_give_a_result_or_one_line(tmp_path: Path, seed: int):
@@ -80,7 +68,7 @@ def test_random_scenes_give_a_result_or_one_line(tmp_path: Path, seed: int):
     shutil.copy(SPRITES_DIR / "ball.spr", tmp_path / "ball.spr")
     doc = _scene(rng)
     path = tmp_path / "scene.toml"
-    path.write_text("\n".join(f"{json.dumps(k)} = {_toml(v)}" for k, v in doc.items()))
+    path.write_text(toml_text(doc))
     err = io.StringIO()
     command = "nes" if doc["chip"] == "nes" else "vic"
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):

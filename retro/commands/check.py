@@ -338,8 +338,9 @@ def _run_lines(check: RoutineCheck) -> list[str]:
 
 
 def _scene_engine(check: RoutineCheck) -> str:
-    if check.engine == "batch":
-        return "the batched core, each lane stalled as on the scene"
+    if check.engine == "batch":  # stalls per lane as on the scene: the VIC-II's Bad Lines and sprite DMA
+        stalled = "each lane stalled as on the scene" if check.totals.stolen_max else "no call stalled on the scene"
+        return f"the batched core, {stalled}"
     if check.engine_reason.startswith(FREE_REASON):
         return "Machine (--engine scalar, or too few cases for the batched core to pay)"
     return "Machine"

@@ -16,6 +16,8 @@ from retro.analysis.console_run import DEFAULT_FRAMES, MAX_FRAMES
 from retro.errors import InputError
 from retro.fileio import file_option
 from retro.numbers import parse_int
+from retro.routines.chip_access import NesStart
+from retro.routines.runner import RasterStart
 from retro.workers import MAX_WORKERS, SCHEDULER_ENV
 
 
@@ -110,10 +112,10 @@ MAX_AT = 1000  # above every chip's line, cycle and dot count: the scene's chip 
 NEEDS_NES = "needs a NES scene (--scene with chip = \"nes\")"
 
 
-def scene_start(scene: str | Path | None, at_line: int | str | None = None, at_cycle: int | str | None = None,
-                at_dot: int | str | None = None, in_nmi: bool = False) -> SceneStart | None:
-    """--scene and the `scene_entry` options as a SceneStart (None without a scene), every option
-    checked against the scene's chip before any work starts (one-line errors)."""
+def _scene_options(scene: str | Path | None, at_line: int | str | None, at_cycle: int | str | None,
+                   at_dot: int | str | None, in_nmi: bool) -> SceneStart | None:
+    """--scene and the `scene_entry` options as plain data (None without a scene), each option's own
+    range checked; the scene's chip is not read yet."""
     nes_only = [name for name, given in (("--at-dot", at_dot is not None), ("--in-nmi", in_nmi)) if given]
     if file_option(scene, "--scene") is None:
         if nes_only:
@@ -121,29 +123,44 @@ def scene_start(scene: str | Path | None, at_line: int | str | None = None, at_c
         if at_line is not None or at_cycle is not None:
             raise InputError("--at-line and --at-cycle go with --scene")
         return None
-    start = SceneStart(str(scene), None if at_line is None else parse_int(at_line, field="--at-line", lo=0, hi=MAX_AT),
-                       None if at_cycle is None else parse_int(at_cycle, field="--at-cycle", lo=1, hi=MAX_AT),
-                       None if at_dot is None else parse_int(at_dot, field="--at-dot", lo=0, hi=MAX_AT), in_nmi)
-    start.raster_start()
+    return SceneStart(str(scene), None if at_line is None else parse_int(at_line, field="--at-line", lo=0, hi=MAX_AT),
+                      None if at_cycle is None else parse_int(at_cycle, field="--at-cycle", lo=1, hi=MAX_AT),
+                      None if at_dot is None else parse_int(at_dot, field="--at-dot", lo=0, hi=MAX_AT), in_nmi)
+
+
+def scene_start(scene: str | Path | None, at_line: int | str | None = None, at_cycle: int | str | None = None,
+                at_dot: int | str | None = None, in_nmi: bool = False) -> SceneStart | None:
+    """--scene and the `scene_entry` options as a SceneStart (None without a scene), the plain data a
+    check sends to its workers, every option checked against the scene's chip before any work starts
+    (one-line errors)."""
+    start = _scene_options(scene, at_line, at_cycle, at_dot, in_nmi)
+    if start is not None:
+        start.raster_start()
     return start
 
 
-def call_machine(start: SceneStart | None, cpu: str | None):
+def call_start(scene: str | Path | None, at_line: int | str | None = None, at_cycle: int | str | None = None,
+               at_dot: int | str | None = None, in_nmi: bool = False) -> RasterStart | NesStart | None:
+    """The same options for work done in this process (`retro run --entry`, `retro profile`): the scene
+    read once, as the RasterStart/NesStart its machine is built from (None without a scene)."""
+    start = _scene_options(scene, at_line, at_cycle, at_dot, in_nmi)
+    return None if start is None else start.raster_start()
+
+
+def call_machine(where: RasterStart | NesStart | None, cpu: str | None):
     """The machine one call runs on (`retro run --entry`, `retro profile --entry`): a bare CPU without
-    a scene; with one, its chip where `start` puts the call: a VIC-II's beam at --at-line/--at-cycle
-    (default: the scene's [cpu] start), a NES's PPU at --at-line/--at-dot or the NMI handler's start
-    with the frame drawn so far. Returns (machine, the RasterStart/NesStart or None)."""
+    a scene; with one (`call_start`), its chip where `where` puts the call: a VIC-II's beam at
+    --at-line/--at-cycle (default: the scene's [cpu] start), a NES's PPU at --at-line/--at-dot or the
+    NMI handler's start with the frame drawn so far."""
     from dataclasses import replace
 
     from retro.machines import build_machine
     from retro.machines.nes import enter_frame
-    from retro.routines.chip_access import NesStart
 
-    if start is None:
-        return build_machine(None, cpu=cpu), None
-    where = start.raster_start()
+    if where is None:
+        return build_machine(None, cpu=cpu)
     if isinstance(where, NesStart):
         machine = build_machine(where.scene, cpu=cpu)
         enter_frame(machine, where.entry("jsr"))
-        return machine, where
-    return build_machine(replace(where.scene, start_line=where.line, start_cycle=where.cycle), cpu=cpu), where
+        return machine
+    return build_machine(replace(where.scene, start_line=where.line, start_cycle=where.cycle), cpu=cpu)

@@ -102,7 +102,7 @@ def _call(target, *, entry, labels, load, start, budget) -> ProfileReport:
     from retro.loaders import load_program
 
     program = load_program(target, symbols=file_option(labels, "--labels"), load=load)
-    machine, _ = options.call_machine(start, program.cpu)
+    machine = options.call_machine(start, program.cpu)
     machine.load(program)
     address = machine.resolve(entry, "--entry")
     profiler = _profiler_for(machine)
@@ -120,7 +120,6 @@ def _cases(target, *, start, cases, seed) -> ProfileReport:
     from retro.routines.runner import RoutineRunner
 
     routine = get(str(target))
-    start = None if start is None else start.raster_start()
     seed = routine.seed if seed is None else parse_int(seed, field="--seed", lo=0, hi=2**32 - 1)
     runner = RoutineRunner(routine, seed, start)
     machine = runner.machine
@@ -160,11 +159,11 @@ def profile(target: str | Path, *, entry: str | None = None, frames: int | str |
         if any(v is not None for v in (entry, frames, until, until_value, labels, load)):
             raise InputError("--entry, --frames, --until, --until-value, --labels, --load: not for a routine spec "
                              "(its cases are called as the spec says)")
-        report = _cases(target, start=options.scene_start(scene, at_line, at_cycle, at_dot, in_nmi), cases=cases,
+        report = _cases(target, start=options.call_start(scene, at_line, at_cycle, at_dot, in_nmi), cases=cases,
                         seed=seed)
     elif entry is not None and frames is None and until is None and until_value is None:
         report = _call(target, entry=entry, labels=labels, load=load, budget=budget,
-                       start=options.scene_start(scene, at_line, at_cycle, at_dot, in_nmi))
+                       start=options.call_start(scene, at_line, at_cycle, at_dot, in_nmi))
     else:
         given = [name for name, value in (("--at-line", at_line), ("--at-cycle", at_cycle), ("--at-dot", at_dot),
                                           ("--in-nmi", in_nmi or None)) if value is not None]

@@ -292,8 +292,7 @@ def run(path: str | Path, entry: str | int, *, labels: str | Path | None = None,
     budget = parse_int(budget, field="--budget", lo=1, hi=MAX_BUDGET)
     status = status_with_flags(flags)
     program = _call_program(path, entry, labels, load, cpu)
-    start = options.scene_start(scene, at_line, at_cycle, at_dot, in_nmi)
-    machine = _call_machine(path, program, start, cpu)
+    machine = _call_machine(path, program, options.call_start(scene, at_line, at_cycle, at_dot, in_nmi), cpu)
     memory = dict(parse_assignment(s) for s in sets)
     for target in memory:
         machine.resolve(target, f"--set {target}")
@@ -322,14 +321,14 @@ def _call_program(path: str | Path, entry: str | int, labels, load, cpu: str | N
     return program
 
 
-def _call_machine(path: str | Path, program: Program, start, cpu: str | None) -> Machine:
-    """The machine a call runs on (with the scene's chip where `start` puts the call, for the program's
-    CPU), the program loaded."""
-    scene_cpu = None if start is None else start.raster_start().scene.cpu_variant
+def _call_machine(path: str | Path, program: Program, where, cpu: str | None) -> Machine:
+    """The machine a call runs on (with the scene's chip where `where` (options.call_start) puts the
+    call, for the program's CPU), the program loaded."""
+    scene_cpu = None if where is None else where.scene.cpu_variant
     if scene_cpu is not None and program.cpu and scene_cpu != program.cpu:
-        raise InputError(f"--scene {start.scene}: a scene for the {scene_cpu.upper()}, "
+        raise InputError(f"--scene {where.scene.source}: a scene for the {scene_cpu.upper()}, "
                          f"but {path} is a program for the {program.cpu.upper()}")
-    machine, _ = options.call_machine(start, _cpu(cpu, program, path))
+    machine = options.call_machine(where, _cpu(cpu, program, path))
     machine.load(program)
     return machine
 

@@ -58,6 +58,11 @@ UNSUPPORTED_65C02 = {**UNSUPPORTED, 0x7C: "JMP (abs,X)", 0xCB: "WAI", 0xDB: "STP
 JSR_LENGTH = 3
 
 
+def return_opcodes(interrupt: bool) -> frozenset[int]:
+    """The opcodes that end a routine: RTS, and RTI too when its entry is an interrupt handler."""
+    return frozenset({OPCODE_RTS, OPCODE_RTI}) if interrupt else frozenset({OPCODE_RTS})
+
+
 @dataclass
 class Node:
     pc: int
@@ -197,7 +202,7 @@ def analyse(read: Callable[[int], int], entry: int, loop_bounds: dict[int, int] 
     `mocks` {JSR target: its cycles through its RTS}, `interrupt` (the entry is a handler: its RTI ends
     it), `exits` (reaching one ends it); the interrupt sequence's own cycles are the caller's to add."""
     describe = describe or (lambda a: f"${a:04X}")
-    ends = frozenset({OPCODE_RTS, OPCODE_RTI}) if interrupt else frozenset({OPCODE_RTS})
+    ends = return_opcodes(interrupt)
     if memory is None:
         code: set[int] = set()
         for pc, length in instruction_lengths(read, [entry], within, cpu, ends=ends, exits=exits).items():

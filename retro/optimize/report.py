@@ -8,6 +8,7 @@ import json
 import os
 from pathlib import Path
 
+from retro import fileio
 from retro.analysis.raster import TIMELINES, raster_figures
 
 # [section] keys whose value names a file beside the spec (FILE or FILE.py:FUNCTION)
@@ -73,28 +74,4 @@ def new_spec(doc: dict, spec_dir: Path, out_dir: Path, program_name: str, labels
 
 def toml_text(doc: dict) -> str:
     """TOML for a spec document (scalars and inline tables inside sections, as specs are written)."""
-    top = [f"{key} = {_value(value)}" for key, value in doc.items() if not isinstance(value, dict)]
-    parts = ["\n".join(top)] if top else []
-    for key, value in doc.items():
-        if isinstance(value, dict):
-            lines = [f"[{_key(key)}]"] + [f"{_key(k)} = {_value(v)}" for k, v in value.items()]
-            parts.append("\n".join(lines))
-    return "\n\n".join(parts) + "\n"
-
-
-def _key(key: str) -> str:
-    return key if key.replace("_", "").replace("-", "").isalnum() else json.dumps(key)
-
-
-def _value(value) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, (int, float)):
-        return repr(value)
-    if isinstance(value, str):
-        return json.dumps(value)
-    if isinstance(value, list):
-        return "[" + ", ".join(_value(v) for v in value) + "]"
-    if isinstance(value, dict):
-        return "{ " + ", ".join(f"{_key(k)} = {_value(v)}" for k, v in value.items()) + " }"
-    raise TypeError(type(value))
+    return fileio.toml_text(doc, tables=1)

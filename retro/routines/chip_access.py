@@ -9,14 +9,15 @@ run on the batched core with each instruction's stall added per lane (`BusStalls
 
 `chip_free(...)` decides from the routine's code, statically, and says why. It is conservative:
 when unsure, the answer is no (Machine runs the calls):
-- every instruction reachable from the entry is decoded (`retro.cpu.flow.decode`); an indirect jump,
-  RTI, BRK, or a JSR out of the program make the code unknown;
+- every instruction reachable from the entry is decoded (`retro.cpu.flow.decode`) up to its RTS (an
+  interrupt handler's: RTS or RTI); an indirect jump, any other RTI, BRK, or a JSR out of the program
+  make the code unknown;
 - an access with an absolute address (indexed: the 256 bytes from the base) that reaches a page a
   chip owns touches the chip; an indirect access ((zp,X), (zp),Y, (zp)) might reach anything;
 - a store whose absolute address range meets the routine's own code could rewrite an operand;
 - more pushes (PHA, PHP) than pulls, or TXS, could make an RTS jump where the decoder did not look;
 - with interrupt sources enabled in the scene, an IRQ could come unless I is set on entry and no
-  CLI, PLP or RTI is in the code.
+  CLI, PLP or RTI is in the code (a handler's own closing RTI ends the call: it does not count).
 
 On a NES scene (`NesStart`, `NesCalls`) the PPU steals cycles only through OAM DMA, which takes a
 write to $4014, a chip register: a routine that touches none runs on the batched core with no stall
@@ -30,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from retro.cpu.flow import decode
+from retro.cpu.flow import decode, return_opcodes
 from retro.cpu.timing import timing_of
 from retro.errors import InputError
 from retro.machines.nes import FrameEntry, cycles_to_nmi, enter_frame, frame_entry, nmi_entry, ppu_of
@@ -50,27 +51,29 @@ OPCODE_JSR = 0x20
 
 
 def chip_free(read, entry: int, program: tuple[int, int], chip_pages: frozenset[int], cpu: str,
-              interrupts: bool) -> tuple[bool, str]:
+              interrupts: bool, handler: bool = False) -> tuple[bool, str]:
     """(whether no call can touch a chip register or be interrupted, why) -- module docstring.
     `program` is (first, end) of the program's bytes, `chip_pages` the pages chips own,
     `interrupts` whether the chip has an interrupt source enabled (the caller has checked that I
-    is set on entry)."""
-    code, unknown = _reachable_code(read, entry, program, cpu)
+    is set on entry), `handler` whether the entry is an interrupt handler (its RTI returns)."""
+    code, unknown = _reachable_code(read, entry, program, cpu, return_opcodes(handler))
     if unknown:
         return False, unknown
     mnemonics: set[str] = set()
     for pc in sorted(code):
         op = timing_of(read(pc), cpu)
-        mnemonics.add(op.mnemonic)
+        if not (handler and op.mnemonic == "RTI"):  # the handler's return ends the call, I and all
+            mnemonics.add(op.mnemonic)
         reason = _access_problem(read, pc, op, code, chip_pages)
         if reason:
             return False, reason
     return _stack_and_interrupts(read, code, cpu, interrupts, mnemonics)
 
 
-def _reachable_code(read, entry: int, program: tuple[int, int], cpu: str) -> tuple[dict[int, int], str]:
-    """{address: length} of every instruction reachable from `entry` (JSR callees included), or why
-    the code cannot be followed statically."""
+def _reachable_code(read, entry: int, program: tuple[int, int], cpu: str,
+                    ends: frozenset[int]) -> tuple[dict[int, int], str]:
+    """{address: length} of every instruction reachable from `entry` (JSR callees included) up to the
+    opcodes that return (`ends`), or why the code cannot be followed statically."""
     outside: list[int] = []
 
     def note_call(pc: int, target: int) -> tuple[int, int]:
@@ -86,7 +89,7 @@ def _reachable_code(read, entry: int, program: tuple[int, int], cpu: str) -> tup
             continue
         seen.add(start)
         try:
-            nodes = decode(read, start, note_call, cpu)
+            nodes = decode(read, start, note_call, cpu, ends if start == entry else return_opcodes(False))
         except (InputError, KeyError, ValueError) as exc:
             return code, f"the code is not followed statically ({exc})"
         if outside:
@@ -195,6 +198,7 @@ class NesCalls:
         self.machine = machine
         self.ppu = ppu_of(machine)
         self.entry = start.entry(enter)
+        self.handler = enter != "jsr"
         enter_frame(machine, self.entry)
         self.ppu.dma_stalled = 0
         self._snapshot = self.ppu.snapshot()
@@ -211,7 +215,7 @@ class NesCalls:
     def verdict(self, read, entry: int, program: tuple[int, int], cpu: str, limit: int) -> tuple[bool, str]:
         """Whether the batched core may run the calls (no stall can happen) and why (module docstring)."""
         pages = frozenset(page for page, device in enumerate(self.machine.bus.page_devices) if device is not None)
-        free, why = chip_free(read, entry, program, pages, cpu, False)
+        free, why = chip_free(read, entry, program, pages, cpu, False, self.handler)
         if not free:
             return False, why
         to_nmi = cycles_to_nmi(self.ppu, self.entry)

@@ -277,7 +277,7 @@ class RoutineRunner:
         if interrupts and (not self.plan.base_flags & FLAG_I or any(bit == FLAG_I for _, bit in self.plan.flags)):
             return False, "the scene enables VIC-II interrupts and I may be clear on entry"
         return chip_free(memory.__getitem__, self.entry, (self.program.origin, self.program.end), pages,
-                         self.routine.cpu, interrupts)
+                         self.routine.cpu, interrupts, self.routine.world.enter != "jsr")
 
     @property
     def batch_refusal(self) -> str | None:

@@ -56,10 +56,9 @@ def routine_code(read, entries: list[int], within: tuple[int, int], cpu: str = "
     """{address: length} of every instruction reachable from the entries (following branches, JMP and
     JSR into the program), as the static analysis decodes them (an interrupt handler's RTI and the
     world's exits end a path); code it does not follow counts none."""
-    from retro.cpu.flow import OPCODE_RTI, OPCODE_RTS, instruction_lengths
+    from retro.cpu.flow import instruction_lengths, return_opcodes
 
-    ends = frozenset({OPCODE_RTS, OPCODE_RTI}) if world.enter != "jsr" else frozenset({OPCODE_RTS})
-    return instruction_lengths(read, entries, within, cpu, skip_undecodable=True, ends=ends,
+    return instruction_lengths(read, entries, within, cpu, skip_undecodable=True, ends=return_opcodes(world.enter != "jsr"),
                                exits=frozenset(world.exits))
 
 

@@ -18,6 +18,8 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
+from retro.fileio import toml_text, toml_value
+
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
 
@@ -55,31 +57,6 @@ def _paths(doc, prefix=()) -> Iterator[tuple]:
                 yield from _paths(value, prefix + (i,))
 
 
-def _dump(value) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, (int, float)):
-        return repr(value)
-    if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(value, list):
-        return "[" + ", ".join(_dump(v) for v in value) + "]"
-    if isinstance(value, dict):
-        return "{ " + ", ".join(f'"{k}" = {_dump(v)}' for k, v in value.items()) + " }"
-    raise TypeError(type(value))
-
-
-def dump_toml(doc: dict) -> str:
-    """A TOML document as one root table of inline values (enough for these inputs)."""
-    lines = []
-    for key, value in doc.items():
-        if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
-            lines.append(f'"{key}" = [' + ", ".join(_dump(v) for v in value) + "]")
-        else:
-            lines.append(f'"{key}" = {_dump(value)}')
-    return "\n".join(lines) + "\n"
-
-
 def _replace(doc, path: tuple, marker: str):
     """A deep copy of doc with the value at path replaced by a marker string."""
     if not path:
@@ -97,10 +74,10 @@ def _mutations(text: str) -> Iterator[tuple[str, str, str]]:
     """(description, TOML text, the key) for every key path of a document and every hostile value."""
     doc = tomllib.loads(text)
     for path in _paths(doc):
-        template = dump_toml(_replace(doc, path, MARKER))
+        template = toml_text(_replace(doc, path, MARKER))
         key = next(str(step) for step in reversed(path) if not isinstance(step, int))
         for value in HOSTILE_TOML:
-            yield ".".join(map(str, path)) + " = " + value[:20], template.replace(_dump(MARKER), value), key
+            yield ".".join(map(str, path)) + " = " + value[:20], template.replace(toml_value(MARKER), value), key
 
 
 def _files_of(folder: Path, names: list[str]) -> dict:

@@ -37,7 +37,9 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tests" / "formats"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from corpus import _dump, _paths, _replace, dump_toml  # noqa: E402  (the corpus's TOML writer)
+from corpus import _paths, _replace  # noqa: E402
+
+from retro.fileio import toml_text, toml_value  # noqa: E402
 
 SEEDS = (0x6502, 0x2A03)  # the fuzzer's seed numbers: each gives its own random places
 FLIPS_PER_SEED = 6
@@ -282,11 +284,11 @@ def _toml_mutations(seed: Seed) -> Iterator[tuple[str, bytes, str]]:
     doc = tomllib.loads(seed.data.decode())
     marker = "@@FUZZ@@"
     for path in _paths(doc):
-        template = dump_toml(_replace(doc, path, marker))
+        template = toml_text(_replace(doc, path, marker))
         key = ".".join(map(str, path))
         last = next(str(p) for p in reversed(path) if not isinstance(p, int))
         for kind, value in WRONG_TYPES.items():
-            yield f"{key} = {kind}", template.replace(_dump(marker), value).encode(), last
+            yield f"{key} = {kind}", template.replace(toml_value(marker), value).encode(), last
 
 
 def _json_paths(doc, prefix=()):

@@ -34,7 +34,7 @@ def _spec(tmp_path: Path, name: str, source: str, *, inputs: str = 'a = "A"', ou
 
 
 def _scene(tmp_path: Path, ctrl: int = 0) -> str:
-    path = tmp_path / f"scene_{ctrl}.toml"  # one file per content: checks in one process cache runners by path
+    path = tmp_path / f"scene_{ctrl}.toml"
     path.write_text(f'chip = "nes"\n[ppu]\nctrl = {ctrl}\n[[oam]]\ny = 100\ntile = 0\nx = 100\n')
     return str(path)
 

@@ -14,6 +14,7 @@ from retro.analysis.check.coverage import count_steps, from_lanes
 from retro.analysis.check.results import describe_outputs
 from retro.analysis.coverage_model import CodeCoverage
 from retro.errors import InputError, RunError
+from retro.fileio import reads_unchanged, recording_reads
 from retro.routines import cases as case_sets
 from retro.routines.chip_access import NesStart
 from retro.routines.outputs import row_of
@@ -32,7 +33,7 @@ AUTO_COMPILED_CASES = 16_000_000  # planned cases from which "auto" takes the co
 AGREEMENT_PER_PART = 2_000  # cases of each part also run on Machine when the batched core runs the check
 TRACE_SHOWN = 400  # instructions of the first failing case's trace in the report
 
-_RUNNERS: dict[tuple, RoutineRunner] = {}
+_RUNNERS: dict[tuple, tuple[set, RoutineRunner]] = {}  # the files a runner was built from (fileio), it
 _BUILT: dict[str, Routine] = {}  # specs built in Python (retro.testing), by a key standing for their path
 _BUILT_PREFIX = "<built>:"
 
@@ -98,11 +99,18 @@ def nes_start(scene, line: int | None, dot: int | None, in_nmi: bool, cycle: int
 
 
 def runner_for(spec: str, seed: int, start: SceneStart | None = None, fill: str | None = None) -> RoutineRunner:
-    """The cached runner of a spec (`fill`: an entry-state variant's, retro.routines.entry)."""
+    """The cached runner of a spec (`fill`: an entry-state variant's, retro.routines.entry), built
+    again when a file it was built from changed since (the spec, its program, the scene, the scene's
+    sprite files): a file edited between two checks in one process (a notebook, the pytest plugin)
+    is never run stale."""
     key = (str(spec), seed, start, fill)
-    if key not in _RUNNERS:
-        _RUNNERS[key] = RoutineRunner(routine_of(str(spec)), seed, start.raster_start() if start else None, fill)
-    return _RUNNERS[key]
+    cached = _RUNNERS.get(key)
+    if cached is not None and reads_unchanged(cached[0]):
+        return cached[1]
+    with recording_reads() as reads:
+        runner = RoutineRunner(routine_of(str(spec)), seed, start.raster_start() if start else None, fill)
+    _RUNNERS[key] = reads, runner
+    return runner
 
 
 @dataclass
