@@ -82,8 +82,11 @@ def live_after(listing: Listing, at_return: frozenset) -> list[frozenset]:
         for i in reversed(range(len(instructions))):
             instruction = instructions[i]
             name = instruction.mnemonic
+            local_jump = name == "JMP" and isinstance(instruction.target, str)  # to a label of the routine
             if name == "RTS":
                 out = at_return
+            elif local_jump:
+                out = live_in[where[instruction.target]]
             elif name in ("JMP", "JSR", "RTI", "BRK") or not known(instruction):
                 out = everything
             else:
@@ -92,7 +95,7 @@ def live_after(listing: Listing, at_return: frozenset) -> list[frozenset]:
                     target = instruction.target
                     out = out | (live_in[where[target]] if isinstance(target, str) else everything)
             reads, writes, read_memory, written = effects(instruction)
-            if name == "RTS":
+            if name == "RTS" or local_jump:
                 incoming = out
             elif name in ("RTI", "JMP", "JSR", "BRK") or not known(instruction):
                 incoming = everything

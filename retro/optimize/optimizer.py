@@ -15,6 +15,7 @@ from retro.errors import InputError, RunError
 from retro.optimize.code import Instruction, Listing, assemble, code_bytes, program_with, read_listing
 from retro.optimize.effects import ALL_MEMORY, live_after, windowable
 from retro.optimize.evaluate import LaneRunner, Proof, Prover, outputs_equal, sample_cases, scratch_of
+from retro.optimize.flow import rewrites as flow_rewrites
 from retro.optimize.stochastic import rewrite
 from retro.optimize.search import (BRANCHES, BRK, END, FLAG_BITS, Executor, cycles_of, enumerate_window,
                                    instruction_pool, rank, state_of, state_ports)
@@ -61,8 +62,9 @@ class Change:
     start: int
     removed: tuple[Instruction, ...]
     added: tuple[Instruction, ...]
-    kind: str  # "window" or "synthesis"
+    kind: str  # "window", "synthesis", "flow" or "stochastic"
     proof: Proof
+    what: str = ""  # a flow rewrite: which (retro.optimize.flow)
 
 
 @dataclass
@@ -215,6 +217,15 @@ class Search:
         improved = True
         while improved and self.options.windows and time.monotonic() < deadline:
             improved = False
+            flowed = self.flow_change(current, outcome, best_score)
+            if flowed is not None:
+                current, best_score, change = flowed
+                outcome.changes.append(change)
+                outcome.best, outcome.best_proof = current, change.proof
+                self.progress(f"flow: {change.what}; worst {change.proof.cycles['max']}, mean "
+                              f"{change.proof.cycles['mean']:.2f}, {code_bytes(current)} bytes")
+                improved = True
+                continue
             for start, stop, kind in self.windows(current):
                 if time.monotonic() > deadline:
                     outcome.complete = False
@@ -339,20 +350,33 @@ class Search:
             if kind == "window" and tuple(sequence) == tuple(window):
                 continue
             new = self.replaced(listing, start, stop, sequence)
-            new_code = assemble(new, cpu)
-            if new_code is None or len(new_code) > self.size:
-                continue
-            outcome.routine_tests += 1
-            if not self.sample_ok(new_code):
-                continue
-            proof = self.proven(new_code, outcome)
-            if not proof.passed:
-                continue
-            if self.options.no_slower and proof.slower:
-                continue
-            new_score = score(objective, proof, len(new_code))
-            if new_score < best_score:
-                return new, new_score, Change(start, tuple(window), tuple(sequence), kind, proof)
+            better = self.better(new, outcome, best_score)
+            if better is not None:
+                return new, better[0], Change(start, tuple(window), tuple(sequence), kind, better[1])
+        return None
+
+    def better(self, new: Listing, outcome: Outcome, best_score: tuple) -> tuple[tuple, Proof] | None:
+        """(score, proof) of a candidate listing that fits, passes the samples and its proof (and
+        --no-slower) with a better score than `best_score`; else None."""
+        new_code = assemble(new, self.routine.cpu)
+        if new_code is None or len(new_code) > self.size:
+            return None
+        outcome.routine_tests += 1
+        if not self.sample_ok(new_code):
+            return None
+        proof = self.proven(new_code, outcome)
+        if not proof.passed or (self.options.no_slower and proof.slower):
+            return None
+        new_score = score(self.options.objective, proof, len(new_code))
+        return (new_score, proof) if new_score < best_score else None
+
+    def flow_change(self, listing: Listing, outcome: Outcome, best_score: tuple):
+        """The first control-flow rewrite (retro.optimize.flow) that is proven and better, as
+        (listing, score, change), or None."""
+        for what, new in flow_rewrites(listing):
+            better = self.better(new, outcome, best_score)
+            if better is not None:
+                return new, better[0], Change(0, listing.instructions, new.instructions, "flow", better[1], what)
         return None
 
     def proven(self, code: bytes, outcome: Outcome) -> Proof:
