@@ -13,8 +13,9 @@ import numpy as np
 from retro.cpu.batch import LaneError
 from retro.errors import InputError, RunError
 from retro.optimize.code import Instruction, Listing, assemble, code_bytes, program_with, read_listing
-from retro.optimize.effects import ALL_MEMORY, live_after, windowable
+from retro.optimize.effects import ALL_MEMORY, live_after, windowable, writes_through_index
 from retro.optimize.evaluate import LaneRunner, Proof, Prover, outputs_equal, sample_cases, scratch_of
+from retro.optimize.facts import entry_facts, facts_before, window_agrees
 from retro.optimize.flow import rewrites as flow_rewrites
 from retro.optimize.stochastic import rewrite
 from retro.optimize.search import (BRANCHES, BRK, END, FLAG_BITS, Executor, cycles_of, enumerate_window,
@@ -86,6 +87,7 @@ class Outcome:
     complete: bool = True  # every window was searched to its length within the budget
     windows: int = 0
     rewrites: int = 0  # stochastic moves tried
+    local_rejections: int = 0  # window changes that differ from the window on an entry state the facts allow
     program: object = None  # the new Program
 
 
@@ -100,6 +102,7 @@ def preserved_ports(names: tuple[str, ...]) -> tuple[Port, ...]:
 def direct_addresses(routine: Routine, listing: Listing) -> tuple[int, ...]:
     """Addresses the search may read and write: the routine's direct operands and its ports in memory."""
     found = {i.operand for i in listing.instructions if i.mode in ("zpg", "abs") and i.target is None}
+    found.update(b for i in listing.instructions if i.mode == "iny" for b in (i.operand, (i.operand + 1) & 0xFF))
     for port in routine.inputs + routine.outputs:
         if port.via is None:
             found.update(p.address for p in port.places if p.kind == "memory")
@@ -155,6 +158,10 @@ class Search:
         if original != routine.program.code[start:start + len(original)]:
             raise InputError(f"{routine.spec_path}: the routine's code does not assemble back to its bytes")
         self.addresses = direct_addresses(routine, self.listing)
+        # a window may read through an index when every byte it can read that differs between cases
+        # is one the search's states hold: nothing written through an index, no input behind a pointer
+        self.indexed_reads = not any(writes_through_index(i) for i in self.listing.instructions) and not any(
+            port.via is not None for port in routine.inputs + routine.outputs)
         self.scratch = scratch_of(routine, self.addresses)
         preserve = preserved_ports(options.preserve)
         self.preserve = preserve
@@ -301,7 +308,7 @@ class Search:
         for length in range(1, min(self.options.window, n) + 1):  # short windows first: cheap, and most gains
             for start in range(n - length + 1):
                 stop = start + length
-                if all(windowable(i) for i in instructions[start:stop]) and not any(
+                if all(windowable(i, self.indexed_reads) for i in instructions[start:stop]) and not any(
                         k in targets for k in range(start + 1, stop)):
                     yield start, stop, "window"
 
@@ -335,6 +342,7 @@ class Search:
             for instruction in window:
                 target = executor.step(target, instruction)
             live = live_after(listing, self.at_return)[stop - 1]
+            entry_facts_at = facts_before(listing, entry_facts(self.routine.entry_state))[start] or frozenset()
             bound = rank(objective, target.filled().cycles[None, :], addresses[stop] - addresses[start])[0]
             length = stop - start
         share = max(self.options.budget / (2 if kind == "synthesis" else WINDOW_SHARE), MIN_WINDOW_SECONDS)
@@ -348,6 +356,10 @@ class Search:
                 outcome.complete = False
                 break
             if kind == "window" and tuple(sequence) == tuple(window):
+                continue
+            if kind == "window" and self.prover.kind != "exhaustive" and not window_agrees(
+                    executor, window, sequence, live, entry_facts_at):
+                outcome.local_rejections += 1  # a sampled proof alone would not stand behind it
                 continue
             new = self.replaced(listing, start, stop, sequence)
             better = self.better(new, outcome, best_score)

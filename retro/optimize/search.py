@@ -23,7 +23,7 @@ from retro.cpu.disassembly import opcode_table
 from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z
 from retro.cpu.timing import BRANCH_CONDITIONS, BRANCH_TAKEN_CYCLES
 from retro.optimize.code import Instruction, Listing, opcode_of
-from retro.optimize.effects import ALL_MEMORY, STORES
+from retro.optimize.effects import ALL_MEMORY, INDEXED_READ_MODES, STORES
 from retro.routines.places import Place, Port
 
 FLAG_BITS = {"C": FLAG_C, "Z": FLAG_Z, "I": FLAG_I, "D": FLAG_D, "V": FLAG_V, "N": FLAG_N}
@@ -95,6 +95,9 @@ class Executor:
         address = operand if instruction.mode in ("zpg", "abs") else None
         if address is not None:
             cpu.memory.fill(address, state.memory[address].reshape(n))
+        elif instruction.mode in INDEXED_READ_MODES:  # the address is per lane: every byte the state holds
+            for at, values in state.memory.items():
+                cpu.memory.fill(at, values.reshape(n))
         group = Lanes(cpu, slice(None), state.a.reshape(n).copy(), state.x.reshape(n).copy(),
                       state.y.reshape(n).copy(), state.p.reshape(n).copy(), np.full(n, 0xFD, dtype=np.int32),
                       np.zeros(n, dtype=np.int64))

@@ -22,28 +22,40 @@ FULL = os.environ.get("RETRO_EXHAUSTIVE") == "1"
 BUDGET = 600.0 if FULL else 12.0  # the issue's 10 minutes on 2 cores; CI: what finds the single waste
 
 
-@pytest.fixture(scope="module")
-def aabb8_cost():
-    check = check_routine(str(ASM_DIR / "aabb8.toml"), search_budget=0)
-    routine = load_spec(ASM_DIR / "aabb8.toml")
-    listing = read_listing(routine.program, routine.entry_address, routine.cpu)
-    return check.totals.cycles_max, code_bytes(listing)
+_REAL_COSTS: dict = {}
 
 
-@pytest.mark.parametrize("name, waste", [
+def real_cost(base: str) -> tuple[int, int]:
+    """(worst cycles, code bytes) of the real routine, from `retro check` and its listing."""
+    if base not in _REAL_COSTS:
+        check = check_routine(str(ASM_DIR / f"{base}.toml"), search_budget=0)
+        routine = load_spec(ASM_DIR / f"{base}.toml")
+        listing = read_listing(routine.program, routine.entry_address, routine.cpu)
+        _REAL_COSTS[base] = check.totals.cycles_max, code_bytes(listing)
+    return _REAL_COSTS[base]
+
+
+WASTES = [
     ("aabb8_sec", "a SEC where the carry is set already"),
     ("aabb8_txa", "a store and loads where TXA does"),
     ("aabb8_jmp", "a BCC over a JMP where a BCS falls through"),
     ("aabb8_cmp", "a CMP repeating the carry it already holds"),
-])
-def test_a_wasteful_aabb8_reaches_the_real_cost(tmp_path, aabb8_cost, name, waste):
-    worst, size = aabb8_cost
+    ("tile_reload", "a table entry read again through Y (an indexed window)"),
+    ("tile_tax", "a store and a load where TAX does"),
+    ("tile_jmp", "a BCC over a JMP where a BCS falls through"),
+    ("tile_cmp", "a CPY #0 repeating the flags LDY set"),
+]
+
+
+@pytest.mark.parametrize("name, waste", WASTES, ids=[w[0] for w in WASTES])
+def test_a_wasteful_routine_reaches_the_real_cost(tmp_path, name, waste):
+    worst, size = real_cost(name.split("_")[0])
     spec = WASTEFUL / f"{name}.toml"
     result = optimize_command(str(spec), budget=BUDGET, out=str(tmp_path))
     assert result.before["bytes"] > size, waste
     assert result.after["worst"] <= worst and result.after["bytes"] <= size, waste
     check = check_routine(str(tmp_path / f"{name}_optimized.toml"), search_budget=0)
-    assert not failed([check]) and check.totals.cycles_max == result.after["worst"]
+    assert not failed([check]) and check.totals.cycles_max <= result.after["worst"]
 
 
 # ---- the control-flow rewrites (retro.optimize.flow) ----------------------------------------------
@@ -78,3 +90,62 @@ def test_a_block_reached_only_by_a_jmp_moves_to_it():
     assert _names(moved) == [("LDA", 1), ("STA", 0x10), ("RTS", None), ("LDA", 2), ("RTS", None)]
     assert dict(moved.labels) == {"far": 1, "mid": 3} and assemble(moved) is not None
     assert _names(found["the blocks a JMP went over moved to the end"]) == _names(moved)
+
+
+# ---- facts at a window's entry (retro.optimize.facts) --------------------------------------------
+
+def _listing_of(name):
+    routine = load_spec(WASTEFUL / f"{name}.toml")
+    return routine, read_listing(routine.program, routine.entry_address, routine.cpu)
+
+
+def test_facts_know_the_carry_a_branch_and_a_compare_leave():
+    from retro.optimize.facts import entry_facts, facts_before
+    routine, listing = _listing_of("aabb8_cmp")
+    facts = facts_before(listing, entry_facts(routine.entry_state))
+    at = dict(listing.labels)["_b_left"]
+    assert listing.instructions[at].mnemonic == "CMP"
+    assert {("const", "C", 1), ("carry", "A", 0x12), ("const", "D", 0)} <= facts[at]
+    after_cmp = facts[at + 1]
+    assert ("carry", "A", 0x12) in after_cmp and ("const", "C", 1) not in after_cmp  # CMP wrote C
+    assert ("const", "C", 1) in facts[6]  # BCC _out not taken: C set (the SEC-free path of aabb8)
+
+
+def test_facts_see_a_stored_register_as_the_byte():
+    from retro.optimize.facts import facts_before
+    routine, listing = _listing_of("aabb8_txa")
+    facts = facts_before(listing)
+    loads = [k for k, i in enumerate(listing.instructions) if i.mnemonic == "LDA" and i.operand == 0x16]
+    assert len(loads) == 2 and all(("eq", 0x16, "X") in facts[k] for k in loads)
+
+
+def test_a_window_change_wrong_on_an_unsampled_state_is_refused():
+    """At aabb8's `_c1_a_above` (C clear, A = ay - by - 1 mod 256): `SBC #0 / CLC` and `ADC #$FE`
+    agree on most A but not on A = 1 (ay = 0, by = 255), a state the samples may miss; the facts
+    check runs every A the facts allow and refuses it. `SEC` where the carry is set is allowed."""
+    from retro.optimize.code import Instruction
+    from retro.optimize.facts import window_agrees
+    from retro.optimize.search import Executor
+    executor = Executor("6510", bytes(0x10000), 1, 0xC000)
+    facts = frozenset({("const", "C", 0), ("const", "D", 0)})
+    live = frozenset("ACD") | {0x11}
+    window = (Instruction("SBC", "imm", 0), Instruction("CLC", "imp"))
+    assert window_agrees(executor, window, (Instruction("ADC", "imm", 0xFE),), live, facts) is False
+    assert window_agrees(executor, window, window, live, facts) is True
+    sec = (Instruction("SEC", "imp"),)
+    assert window_agrees(executor, sec, (), frozenset("AC"), frozenset({("const", "C", 1)})) is True
+    assert window_agrees(executor, sec, (), frozenset("AC"), frozenset()) is False
+    cmp = (Instruction("CMP", "zpg", 0x12),)
+    known = frozenset({("const", "C", 1), ("carry", "A", 0x12)})
+    assert window_agrees(executor, cmp, (), frozenset("AC"), known) is True
+    assert window_agrees(executor, cmp, (), frozenset("AC"), frozenset({("const", "C", 1)})) is False
+
+
+@pytest.mark.exhaustive
+def test_a_wasteful_aabb8_result_passes_the_exhaustive_sweep(tmp_path):
+    """The windows' changes on aabb8 stand on a sampled proof: the facts check must keep out the
+    ones the sweep (`retro check --exhaustive`) would fail."""
+    result = optimize_command(str(WASTEFUL / "aabb8_sec.toml"), budget=BUDGET, out=str(tmp_path))
+    assert result.proof["kind"] == "sampled"
+    check = check_routine(str(tmp_path / "aabb8_sec_optimized.toml"), exhaustive=True, search_budget=0)
+    assert not failed([check])
