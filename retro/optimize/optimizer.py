@@ -305,11 +305,19 @@ class Search:
             self.synthesised = True  # once: a second run on its own result would search the same space again
             yield 0, n - 1, "synthesis"
         targets = listing.targets
+        where = dict(listing.labels)
+
+        def fits(instruction, stop: int) -> bool:  # straight-line, or a branch to the window's end (a join)
+            if instruction.is_branch:
+                return (instruction.mnemonic in BRANCHES and isinstance(instruction.target, str)
+                        and where[instruction.target] == stop)
+            return windowable(instruction, self.indexed_reads)
+
         for length in range(1, min(self.options.window, n) + 1):  # short windows first: cheap, and most gains
             for start in range(n - length + 1):
                 stop = start + length
-                if all(windowable(i, self.indexed_reads) for i in instructions[start:stop]) and not any(
-                        k in targets for k in range(start + 1, stop)):
+                if all(fits(i, stop) for i in instructions[start:stop]) and not any(
+                        k in targets for k in range(start + 1, stop)) and not instructions[stop - 1].is_branch:
                     yield start, stop, "window"
 
     def search_window(self, listing: Listing, start: int, stop: int, kind: str, deadline: float,
@@ -338,6 +346,9 @@ class Search:
             length = max(self.options.window, SYNTHESIS_LENGTH)
             pool = [i for i in pool if i.mode != "rel"] + [Instruction(b, "rel", target=END) for b in BRANCHES]
         else:
+            window = tuple(replace(i, target=END) if i.is_branch else i for i in window)  # branches to the join
+            if any(i.is_branch for i in window):
+                pool = [i for i in pool if not i.is_branch] + [Instruction(b, "rel", target=END) for b in BRANCHES]
             target = state
             for instruction in window:
                 target = executor.step(target, instruction)

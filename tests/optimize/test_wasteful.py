@@ -149,3 +149,21 @@ def test_a_wasteful_aabb8_result_passes_the_exhaustive_sweep(tmp_path):
     assert result.proof["kind"] == "sampled"
     check = check_routine(str(tmp_path / "aabb8_sec_optimized.toml"), exhaustive=True, search_budget=0)
     assert not failed([check])
+
+
+def test_a_window_spans_a_branch_and_its_join():
+    from retro.optimize.optimizer import Options, optimize
+    outcome = optimize(load_spec(WASTEFUL / "join.toml"), Options(budget=10, synthesis=False, stochastic=False))
+    assert [(c.kind, [i.mnemonic for i in c.removed], c.added) for c in outcome.changes] == [
+        ("window", ["BCC", "CLC"], ())]
+    assert outcome.best_proof.kind == "exhaustive" and outcome.best_proof.cycles["max"] == 14
+
+
+def test_a_window_reads_through_an_index():
+    """tile_reload's second `LDA tile_rowhi,Y` goes by a window alone (no rewriting, no synthesis)."""
+    from retro.optimize.optimizer import Options, optimize
+    outcome = optimize(load_spec(WASTEFUL / "tile_reload.toml"), Options(budget=BUDGET, synthesis=False,
+                                                                         stochastic=False))
+    removed = [i for c in outcome.changes for i in c.removed]
+    assert any(i.mnemonic == "LDA" and i.mode == "aby" for i in removed)
+    assert outcome.best_proof.kind == "exhaustive" and outcome.best_proof.passed
