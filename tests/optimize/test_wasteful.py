@@ -167,3 +167,17 @@ def test_a_window_reads_through_an_index():
     removed = [i for c in outcome.changes for i in c.removed]
     assert any(i.mnemonic == "LDA" and i.mode == "aby" for i in removed)
     assert outcome.best_proof.kind == "exhaustive" and outcome.best_proof.passed
+
+
+@pytest.mark.exhaustive
+def test_every_waste_at_once_goes(tmp_path):
+    """aabb8_all holds the four aabb8 wastes together: they go one by one (about a minute on the
+    shared machine). The bounded form (CI, 20 s) asks for progress and a result `retro check` passes."""
+    worst, size = real_cost("aabb8")
+    result = optimize_command(str(WASTEFUL / "aabb8_all.toml"), budget=BUDGET, out=str(tmp_path))
+    assert result.before["worst"] > worst and result.before["bytes"] > size
+    assert result.after["worst"] < result.before["worst"]
+    if FULL:
+        assert result.after["worst"] <= worst and result.after["bytes"] <= size
+    check = check_routine(str(tmp_path / "aabb8_all_optimized.toml"), search_budget=0)
+    assert not failed([check])
