@@ -5,6 +5,7 @@ diff of the listings, the proof record and a spec for the new routine that `retr
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from dataclasses import dataclass, replace
 
@@ -19,7 +20,9 @@ from retro.optimize.optimizer import DEFAULT_WINDOW, OBJECTIVES, Options, Outcom
 from retro.optimize.report import cost_row, cost_table, listing_diff, new_spec, toml_text
 from retro.optimize.syntax import SYNTAXES, format_source, plain_lines
 from retro.program import format_vice_labels, prg_bytes
+from retro.numbers import parse_int
 from retro.routines.spec import load_spec, read_spec_document
+from retro.workers import MAX_WORKERS, SCHEDULER_ENV
 
 SOURCE_SUFFIX = {"ca65": ".s", "ophis": ".oph", "kickass": ".asm", "dasm": ".asm", "xa": ".a65", "acme": ".a",
                  "64tass": ".asm"}
@@ -50,9 +53,13 @@ def _labels(listing: Listing) -> dict[str, int]:
 @all_or_nothing
 def optimize(spec: str, *, objective: str = "worst", no_slower: bool = False, budget: float = 30.0,
              window: int = DEFAULT_WINDOW, seed: int | None = None, preserve: tuple[str, ...] = (),
-             syntax: str = "acme", out: str = "optimized", progress=None) -> Optimized:
-    """Search for a faster routine for `spec`; every result is proven before it is reported."""
-    opts = Options(objective, no_slower, budget, window, seed, tuple(p.upper() for p in preserve))
+             syntax: str = "acme", out: str = "optimized", progress=None, jobs: int = 1,
+             scheduler: str | None = None) -> Optimized:
+    """Search for a faster routine for `spec`; every result is proven before it is reported. The
+    search's work units run in this process (`jobs` 1), on `jobs` local Dask workers, or on the
+    cluster at `scheduler` (retro.workers)."""
+    opts = Options(objective, no_slower, budget, window, seed, tuple(p.upper() for p in preserve), jobs=jobs,
+                   scheduler=scheduler)
     check_options(opts)
     if syntax not in SYNTAXES:
         raise InputError(f"--syntax: {syntax!r} is not one of {', '.join(SYNTAXES)}")
@@ -145,6 +152,8 @@ def add_options(p: argparse.ArgumentParser) -> None:
                    help="registers and flags left as the original leaves them, e.g. X,Y,C (default: only the outputs)")
     p.add_argument("--syntax", default="acme", help=f"source syntax: {', '.join(SYNTAXES)} (default acme)")
     options.out(p, "optimized")
+    options.jobs(p, 1)
+    options.scheduler(p)
     p.add_argument("--json", action="store_true", help="print the result as JSON")
 
 
@@ -152,6 +161,8 @@ def main(args: argparse.Namespace) -> int:
     preserve = tuple(part.strip() for part in args.preserve.replace(" ", ",").split(",") if part.strip())
     result = optimize(args.spec, objective=args.objective, no_slower=args.no_slower, budget=args.budget,
                       window=args.window, seed=args.seed, preserve=preserve, syntax=args.syntax, out=args.out,
+                      jobs=parse_int(args.jobs, field="--jobs", lo=1, hi=MAX_WORKERS),
+                      scheduler=args.scheduler or os.environ.get(SCHEDULER_ENV) or None,
                       progress=lambda line: print(f"retro optimize: {line}", file=sys.stderr))
     options.show(lines, as_json if args.json else None, result, indent=1)
     return 0

@@ -104,11 +104,13 @@ def code_bytes(listing: Listing) -> int:
     return sum(i.length for i in listing.instructions)
 
 
-def _successors(decoded, address: int, entry: int) -> list[int]:
+def _successors(decoded, address: int, entry: int, jumps: bool) -> list[int]:
     """Where the routine may go on after the instruction at `address` (branches back before the
-    entry are left out: they are refused as a whole)."""
+    entry are left out: they are refused as a whole); with `jumps`, a JMP's target too."""
     following = []
     if decoded.mode == "rel" and decoded.target >= entry:
+        following.append(decoded.target)
+    if jumps and decoded.mnemonic == "JMP" and decoded.mode == "abs" and decoded.target >= entry:
         following.append(decoded.target)
     if decoded.mnemonic == "BRA":
         following.append(decoded.target)
@@ -117,7 +119,7 @@ def _successors(decoded, address: int, entry: int) -> list[int]:
     return following
 
 
-def _decode_reachable(program: Program, entry: int, cpu: str) -> dict:
+def _decode_reachable(program: Program, entry: int, cpu: str, jumps: bool) -> dict:
     """Address -> decoded instruction for every instruction reachable from the entry inside the program."""
     code = program.code
 
@@ -136,7 +138,7 @@ def _decode_reachable(program: Program, entry: int, cpu: str) -> dict:
         instruction = decoded[address] = decode_at(read, address, cpu)
         if instruction.mode == "zpr":
             raise InputError(f"${address:04X}: {instruction.text}: the 65C02's BBR/BBS are not optimised")
-        pending += _successors(instruction, address, entry)
+        pending += _successors(instruction, address, entry, jumps)
     return decoded
 
 
@@ -178,17 +180,24 @@ def read_listing(program: Program, entry: int, cpu: str = "6510") -> Listing:
     JSR and the next instruction followed; RTS, RTI, JMP and BRK end a path), which must form one
     block of code from the entry (data inside it, or a jump into the middle of an instruction, is
     refused). Branch targets inside the block get the program's label for their address, else
-    `L_XXXX`; JMP/JSR targets and targets outside keep their address."""
-    decoded = _decode_reachable(program, entry, cpu)
+    `L_XXXX`, and so do JMP targets inside the block: a JMP to a block after the routine's end
+    (an out-of-line block) is followed when the whole still forms one block, else a JMP ends its
+    path and keeps its address, as JSR targets and targets outside do."""
+    try:
+        decoded = _decode_reachable(program, entry, cpu, jumps=True)
+        end = _end_of_block(decoded, entry)
+    except InputError:
+        decoded = _decode_reachable(program, entry, cpu, jumps=False)
+        end = _end_of_block(decoded, entry)
     ordered = sorted(decoded)
     index_of = {address: k for k, address in enumerate(ordered)}
-    index_of[_end_of_block(decoded, entry)] = len(ordered)
+    index_of[end] = len(ordered)
     names = address_names(program.symbols)
     labels: dict[str, int] = {}
     instructions = []
     for d in (decoded[address] for address in ordered):
         target = d.target if _has_target(d) else None
-        if d.mode == "rel" and target in index_of:
+        if (d.mode == "rel" or d.mnemonic == "JMP") and target in index_of:
             target, at = names.get(target) or f"L_{target:04X}", index_of[target]
             labels[target] = at
         instructions.append(Instruction(d.mnemonic, d.mode, None if _has_target(d) else _operand(d), target))

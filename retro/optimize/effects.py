@@ -36,6 +36,7 @@ REGISTER_EFFECTS: dict[str, tuple[frozenset, frozenset]] = {
 }
 STORES = frozenset({"STA", "STX", "STY"})
 READ_MODIFY_WRITE = frozenset({"INC", "DEC", "ASL", "LSR", "ROL", "ROR"})
+INDEXED_READ_MODES = ("zpx", "zpy", "abx", "aby", "iny")  # windows may read through these (retro.optimize.search)
 INDEX_OF_MODE = {"zpx": "X", "abx": "X", "inx": "X", "zpy": "Y", "aby": "Y", "iny": "Y"}
 
 
@@ -82,8 +83,11 @@ def live_after(listing: Listing, at_return: frozenset) -> list[frozenset]:
         for i in reversed(range(len(instructions))):
             instruction = instructions[i]
             name = instruction.mnemonic
+            local_jump = name == "JMP" and isinstance(instruction.target, str)  # to a label of the routine
             if name == "RTS":
                 out = at_return
+            elif local_jump:
+                out = live_in[where[instruction.target]]
             elif name in ("JMP", "JSR", "RTI", "BRK") or not known(instruction):
                 out = everything
             else:
@@ -92,7 +96,7 @@ def live_after(listing: Listing, at_return: frozenset) -> list[frozenset]:
                     target = instruction.target
                     out = out | (live_in[where[target]] if isinstance(target, str) else everything)
             reads, writes, read_memory, written = effects(instruction)
-            if name == "RTS":
+            if name == "RTS" or local_jump:
                 incoming = out
             elif name in ("RTI", "JMP", "JSR", "BRK") or not known(instruction):
                 incoming = everything
@@ -105,7 +109,18 @@ def live_after(listing: Listing, at_return: frozenset) -> list[frozenset]:
     return after
 
 
-def windowable(instruction) -> bool:
-    """An instruction a window may hold: known, straight-line, direct addressing."""
-    return (known(instruction) and not instruction.is_branch and instruction.mode in DIRECT_MODES
-            and instruction.target is None)
+def windowable(instruction, indexed: bool = False) -> bool:
+    """An instruction a window may hold: known, straight-line, direct addressing; with `indexed`,
+    also a read through an indexed or (zp),Y operand (never a write: its address is per case)."""
+    if not known(instruction) or instruction.is_branch or instruction.target is not None:
+        return False
+    if instruction.mode in DIRECT_MODES:
+        return True
+    return (indexed and instruction.mode in INDEXED_READ_MODES and instruction.mnemonic not in STORES
+            and instruction.mnemonic not in READ_MODIFY_WRITE)
+
+
+def writes_through_index(instruction) -> bool:
+    """A store or read-modify-write whose address depends on X, Y or a pointer."""
+    return (instruction.mode not in DIRECT_MODES and instruction.mode != "rel"
+            and (instruction.mnemonic in STORES or instruction.mnemonic in READ_MODIFY_WRITE))

@@ -116,7 +116,7 @@ class Samples:
 
 def answered(routine: Routine, columns: list, memory: dict) -> tuple[list, np.ndarray]:
     """The reference's answers and which cases count (inside the domain and answered)."""
-    inside = case_sets._inside(routine, columns)
+    inside = case_sets.in_domain(routine, columns)
     answers, answerable = reference_answers(routine, columns, None, memory, inside)
     return answers, inside & answerable
 

@@ -8,18 +8,18 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
-import numpy as np
-
-from retro.cpu.batch import LaneError
 from retro.errors import InputError, RunError
 from retro.optimize.code import Instruction, Listing, assemble, code_bytes, program_with, read_listing
-from retro.optimize.effects import ALL_MEMORY, live_after, windowable
+from retro.optimize.effects import ALL_MEMORY, windowable, writes_through_index
 from retro.optimize.evaluate import LaneRunner, Proof, Prover, outputs_equal, sample_cases, scratch_of
-from retro.optimize.stochastic import rewrite
-from retro.optimize.search import (BRANCHES, BRK, END, FLAG_BITS, Executor, cycles_of, enumerate_window,
-                                   instruction_pool, rank, state_of, state_ports)
+from retro.optimize.facts import entry_facts, facts_before, window_agrees
+from retro.optimize.flow import rewrites as flow_rewrites
+from retro.optimize.search import BRANCHES, END, FLAG_BITS, Executor
+from retro.optimize.stochastic import WALK_MOVES
+from retro.optimize.units import SearchContext, WalkResult, WindowResult, run_walk, run_window
 from retro.routines.places import FLAGS, Place, Port
 from retro.routines.spec import Routine
+from retro.workers import MAX_WORKERS, Workers, run_in_order, session
 
 OBJECTIVES = ("worst", "mean", "bytes")
 PRESERVABLE = ("A", "X", "Y", "C", "Z", "N", "V", "D")
@@ -28,7 +28,7 @@ WINDOW_SHARE = 8  # a window's enumeration takes at most 1/this of the budget (s
 MIN_WINDOW_SECONDS = 0.5  # ... but at least this long
 SYNTHESIS_LENGTH = 6
 STOCHASTIC_MIN_LIMIT = 200  # cycles a rewrite's call may take at least (else 4 x the best's worst case)
-SYNTHESIS_LANES = 64  # sample cases the synthesis enumerates on (it searches deeper, on more states)  # a routine of at most this many instructions (before its RTS) is also searched whole
+WALKS_PER_ROUND = 4  # stochastic walks run from the same best routine before the results are looked at
 
 
 @dataclass(frozen=True)
@@ -42,6 +42,8 @@ class Options:
     synthesis: bool = True
     windows: bool = True  # the enumerative window search (off: only synthesis and stochastic rewriting)
     stochastic: bool = True  # rewrite at random for the budget the windows leave
+    jobs: int = 1  # local worker processes for the work units (1: this process)
+    scheduler: str | None = None  # a Dask scheduler's address: the work units run on that cluster
 
 
 def check_options(options: Options) -> None:
@@ -51,6 +53,8 @@ def check_options(options: Options) -> None:
         raise InputError(f"--budget: {options.budget:g} seconds: give a time above 0")
     if not 1 <= options.window <= 8:
         raise InputError(f"--window: {options.window}: give 1 to 8 instructions")
+    if not 1 <= options.jobs <= MAX_WORKERS:
+        raise InputError(f"--jobs: {options.jobs}: give 1 to {MAX_WORKERS} worker processes")
     for name in options.preserve:
         if name not in PRESERVABLE:
             raise InputError(f"--preserve: {name!r} is not one of {', '.join(PRESERVABLE)}")
@@ -61,8 +65,9 @@ class Change:
     start: int
     removed: tuple[Instruction, ...]
     added: tuple[Instruction, ...]
-    kind: str  # "window" or "synthesis"
+    kind: str  # "window", "synthesis", "flow" or "stochastic"
     proof: Proof
+    what: str = ""  # a flow rewrite: which (retro.optimize.flow)
 
 
 @dataclass
@@ -84,6 +89,7 @@ class Outcome:
     complete: bool = True  # every window was searched to its length within the budget
     windows: int = 0
     rewrites: int = 0  # stochastic moves tried
+    local_rejections: int = 0  # window changes that differ from the window on an entry state the facts allow
     program: object = None  # the new Program
 
 
@@ -98,6 +104,7 @@ def preserved_ports(names: tuple[str, ...]) -> tuple[Port, ...]:
 def direct_addresses(routine: Routine, listing: Listing) -> tuple[int, ...]:
     """Addresses the search may read and write: the routine's direct operands and its ports in memory."""
     found = {i.operand for i in listing.instructions if i.mode in ("zpg", "abs") and i.target is None}
+    found.update(b for i in listing.instructions if i.mode == "iny" for b in (i.operand, (i.operand + 1) & 0xFF))
     for port in routine.inputs + routine.outputs:
         if port.via is None:
             found.update(p.address for p in port.places if p.kind == "memory")
@@ -153,6 +160,10 @@ class Search:
         if original != routine.program.code[start:start + len(original)]:
             raise InputError(f"{routine.spec_path}: the routine's code does not assemble back to its bytes")
         self.addresses = direct_addresses(routine, self.listing)
+        # a window may read through an index when every byte it can read that differs between cases
+        # is one the search's states hold: nothing written through an index, no input behind a pointer
+        self.indexed_reads = not any(writes_through_index(i) for i in self.listing.instructions) and not any(
+            port.via is not None for port in routine.inputs + routine.outputs)
         self.scratch = scratch_of(routine, self.addresses)
         preserve = preserved_ports(options.preserve)
         self.preserve = preserve
@@ -162,6 +173,7 @@ class Search:
         self.at_return = live_at_return(routine, options.preserve)
         self.kept_samples = None
         self.synthesised = False
+        self.workers = Workers(options.jobs, options.scheduler)
 
     # ---- whole-routine runs --------------------------------------------------------------------
 
@@ -179,18 +191,6 @@ class Search:
             s = self.samples
             outcome = self.lanes.run(code, self.routine.entry_address, s.columns, s.indices)
             self.kept_samples = outcome.outputs[-len(self.preserve):]
-
-    def window_states(self, code: bytes, start_address: int):
-        """The machine state where the routine reaches `start_address`, per sample case that does:
-        (state, lanes) from a run with BRK there (and the direct addresses read as outputs)."""
-        probe = replace(self.routine, outputs=state_ports(self.addresses))
-        runner = LaneRunner(probe, self.seed, self.scratch)
-        patched = bytearray(code)
-        patched[start_address - self.routine.entry_address] = BRK
-        s = self.samples
-        outcome = runner.run(bytes(patched), self.routine.entry_address, s.columns, s.indices)
-        lanes = np.flatnonzero(outcome.error == LaneError.BRK)
-        return state_of(outcome.outputs, self.addresses, lanes), lanes, runner
 
     # ---- the loop ------------------------------------------------------------------------------
 
@@ -213,68 +213,64 @@ class Search:
         best_score = score(self.options.objective, first, self.size)
         current = self.listing
         improved = True
-        while improved and self.options.windows and time.monotonic() < deadline:
-            improved = False
-            for start, stop, kind in self.windows(current):
-                if time.monotonic() > deadline:
-                    outcome.complete = False
-                    break
-                found = self.search_window(current, start, stop, kind, deadline, outcome, best_score)
-                if found is not None:
-                    current, best_score, change = found
+        with session():  # one cluster for every pass (when the units run on one)
+            while improved and self.options.windows and time.monotonic() < deadline:
+                improved = False
+                flowed = self.flow_change(current, outcome, best_score)
+                if flowed is None:
+                    flowed = self.window_pass(current, deadline, outcome, best_score)
+                if flowed is not None:
+                    current, best_score, change = flowed
                     outcome.changes.append(change)
                     outcome.best, outcome.best_proof = current, change.proof
-                    self.progress(f"{kind} at instruction {start}: {len(change.removed)} -> {len(change.added)} "
-                                  f"instructions; worst {change.proof.cycles['max']}, mean "
+                    what = change.what or (f"{change.kind} at instruction {change.start}: {len(change.removed)} -> "
+                                           f"{len(change.added)} instructions")
+                    self.progress(f"{what}; worst {change.proof.cycles['max']}, mean "
                                   f"{change.proof.cycles['mean']:.2f}, {code_bytes(current)} bytes")
                     improved = True
-                    break
-        if self.options.stochastic and time.monotonic() < deadline:
-            self.rewrite(outcome, deadline)
+            if self.options.stochastic and time.monotonic() < deadline:
+                self.rewrite(outcome, deadline)
         outcome.seconds = time.monotonic() - began
         outcome.program = program_with(routine.program, outcome.best, routine.cpu, self.size)
         return outcome
 
+    def context(self) -> SearchContext:
+        """What the work units share (retro.optimize.units), as of now (samples grow by counterexamples)."""
+        return SearchContext(str(self.routine.spec_path.resolve()), self.seed, self.options.objective, self.scratch,
+                             self.addresses, self.at_return, self.preserve, self.samples, self.kept_samples,
+                             self.routine)
+
     def rewrite(self, outcome: Outcome, deadline: float) -> None:
         """Stochastic rewriting of the best routine for the rest of the budget (retro.optimize.stochastic):
-        moves run on the samples with a tight cycle limit (a move can make a loop that never ends)."""
-        routine, objective = self.routine, self.options.objective
+        rounds of WALKS_PER_ROUND walks (work units) from the best routine so far, each with its own
+        seed; their rewrites are proven here in task order and the best proven one is kept."""
+        objective = self.options.objective
         limit = max(4 * outcome.best_proof.cycles["max"], STOCHASTIC_MIN_LIMIT)
-        lanes = LaneRunner(replace(routine, limit=limit, outputs=routine.outputs + self.preserve), self.seed,
-                           self.scratch)
         best_score = [score(objective, outcome.best_proof, code_bytes(outcome.best))]
+        walks = [0]
 
-        def cost(code: bytes):
-            s = self.samples
-            run = lanes.run(code, routine.entry_address, s.columns, s.indices)
-            ok = outputs_equal(run, s.expected)
-            if self.preserve:
-                ok &= outputs_equal(run, [None] * len(routine.outputs) + list(self.kept_samples), skip=True)
-            outcome.routine_tests += 1
-            cycles = run.cycles[run.error == 0]
-            if not len(cycles):
-                return None
-            value = {"worst": float(cycles.max()), "mean": float(cycles.mean()), "bytes": float(len(code))}[objective]
-            return int((~ok).sum()), value
+        def report(result: WalkResult) -> bool:
+            outcome.rewrites += result.tried
+            outcome.routine_tests += result.runs
+            for listing in result.candidates:
+                if time.monotonic() > deadline:
+                    return True
+                better = self.better(listing, outcome, best_score[0])
+                if better is not None:
+                    best_score[0] = better[0]
+                    outcome.changes.append(Change(0, outcome.best.instructions, listing.instructions, "stochastic",
+                                                  better[1]))
+                    outcome.best, outcome.best_proof = listing, better[1]
+                    self.progress(f"stochastic rewrite: worst {better[1].cycles['max']}, mean "
+                                  f"{better[1].cycles['mean']:.2f}, {code_bytes(listing)} bytes")
+            return time.monotonic() > deadline
 
-        def found(listing: Listing, code: bytes) -> bool:
-            if not self.sample_ok(code):
-                return False
-            proof = self.proven(code, outcome)
-            if not proof.passed or (self.options.no_slower and proof.slower):
-                return False
-            new_score = score(objective, proof, len(code))
-            if new_score >= best_score[0]:
-                return False
-            best_score[0] = new_score
-            outcome.changes.append(Change(0, outcome.best.instructions, listing.instructions, "stochastic", proof))
-            outcome.best, outcome.best_proof = listing, proof
-            self.progress(f"stochastic rewrite: worst {proof.cycles['max']}, mean {proof.cycles['mean']:.2f}, "
-                          f"{len(code)} bytes")
-            return True
-
-        pool = instruction_pool(routine.cpu, outcome.best, (), self.addresses)
-        outcome.rewrites += rewrite(outcome.best, cost, pool, routine.cpu, self.size, deadline, self.seed, found)
+        while time.monotonic() < deadline:
+            context, start = self.context(), outcome.best
+            tasks = [(context, start, limit, self.size, self.seed * 7919 + walks[0] + k, WALK_MOVES)
+                     for k in range(WALKS_PER_ROUND)]
+            walks[0] += WALKS_PER_ROUND
+            run_in_order(run_walk, tasks, self.workers, report)
 
     def windows(self, listing: Listing):
         """(start, stop, kind): the whole routine first when it is short, then every window of up to
@@ -287,72 +283,101 @@ class Search:
             self.synthesised = True  # once: a second run on its own result would search the same space again
             yield 0, n - 1, "synthesis"
         targets = listing.targets
+        where = dict(listing.labels)
+
+        def fits(instruction, stop: int) -> bool:  # straight-line, or a branch to the window's end (a join)
+            if instruction.is_branch:
+                return (instruction.mnemonic in BRANCHES and isinstance(instruction.target, str)
+                        and where[instruction.target] == stop)
+            return windowable(instruction, self.indexed_reads)
+
         for length in range(1, min(self.options.window, n) + 1):  # short windows first: cheap, and most gains
             for start in range(n - length + 1):
                 stop = start + length
-                if all(windowable(i) for i in instructions[start:stop]) and not any(
-                        k in targets for k in range(start + 1, stop)):
+                if all(fits(i, stop) for i in instructions[start:stop]) and not any(
+                        k in targets for k in range(start + 1, stop)) and not instructions[stop - 1].is_branch:
                     yield start, stop, "window"
 
-    def search_window(self, listing: Listing, start: int, stop: int, kind: str, deadline: float,
-                      outcome: Outcome, best_score: tuple):
-        cpu, objective = self.routine.cpu, self.options.objective
-        outcome.windows += 1
-        code = assemble(listing, cpu)
-        addresses = [listing.origin]
-        for i in listing.instructions:
-            addresses.append(addresses[-1] + i.length)
-        cpu_began = time.process_time()
-        state, lanes, probe = self.window_states(code, addresses[start])
-        if not len(lanes):
-            return None
-        window = listing.instructions[start:stop]
-        executor = Executor(cpu, bytes(probe.runner.call_image), len(lanes), addresses[start])
-        pool = instruction_pool(cpu, listing, window, self.addresses)
-        if kind == "synthesis":
-            state, lanes = _first_lanes(state, lanes, SYNTHESIS_LANES)
-            target, live = self.synthesis_target(state, lanes)
-            worst_cycles = outcome.best_proof.cycles["max"] - cycles_of(cpu, listing.instructions[-1])
-            mean_cycles = outcome.best_proof.cycles["mean"] - cycles_of(cpu, listing.instructions[-1])
-            size = addresses[stop] - addresses[start]
-            bound = {"worst": (worst_cycles, size + 1), "mean": (mean_cycles, size + 1), "bytes": (size, worst_cycles + 1)}[
-                objective]
-            length = max(self.options.window, SYNTHESIS_LENGTH)
-            pool = [i for i in pool if i.mode != "rel"] + [Instruction(b, "rel", target=END) for b in BRANCHES]
-        else:
-            target = state
-            for instruction in window:
-                target = executor.step(target, instruction)
-            live = live_after(listing, self.at_return)[stop - 1]
-            bound = rank(objective, target.filled().cycles[None, :], addresses[stop] - addresses[start])[0]
-            length = stop - start
-        share = max(self.options.budget / (2 if kind == "synthesis" else WINDOW_SHARE), MIN_WINDOW_SECONDS)
-        found = enumerate_window(executor, cpu, state, target, live, pool, length, bound,
-                                 min(deadline, time.monotonic() + share), objective)
-        outcome.tested += found.tested
-        outcome.complete &= found.complete
-        outcome.search_seconds += time.process_time() - cpu_began
-        for _, sequence in found.found:
+    def window_pass(self, listing: Listing, deadline: float, outcome: Outcome, best_score: tuple):
+        """Every window of the listing as a work unit (retro.optimize.units.run_window), their results
+        taken in window order: the first window whose candidate is proven and better ends the pass,
+        as (listing, score, change); None when none is (or the budget ran out)."""
+        taken: list = []
+        facts = facts_before(listing, entry_facts(self.routine.entry_state))
+        executor = Executor(self.routine.cpu, bytes(self.lanes.runner.call_image), 1, listing.origin)
+
+        def tasks():
+            context = self.context()
+            best_cycles = (outcome.best_proof.cycles["max"], outcome.best_proof.cycles["mean"])
+            for start, stop, kind in self.windows(listing):
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    outcome.complete = False
+                    return
+                share = max(self.options.budget / (2 if kind == "synthesis" else WINDOW_SHARE), MIN_WINDOW_SECONDS)
+                length = max(self.options.window, SYNTHESIS_LENGTH) if kind == "synthesis" else stop - start
+                yield context, listing, start, stop, kind, min(share, left), best_cycles, length
+
+        def report(result: WindowResult) -> bool:
+            outcome.windows += 1
+            outcome.tested += result.tested
+            outcome.complete &= result.complete
+            outcome.search_seconds += result.cpu_seconds
+            found = self.window_candidates(listing, result, facts[result.start] or frozenset(), executor, deadline,
+                                           outcome, best_score)
+            if found is not None:
+                taken.append(found)
+                return True
+            if time.monotonic() > deadline:
+                outcome.complete = False
+                return True
+            return False
+
+        run_in_order(run_window, tasks(), self.workers, report)
+        return taken[0] if taken else None
+
+    def window_candidates(self, listing: Listing, result: WindowResult, facts: frozenset, executor: Executor,
+                          deadline: float, outcome: Outcome, best_score: tuple):
+        """The first of a window's sequences that is proven and better, as (listing, score, change)."""
+        start, stop, kind, window = result.start, result.stop, result.kind, result.window
+        for sequence in result.found:
             if time.monotonic() > deadline:  # candidates left untested: the search is not complete
                 outcome.complete = False
                 break
             if kind == "window" and tuple(sequence) == tuple(window):
                 continue
+            if kind == "window" and self.prover.kind != "exhaustive" and not window_agrees(
+                    executor, window, sequence, result.live, facts):
+                outcome.local_rejections += 1  # a sampled proof alone would not stand behind it
+                continue
             new = self.replaced(listing, start, stop, sequence)
-            new_code = assemble(new, cpu)
-            if new_code is None or len(new_code) > self.size:
-                continue
-            outcome.routine_tests += 1
-            if not self.sample_ok(new_code):
-                continue
-            proof = self.proven(new_code, outcome)
-            if not proof.passed:
-                continue
-            if self.options.no_slower and proof.slower:
-                continue
-            new_score = score(objective, proof, len(new_code))
-            if new_score < best_score:
-                return new, new_score, Change(start, tuple(window), tuple(sequence), kind, proof)
+            better = self.better(new, outcome, best_score)
+            if better is not None:
+                return new, better[0], Change(start, tuple(window), tuple(sequence), kind, better[1])
+        return None
+
+    def better(self, new: Listing, outcome: Outcome, best_score: tuple) -> tuple[tuple, Proof] | None:
+        """(score, proof) of a candidate listing that fits, passes the samples and its proof (and
+        --no-slower) with a better score than `best_score`; else None."""
+        new_code = assemble(new, self.routine.cpu)
+        if new_code is None or len(new_code) > self.size:
+            return None
+        outcome.routine_tests += 1
+        if not self.sample_ok(new_code):
+            return None
+        proof = self.proven(new_code, outcome)
+        if not proof.passed or (self.options.no_slower and proof.slower):
+            return None
+        new_score = score(self.options.objective, proof, len(new_code))
+        return (new_score, proof) if new_score < best_score else None
+
+    def flow_change(self, listing: Listing, outcome: Outcome, best_score: tuple):
+        """The first control-flow rewrite (retro.optimize.flow) that is proven and better, as
+        (listing, score, change), or None."""
+        for what, new in flow_rewrites(listing):
+            better = self.better(new, outcome, best_score)
+            if better is not None:
+                return new, better[0], Change(0, listing.instructions, new.instructions, "flow", better[1], what)
         return None
 
     def proven(self, code: bytes, outcome: Outcome) -> Proof:
@@ -381,43 +406,6 @@ class Search:
         sequence = tuple(replace(i, target=name) if i.target == END else i for i in sequence)
         labels = listing.labels if names else listing.labels + ((name, stop),)
         return replace(listing, labels=labels).with_window(start, stop, sequence)
-
-    def synthesis_target(self, state, lanes):
-        """The state the whole routine must end in: the reference's answers in the output places."""
-        target = type(state)(state.a.copy(), state.x.copy(), state.y.copy(), state.p.copy(), dict(state.memory))
-        live = set()
-        for port, expected in zip(self.routine.outputs, self.samples.expected):
-            values = expected[lanes]
-            for k, place in enumerate(port.places):
-                byte = (values[:, k] if port.table else (values >> (8 * k)) & 0xFF).astype(np.int32)
-                if place.kind == "register":
-                    setattr(target, place.register, byte)
-                    live.add(place.register.upper())
-                elif place.kind == "flag":
-                    target.p = np.where(values != 0, target.p | place.bit, target.p & ~place.bit).astype(np.int32)
-                    live.add(next(n for n, b in FLAG_BITS.items() if b == place.bit))
-                elif place.kind == "memory":
-                    target.memory[place.address] = byte
-                    live.add(place.address)
-        if self.preserve:
-            for port, kept in zip(self.preserve, self.kept_samples):
-                place = port.places[0]
-                if place.kind == "register":
-                    setattr(target, place.register, np.asarray(kept[lanes], dtype=np.int32))
-                    live.add(place.register.upper())
-                else:
-                    target.p = np.where(kept[lanes] != 0, target.p | place.bit, target.p & ~place.bit).astype(np.int32)
-                    live.add(next(n for n, b in FLAG_BITS.items() if b == place.bit))
-        return target, frozenset(live)
-
-
-def _first_lanes(state, lanes: np.ndarray, count: int):
-    """The state on its first `count` sample cases only (synthesis enumerates on fewer cases; the
-    whole-routine run and the proof see them all)."""
-    if len(lanes) <= count:
-        return state, lanes
-    return (type(state)(state.a[:count], state.x[:count], state.y[:count], state.p[:count],
-                        {a: v[:count] for a, v in state.memory.items()}), lanes[:count])
 
 
 def optimize(routine: Routine, options: Options, progress: Callable[[str], None] | None = None) -> Outcome:

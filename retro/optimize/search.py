@@ -23,7 +23,7 @@ from retro.cpu.disassembly import opcode_table
 from retro.cpu.mpu import FLAG_C, FLAG_D, FLAG_I, FLAG_N, FLAG_V, FLAG_Z
 from retro.cpu.timing import BRANCH_CONDITIONS, BRANCH_TAKEN_CYCLES
 from retro.optimize.code import Instruction, Listing, opcode_of
-from retro.optimize.effects import ALL_MEMORY, STORES
+from retro.optimize.effects import ALL_MEMORY, INDEXED_READ_MODES, READ_MODIFY_WRITE, STORES
 from retro.routines.places import Place, Port
 
 FLAG_BITS = {"C": FLAG_C, "Z": FLAG_Z, "I": FLAG_I, "D": FLAG_D, "V": FLAG_V, "N": FLAG_N}
@@ -53,6 +53,8 @@ class State:
     cycles: np.ndarray | None = None  # per lane, cycles so far (None: 0)
 
     def filled(self) -> "State":
+        if self.done is not None and self.cycles is not None:
+            return self
         zeros = np.zeros(self.a.shape, dtype=np.int32)
         return State(self.a, self.x, self.y, self.p, self.memory,
                      zeros.astype(bool) if self.done is None else self.done,
@@ -85,42 +87,65 @@ class Executor:
         self.opcode = opcode_of(cpu)
         self.handlers = BatchCpu(cpu, image, 1).handlers
         self.cycles = {opcode: op.cycles for opcode, op in opcode_table(cpu).items()}
+        self._cpus: dict[int, tuple] = {}  # lanes -> (BatchCpu, S, cycles): made once, reused by every step
+
+    def _cpu(self, n: int) -> tuple:
+        """A machine of n lanes to run one instruction on. Reused: a step fills every byte its
+        instruction may read before it runs, so what an earlier step left behind is never read."""
+        made = self._cpus.get(n)
+        if made is None:
+            if len(self._cpus) > 8:
+                self._cpus.clear()
+            made = self._cpus[n] = (BatchCpu(self.variant, self.image, n), np.full(n, 0xFD, dtype=np.int32),
+                                    np.zeros(n, dtype=np.int64))
+        return made
 
     def step(self, state: State, instruction: Instruction) -> State:
         shape = state.a.shape
-        n = int(np.prod(shape))
-        cpu = BatchCpu(self.variant, self.image, n)
+        n = state.a.size
         opcode = self.opcode[(instruction.mnemonic, instruction.mode)]
+        state = state.filled()
+        done = state.done
+        if instruction.mode == "rel":  # a branch to the end: the lanes it takes are done
+            bit, value = BRANCH_CONDITIONS[opcode]
+            taken = (((state.p & bit) != 0) == bool(value)) & ~done
+            spent = np.where(done, 0, BRANCH_CYCLES + taken * BRANCH_TAKEN_CYCLES)
+            return State(state.a, state.x, state.y, state.p, state.memory, done | taken,
+                         (state.cycles + spent).astype(np.int32))
+        cpu, sp, cycles = self._cpu(n)
         operand = instruction.operand or 0
         address = operand if instruction.mode in ("zpg", "abs") else None
         if address is not None:
             cpu.memory.fill(address, state.memory[address].reshape(n))
-        group = Lanes(cpu, slice(None), state.a.reshape(n).copy(), state.x.reshape(n).copy(),
-                      state.y.reshape(n).copy(), state.p.reshape(n).copy(), np.full(n, 0xFD, dtype=np.int32),
-                      np.zeros(n, dtype=np.int64))
-        state = state.filled()
-        if instruction.mode == "rel":  # a branch to the end: the lanes it takes are done
-            bit, value = BRANCH_CONDITIONS[opcode]
-            taken = (((state.p & bit) != 0) == bool(value)) & ~state.done
-            spent = np.where(state.done, 0, BRANCH_CYCLES + taken * BRANCH_TAKEN_CYCLES)
-            return State(state.a, state.x, state.y, state.p, state.memory, state.done | taken,
-                         (state.cycles + spent).astype(np.int32))
+        elif instruction.mode in INDEXED_READ_MODES:  # the address is per lane: every byte the state holds
+            for at, values in state.memory.items():
+                cpu.memory.fill(at, values.reshape(n))
+        cycles.fill(0)
+        # the handlers assign new arrays to a, x, y and p, never change them in place: no copies
+        group = Lanes(cpu, slice(None), state.a.reshape(n), state.x.reshape(n), state.y.reshape(n),
+                      state.p.reshape(n), sp, cycles)
         self.handlers[opcode](group, self.at, operand & 0xFF, operand >> 8)
-        written = dict(state.memory)
+        memory = state.memory
         if address is not None and (instruction.mnemonic in STORES or instruction.mnemonic in
                                     ("INC", "DEC", "ASL", "LSR", "ROL", "ROR")):
+            memory = dict(memory)
             value = cpu.memory.read(slice(None), address)
-            written[address] = (np.full(n, value, dtype=np.int32) if isinstance(value, int)
-                                else value.astype(np.int32)).reshape(shape)
-
-        done = state.done
+            memory[address] = (np.full(n, value, dtype=np.int32) if isinstance(value, int)
+                               else value.astype(np.int32)).reshape(shape)
+            if done.any():
+                memory[address] = np.where(done, state.memory[address], memory[address])
+        spent = group.cycles.reshape(shape)  # the handler's own cycles: page crossings of indexed reads too
+        if not done.any():
+            def lanes(values, old):
+                values = np.asarray(values, dtype=np.int32)
+                return values.reshape(shape) if values.size == n else np.broadcast_to(values, shape)
+            return State(lanes(group.a, state.a), lanes(group.x, state.x), lanes(group.y, state.y),
+                         lanes(group.p, state.p), memory, done, (state.cycles + spent).astype(np.int32))
 
         def lanes(values, old):
             return np.where(done, old, np.broadcast_to(np.asarray(values, dtype=np.int32), (n,)).reshape(shape))
-        memory = {a: v if v is state.memory[a] else np.where(done, state.memory[a], v) for a, v in written.items()}
-        spent = np.where(done, 0, self.cycles[opcode]).astype(np.int32)
         return State(lanes(group.a, state.a), lanes(group.x, state.x), lanes(group.y, state.y),
-                     lanes(group.p, state.p), memory, done, state.cycles + spent)
+                     lanes(group.p, state.p), memory, done, (state.cycles + np.where(done, 0, spent)).astype(np.int32))
 
 
 def cycles_of(cpu: str, instruction: Instruction) -> int:
@@ -175,12 +200,30 @@ def _rows(state: State, rows: np.ndarray) -> State:
                  {a: v[rows] for a, v in state.memory.items()}, state.done[rows], state.cycles[rows])
 
 
-def _keys(state: State) -> list[bytes]:
+def _slice(state: State, low: int, high: int) -> State:
+    """States low..high-1 of many (views: nothing copied)."""
+    state = state.filled()
+    return State(state.a[low:high], state.x[low:high], state.y[low:high], state.p[low:high],
+                 {a: v[low:high] for a, v in state.memory.items()}, state.done[low:high], state.cycles[low:high])
+
+
+def _keys(state: State, addresses) -> list[bytes]:
     """One key per state of many (rows of (states, lanes) arrays): its bytes on every sample case
-    and which cases are done."""
-    parts = [state.a, state.x, state.y, state.p, state.filled().done] + [state.memory[a] for a in sorted(state.memory)]
+    and which cases are done; of memory only `addresses` (bytes no instruction of the pool writes
+    are the same in every state)."""
+    parts = [state.a, state.x, state.y, state.p, state.filled().done] + [state.memory[a] for a in addresses]
     matrix = np.ascontiguousarray(np.concatenate([part.astype(np.uint8) for part in parts], axis=1))
-    return [row.tobytes() for row in matrix]
+    return matrix.view(np.dtype((np.void, matrix.shape[1]))).ravel().tolist()
+
+
+def _order(objective: str, cycles: np.ndarray, size: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """`rank` as two arrays (what orders first, then what breaks ties), one element per state."""
+    worst = cycles.max(axis=-1)
+    if objective == "bytes":
+        return size, worst
+    if objective == "mean":
+        return cycles.mean(axis=-1), size
+    return worst, size
 
 
 @dataclass
@@ -217,7 +260,10 @@ def enumerate_window(executor: Executor, cpu: str, start: State, target: State, 
     if target_matches(first, target, live)[0]:
         result.found.append(((0, 0), ()))
         return result
-    seen = {_keys(first)[0]: (0, 0)}
+    key_addresses = sorted(a for a in start.memory if any(
+        i.operand == a and i.mode in ("zpg", "abs") and (i.mnemonic in STORES or i.mnemonic in READ_MODIFY_WRITE)
+        for i in pool))
+    seen = {_keys(first, key_addresses)[0]: (0, 0)}
     frontier, sequences, sizes = first, [()], np.zeros(1, dtype=np.int64)
     for level in range(length):
         last = level == length - 1  # the last level keeps no states: only its goals count
@@ -230,10 +276,10 @@ def enumerate_window(executor: Executor, cpu: str, start: State, target: State, 
                 if time.monotonic() > deadline:
                     result.complete = False
                     return _sorted(result)
-                chunk = np.arange(rows, min(rows + CHUNK_STATES, len(sizes)))
-                part = frontier if len(chunk) == len(sizes) else _rows(frontier, chunk)
-                kept = _expand(executor, part, instruction, sizes[chunk], sequences[rows:rows + len(chunk)],
-                               target, live, bound, objective, seen, result, last)
+                end = min(rows + CHUNK_STATES, len(sizes))
+                part = frontier if end - rows == len(sizes) else _slice(frontier, rows, end)
+                kept = _expand(executor, part, instruction, sizes[rows:end], sequences[rows:end],
+                               target, live, bound, objective, seen, result, last, key_addresses)
                 if kept is not None:
                     next_states.append(kept[0])
                     next_sequences += kept[1]
@@ -250,45 +296,48 @@ def enumerate_window(executor: Executor, cpu: str, start: State, target: State, 
 
 def _expand(executor: Executor, frontier: State, instruction: Instruction, sizes: np.ndarray, sequences: list,
             target: State, live: frozenset, bound: tuple, objective: str, seen: dict, result: Enumeration,
-            last: bool = False):
+            last: bool = False, key_addresses=()):
     """One instruction after each of the states: goals go to `result.found`; (states, sequences,
     sizes) kept for the next level, or None."""
     new = executor.step(frontier, instruction)
     spent = sizes + instruction.length
-    ranks = rank(objective, new.cycles, spent)
+    first, second = _order(objective, new.cycles, spent)
     result.tested += len(sizes)
-    within = [k for k, r in enumerate(ranks) if r < bound]
-    if within and instruction.mode == "rel":  # a case that ended must have ended right: it cannot change
-        ended_right = target_matches(_masked(new, target), target, live)
-        within = [k for k in within if ended_right[k]]
-    if not within:
+    inside = (first < bound[0]) | ((first == bound[0]) & (second < bound[1]))
+    if instruction.mode == "rel" and inside.any():  # a case that ended must have ended right: it cannot change
+        inside &= target_matches(_masked(new, target), target, live)
+    within = np.flatnonzero(inside)
+    if not len(within):
         return None
-    if len(within) < len(ranks):
-        new = _rows(new, np.asarray(within))
+    if len(within) < len(sizes):
+        new = _rows(new, within)
+    ranks = list(zip(first[within].tolist(), second[within].tolist()))
     goals = target_matches(new, target, live)
     if last:
         for k in np.flatnonzero(goals).tolist():
-            result.found.append((ranks[within[k]], sequences[within[k]] + (instruction,)))
+            result.found.append((ranks[k], sequences[within[k]] + (instruction,)))
         return None
+    finished = new.done.all(axis=-1)
     keep, next_sequences, next_sizes = [], [], []
-    for k, key in enumerate(_keys(new)):
-        row = within[k]
+    goals, finished, rows = goals.tolist(), finished.tolist(), within.tolist()
+    for k, key in enumerate(_keys(new, key_addresses)):
         old = seen.get(key)
-        if old is not None and old <= ranks[row]:
+        rank_k = ranks[k]
+        if old is not None and old <= rank_k:
             continue
         if len(seen) < MAX_STATES:
-            seen[key] = ranks[row]
+            seen[key] = rank_k
         else:
             result.complete = False
-        sequence = sequences[row] + (instruction,)
+        sequence = sequences[rows[k]] + (instruction,)
         if goals[k]:
-            result.found.append((ranks[row], sequence))
+            result.found.append((rank_k, sequence))
             continue
-        if new.done[k].all():
+        if finished[k]:
             continue  # every case has ended and it is not the target
         keep.append(k)
         next_sequences.append(sequence)
-        next_sizes.append(int(spent[row]))
+        next_sizes.append(int(spent[rows[k]]))
     if not keep:
         return None
     return _rows(new, np.asarray(keep)), next_sequences, next_sizes

@@ -7,7 +7,6 @@ mismatch that beats the best is proven like any other candidate (retro.optimize.
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable
 from dataclasses import replace
 
@@ -18,7 +17,7 @@ from retro.optimize.effects import windowable
 
 MISMATCH_WEIGHT = 100.0  # a wrong sample case costs as much as this many cycles
 TEMPERATURE = 2.0
-RESTART_EVERY = 400  # moves from the best routine found so far
+WALK_MOVES = 400  # moves of one walk (a work unit), from the best routine found so far
 
 
 def _pick(rng: np.random.Generator, items: list):
@@ -87,17 +86,12 @@ def _other_target(listing: Listing, pool: list[Instruction], rng: np.random.Gene
 MOVES = (_replace_one, _insert, _delete, _swap_neighbours, _other_operand, _other_target)
 
 
-def moves(listing: Listing, pool: list[Instruction], rng: np.random.Generator) -> Listing | None:
-    """One random move; None when it does not apply (the caller draws again)."""
-    return _pick(rng, MOVES)(listing, pool, rng)
-
-
-def rewrite(start: Listing, cost: Callable[[bytes], tuple | None], pool: list[Instruction], cpu: str,
-            size_limit: int, deadline: float, seed: int, found: Callable[[Listing, bytes], bool]) -> int:
-    """Metropolis search from `start` until `deadline`. `cost(code)`: (mismatched sample cases, the
-    objective's value) or None when the code cannot run; `found(listing, code)` is told of every
-    rewrite with no mismatch cheaper than the best so far (it proves it and says whether it was
-    kept). Returns the moves tried."""
+def walk(start: Listing, cost: Callable[[bytes], tuple | None], pool: list[Instruction], cpu: str,
+         size_limit: int, moves: int, seed: int) -> tuple[list[Listing], int]:
+    """`moves` Metropolis moves from `start` (one restart of the search; retro.optimize.units runs
+    many). `cost(code)`: (mismatched sample cases, the objective's value) or None when the code
+    cannot run. Returns the rewrites with no mismatch, each cheaper than every one before it (and
+    than `start`), in the order found, and the moves tried: the caller proves them."""
     rng = np.random.default_rng(seed)
 
     def scalar(value: tuple) -> float:
@@ -105,15 +99,12 @@ def rewrite(start: Listing, cost: Callable[[bytes], tuple | None], pool: list[In
 
     first = cost(assemble(start, cpu))
     if first is None:
-        return 0
+        return [], 0
     current, current_cost = start, scalar(first)
-    best, best_value = start, first[1]
-    tried = 0
-    while time.monotonic() < deadline:
-        tried += 1
-        if tried % RESTART_EVERY == 0:
-            current, current_cost = best, scalar((0, best_value))
-        proposal = moves(current, pool, rng)
+    best_value = first[1] if first[0] == 0 else math.inf
+    found: list[Listing] = []
+    for _ in range(moves):
+        proposal = _pick(rng, MOVES)(current, pool, rng)
         if proposal is None:
             continue
         code = assemble(proposal, cpu)
@@ -122,9 +113,10 @@ def rewrite(start: Listing, cost: Callable[[bytes], tuple | None], pool: list[In
         value = cost(code)
         if value is None:
             continue
-        if value[0] == 0 and value[1] < best_value and found(proposal, code):
-            best, best_value = proposal, value[1]
+        if value[0] == 0 and value[1] < best_value:
+            best_value = value[1]
+            found.append(proposal)
         total = scalar(value)
         if total <= current_cost or rng.random() < math.exp((current_cost - total) / TEMPERATURE):
             current, current_cost = proposal, total
-    return tried
+    return found, moves

@@ -362,7 +362,7 @@ def domain_draw(routine: Routine, seed: int, count: int) -> DomainDraw | None:
     ports = routine.part_inputs("random")
     probing = np.random.default_rng(seed + PROBE_RNG_OFFSET)
     probe = [_random_column(port, probing, PROBE) for port in ports]
-    share = float(_inside(routine, probe).mean())
+    share = float(in_domain(routine, probe).mean())
     if not (routine.random_inside or (routine.random_inside is None and share < INSIDE_SHARE)):
         return DomainDraw(False, share, count, count)
     box = _narrowed(routine, ports)
@@ -397,7 +397,8 @@ def domain_draw(routine: Routine, seed: int, count: int) -> DomainDraw | None:
     return DomainDraw(True, share, count, sum(len(b[0]) for b in made), "rejection", ranges, candidates(), made)
 
 
-def _inside(routine: Routine, columns: Columns) -> np.ndarray:
+def in_domain(routine: Routine, columns: Columns) -> np.ndarray:
+    """Per case: whether it lies inside the spec's domain (every `where` condition holds)."""
     inside = np.ones(len(columns[0]), dtype=bool)
     for condition in routine.domain:
         inside &= condition.over(columns)
@@ -439,7 +440,7 @@ def _valid_combinations(routine: Routine, box: list[Port], total: int) -> np.nda
     valid = []
     for start in range(0, total, 1 << 16):
         indices = np.arange(start, min(start + (1 << 16), total), dtype=np.uint64)
-        valid.append(indices[_inside(routine, _combinations(box, indices))])
+        valid.append(indices[in_domain(routine, _combinations(box, indices))])
     return np.concatenate(valid)
 
 
@@ -456,7 +457,7 @@ def _draw_inside(routine: Routine, box: list[Port], seed: int, count: int, stric
         while made < count and drawn[0] < budget:
             candidates = [_random_column(port, rng, DRAW_BATCH) for port in box]
             drawn[0] += DRAW_BATCH
-            kept = [c[_inside(routine, candidates)] for c in candidates]
+            kept = [c[in_domain(routine, candidates)] for c in candidates]
             kept = [c[:count - made] for c in kept]
             made += len(kept[0])
             for start in range(0, len(kept[0]), CHUNK):
