@@ -44,7 +44,8 @@ LOCK_FILE = ".lock"
 FALLBACK_REASON = {translate.FALLBACK_STOP: "an instruction the compiled engine leaves to the batched core "
                                             "(BRK, RTI, JAM, an unstable opcode, STP or WAI)",
                    translate.FALLBACK_JUMP: "a jump to code not found before the run (RTS or JMP (ind) to an "
-                                            "address no block starts at)",
+                                            "address no block starts at, or to one whose code is translated "
+                                            "inside the block before it)",
                    translate.FALLBACK_WRITE: "a write into the routine's own code",
                    translate.FALLBACK_DECIMAL: "decimal mode on entry to code translated for binary mode only "
                                                "(no SED or PLP in it)"}
@@ -251,8 +252,8 @@ def compile_routine(image: bytes, entry: int, cpu: str, return_pc: int, inputs_a
     code_map = np.zeros(MEMORY, dtype=np.uint8)
     code_map[list(translation.code_bytes)] = 1
     addr_block = np.full(MEMORY, translate.NO_BLOCK, dtype=np.int32)
-    for address, number in translation.blocks.items():
-        addr_block[address] = number
+    for address, number in translation.blocks.items():  # (a jump to an inlined block's number falls back:
+        addr_block[address] = number  # the dispatch has no arm for it, translate's `else`)
     return CompiledRoutine(translation, function, seconds, from_cache, code_map, addr_block)
 
 

@@ -44,7 +44,7 @@ RETURNED = 0
 BUDGET = 4  # the cycle budget was spent (retro.cpu.batch.LaneError.BUDGET)
 FALLBACK = 100  # from here up: the call left the translated code and runs again on the batched core
 FALLBACK_STOP = 101  # an instruction not translated (BRK, RTI, JAM, unstable, STP, WAI)
-FALLBACK_JUMP = 102  # RTS or JMP (ind) to an address no block starts at
+FALLBACK_JUMP = 102  # RTS or JMP (ind) to an address no dispatched block starts at
 FALLBACK_WRITE = 103  # a write into the routine's own code bytes
 FALLBACK_DECIMAL = 104  # D set on entry to code translated for binary mode only (`decimal_free`)
 NO_BLOCK = -1
@@ -701,6 +701,10 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
         e.indent = " " * 16
         emit_block(start)
         pending += sorted(e.chained - done - set(pending))
+    e.indent = " " * 12
+    e.put("else:  # a block number the dispatch does not run (inlined code): never spin, leave the call")
+    e.put(f"    status = {FALLBACK_JUMP}")
+    e.put("    break")
     name = "run_calls"
     restore = "\n".join(f"        mem[{address}] = image[{address}]" for address in sorted(e.fixed_writes))
     placing_lanes, copying = _lane_lines(lanes, outputs)

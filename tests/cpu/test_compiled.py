@@ -237,6 +237,19 @@ def test_code_that_cannot_set_d_runs_binary_and_leaves_a_call_entered_with_d_set
     assert left == LANES and set(compiled) == {"fallback"}
 
 
+def test_d_set_by_plp_is_decimal_mode_though_no_column_sets_p(compiled_cache):
+    """LDA $20; PHA; PLP (P from the data: D on about half the calls); LDA $22; ADC $24; STA $40; PHP;
+    PLA; STA $41; RTS, entered with D clear and no P column: PLP can set D, so the code keeps its
+    decimal ADC (the same results and flags as the batched core)."""
+    code = bytes([0xA5, 0x20, 0x48, 0x28, 0xA5, 0x22, 0x65, 0x24, 0x85, 0x40, 0x08, 0x68, 0x85, 0x41, 0x60])
+    registers, memory = random_states(7, LANES)
+    registers[:, 3] = 0x20
+    compiled, left = on_compiled("6510", code, registers, memory, [0x40, 0x41], p=0x20)
+    assert left == 0 and sum((m & 0x08) != 0 for m in memory[:, 0x20].tolist()) > LANES // 4
+    problems = _differences("compiled vs batch", compiled, on_batch("6510", code, registers, memory, [0x40, 0x41]))
+    assert not problems, "\n".join(problems[:10])
+
+
 def test_decimal_mode_on_every_operand_pair(compiled_cache):
     """SED; ADC, SBC (and ARR on the NMOS) of every A, every third operand and both carries, results and
     flags stored, against the batched core: the 6510's NMOS decimal mode, the 2A03's binary, the 65C02's
@@ -323,3 +336,16 @@ def test_a_taken_branch_into_the_next_page_costs_two_cycles_more(compiled_cache)
     done = routine.run(bytes(image), (carry,), np.asarray([0, 0, 0, 0x20], dtype=np.int64), sp, BUDGET, RETURN_TRAP,
                        CALL_STACK_TOP, np.zeros(0, dtype=np.int64))
     assert done["cycles"].tolist() == [22, 18] and done["status"].tolist() == [0, 0]
+
+
+def test_a_return_into_an_inlined_block_falls_back_instead_of_spinning(compiled_cache):
+    """LDA #$C0; PHA; LDA #$A9; PHA (a return address: $C0AA); CLC; BCC $C0AA; RTS; $C0AA: LDA #7; RTS.
+    $C0AA has one way in by its code (the branch), so its code is translated inside the first block;
+    the first RTS returns there at run time. That call must come back (left to the batched core), never
+    spin in the dispatch (it did: the budget is only looked at between blocks)."""
+    code = bytes([0xA9, 0xC0, 0x48, 0xA9, 0xA9, 0x48, 0x18, 0x90, 0x01, 0x60, 0xA9, 0x07, 0x60])
+    registers = np.array([[0, 0, 0, 0x20]])
+    memory = np.zeros((1, len(PLACED)), dtype=np.int64)
+    compiled, left = on_compiled("6510", code, registers, memory)
+    assert left == 1 and compiled == ["fallback"]
+    assert on_batch("6510", code, registers, memory)[0][0] == 7
