@@ -44,8 +44,11 @@ LOCK_FILE = ".lock"
 FALLBACK_REASON = {translate.FALLBACK_STOP: "an instruction the compiled engine leaves to the batched core "
                                             "(BRK, RTI, JAM, an unstable opcode, STP or WAI)",
                    translate.FALLBACK_JUMP: "a jump to code not found before the run (RTS or JMP (ind) to an "
-                                            "address no block starts at)",
-                   translate.FALLBACK_WRITE: "a write into the routine's own code"}
+                                            "address no block starts at, or to one whose code is translated "
+                                            "inside the block before it)",
+                   translate.FALLBACK_WRITE: "a write into the routine's own code",
+                   translate.FALLBACK_DECIMAL: "decimal mode on entry to code translated for binary mode only "
+                                               "(no SED or PLP in it)"}
 OUT_ROWS = ("a", "x", "y", "p", "cycles", "status")  # the rows of the function's `out` array
 
 
@@ -104,6 +107,10 @@ class CompiledRoutine:
         columns = tuple(columns) or (np.zeros(n, dtype=np.int64),)
         if lane_addr is None:
             lane_addr, lane_bytes = np.zeros(0, dtype=np.int64), np.zeros((0, n), dtype=np.uint8)
+        made_for = self.translation
+        if ((made_for.lanes is not None and tuple(lane_addr.tolist()) != made_for.lanes)
+                or (made_for.outputs is not None and tuple(out_addr.tolist()) != made_for.outputs)):
+            raise ValueError("the lane or output addresses differ from those the routine was compiled for")
         out = np.empty((len(OUT_ROWS), n), dtype=np.int64)
         out_bytes = np.empty((len(out_addr), n), dtype=np.uint8)
         try:
@@ -228,21 +235,25 @@ def _function(translation: Translation, columns: int) -> tuple[object, float, bo
 
 
 def compile_routine(image: bytes, entry: int, cpu: str, return_pc: int, inputs_at=(), columns: int = 0,
-                    places: tuple = (), sets: tuple = ()) -> CompiledRoutine:
+                    places: tuple = (), sets: tuple = (), lanes: tuple[int, ...] | None = None,
+                    outputs: tuple[int, ...] | None = None) -> CompiledRoutine:
     """The routine at entry in this memory image, compiled (or loaded from the cache) for calls whose
     inputs come in `columns` case columns placed by `places` and `sets` rows (retro.cpu.translate's
-    `_placing`; `CompiledRoutine.run`); Untranslatable when the compiled engine does not take it (the
-    message says why)."""
+    `_placing`; `CompiledRoutine.run`), and, when given, the `lane_addr` and `out_addr` every run
+    passes (`lanes`, `outputs`: one line each in the code instead of a loop); Untranslatable when the
+    compiled engine does not take it (the message says why)."""
     problem = numba_problem()
     if problem is not None:
         raise Untranslatable(problem)
-    translation = translate.translate(image.__getitem__, entry, cpu, return_pc, inputs_at, places, sets)
+    translation = translate.translate(image.__getitem__, entry, cpu, return_pc, inputs_at, places, sets,
+                                      None if lanes is None else tuple(lanes),
+                                      None if outputs is None else tuple(outputs))
     function, seconds, from_cache = _function(translation, columns)
     code_map = np.zeros(MEMORY, dtype=np.uint8)
     code_map[list(translation.code_bytes)] = 1
     addr_block = np.full(MEMORY, translate.NO_BLOCK, dtype=np.int32)
-    for address, number in translation.blocks.items():
-        addr_block[address] = number
+    for address, number in translation.blocks.items():  # (a jump to an inlined block's number falls back:
+        addr_block[address] = number  # the dispatch has no arm for it, translate's `else`)
     return CompiledRoutine(translation, function, seconds, from_cache, code_map, addr_block)
 
 

@@ -38,14 +38,15 @@ from retro.cpu.timing import (
     branch_target,
 )
 
-TRANSLATOR_VERSION = 3  # part of every cache key: a change of the generated code's meaning bumps it
+TRANSLATOR_VERSION = 4  # part of every cache key: a change of the generated code's meaning bumps it
 # A call's status (the compiled function's per-call result): 0 returned, else why it stopped.
 RETURNED = 0
 BUDGET = 4  # the cycle budget was spent (retro.cpu.batch.LaneError.BUDGET)
 FALLBACK = 100  # from here up: the call left the translated code and runs again on the batched core
 FALLBACK_STOP = 101  # an instruction not translated (BRK, RTI, JAM, unstable, STP, WAI)
-FALLBACK_JUMP = 102  # RTS or JMP (ind) to an address no block starts at
+FALLBACK_JUMP = 102  # RTS or JMP (ind) to an address no dispatched block starts at
 FALLBACK_WRITE = 103  # a write into the routine's own code bytes
+FALLBACK_DECIMAL = 104  # D set on entry to code translated for binary mode only (`decimal_free`)
 NO_BLOCK = -1
 WORD = 0xFFFF
 BYTE = 0xFF
@@ -71,6 +72,8 @@ class Translation:
     fixed_writes: tuple[int, ...]  # addresses written at a fixed address (restored after every call)
     instructions: int
     placed: tuple[int, ...] = ()  # addresses the function puts the case columns' bytes at (`places`)
+    lanes: tuple[int, ...] | None = None  # the `lane_addr` the function was made for (None: any, looped over)
+    outputs: tuple[int, ...] | None = None  # the `out_addr` likewise
 
 
 def tables_for(cpu: str) -> dict[int, Op]:
@@ -141,6 +144,7 @@ class _Emitter:
         self.cpu = cpu
         self.decimal = cpu == "6510"  # NMOS decimal mode; the 2A03 has none; the 65C02's own below
         self.cmos = cpu == WDC_65C02
+        self.binary = False  # D is 0 throughout (`decimal_free`): ADC and SBC inline, binary only
         self.code_bytes = code_bytes
         self.read = read
         self.lines: list[str] = []
@@ -232,14 +236,18 @@ class _Emitter:
     def add(self, name: str, value: str) -> None:
         """ADC (or SBC: `name` "sbc") of value: one call of the helper for this CPU's decimal mode
         (retro.cpu.compiled_ops); the 2A03 has none, the 65C02 takes a cycle more with D set."""
-        if self.decimal or self.cmos:
+        if self.binary or not (self.decimal or self.cmos):
+            operand = f"({value} ^ 255)" if name == "sbc" else value
+            self.put(f"t = a + {operand} + fc")
+            self.put(f"fv = (((a ^ t) & ({operand} ^ t)) >> 7) & 1")
+            self.put("fc = t >> 8")
+            self.put("a = t & 255")
+            self.nz("a")
+        else:
             family = "cmos" if self.cmos else "nmos"
             self.put(f"a, nv, zv, fv, fc = {name}_{family}(a, {value}, fc, fd)")
             if self.cmos:
                 self.put("cycles += fd")
-        else:
-            operand = f"{value} ^ 255" if name == "sbc" else value
-            self.put(f"a, nv, zv, fv, fc = adc_binary(a, {operand}, fc)")
 
     def compare(self, register: str, value: str) -> None:
         self.put(f"t = {register} - {value}")
@@ -611,6 +619,17 @@ def _inlined(starts: list[int], instructions: dict, entry: int, return_pc: int, 
             if start != entry and start not in returned_to and len(sources) == 1 and sources[0] < start}
 
 
+def decimal_free(instructions: Iterable[Op | None], sets: tuple) -> bool:
+    """Whether D stays as it was on entry through the code (no SED, no PLP) and no case column sets
+    P: then a call entered with D clear runs in binary mode throughout, and ADC and SBC are translated
+    for binary mode only (a call entered with D set falls back: FALLBACK_DECIMAL)."""
+    return (not any(op is not None and op.mnemonic in ("SED", "PLP") for op in instructions)
+            and not any(what == SET_P or (what == SET_FLAG and shift == DECIMAL_BIT) for _, shift, what in sets))
+
+
+DECIMAL_BIT = 0x08  # P's D flag
+
+
 def _placing(places: tuple, sets: tuple) -> str:
     """The lines that put a lane's inputs in place: `places` rows (column, shift, address) put the byte
     (column >> shift) & 255 at address; `sets` rows (column, shift, what) OR that byte into A, X, Y or P
@@ -624,11 +643,27 @@ def _placing(places: tuple, sets: tuple) -> str:
     return "\n".join(" " * 8 + line for line in lines)
 
 
+def _lane_lines(lanes: tuple[int, ...] | None, outputs: tuple[int, ...] | None) -> tuple[str, str]:
+    """The lines that put the per-lane bytes in place and copy the output bytes out: one line per
+    address when the addresses are known (an empty loop costs more than aabb8's whole call), else loops."""
+    if lanes is None:
+        placing = "        for k in range(lane_addr.shape[0]):\n            mem[lane_addr[k]] = lane_bytes[k, lane]"
+    else:
+        placing = "\n".join(f"        mem[{address}] = lane_bytes[{k}, lane]" for k, address in enumerate(lanes))
+    if outputs is None:
+        copying = "        for k in range(out_addr.shape[0]):\n            out_bytes[k, lane] = mem[out_addr[k]]"
+    else:
+        copying = "\n".join(f"        out_bytes[{k}, lane] = mem[{address}]" for k, address in enumerate(outputs))
+    return placing, copying
+
+
 def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
-              inputs_at: Iterable[int] = (), places: tuple = (), sets: tuple = ()) -> Translation:
+              inputs_at: Iterable[int] = (), places: tuple = (), sets: tuple = (),
+              lanes: tuple[int, ...] | None = None, outputs: tuple[int, ...] | None = None) -> Translation:
     """The routine at entry (its bytes as `read` gives them: the memory every call starts from) as
     the source of one function (see the module docstring; `places` and `sets`: where the case
-    columns go, `_placing`); Untranslatable when it certainly modifies its own code."""
+    columns go, `_placing`; `lanes` and `outputs`: the `lane_addr` and `out_addr` every run will
+    pass, when known, `_lane_lines`); Untranslatable when it certainly modifies its own code."""
     starts, instructions = find_blocks(read, entry, cpu, return_pc)
     code_bytes = frozenset((pc + k) & WORD for pc, op in instructions.items()
                            for k in range(MODE_LENGTH[op.mode] if op is not None else 1))
@@ -642,6 +677,7 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
     leaders = set(starts)
     e = _Emitter(cpu, code_bytes, read)
     e.inlined = inlined
+    e.binary = (e.decimal or e.cmos) and decimal_free(instructions.values(), sets)
 
     def emit_block(start: int) -> None:
         pc = start
@@ -665,13 +701,20 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
         e.indent = " " * 16
         emit_block(start)
         pending += sorted(e.chained - done - set(pending))
+    e.indent = " " * 12
+    e.put("else:  # a block number the dispatch does not run (inlined code): never spin, leave the call")
+    e.put(f"    status = {FALLBACK_JUMP}")
+    e.put("    break")
     name = "run_calls"
     restore = "\n".join(f"        mem[{address}] = image[{address}]" for address in sorted(e.fixed_writes))
+    placing_lanes, copying = _lane_lines(lanes, outputs)
     source = _FUNCTION.format(name=name, entry_block=blocks[entry], body="\n".join(e.lines), budget_status=BUDGET,
+                              bad="fd * 2" if e.binary else "0", fallback_decimal=FALLBACK_DECIMAL,
+                              lane_placing=placing_lanes, out_copying=copying,
                               fallback_write=FALLBACK_WRITE, z_bit=_Z_BIT, restore=restore,
                               placing=_placing(places, sets))
     return Translation(source, name, blocks, code_bytes, tuple(sorted(e.fixed_writes)), len(instructions),
-                       tuple(address for _, _, address in places))
+                       tuple(address for _, _, address in places), lanes, outputs)
 
 
 # The function around the blocks: one call per lane, inputs placed from the case columns (`cols`, a
@@ -685,8 +728,7 @@ LOG_MASK = 65535
 def {name}(mem, image, log, code_map, addr_block, cols, lane_addr, lane_bytes, base, start_sp, budget, return_pc,
            return_sp, out_addr, out, out_bytes):
     for lane in range(out.shape[1]):
-        for k in range(lane_addr.shape[0]):
-            mem[lane_addr[k]] = lane_bytes[k, lane]
+{lane_placing}
         a = base[0]
         x = base[1]
         y = base[2]
@@ -699,7 +741,7 @@ def {name}(mem, image, log, code_map, addr_block, cols, lane_addr, lane_bytes, b
         fi = (p >> 2) & 1
         zv = (p & 2) ^ 2
         fc = p & 1
-        bad = 0
+        bad = {bad}  # 1: a write into the code; 2: D set on entry to binary-only code
         sp = np.int64(start_sp)
         cycles = np.int64(0)
         status = 0
@@ -713,7 +755,7 @@ def {name}(mem, image, log, code_map, addr_block, cols, lane_addr, lane_bytes, b
         pg = np.int64(0)
         while True:
             if cycles >= budget or bad:
-                status = {fallback_write} if bad else {budget_status}
+                status = ({fallback_write} if bad == 1 else {fallback_decimal}) if bad else {budget_status}
                 break
 {body}
         if status == 0 and bad:
@@ -726,8 +768,7 @@ def {name}(mem, image, log, code_map, addr_block, cols, lane_addr, lane_bytes, b
         out[3, lane] = (nv & 128) | (fv << 6) | 32 | (fd << 3) | (fi << 2) | {z_bit} | fc
         out[4, lane] = cycles
         out[5, lane] = status
-        for k in range(out_addr.shape[0]):
-            out_bytes[k, lane] = mem[out_addr[k]]
+{out_copying}
         if nlog > LOG_MASK + 1:  # more writes than the log holds: the whole memory
             mem[:] = image
         else:

@@ -157,20 +157,21 @@ def compiled_routine(runner: RoutineRunner):
     inputs_at = [address for _, address, _ in plan.bytes] + [a for _, addresses in plan.tables for a in addresses]
     trapped = bytearray(image)
     push_return_trap(trapped)
-    places = ()  # memory inputs go through lane_bytes (numpy casts them to bytes in one pass)
+    places = tuple((index, shift, address) for index, address, shift in plan.bytes)  # read from the columns per call
     sets = tuple([(index, shift, SET_REGISTERS.index(register)) for index, register, shift in plan.registers]
                  + [(index, bit, SET_FLAG) for index, bit in plan.flags])
     routine = compile_routine(bytes(trapped), runner.entry, runner.routine.cpu, RETURN_TRAP, inputs_at,
-                              len(runner.routine.inputs), places, sets)
+                              len(runner.routine.inputs), places, sets,
+                              lanes=tuple(a for _, addresses in plan.tables for a in addresses),
+                              outputs=tuple(int(a) for a in plan.output_addresses))
     runner._compiled = (routine, [(a, image[a]) for a in sorted(routine.translation.code_bytes)], image)
     return routine
 
 
 def _lane_bytes(plan, columns: list, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """The memory inputs as (addresses, one row of bytes per address): numpy casts each column to
-    bytes in one pass (the kernel reads registers and flags from the columns itself)."""
-    tables: list[tuple[int, np.ndarray]] = [(address, columns[index] >> shift if shift else columns[index])
-                                            for index, address, shift in plan.bytes]
+    """The table inputs as (addresses, one row of bytes per address): numpy casts each column to
+    bytes in one pass (the kernel reads registers, flags and single bytes from the columns itself)."""
+    tables: list[tuple[int, np.ndarray]] = []
     for index, addresses in plan.tables:
         tables += [(address, columns[index][:, k]) for k, address in enumerate(addresses)]
     lane_addr = np.asarray([address for address, _ in tables], dtype=np.int64)

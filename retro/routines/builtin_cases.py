@@ -89,14 +89,29 @@ def _block(names: str, **columns) -> dict[str, np.ndarray]:
     return {name: np.broadcast_to(np.asarray(columns[name], dtype=np.int64), (n,)).copy() for name in names.split()}
 
 
-def aabb8_sweep() -> Iterator[dict]:
-    """Every (ax, aw) against boxes placed across the 255/256 end, and every (ay, ah) likewise."""
-    first, size = _grid(BYTE, BYTE)
+AABB8_OVERLAPPING = {"x": (10, 5, 8, 5), "y_a_first": (10, 5, 12, 5), "y_b_first": (12, 5, 10, 5)}
+# (position, size, other position, other size) the axis not swept is held at: the boxes overlap there,
+# so the answer is the swept axis's. y is swept twice: the routine's y test has one copy for each way
+# its x test goes (box A starting first on x, or box B), each entered with its own carry.
+AABB8_AXIS_CALLS = BYTE ** 4  # every (position, size, other position, other size) of one axis
+
+
+def aabb8_sweep(starts: Iterable[int] = range(BYTE)) -> Iterator[dict]:
+    """Every input of each axis: all 2^32 (ax, aw, bx, bw) with y overlapping, then all 2^32 (ay, ah,
+    by, bh) after each way the x test goes: 3 x 2^32 calls, in blocks of 65,536 (every size against
+    every other size for one pair of positions; never more than one block in memory). `starts`: the
+    positions of box A swept (a bounded form for tests: a few of them)."""
+    size, other_size = _grid(BYTE, BYTE)
     names = "ax ay aw ah bx by bw bh"
-    for bx, bw in ((0, 1), (120, 16), (250, 6)):
-        yield _block(names, ax=first, ay=10, aw=size, ah=5, bx=bx, by=8, bw=bw, bh=5)
-    for by, bh in ((0, 1), (250, 6)):
-        yield _block(names, ax=10, ay=first, aw=5, ah=size, bx=8, by=by, bw=5, bh=bh)
+    ay, ah, by, bh = AABB8_OVERLAPPING["x"]
+    for ax in starts:
+        for bx in range(BYTE):
+            yield _block(names, ax=ax, ay=ay, aw=size, ah=ah, bx=bx, by=by, bw=other_size, bh=bh)
+    for held in ("y_a_first", "y_b_first"):
+        ax, aw, bx, bw = AABB8_OVERLAPPING[held]
+        for ay in starts:
+            for by in range(BYTE):
+                yield _block(names, ax=ax, ay=ay, aw=aw, ah=size, bx=bx, by=by, bw=bw, bh=other_size)
 
 
 # ---- aabb_sprite -------------------------------------------------------------------------------

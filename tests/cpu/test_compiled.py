@@ -17,7 +17,7 @@ from retro.cpu.batch import BatchCpu, LaneError
 from retro.cpu.compiled import SET_A, SET_FLAG, SET_P, SET_X, SET_Y, compile_routine, numba_problem
 from retro.cpu.machine import CALL_STACK_TOP, RETURN_TRAP, push_return_trap
 from retro.cpu.opcodes import DOCUMENTED, MODE_LENGTH, RESERVED, STABLE
-from retro.cpu.translate import FALLBACK, Untranslatable, tables_for
+from retro.cpu.translate import FALLBACK, Untranslatable, tables_for, translate
 from retro.errors import RunError
 from retro.machines import build_machine
 
@@ -49,9 +49,10 @@ def _operand(rng: random.Random, mode: str) -> list[int]:
     return []
 
 
-def random_program(cpu: str, seed: int, length: int = 70) -> bytes:
+def random_program(cpu: str, seed: int, length: int = 70, decimal: bool = True) -> bytes:
     """Random instructions with branches (forward, and backward in counted loops), a JSR, P from the
-    data (LDA zp; PHA; PLP: D and the other flags vary per call) and SED; ends with RTS."""
+    data (LDA zp; PHA; PLP: D and the other flags vary per call) and SED (neither when not `decimal`:
+    code that cannot set D); ends with RTS."""
     rng = random.Random(seed)
     pool = _pool(cpu)
     table = tables_for(cpu)
@@ -67,6 +68,8 @@ def random_program(cpu: str, seed: int, length: int = 70) -> bytes:
                 op = rng.choice(pool)
                 items.append(bytes([op, *_operand(rng, table[op].mode)]))
             items.append(("label", labels))
+        elif roll < 0.14 and not decimal:
+            items.append(bytes([0xD8, 0x18]))  # CLD; CLC
         elif roll < 0.12:  # flags from the data, decimal mode included
             items.append(bytes([0xA5, rng.randrange(0x20, 0x40), 0x48, 0x28]))  # LDA zp; PHA; PLP
         elif roll < 0.14:
@@ -165,15 +168,17 @@ def on_batch(cpu: str, code: bytes, registers, memory, watched=WATCHED) -> list:
              tuple(watched[i].tolist())) for i in range(n)]
 
 
-def on_compiled(cpu: str, code: bytes, registers, memory, watched=WATCHED) -> tuple[list, int]:
-    """(results, calls left to the batched core); a call stopped by the budget is None."""
+def on_compiled(cpu: str, code: bytes, registers, memory, watched=WATCHED, p: int | None = None) -> tuple[list, int]:
+    """(results, calls left to the batched core); a call stopped by the budget is None. `p`: P the
+    same for every call, in the base registers (no column sets P), registers[:, 3] ignored."""
     image = image_with(code)
     sp = push_return_trap(image)
-    routine = compile_routine(bytes(image), CODE, cpu, RETURN_TRAP, columns=4,
-                              sets=((0, 0, SET_A), (1, 0, SET_X), (2, 0, SET_Y), (3, 0, SET_P)))
+    sets = ((0, 0, SET_A), (1, 0, SET_X), (2, 0, SET_Y)) + (((3, 0, SET_P),) if p is None else ())
+    routine = compile_routine(bytes(image), CODE, cpu, RETURN_TRAP, columns=4, sets=sets)
     flags = ((registers[:, 3] | 0x20) & ~0x10).astype(np.int64)
     columns = (*(np.ascontiguousarray(registers[:, k], dtype=np.int64) for k in range(3)), flags)
-    done = routine.run(bytes(image), columns, np.zeros(4, dtype=np.int64), sp, BUDGET, RETURN_TRAP, CALL_STACK_TOP,
+    base = np.asarray([0, 0, 0, 0 if p is None else p], dtype=np.int64)
+    done = routine.run(bytes(image), columns, base, sp, BUDGET, RETURN_TRAP, CALL_STACK_TOP,
                        np.asarray(watched, dtype=np.int64), PLACED, np.ascontiguousarray(memory.T.astype(np.uint8)))
     results, left = [], 0
     for i in range(len(registers)):
@@ -209,6 +214,40 @@ def test_random_routines_agree_on_all_three_engines(cpu, seed, compiled_cache):
     assert not problems, "\n".join(problems[:10])
     assert left < LANES // 4  # nearly every call ran compiled (a (zp),Y store may land in the code: batched)
     assert sum(r is not None for r in machine) > LANES // 2
+
+
+@pytest.mark.parametrize("cpu", ["6510", "65c02"])
+def test_code_that_cannot_set_d_runs_binary_and_leaves_a_call_entered_with_d_set(cpu, compiled_cache):
+    """No SED, no PLP, no column sets P: ADC and SBC are translated for binary mode only (inline), the
+    same as the batched core on every call entered with D clear; entered with D set, every call is
+    left to the batched core (which gets it right: decimal mode)."""
+    code = random_program(cpu, 11, decimal=False)
+    registers, memory = random_states(5, LANES)
+    clear = 0x21  # carry set, D clear
+    registers[:, 3] = clear
+    compiled, left = on_compiled(cpu, code, registers, memory, p=clear)
+    problems = _differences("compiled vs batch", compiled, on_batch(cpu, code, registers, memory))
+    assert not problems, "\n".join(problems[:10])
+    assert left < LANES // 4
+    image = image_with(code)
+    source = translate(image.__getitem__, CODE, cpu, RETURN_TRAP, sets=((0, 0, SET_A),)).source
+    assert "t = a + " in source and "_nmos(" not in source and "_cmos(" not in source  # ADC/SBC inline, binary
+    decimal = clear | 0x08
+    compiled, left = on_compiled(cpu, code, registers, memory, p=decimal)
+    assert left == LANES and set(compiled) == {"fallback"}
+
+
+def test_d_set_by_plp_is_decimal_mode_though_no_column_sets_p(compiled_cache):
+    """LDA $20; PHA; PLP (P from the data: D on about half the calls); LDA $22; ADC $24; STA $40; PHP;
+    PLA; STA $41; RTS, entered with D clear and no P column: PLP can set D, so the code keeps its
+    decimal ADC (the same results and flags as the batched core)."""
+    code = bytes([0xA5, 0x20, 0x48, 0x28, 0xA5, 0x22, 0x65, 0x24, 0x85, 0x40, 0x08, 0x68, 0x85, 0x41, 0x60])
+    registers, memory = random_states(7, LANES)
+    registers[:, 3] = 0x20
+    compiled, left = on_compiled("6510", code, registers, memory, [0x40, 0x41], p=0x20)
+    assert left == 0 and sum((m & 0x08) != 0 for m in memory[:, 0x20].tolist()) > LANES // 4
+    problems = _differences("compiled vs batch", compiled, on_batch("6510", code, registers, memory, [0x40, 0x41]))
+    assert not problems, "\n".join(problems[:10])
 
 
 def test_decimal_mode_on_every_operand_pair(compiled_cache):
@@ -297,3 +336,16 @@ def test_a_taken_branch_into_the_next_page_costs_two_cycles_more(compiled_cache)
     done = routine.run(bytes(image), (carry,), np.asarray([0, 0, 0, 0x20], dtype=np.int64), sp, BUDGET, RETURN_TRAP,
                        CALL_STACK_TOP, np.zeros(0, dtype=np.int64))
     assert done["cycles"].tolist() == [22, 18] and done["status"].tolist() == [0, 0]
+
+
+def test_a_return_into_an_inlined_block_falls_back_instead_of_spinning(compiled_cache):
+    """LDA #$C0; PHA; LDA #$A9; PHA (a return address: $C0AA); CLC; BCC $C0AA; RTS; $C0AA: LDA #7; RTS.
+    $C0AA has one way in by its code (the branch), so its code is translated inside the first block;
+    the first RTS returns there at run time. That call must come back (left to the batched core), never
+    spin in the dispatch (it did: the budget is only looked at between blocks)."""
+    code = bytes([0xA9, 0xC0, 0x48, 0xA9, 0xA9, 0x48, 0x18, 0x90, 0x01, 0x60, 0xA9, 0x07, 0x60])
+    registers = np.array([[0, 0, 0, 0x20]])
+    memory = np.zeros((1, len(PLACED)), dtype=np.int64)
+    compiled, left = on_compiled("6510", code, registers, memory)
+    assert left == 1 and compiled == ["fallback"]
+    assert on_batch("6510", code, registers, memory)[0][0] == 7
