@@ -4,9 +4,12 @@ that must not pay for Dask (`retro demo`, `retro check mul8`).
 
     python benchmarks/dask_cpu.py [ROUTINE ...] [--engine batch] [--skip-small] [--before DIR]
 
-Default: mul8 and aabb8 with --exhaustive on the batched core. The workers' CPU is read from the workers
-themselves (time.process_time in each, at the cluster's start and before it closes), the parent's from
-this process; the JSON of both runs must be identical (else the script fails).
+Each check runs in a fresh process (imports apart), once in one process and once on the workers.
+
+Default: hit_slot, mul8 and tile with --exhaustive on the batched core. The CPU of the worker processes and
+of the server they are forked from is read from /proc (psutil) at the cluster's start and before it
+closes, the parent's (with the scheduler and the nannies, threads of it) from this process; the JSON of
+both runs must be identical (else the script fails).
 """
 
 from __future__ import annotations
@@ -21,51 +24,72 @@ from contextlib import contextmanager
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-
-from retro import workers  # noqa: E402
-from retro.analysis.check import run  # noqa: E402
-from retro.commands.check import as_json  # noqa: E402
 
 
 def _records(checks) -> str:
+    from retro.commands.check import as_json
+
     records = as_json(checks)
     for record in records:
         record.pop("compile_seconds", None)
     return json.dumps(records, sort_keys=True)
 
 
-def one_process(name: str, engine: str) -> tuple[float, str]:
+def one_process(name: str, engine: str) -> dict:
+    from retro.analysis.check import run
+
     began = time.process_time()
     checks = run.run_checks([name], exhaustive=True, jobs=1, engine=engine, search_budget=0)
-    return time.process_time() - began, _records(checks)
+    return {"cpu": time.process_time() - began, "start": 0.0, "records": _records(checks)}
 
 
-def two_workers(name: str, engine: str) -> tuple[float, float, float, float, str]:
-    """(parent CPU, workers' CPU, of which their start, the parent's CPU to start the cluster, JSON)."""
-    seen: dict[str, dict] = {}
+def _children_cpu() -> float:
+    """CPU seconds of every process below this one (the forkserver and the workers forked from it)."""
+    import psutil
+
+    spent = 0.0
+    for child in psutil.Process().children(recursive=True):
+        try:
+            times = child.cpu_times()
+        except psutil.Error:  # gone meanwhile
+            continue
+        spent += times.user + times.system
+    return spent
+
+
+def two_workers(name: str, engine: str) -> dict:
+    """The CPU of this process and of its children (the worker processes and the server they are forked
+    from, which imports the tasks' code once for both) over the check, and of that the cluster's start:
+    the children's CPU when it is up and the parent's to start it."""
+    from retro import workers
+    from retro.analysis.check import run
+
+    seen: dict[str, float] = {}
     real = workers._client
 
     @contextmanager
     def measured(w):
         before = time.process_time()
         with real(w) as client:
-            seen["start"] = client.run(time.process_time)
-            seen["parent_start"] = {"": time.process_time() - before}
+            seen["start"] = _children_cpu() + time.process_time() - before
             yield client
-            seen["end"] = client.run(time.process_time)
+            seen["children"] = _children_cpu()
 
     workers._client = measured
-    rule = run.PARALLEL_CALLS
-    run.PARALLEL_CALLS = dict.fromkeys(rule, 0)  # on the workers even where the rule would keep it in one process
-    try:
-        began = time.process_time()
-        checks = run.run_checks([name], exhaustive=True, jobs=2, engine=engine, search_budget=0)
-        parent = time.process_time() - began
-    finally:
-        workers._client, run.PARALLEL_CALLS = real, rule
-    return (parent, sum(seen["end"].values()), sum(seen["start"].values()), seen["parent_start"][""],
-            _records(checks))
+    run.PARALLEL_CALLS = dict.fromkeys(run.PARALLEL_CALLS, 0)  # on the workers even where the rule would not
+    began = time.process_time()
+    checks = run.run_checks([name], exhaustive=True, jobs=2, engine=engine, search_budget=0)
+    return {"cpu": time.process_time() - began + seen["children"], "start": seen["start"], "records": _records(checks)}
+
+
+def measured(root: Path, how: str, name: str, engine: str) -> dict:
+    """One check measured in a fresh process run from `root` (imports done before the clock starts, no
+    cache of a previous run)."""
+    done = subprocess.run([sys.executable, __file__, "--measure", how, "--engine", engine, name], cwd=root,
+                          capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(root)})
+    if done.returncode:
+        raise SystemExit(f"{how} {name} in {root}: exit {done.returncode}: {done.stderr[-500:]}")
+    return json.loads(done.stdout.splitlines()[-1])
 
 
 START = """
@@ -95,34 +119,45 @@ def start_seconds(root: Path, argv: list[str]) -> tuple[float, float, str]:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("routines", nargs="*", default=["mul8", "aabb8"])
+    parser.add_argument("routines", nargs="*", default=[str(ROOT / "examples/object_table/hit_slot.toml"), "mul8",
+                                                        "tile"])
     parser.add_argument("--engine", default="batch")
     parser.add_argument("--skip-small", action="store_true")
-    parser.add_argument("--before", metavar="DIR", help="a checkout of the code before Dask, timed beside this one")
+    parser.add_argument("--before", metavar="DIR", help="a checkout of earlier code, timed beside this one")
+    parser.add_argument("--measure", choices=["one", "two"], help=argparse.SUPPRESS)  # (the fresh process's part)
     args = parser.parse_args()
+    if args.measure:
+        sys.path.insert(0, os.getcwd())
+        import retro.analysis.check.run  # noqa: F401  (imports apart from the measure)
+        import retro.commands.check  # noqa: F401
+
+        how = one_process if args.measure == "one" else two_workers
+        print(json.dumps(how(args.routines[0], args.engine)))
+        return 0
+    roots = [("before", Path(args.before).resolve())] if args.before else []
+    roots.append(("now", ROOT))
     if not args.skip_small:
         import tempfile
 
         with tempfile.TemporaryDirectory() as out:
             for argv in (["demo", "--out", out], ["check", "mul8", "--quiet"]):
                 shown = " ".join(argv[:2])
-                for label, root in (("before", args.before), ("now", ROOT)):
-                    if root is None:
-                        continue
-                    wall, cpu, dask = start_seconds(Path(root), argv)
+                for label, root in roots:
+                    wall, cpu, dask = start_seconds(root, argv)
                     print(f"retro {shown:<12} {label:<7} {wall:6.2f} s wall {cpu:6.2f} CPU-s  Dask imported: {dask}")
-    print(f"{'check --exhaustive':<22} {'1 process':>10} {'2 workers':>10} {'(start)':>9} {'ratio':>7} "
+    print(f"{'check --exhaustive':<24} {'code':<7} {'1 process':>10} {'2 workers':>10} {'(start)':>9} {'ratio':>7} "
           f"{'beyond start':>13}")
     for name in args.routines:
-        alone, expected = one_process(name, args.engine)
-        parent, spent, start, parent_start, got = two_workers(name, args.engine)
-        if got != expected:
-            print(f"{name}: the two-worker JSON differs from one process's", file=sys.stderr)
-            return 1
-        total = parent + spent
-        beyond = total - start - parent_start
-        print(f"{name + ' (' + args.engine + ')':<22} {alone:9.2f}s {total:9.2f}s {start + parent_start:8.2f}s "
-              f"{total / alone:6.2f}x {beyond / alone:12.2f}x")
+        label = Path(name).name if name.endswith(".toml") else name
+        for code, root in roots:
+            alone = measured(root, "one", name, args.engine)
+            two = measured(root, "two", name, args.engine)
+            if two["records"] != alone["records"]:
+                print(f"{name}: the two-worker JSON differs from one process's ({code})", file=sys.stderr)
+                return 1
+            beyond = two["cpu"] - two["start"]
+            print(f"{label + ' (' + args.engine + ')':<24} {code:<7} {alone['cpu']:9.2f}s {two['cpu']:9.2f}s "
+                  f"{two['start']:8.2f}s {two['cpu'] / alone['cpu']:6.2f}x {beyond / alone['cpu']:12.2f}x")
     return 0
 
 

@@ -78,6 +78,7 @@ def run_in_order(function: Callable, tasks: Iterable[tuple], workers: Workers | 
             if report(function(*task)):
                 return
         return
+    _preload(function.__module__)
     if _session is not None:  # one cluster for the whole command (`session`)
         if workers not in _session:
             _session[workers] = _session_stack.enter_context(_client(workers))
@@ -129,6 +130,47 @@ def _run_on(client, function: Callable, tasks: Iterable[tuple], report: Callable
             client.cancel(list(pending))
 
 
+# The embedded cluster's Dask settings: its workers hold one long task at a time, so Dask's own sampling
+# profiler (every 10 ms), event-loop tick check (20 ms), system monitor (500 ms), memory monitor (100 ms),
+# work stealing and active memory manager only cost CPU: together about 0.1 CPU-second per second of an
+# idle two-worker cluster, measured (benchmarks/dask_cpu.py); with these, about a tenth of it.
+EMBEDDED_CONFIG = {
+    "distributed.worker.multiprocessing-method": "forkserver",  # workers forked from a server process (a
+    # fraction of spawn's start, which imports everything again per worker)
+    "distributed.logging.distributed": "critical",  # errors reach us as exceptions
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.tick.interval": "1s",
+    "distributed.admin.system-monitor.interval": "10s",
+    "distributed.admin.system-monitor.gil.enabled": False,
+    "distributed.worker.memory.monitor-interval": "10s",
+    "distributed.scheduler.work-stealing": False,  # tasks go out IN_FLIGHT per thread: nothing to steal
+    "distributed.scheduler.active-memory-manager.start": False,
+}
+
+
+def _preload(module: str) -> None:
+    """The worker processes of this process's embedded clusters are forked from a server process that
+    imports `module` (the tasks' code) once, before the first cluster starts: each worker inherits it
+    rather than importing it again (about 0.4 CPU-second per worker for the check). No effect once
+    that server runs (a later cluster in the same process), nor on another machine's workers."""
+    import multiprocessing
+
+    import dask
+    from distributed.utils import get_mp_context  # (before setting its keys: its defaults come with it)
+
+    global _preloaded
+    if _preloaded or module == "__main__":  # (a script's main module is imported by each worker anyway)
+        return
+    _preloaded = True
+    with dask.config.set(EMBEDDED_CONFIG):
+        context = get_mp_context()  # distributed sets its own list first (itself, numpy, ...)
+    if isinstance(context, type(multiprocessing.get_context("forkserver"))):
+        context.set_forkserver_preload(["distributed", module])
+
+
+_preloaded = False
+
+
 @contextmanager
 def _client(workers: Workers) -> Iterator[Any]:
     """A Dask client of the scheduler at `workers.scheduler`, else of an embedded local cluster of
@@ -148,10 +190,7 @@ def _client(workers: Workers) -> Iterator[Any]:
         finally:
             client.close()
         return
-    # for this process's clusters: workers forked from a server process (a fraction of spawn's start, which
-    # imports everything again per worker); their logs only when critical (errors reach us as exceptions)
-    dask.config.set({"distributed.worker.multiprocessing-method": "forkserver",
-                     "distributed.logging.distributed": "critical"})
+    dask.config.set(EMBEDDED_CONFIG)  # for this process's clusters
     cluster = LocalCluster(n_workers=workers.count, threads_per_worker=1, processes=True, dashboard_address=":0",
                            preload=[__name__], silence_logs=logging.CRITICAL, memory_limit=0)
     client = Client(cluster, set_as_default=False)
@@ -167,10 +206,8 @@ def _close(client, cluster, pids: list[int]) -> None:
     CLOSE_SECONDS). On a stop the workers are killed at once (they hold nothing to save) and nothing
     waits: the process is ending, and a cluster closed under a stop can wait on workers already gone."""
     if interrupts.stopping():
-        from distributed.core import Status
-
         for nanny in cluster.workers.values():
-            nanny.status = Status.closing  # a nanny restarts a worker that dies, unless it is closing
+            nanny.close_gracefully(reason="retro-stop")  # else a nanny restarts a worker that dies
         _kill(pids)
         cluster.shutdown_on_close = False  # nor is the cluster closed at exit (distributed's atexit would wait)
         return
