@@ -597,7 +597,7 @@ def _exits(start: int, instructions: dict, leaders: set[int], return_pc: int, re
         op = instructions[pc]
         targets, falls = _successors(pc, op, read)
         if op is not None and op.mnemonic == "JSR":
-            return targets[:1], targets[1:]
+            return [t for t in targets[:1] if t != return_pc], targets[1:]  # a JSR to the return address starts no block
         following = (pc + MODE_LENGTH[op.mode]) & WORD if op is not None else pc
         if op is None or not falls or op.mode in ("rel", "zpr") or following in leaders or following == return_pc:
             return [t for t in targets + ([following] if falls else []) if t != return_pc], []

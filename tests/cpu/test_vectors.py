@@ -20,45 +20,19 @@ from retro.cpu.bus import Bus
 from retro.cpu.mpu import MPU2A03, MPU6510, CpuHalt
 from vectors import (
     FLAG_D,
+    Harness,
     JAM,
     NOP_ABS,
     NOP_ABS_X,
-    PUSHES_P,
     SUPPORTED,
     UNSTABLE,
     all_vectors,
+    binary_expectation,
     differences,
     expected_cycles,
     load,
     nop_effective_address,
 )
-
-
-class Harness:
-    """One MPU on one 64 KiB memory, reused: each vector's bytes are cleared after it runs."""
-
-    def __init__(self, cpu_class):
-        self.bus = Bus()
-        self.memory = self.bus.memory
-        self.mpu = cpu_class(memory=self.memory, page_devices=self.bus.page_devices)
-
-    def run(self, vector: dict, p: int | None = None) -> dict:
-        initial = vector["initial"]
-        for address, value in initial["ram"]:
-            self.memory[address] = value
-        mpu = self.mpu
-        mpu.pc, mpu.sp, mpu.a, mpu.x, mpu.y = initial["pc"], initial["s"], initial["a"], initial["x"], initial["y"]
-        mpu.p = initial["p"] if p is None else p
-        start = mpu.processorCycles
-        try:
-            mpu.step()
-            state = {"pc": mpu.pc, "s": mpu.sp, "a": mpu.a, "x": mpu.x, "y": mpu.y, "p": mpu.p,
-                     "ram": [[address, self.memory[address]] for address, _ in vector["final"]["ram"]],
-                     "cycles": mpu.processorCycles - start}
-        finally:
-            for address, _ in initial["ram"] + vector["final"]["ram"]:
-                self.memory[address] = 0
-        return state
 
 
 def test_every_supported_vector_matches_on_the_6510(vector_dir, figures):
@@ -76,17 +50,6 @@ def test_every_supported_vector_matches_on_the_6510(vector_dir, figures):
     assert not failures, f"{len(failures)} vectors differ, first: {failures[:5]}"
     figures["6510"] = (f"CPU vectors, 6510: {matched}/{matched} vectors of {len(SUPPORTED)} opcodes match "
                        f"({corrected} NOP abs/abs,X cycle counts corrected for ProcessorTests issue #46)")
-
-
-def binary_expectation(reference: Harness, opcode: int, vector: dict) -> dict:
-    """What a 6502 without decimal mode does: the 6510 run with D clear, then D as the vector ends.
-
-    The final D never depends on arithmetic (only SED, CLD, PLP and RTI change it), so it is taken
-    from the vector. BRK and PHP do no arithmetic and push D, so for them the vector itself holds."""
-    if opcode in PUSHES_P:
-        return vector["final"]
-    state = reference.run(vector, p=vector["initial"]["p"] & ~FLAG_D)
-    return {**state, "p": state["p"] & ~FLAG_D | vector["final"]["p"] & FLAG_D}
 
 
 def test_2a03_matches_with_d_clear_and_stays_binary_with_d_set(vector_dir, figures):

@@ -8,6 +8,8 @@ import json
 from collections.abc import Iterator
 from pathlib import Path
 
+from retro.cpu.bus import Bus
+
 # Facts from 64doc / No More Secrets, written here independently of retro.cpu.mpu.
 JAM = {0x02, 0x12, 0x22, 0x32, 0x42, 0x52, 0x62, 0x72, 0x92, 0xB2, 0xD2, 0xF2}
 UNSTABLE = {0x93: "SHA", 0x9F: "SHA", 0x9E: "SHX", 0x9C: "SHY", 0x9B: "TAS", 0xBB: "LAS", 0x8B: "ANE",
@@ -64,3 +66,41 @@ def all_vectors(directory: Path) -> Iterator[tuple[int, dict]]:
     for opcode in SUPPORTED:
         for vector in load(directory, opcode):
             yield opcode, vector
+
+
+class Harness:
+    """One MPU on one 64 KiB memory, reused: each vector's bytes are cleared after it runs."""
+
+    def __init__(self, cpu_class):
+        self.bus = Bus()
+        self.memory = self.bus.memory
+        self.mpu = cpu_class(memory=self.memory, page_devices=self.bus.page_devices)
+
+    def run(self, vector: dict, p: int | None = None) -> dict:
+        initial = vector["initial"]
+        for address, value in initial["ram"]:
+            self.memory[address] = value
+        mpu = self.mpu
+        mpu.pc, mpu.sp, mpu.a, mpu.x, mpu.y = initial["pc"], initial["s"], initial["a"], initial["x"], initial["y"]
+        mpu.p = initial["p"] if p is None else p
+        start = mpu.processorCycles
+        try:
+            mpu.step()
+            state = {"pc": mpu.pc, "s": mpu.sp, "a": mpu.a, "x": mpu.x, "y": mpu.y, "p": mpu.p,
+                     "ram": [[address, self.memory[address]] for address, _ in vector["final"]["ram"]],
+                     "cycles": mpu.processorCycles - start}
+        finally:
+            for address, _ in initial["ram"] + vector["final"]["ram"]:
+                self.memory[address] = 0
+        return state
+
+
+def binary_expectation(reference: Harness, opcode: int, vector: dict) -> dict:
+    """What a 6502 without decimal mode does: the 6510 run with D clear, then D as the vector ends.
+
+    The final D never depends on arithmetic (only SED, CLD, PLP and RTI change it), so it is taken
+    from the vector. BRK and PHP do no arithmetic and push D, so for them the vector itself holds."""
+    if opcode in PUSHES_P:
+        return vector["final"]
+    state = reference.run(vector, p=vector["initial"]["p"] & ~FLAG_D)
+    return {**state, "p": state["p"] & ~FLAG_D | vector["final"]["p"] & FLAG_D}
