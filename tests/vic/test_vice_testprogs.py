@@ -1,5 +1,5 @@
 """VICE's own VIC-II collision test programs (the VICE testprogs repository: VICII/spritecollisions,
-spritex, spritey), run from their BASIC SYS line through `retro run`'s own function, each verdict
+spritex, spritey, split-tests/spritescan), run from their BASIC SYS line through `retro run`'s own function, each verdict
 read from the result byte they write at $D7FF (VICE's testbench: $00 passed, $FF failed).
 
 The programs are never in the repository: they are read from $RETRO_VICE_TESTPROGS or
@@ -70,6 +70,29 @@ def test_spritex_cases_agree_with_the_real_machine():
     (got,) = report.peeks.values()
     wrong = {i + 1 for i, (a, b) in enumerate(zip(got, SPRITEX_REFERENCE)) if a != b}
     assert wrong == set(), got
+
+
+SPRITESCAN = "VICII/split-tests/spritescan/spritescan.prg"
+SPRITESCAN_BUFFER = "$6F00"  # BUFFER..BUFFER_END ($6F00-$7FFF): the header and the $1000 bytes of results
+SPRITESCAN_IDENT = 32  # the dumps' first 32 bytes name an older revision ("SPRITESCAN R01"); the program skips them
+SPRITESCAN_DUMPS = ("dump6569.bin", "dump8565.bin")  # real machines: a PAL breadbox's 6569, a C64C's 8565R2
+
+
+def test_spritescan_agrees_with_the_real_machines_dumps():
+    """split-tests/spritescan from its SYS line, with CIA 1's timer A (its frame measurement) and the
+    print routines it calls stood in for (retro.machines.c64_stubs): its own check against the 6569
+    dump passes, and its whole result buffer equals both real-machine dumps byte for byte (but the
+    revision name; the 6572 dump is of a PAL-N Drean, a chip retro does not model)."""
+    path = _program(SPRITESCAN)
+    dumps = {name: (path.parent / "dumps" / name).read_bytes() for name in SPRITESCAN_DUMPS}
+    report = run.run_c64_program(path, frames=4000, result=RESULT,
+                                 peeks=[f"{SPRITESCAN_BUFFER}:{len(dumps['dump6569.bin'])}"])
+    (got,) = report.peeks.values()
+    assert report.printed[2] == "TIMING:  63 CYCLES/LINE,  312 LINES"  # timer A: 63 cycles a line
+    assert report.verdict.passed is True, run.lines(report)
+    for name, dump in dumps.items():
+        wrong = [i for i in range(SPRITESCAN_IDENT, len(dump)) if got[i] != dump[i]]
+        assert wrong == [], f"{name}: {len(wrong)} bytes differ, first at +${wrong[0]:04X}"
 
 
 def test_the_character_rom_is_refused_when_a_latch_needs_it():
