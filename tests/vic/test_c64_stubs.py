@@ -53,6 +53,15 @@ def test_a_continuous_timer_reloads_after_showing_zero_and_flags_the_underflow()
     assert cia.read(ICR, 11) == 0x00  # reading cleared it
 
 
+@pytest.mark.parametrize("cycle, value", [(3 + 4 * 5, 0), (4 + 4 * 5, 3), (6 + 4 * 1000, 1)])
+def test_a_continuous_timer_read_after_many_periods(cycle, value):
+    cia = Cia1Timers()
+    cia.write(TA_LO, 3, 0)
+    cia.write(TA_HI, 0, 0)
+    cia.write(CRA, 0x11, 0)
+    assert cia.read(TA_LO, cycle) == value
+
+
 def test_a_one_shot_timer_stops_at_its_underflow_with_the_latch_loaded():
     cia = Cia1Timers()
     cia.write(TB_LO, 2, 0)

@@ -103,3 +103,36 @@ def test_the_character_rom_is_refused_when_a_latch_needs_it():
     path = _program("VICII/spritecollisions/sprite-gfx-collision-cycle.prg")
     with pytest.raises(Exception, match="character ROM .*RETRO_C64_CHARGEN"):
         run.run_c64_program(path, frames=FRAMES, result=RESULT)
+
+
+GFX_CYCLE = "VICII/spritecollisions/sprite-gfx-collision-cycle.prg"
+GFX_CYCLE_PASSES = [1, 1] + [0] * 38  # its table refpal: $D01F as the C64 and C64C read it, X $56 on
+
+
+def test_sprite_gfx_collision_cycle_with_the_users_character_rom():
+    """With the real character ROM (the user's image in RETRO_C64_CHARGEN) the program passes."""
+    if not os.environ.get("RETRO_C64_CHARGEN"):
+        pytest.skip("RETRO_C64_CHARGEN is not set: sprite-gfx-collision-cycle draws its background from the "
+                    "character ROM (Commodore's, not in retro): set it to a 4096-byte image to run this test")
+    report = run.run_c64_program(_program(GFX_CYCLE), frames=FRAMES, result=RESULT, peeks=["$0450:40"])
+    assert report.verdict.passed is True, run.lines(report)
+    assert list(report.peeks.values())[0] == GFX_CYCLE_PASSES
+
+
+@pytest.mark.parametrize("row2, passes", [(0xFF, True), (0x00, False)])
+def test_sprite_gfx_collision_cycle_depends_on_one_glyph_row_only(tmp_path, monkeypatch, row2, passes):
+    """The program's only sprite pixel (sprite 0's first, at Y $34: raster line 53) runs over X $56-$7D,
+    columns 7-12 of text row 0, which hold screen code 160 (reverse space): its $D01F depends on the
+    character ROM only through glyph 160's row 2 (line 53 = 51 + 2 with YSCROLL 3). An image holding
+    that row solid and nothing else passes, as the real ROM's solid reverse space does [Programmer's
+    Reference Guide, appendix B]; everything solid but that row fails. Not the real ROM: see the test
+    above for it."""
+    image = bytearray(b"\xff" * 4096) if not passes else bytearray(4096)
+    image[160 * 8 + 2] = row2
+    path = tmp_path / "glyph160.bin"
+    path.write_bytes(image)
+    monkeypatch.setenv("RETRO_C64_CHARGEN", str(path))
+    report = run.run_c64_program(_program(GFX_CYCLE), frames=FRAMES, result=RESULT, peeks=["$0450:40"])
+    assert report.verdict.passed is passes, run.lines(report)
+    if passes:
+        assert list(report.peeks.values())[0] == GFX_CYCLE_PASSES
