@@ -31,7 +31,7 @@ import math
 import os
 from dataclasses import dataclass, field
 
-from retro.analysis.console_run import HALTED, MAX_FRAMES, REACHED, REPORTED, VALUE_SEEN, \
+from retro.analysis.console_run import FRAMES_DONE, HALTED, MAX_FRAMES, REACHED, REPORTED, VALUE_SEEN, \
     StopRun, Verdict, run_frames
 from retro.chips.vic.constants import CHAR_ROM_BYTES, PAL, REG_SPRITE_ENABLE, REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT, \
     VIC_BASE
@@ -169,11 +169,13 @@ class ResultPort:
         return self.memory[address]
 
 
-def debug_cart_verdict(address: int, written: int | None) -> Verdict:
-    """The verdict of VICE's testbench protocol from the first byte written at `address` (None: none)."""
+def debug_cart_verdict(address: int, written: int | None, frames_out: int | None = None) -> Verdict:
+    """The verdict of VICE's testbench protocol from the first byte written at `address` (None: none);
+    `frames_out`: the frame count, when the run ended because it ran out."""
     protocol = f"result byte ${address:04X} (VICE testbench: $00 passed, $FF failed)"
     if written is None:
-        return Verdict(protocol, None, None, "nothing written there yet")
+        return Verdict(protocol, None, None, "nothing written there yet" if frames_out is None
+                       else f"nothing written there in {frames_out:,} frames: more --frames?")
     if written == DEBUG_CART_PASSED:
         return Verdict(protocol, written, True, "passed")
     return Verdict(protocol, written, False, "failed" if written == DEBUG_CART_FAILED
@@ -314,7 +316,8 @@ def run_c64(program: Program, entry: int, *, frames: int, scene: VicScene | None
                          f"{ROM_MISSING_HINT}",)
     return C64Run(machine=machine, entry=entry, frames_asked=frames, cycles=machine.cycle - start,
                   instructions=instructions, stopped=stopped, halt_pc=watch.halt_pc, sys_line=sys_line,
-                  notes=notes, verdict=None if result is None else debug_cart_verdict(result_at, result.written),
+                  notes=notes, verdict=None if result is None else debug_cart_verdict(
+                      result_at, result.written, frames if stopped == FRAMES_DONE else None),
                   printed=stubs.editor.transcript)
 
 
