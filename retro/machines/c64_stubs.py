@@ -127,18 +127,18 @@ class ScreenEditor:
             row = TEXT_ROWS - 1
         memory = self.memory
         screen = memory[HIBASE] << 8
-        line, colours = screen + row * TEXT_COLUMNS, COLOR_RAM + row * TEXT_COLUMNS
+        line, colours = (screen + row * TEXT_COLUMNS) & 0xFFFF, COLOR_RAM + row * TEXT_COLUMNS
         memory[TBLX], memory[PNTR] = row, column
         memory[PNT], memory[PNT + 1] = line & 0xFF, line >> 8
         memory[USER], memory[USER + 1] = colours & 0xFF, colours >> 8
 
     def _scroll(self, rows: int) -> None:
         memory = self.memory
+        cells = TEXT_COLUMNS * TEXT_ROWS
+        shift = rows * TEXT_COLUMNS
         for base, blank in ((memory[HIBASE] << 8, SPACE), (COLOR_RAM, memory[COLOR] & 0x0F)):
-            cells = TEXT_COLUMNS * TEXT_ROWS
-            keep = max(cells - rows * TEXT_COLUMNS, 0)
-            memory[base:base + keep] = memory[base + cells - keep:base + cells]
-            memory[base + keep:base + cells] = [blank] * (cells - keep)
+            for i in range(cells):  # addresses wrap at 64K, as the CPU's do
+                memory[(base + i) & 0xFFFF] = memory[(base + i + shift) & 0xFFFF] if i + shift < cells else blank
 
     def _text(self, text: str) -> None:
         self.lines[-1] += text
@@ -160,7 +160,7 @@ class ScreenEditor:
             self.quote_mode = not self.quote_mode
         code = screen_code(petscii) | (REVERSE_BIT if memory[RVS] else 0)
         offset = row * TEXT_COLUMNS + column
-        memory[(memory[HIBASE] << 8) + offset] = code
+        memory[((memory[HIBASE] << 8) + offset) & 0xFFFF] = code
         memory[COLOR_RAM + offset] = memory[COLOR] & 0x0F
         ascii_like = petscii if 0x20 <= petscii <= 0x5F else None
         self._text(TRANSCRIPT_SPECIAL.get(petscii, chr(ascii_like) if ascii_like else f"{{${petscii:02X}}}"))
@@ -173,7 +173,8 @@ class ScreenEditor:
         memory = self.memory
         if petscii == CLEAR:
             screen = memory[HIBASE] << 8
-            memory[screen:screen + TEXT_COLUMNS * TEXT_ROWS] = [SPACE] * (TEXT_COLUMNS * TEXT_ROWS)
+            for i in range(TEXT_COLUMNS * TEXT_ROWS):
+                memory[(screen + i) & 0xFFFF] = SPACE
             self._text("{clr}")
             self._move(0, 0)
         elif petscii == HOME:
@@ -248,5 +249,6 @@ def install_c64_stubs(machine: Machine, bank_port) -> C64Stubs:
     install_on_mpu(machine.mpu, actions)
     for address in actions:
         machine.bus.memory[address] = TRAP_OPCODE
+        machine.trap_names[address] = f"{ROM_STUB_NAMES[address]} (stub)"
     return stubs
 

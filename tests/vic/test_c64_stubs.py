@@ -139,3 +139,9 @@ def test_a_rom_routine_without_a_stub_is_still_refused(tmp_path):
     code = bytes([0x20, 0xD2, 0xFF, 0x60])  # JSR CHROUT
     with pytest.raises(RunError, match=r"\$FFD2 \(CHROUT\)"):
         run.run_c64_program(_program(tmp_path, code), frames=1)
+
+
+def test_a_trace_names_the_stub_not_the_trap_byte(tmp_path):
+    code = bytes([0xA9, 0x00, 0xA0, 0x00, 0x20, 0x1E, 0xAB, 0x60])  # print the empty text at $0000
+    report = run.run_console_or_refuse(_program(tmp_path, code), frames=1, trace=True, trace_limit=10)
+    assert any("$AB1E  STROUT (stub)" in line for line in run.program_trace_lines(report, False))
