@@ -41,6 +41,7 @@ class Mutant:
 
 
 VIC_TESTS = ("tests/vic",)
+STUB_TESTS = ("tests/vic/test_c64_stubs.py",)
 CPU_TESTS = ("tests/cpu",)
 BATCH_TESTS = ("tests/cpu/test_batch_vectors.py", "tests/routines/test_batch_check.py")
 CHECK_TESTS = ("tests/routines/test_user_specs.py", "tests/routines/test_routines_cli.py",
@@ -131,6 +132,30 @@ MUTANTS = [
            "SPRITE_POINTERS = 0x03F8", "SPRITE_POINTERS = 0x03F0", ("tests/vic/test_vic_fetch.py",)),
     Mutant("vic-no-char-rom-window", "retro/chips/vic/constants.py",
            "CHAR_ROM_BANKS = (0, 2)", "CHAR_ROM_BANKS = ()", ("tests/vic/test_vic_fetch.py",)),
+    # CIA 1's timers and the ROM stubs of a C64 program run (spritescan's startup measures the line with timer A)
+    Mutant("cia-timer-counts-in-its-start-cycle", "retro/chips/cia/timers.py",
+           "return (self.counter - elapsed if self.running else self.counter), False, self.running",
+           "return (self.counter - elapsed - 1 if self.running else self.counter), False, self.running", STUB_TESTS),
+    Mutant("cia-continuous-period-is-the-latch", "retro/chips/cia/timers.py",
+           "(elapsed - self.counter - 1) % (self.latch + 1)", "(elapsed - self.counter - 1) % max(self.latch, 1)",
+           STUB_TESTS),
+    Mutant("cia-high-byte-loads-a-running-timer", "retro/chips/cia/timers.py",
+           "            if not self.running:  # \"following", "            if True:  # \"following", STUB_TESTS),
+    Mutant("cia-one-shot-keeps-running", "retro/chips/cia/timers.py",
+           "        if self.one_shot:\n            return self.latch, True, False",
+           "        if False:\n            return self.latch, True, False", STUB_TESTS),
+    Mutant("cia-icr-read-keeps-the-flags", "retro/chips/cia/timers.py",
+           "            self.flags = 0\n            return value", "            return value", STUB_TESTS),
+    Mutant("cia-interrupt-let-through-silently", "retro/chips/cia/timers.py",
+           "        self._refuse_interrupt(address, value)", "        pass", STUB_TESTS),
+    Mutant("linprt-without-the-sign-space", "retro/machines/c64_stubs.py",
+           'for char in f" {mpu.a << 8 | mpu.x}":', 'for char in f"{mpu.a << 8 | mpu.x}":', STUB_TESTS),
+    Mutant("strout-runs-past-a-quote", "retro/machines/c64_stubs.py",
+           "if petscii in (0, QUOTE):", "if petscii == 0:", STUB_TESTS),
+    Mutant("screen-editor-row-pointer-stale", "retro/machines/c64_stubs.py",
+           "        memory[PNT], memory[PNT + 1] = line & 0xFF, line >> 8\n", "", STUB_TESTS),
+    Mutant("ioinit-leaves-cia-1-running", "retro/machines/c64_stubs.py",
+           "            self.cia1.write(CIA1_BASE + register, CR_AFTER_IOINIT, cycle)", "            pass", STUB_TESTS),
     Mutant("vic-memory-read-nowhere", "retro/chips/vic/device.py",
            "if self.fetcher is not None and self.fetcher.due(self.video, self.registers, lo, until):",
            "if False:", ("tests/vic/test_vic_fetch.py",)),

@@ -15,9 +15,11 @@ $030C-$030F as SYS loads them (all 0 after power-on, so I is clear); the RAM vec
 hold the KERNAL's $EA31, $FE66, $FE47. Without a scene the VIC-II holds the registers the KERNAL's
 initialisation writes (table TVIC at $ECB9: $D011 = $9B, display on, so Bad Lines happen).
 
-There is no BASIC or KERNAL ROM (and no CIA, SID or disk). The only KERNAL code present is its IRQ
-entry and exit ($FF48-$FF5A, $EA81-$EA86; `retro.machines.c64.install_kernal_irq_entry`), so that a
-program hooking $0314 runs as on the machine. Any other instruction fetched from a ROM that the port
+There is no BASIC or KERNAL ROM (and no SID or disk; of CIA 1 only its timers). The KERNAL code
+present is its IRQ entry and exit ($FF48-$FF5A, $EA81-$EA86; `retro.machines.c64.install_kernal_irq_entry`),
+so that a program hooking $0314 runs as on the machine, and the stubs of the few ROM routines test
+programs call (retro.machines.c64_stubs: STROUT, LINPRT, IOINIT, with CIA 1's timers). Any other
+instruction fetched from a ROM that the port
 at $01 maps in ($A000-$BFFF with LORAM and HIRAM set, $E000-$FFFF with HIRAM set) ends the run with
 a RunError naming the address and the instruction that got there (`JSR $FFD2`, `JMP $EA31`, or a
 BRK through the KERNAL's $FE66).
@@ -29,7 +31,7 @@ import math
 import os
 from dataclasses import dataclass, field
 
-from retro.analysis.console_run import HALTED, MAX_FRAMES, REACHED, REPORTED, VALUE_SEEN, \
+from retro.analysis.console_run import FRAMES_DONE, HALTED, MAX_FRAMES, REACHED, REPORTED, VALUE_SEEN, \
     StopRun, Verdict, run_frames
 from retro.chips.vic.constants import CHAR_ROM_BYTES, PAL, REG_SPRITE_ENABLE, REGISTER_COUNT, SPRITE_BYTES, SPRITE_COUNT, \
     VIC_BASE
@@ -55,6 +57,7 @@ from retro.machines.c64 import (
     install_kernal_irq_handler_stub,
     vic_of,
 )
+from retro.machines.c64_stubs import ROM_STUB_NAMES, C64Stubs, install_c64_stubs
 from retro.program import Program
 from retro.scenes.vic import VicScene
 
@@ -88,7 +91,8 @@ KERNAL_NAMES = {0xFFD2: "CHROUT", 0xFFE4: "GETIN", 0xFFCF: "CHRIN", 0xFFF0: "PLO
 STUB_RANGES = ((KERNAL_IRQ_ENTRY, KERNAL_IRQ_ENTRY + len(KERNAL_IRQ_ENTRY_CODE)),
                (KERNAL_IRQ_EXIT, KERNAL_IRQ_EXIT + len(KERNAL_IRQ_EXIT_CODE)),
                (KERNAL_IRQ_HANDLER, KERNAL_IRQ_HANDLER + len(KERNAL_IRQ_HANDLER_STUB)),
-               (KERNAL_NMI_EXIT, KERNAL_NMI_EXIT + len(KERNAL_IRQ_EXIT_CODE)))
+               (KERNAL_NMI_EXIT, KERNAL_NMI_EXIT + len(KERNAL_IRQ_EXIT_CODE))) + tuple(
+                   (address, address + 1) for address in ROM_STUB_NAMES)
 MAX_C64_FRAMES = MAX_FRAMES
 
 
@@ -111,6 +115,7 @@ class C64Run:
     peeks: dict[str, list[int]] = field(default_factory=dict)  # filled by the command
     tracer: object = None  # a retro.analysis.trace.Tracer that observed the run (--trace, --watch)
     verdict: Verdict | None = None  # with result_at: the test program's result (debug_cart_verdict)
+    printed: list[str] = field(default_factory=list)  # what the ROM stubs printed, a line per RETURN
 
     @property
     def vic(self) -> VicDevice:
@@ -122,15 +127,13 @@ class C64Run:
 
 
 def rom_at(memory, pc: int) -> bool:
-    """Whether the port at $01 maps a ROM (BASIC or KERNAL) at pc, outside retro's KERNAL stub."""
-    if pc < BASIC_ROM[0]:
+    """Whether the port at $01 maps a ROM (BASIC or KERNAL) at pc, outside retro's KERNAL and ROM stubs."""
+    if pc < BASIC_ROM[0] or any(lo <= pc < hi for lo, hi in STUB_RANGES):
         return False
     port = memory[PORT_DATA]
-    if BASIC_ROM[0] <= pc <= BASIC_ROM[1]:
+    if pc <= BASIC_ROM[1]:
         return port & (LORAM | HIRAM) == LORAM | HIRAM
-    if pc >= KERNAL_ROM[0] and port & HIRAM:
-        return not any(lo <= pc < hi for lo, hi in STUB_RANGES)
-    return False
+    return pc >= KERNAL_ROM[0] and bool(port & HIRAM)
 
 
 def rom_error(machine: Machine, pc: int, came_from: int | None) -> RunError:
@@ -166,11 +169,13 @@ class ResultPort:
         return self.memory[address]
 
 
-def debug_cart_verdict(address: int, written: int | None) -> Verdict:
-    """The verdict of VICE's testbench protocol from the first byte written at `address` (None: none)."""
+def debug_cart_verdict(address: int, written: int | None, frames_out: int | None = None) -> Verdict:
+    """The verdict of VICE's testbench protocol from the first byte written at `address` (None: none);
+    `frames_out`: the frame count, when the run ended because it ran out."""
     protocol = f"result byte ${address:04X} (VICE testbench: $00 passed, $FF failed)"
     if written is None:
-        return Verdict(protocol, None, None, "nothing written there yet")
+        return Verdict(protocol, None, None, "nothing written there yet" if frames_out is None
+                       else f"nothing written there in {frames_out:,} frames: more --frames?")
     if written == DEBUG_CART_PASSED:
         return Verdict(protocol, written, True, "passed")
     return Verdict(protocol, written, False, "failed" if written == DEBUG_CART_FAILED
@@ -234,6 +239,11 @@ def c64_for(program: Program, scene: VicScene | None) -> Machine:
     KERNAL's), its beam where the scene says (else line 0, cycle 1). The VIC-II reads its memory
     (retro.chips.vic.fetch); a scene's screen, colour RAM, character set, bitmap and sprite data are
     put where it fetches them (fetch.memory_parts), and the program may not load over them."""
+    return _c64_with_stubs(program, scene)[0]
+
+
+def _c64_with_stubs(program: Program, scene: VicScene | None) -> tuple[Machine, C64Stubs]:
+    """`c64_for`'s machine and its stubs (CIA 1, the ROM routines: retro.machines.c64_stubs)."""
     char_rom = char_rom_image()
     if scene is None:
         machine = build_c64(kernal_vic_state(), reads_memory=True, char_rom=char_rom)
@@ -243,13 +253,14 @@ def c64_for(program: Program, scene: VicScene | None) -> Machine:
         _fill_scene_memory(machine, scene, program)
     install_kernal_irq_handler_stub(machine)  # a handler hooked at $0314 may end with JMP $EA31
     install_kernal_irq_entry(machine)  # the KERNAL is mapped in: its vector at $FFFE is the hardware's
+    stubs = install_c64_stubs(machine, vic_of(machine).fetcher.bank_port)
     memory = machine.bus.memory
     memory[PORT_DIRECTION], memory[PORT_DATA] = POWER_ON_PORT
     for i, vector in enumerate(KERNAL_VECTORS):
         memory[RAM_VECTORS + 2 * i], memory[RAM_VECTORS + 2 * i + 1] = vector & 0xFF, vector >> 8
     machine.load(program)
     machine.mpu.stop_on_brk = False  # BRK goes through the vector, as on the machine
-    return machine
+    return machine, stubs
 
 
 def _fill_scene_memory(machine: Machine, scene: VicScene, program: Program) -> None:
@@ -278,7 +289,7 @@ def run_c64(program: Program, entry: int, *, frames: int, scene: VicScene | None
     the run stops at the first write there and carries the verdict."""
     if not 1 <= frames <= MAX_C64_FRAMES:
         raise InputError(f"--frames: {frames:,} is not a frame count in 1..{MAX_C64_FRAMES:,}")
-    machine = c64_for(program, scene)
+    machine, stubs = _c64_with_stubs(program, scene)
     mpu = machine.mpu
     memory = machine.bus.memory
     mpu.a, mpu.x, mpu.y = (memory[SYS_REGISTERS + i] for i in range(3))
@@ -305,7 +316,9 @@ def run_c64(program: Program, entry: int, *, frames: int, scene: VicScene | None
                          f"{ROM_MISSING_HINT}",)
     return C64Run(machine=machine, entry=entry, frames_asked=frames, cycles=machine.cycle - start,
                   instructions=instructions, stopped=stopped, halt_pc=watch.halt_pc, sys_line=sys_line,
-                  notes=notes, verdict=None if result is None else debug_cart_verdict(result_at, result.written))
+                  notes=notes, verdict=None if result is None else debug_cart_verdict(
+                      result_at, result.written, frames if stopped == FRAMES_DONE else None),
+                  printed=stubs.editor.transcript)
 
 
 def vic_registers(vic: VicDevice) -> dict:

@@ -404,7 +404,7 @@ def c64_json(report: C64Run) -> dict:
             "frames": round(report.frames_run, 3), "cycles": report.cycles, "instructions": report.instructions,
             "halt_pc": report.halt_pc, "cpu": _cpu_state(report.machine.mpu), "vic": vic_registers(report.vic),
             "ram": bytes(report.machine.memory).hex(), "peek": report.peeks, "notes": list(report.notes),
-            "verdict": report.verdict.as_dict() if report.verdict else None,
+            "verdict": report.verdict.as_dict() if report.verdict else None, "printed": report.printed,
             **_watch_json(report)}
 
 
@@ -430,6 +430,7 @@ def c64_lines(report: C64Run) -> list[str]:
         f"$D019=${vic['d019']:02X} $D01A=${report.vic.peek(0xD01A):02X} $D01E=${vic['d01e']:02X} "
         f"$D01F=${vic['d01f']:02X}")
     out += [f"note: {note}" for note in report.notes]
+    out += [f"printed: {line}".rstrip() for line in report.printed]  # through the ROM stubs (STROUT, LINPRT)
     if report.verdict is not None:
         out.append(f"verdict: {report.verdict.summary()}")
     return out + watch_lines(report)

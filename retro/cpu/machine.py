@@ -25,6 +25,7 @@ from retro.cpu.mpu import (
     OPCODE_BRK,
     CpuHalt,
 )
+from retro.cpu.traps import TRAP_OPCODE
 from retro.cpu.variants import VARIANTS
 from retro.errors import InputError, RunError
 from retro.numbers import parse_int
@@ -127,6 +128,7 @@ class Machine:
         self.stop_s = CALL_STACK_TOP  # S at which the call running now ends
         self.symbols: dict[str, int] = {}
         self.ambiguous: dict[str, tuple[str, ...]] = {}
+        self.trap_names: dict[int, str] = {}  # a trap's address (retro.cpu.traps) -> what listings call it
 
     @property
     def entry_s(self) -> int:
@@ -356,6 +358,8 @@ class Machine:
 
     def disassemble_at(self, address: int) -> str:
         memory = self.mpu.memory
+        if memory[address] == TRAP_OPCODE and address in self.trap_names:
+            return self.trap_names[address]
         mnemonic, mode = self.mpu.disassemble[memory[address]]
         return instruction_text(mnemonic, mode, address, memory[(address + 1) & 0xFFFF], memory[(address + 2) & 0xFFFF])
 
