@@ -193,7 +193,7 @@ def seeds() -> list[Seed]:
         # routine specs and method files
         Seed("routine spec", "boxhit.toml", (boxhit / "boxhit.toml").read_bytes(),
              Target("spec", {n: (boxhit / n).read_bytes() for n in ("boxhit.prg", "boxhit.sym", "boxhit_ref.py")},
-                    ("check", "{dir}/{file}", "--random", "5", "--jobs", "1"), exit_1_allowed=True), kind="toml"),
+                    ("check", "{dir}/{file}", "--random", "5", "--jobs", "1", "--quiet"), exit_1_allowed=True), kind="toml"),
         Seed("method file", "m.toml", (ROOT / "examples" / "methods" / "cross.toml").read_bytes(),
              Target("method", {"cross.py": (ROOT / "examples" / "methods" / "cross.py").read_bytes()}, ()),
              kind="toml"),

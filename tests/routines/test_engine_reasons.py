@@ -70,3 +70,17 @@ def test_each_lane_stalled_is_said_where_the_scene_stalled_a_call(capsys):
     code, out = _check(capsys, "aabb8", "--scene", scene, "--at-line", "250", "--engine", "batch")
     assert code == 0, out
     assert _engine_line(out).startswith("  engine with the scene: the batched core, no call stalled on the scene: ")
+
+
+def test_progress_past_the_planned_cases_says_the_search_found_them(monkeypatch):
+    from types import SimpleNamespace
+
+    from retro.analysis.check import run as check_run
+    from retro.analysis.check.tally import Tally
+
+    monkeypatch.setattr(check_run, "PROGRESS_SECONDS", -1.0)  # every block reported
+    shown: list[str] = []
+    report = check_run._reporter(SimpleNamespace(name="r"), Tally(), 10, False, shown.append)
+    report(Tally(cases=10))
+    report(Tally(cases=3))  # the search's cases, checked after the planned ones
+    assert shown == ["check r: 10/10 cases", "check r: 13 cases (10 planned, plus the search)"]

@@ -337,7 +337,8 @@ def _reporter(routine: Routine, totals: Tally, known: int, unknown: bool,
         now = time.monotonic()
         if progress and now - shown >= PROGRESS_SECONDS:
             shown = now
-            progress(f"check {routine.name}: {done:,} cases ({known:,} planned, plus the sweep)" if unknown else
+            beyond = "the sweep" if unknown else "the search" if done > known else None  # the search's finds
+            progress(f"check {routine.name}: {done:,} cases ({known:,} planned, plus {beyond})" if beyond else
                      f"check {routine.name}: {done:,}/{known:,} cases")
     return report
 
