@@ -86,8 +86,8 @@ def commands(out: Path) -> list[tuple[str, list[str], str]]:
     ]
 
 
-def tree_rss(root: int) -> int:
-    """Resident bytes of a process and all its descendants (from /proc/*/stat and statm)."""
+def process_tree(root: int) -> list[int]:
+    """A process and all its descendants (from /proc/*/stat)."""
     children: dict[int, list[int]] = {}
     for entry in os.listdir("/proc"):
         if entry.isdigit():
@@ -97,16 +97,26 @@ def tree_rss(root: int) -> int:
             except (OSError, IndexError, ValueError):
                 continue
             children.setdefault(parent, []).append(int(entry))
-    total, stack = 0, [root]
+    found, stack = [], [root]
     while stack:
         pid = stack.pop()
-        try:
-            with open(f"/proc/{pid}/statm", "rb") as f:
-                total += int(f.read().split()[1]) * PAGE
-        except (OSError, IndexError, ValueError):
-            pass
+        found.append(pid)
         stack.extend(children.get(pid, []))
-    return total
+    return found
+
+
+def process_rss(pid: int) -> int:
+    """Resident bytes of one process (0: gone)."""
+    try:
+        with open(f"/proc/{pid}/statm", "rb") as f:
+            return int(f.read().split()[1]) * PAGE
+    except (OSError, IndexError, ValueError):
+        return 0
+
+
+def tree_rss(root: int) -> int:
+    """Resident bytes of a process and all its descendants."""
+    return sum(process_rss(pid) for pid in process_tree(root))
 
 
 def measure(arguments: list[str], seconds: float) -> tuple[int, float, str]:
