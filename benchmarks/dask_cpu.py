@@ -65,7 +65,7 @@ def two_workers(name: str, engine: str) -> dict:
     from retro.analysis.check import run
 
     seen: dict[str, float] = {"import": 0.0}
-    real, preload = workers._client, workers._preload
+    real, preload = workers._client, getattr(workers, "_preload", lambda module: None)
 
     def imported(module: str) -> None:  # imports Dask in this process: part of the start
         before = time.process_time()
