@@ -214,3 +214,31 @@ def test_a_small_check_never_imports_dask():
     done = subprocess.run([sys.executable, "-c", SMALL], capture_output=True, text=True, env=ENV, timeout=300)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "[]"
+
+
+def _late_even_tasks(sweep, first, count):
+    """sweep_task with every even task finishing after the next odd one (in a worker process)."""
+    from retro.analysis.check import run
+
+    if (first // count) % 2 == 0:
+        time.sleep(0.5)
+    return run.sweep_task(sweep, first, count)
+
+
+def test_chunks_finishing_out_of_order_give_the_same_json_and_progress_as_they_merge(monkeypatch):
+    """The tasks' tallies are merged in task order whatever order they finish in; a progress line
+    comes as each is merged, counting the cases merged so far."""
+    from retro.analysis.check import run
+
+    spec = str(ROOT / "examples" / "object_table" / "hit_slot.toml")
+    one = _records(run.run_checks([spec], jobs=1, engine="scalar", search_budget=0, random_count=30_000))
+    monkeypatch.setattr(run, "PARALLEL_CALLS", dict.fromkeys(run.PARALLEL_CALLS, 0))
+    monkeypatch.setattr(run, "TASK_BLOCKS", 1)  # 4,096 sampled + 30,000 random cases: tasks of 4,000 cases
+    monkeypatch.setattr(run, "PROGRESS_SECONDS", 0.0)
+    monkeypatch.setattr(run, "sweep_task", _late_even_tasks)  # (the workers' own run module keeps the real one)
+    lines = []
+    two = _records(run.run_checks([spec], jobs=2, engine="scalar", search_budget=0, random_count=30_000,
+                                  progress=lines.append))
+    assert json.dumps(two, sort_keys=True) == json.dumps(one, sort_keys=True)
+    done = [int(line.split(": ")[1].split("/")[0].replace(",", "")) for line in lines if "/" in line]
+    assert len(done) >= 8 and done == sorted(done) and done[-1] == 4_096 + 30_000, lines

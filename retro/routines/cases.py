@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import ast
 from collections import deque
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Generator, Iterable, Iterator
 from dataclasses import dataclass, replace
 from itertools import chain, islice
 
@@ -34,7 +34,8 @@ BOUNDED_PRODUCT = 1 << 16  # an exhaustive set this small runs in full even with
 BOUNDED_SAMPLE = 4_096  # cases sampled from a larger exhaustive set without --exhaustive
 CHUNK = 4_000
 BLOCK_BYTES = 8 << 20  # a column block for the batched core: 8 MiB (65,536 cases of 16 numbers; fewer of tables)
-RANDOM_BLOCK = 1_000_000  # a random generator is called once per block of this many cases
+SEEK_BLOCK = 1 << 16  # random draws are made per block of this many cases, each block from its own generator
+# (`_block_rng`): a worker enters a part at any block without drawing the ones before it
 EXHAUSTIVE_RNG_OFFSET = 2  # the non-swept inputs of the exhaustive part draw from seed + 2
 PROBE_RNG_OFFSET = 4  # the probe of the domain's share draws from seed + 4 (entry state: seed + 3)
 INSIDE_SHARE = 1 / 20  # random cases are drawn inside the domain when fewer uniform draws than this land there
@@ -59,6 +60,8 @@ class Part:
     inside: int | None = None  # the exhaustive part: its combinations inside the domain, when only those run
     seek: Callable[[int], Iterator[Columns]] | None = None  # its blocks from a case index on, without making the
     # cases before it (None: they are made and dropped; `stream`)
+    from_start: bool = False  # its seek runs the part's function from its start (the cases before are counted,
+    # not checked nor converted): reached at a cost that grows with the index
 
     @property
     def cases(self) -> Iterator[tuple]:
@@ -109,22 +112,25 @@ def plan(routine: Routine, *, exhaustive: bool, seed: int | None = None, random:
             full = exhaustive or len(valid) <= bounded_product
             sample = None if full else min(BOUNDED_SAMPLE, bounded_product)
             parts.append(Part("exhaustive", len(valid) if full else sample, total,
-                              lambda: _product(routine, seed, sample, valid), inside=len(valid)))
+                              lambda: _product(routine, seed, sample, valid), inside=len(valid),
+                              seek=(lambda start: _product(routine, seed, None, valid, start)) if full else None))
         elif exhaustive or total <= bounded_product:
             parts.append(Part("exhaustive", total, total, lambda: _product(routine, seed, None),
-                              seek=_product_seek(routine, seed)))
+                              seek=lambda start: _product(routine, seed, None, start=start)))
         else:
             sample = min(BOUNDED_SAMPLE, bounded_product)
             parts.append(Part("exhaustive", sample, total, lambda: _product(routine, seed, sample)))
     if exhaustive and routine.sweep is not None:
-        parts.append(Part("sweep", None, 0, lambda: _lazy_sweep(routine, seed)))
+        parts.append(Part("sweep", None, 0, lambda: _lazy_sweep(routine, seed),
+                          seek=lambda start: _lazy_sweep(routine, seed, start), from_start=True))
     count = random_count(routine, exhaustive, random)
     if count:
         draw = domain_draw(routine, seed, count)
         if draw is not None and draw.inside:
-            parts.append(Part("random", draw.drawn, count, draw.blocks, draw))
+            parts.append(Part("random", draw.drawn, count, draw.blocks, draw, seek=draw.seek))
         else:
-            parts.append(Part("random", count, count, lambda: _random(routine, seed, count), draw))
+            parts.append(Part("random", count, count, lambda: _random(routine, seed, count), draw,
+                              seek=lambda start: _random(routine, seed, count, start)))
     return parts
 
 
@@ -147,39 +153,52 @@ def batches(parts: list[Part], size: int) -> Iterator[Columns]:
         yield from rechunked(chain([first], blocks), block_size(first, size))
 
 
-def stream(parts: list[Part], size: int, first: int = 0) -> Iterator[Columns]:
+def stream(parts: list[Part], size: int, first: int = 0,
+           counted: Callable[[int, int], None] | None = None) -> Iterator[Columns]:
     """The parts' cases from case `first` on (counted over all the parts), in blocks of `size` cases
     (the last one shorter): what a worker makes of a task's description. A part wholly before `first`
-    is passed over by its count, one it starts in is entered by its `seek` when it has one; else its
-    cases before `first` are made and dropped (a user's sweep function can only be run from its start)."""
-    return rechunked(_cases_from(parts, first), size)
+    is passed over by its count, one it starts in is entered by its `seek` when it has one (a spec's sweep
+    function's runs from its start, counting the cases before `first`); else its cases before `first`
+    are made and dropped. `counted(i, n)`: told the count of part i, one that did not say it, once made."""
+    return rechunked(_cases_from(parts, first, counted), size)
 
 
 def reachable(parts: list[Part], first: int) -> bool:
-    """Whether `stream` reaches case `first` without making the cases before it."""
+    """Whether `stream` reaches case `first` without making (or, with a sweep function, counting) the
+    cases before it."""
     done = 0
     for part in parts:
         if part.count is not None and done + part.count <= first:
             done += part.count
             continue
-        return first == done or part.seek is not None
+        return first == done or (part.seek is not None and not part.from_start)
     return True
 
 
-def _cases_from(parts: list[Part], first: int) -> Iterator[Columns]:
+def _cases_from(parts: list[Part], first: int, counted: Callable[[int, int], None] | None) -> Iterator[Columns]:
     done = 0  # cases of the parts before this one
-    for part in parts:
+    for index, part in enumerate(parts):
+        before = done
         if part.count is not None and done + part.count <= first:
             done += part.count
             continue
         skip = max(0, first - done)
-        seen = skip if skip and part.seek is not None else 0  # the part's cases passed over
-        for block in part.seek(skip) if skip and part.seek is not None else part.blocks():
-            n = len(block[0])
-            if seen + n > skip:
-                yield block if seen >= skip else [column[skip - seen:] for column in block]
-            seen += n
-        done += seen
+        if skip and part.seek is not None:
+            if part.from_start:  # (its seek returns how many cases the part made in all)
+                done += yield from part.seek(skip)
+            else:
+                yield from part.seek(skip)
+                done += part.count
+        else:
+            seen = 0  # the part's cases passed over
+            for block in part.blocks():
+                n = len(block[0])
+                if seen + n > skip:
+                    yield block if seen >= skip else [column[skip - seen:] for column in block]
+                seen += n
+            done += seen
+        if part.count is None and counted is not None:
+            counted(index, done - before)
 
 
 def rechunked(blocks: Iterable[Columns], size: int) -> Iterator[Columns]:
@@ -223,44 +242,73 @@ def block_size(block: Columns, size: int) -> int:
 
 # ---- exhaustive product ----------------------------------------------------------------------------
 
-def _product_seek(routine: Routine, seed: int) -> Callable[[int], Iterator[Columns]] | None:
-    """The full product's blocks from a combination on, when every input is swept (else the inputs drawn
-    at random per case draw in order from the first case: no seeking)."""
-    if any(port.name not in routine.exhaustive for port in routine.part_inputs("exhaustive")):
-        return None
-    return lambda start: _product(routine, seed, None, start=start)
+def _block_rng(seed: int, block: int) -> np.random.Generator:
+    """The generator of the random draws of a part's block `block` (of SEEK_BLOCK cases): the first
+    block's is the part's seeded generator, as before blocks existed (a part of at most SEEK_BLOCK
+    cases draws the cases it always drew); block k's is that generator jumped k times (numpy's
+    PCG64.jumped: streams apart by about 2^127 draws, made for parallel streams), so any block is
+    drawn without drawing the blocks before it, and the cases do not depend on how a run is split."""
+    rng = np.random.default_rng(seed)
+    return rng if block == 0 else np.random.Generator(rng.bit_generator.jumped(block))
+
+
+def _by_block(count: int, start: int, block_of: Callable[[int, int, int], Iterator[Columns]]) -> Iterator[Columns]:
+    """Cases start..count-1 of a part made per SEEK_BLOCK: `block_of(k, lo, hi)` yields the column blocks
+    of cases lo..hi-1 of block k (the first block entered is cut at `start`)."""
+    first = start // SEEK_BLOCK
+    blocks = (block_of(k, k * SEEK_BLOCK, min(count, (k + 1) * SEEK_BLOCK)) for k in range(first, -(-count // SEEK_BLOCK)))
+    return _skipped(chain.from_iterable(blocks), start - first * SEEK_BLOCK)
+
+
+def _skipped(blocks: Iterable[Columns], skip: int) -> Iterator[Columns]:
+    """The column blocks without their first `skip` cases."""
+    seen = 0
+    for columns in blocks:
+        n = len(columns[0])
+        if seen + n > skip:
+            yield columns if seen >= skip else [column[skip - seen:] for column in columns]
+        seen += n
 
 
 def _product(routine: Routine, seed: int, sample: int | None, valid: np.ndarray | None = None,
              start: int = 0) -> Iterator[Columns]:
     """Every combination (mixed-radix counting over the swept inputs' values), in blocks (from
     combination `start`); or a seeded sample of `sample` distinct combinations; `valid`: only these
-    combinations (their indices)."""
+    combinations (their indices). The inputs not swept are drawn per case, per SEEK_BLOCK (`_block_rng`)
+    unless sampled."""
     ports = routine.part_inputs("exhaustive")
     swept = [i for i, port in enumerate(ports) if port.name in routine.exhaustive]
     radices = [ports[i].count for i in swept]
     total = int(np.prod(radices, dtype=object))
-    rng = np.random.default_rng(seed + EXHAUSTIVE_RNG_OFFSET)
-    if valid is not None:
-        chosen = valid if sample is None else valid[np.sort(rng.choice(len(valid), size=sample, replace=False))]
-        indices: Iterable[np.ndarray] = (chosen[i:i + CHUNK] for i in range(0, len(chosen), CHUNK))
-    elif sample is None:
-        indices = (np.arange(at, min(at + CHUNK, total), dtype=np.uint64) for at in range(start, total, CHUNK))
-    else:
-        picked = np.sort(rng.choice(total, size=sample, replace=False).astype(np.uint64))
-        indices = (picked[i:i + CHUNK] for i in range(0, sample, CHUNK))
-    for block in indices:
-        n = len(block)
+
+    def columns_of(indices: np.ndarray, rng: np.random.Generator) -> Columns:
         columns: list = [None] * len(ports)
-        rest = block.copy()
+        rest = indices.copy()
         for i, radix in zip(reversed(swept), reversed(radices)):  # the last swept input varies fastest
             digit = rest % np.uint64(radix)
             rest //= np.uint64(radix)
             columns[i] = _digit_values(ports[i], digit)
         for i, port in enumerate(ports):
             if columns[i] is None:
-                columns[i] = _random_column(port, rng, n)
-        yield columns
+                columns[i] = _random_column(port, rng, len(indices))
+        return columns
+
+    if sample is not None:
+        rng = np.random.default_rng(seed + EXHAUSTIVE_RNG_OFFSET)
+        if valid is not None:
+            picked = valid[np.sort(rng.choice(len(valid), size=sample, replace=False))]
+        else:
+            picked = np.sort(rng.choice(total, size=sample, replace=False).astype(np.uint64))
+        for i in range(0, sample, CHUNK):
+            yield columns_of(picked[i:i + CHUNK], rng)
+        return
+
+    def block_of(block: int, lo: int, hi: int) -> Iterator[Columns]:
+        rng = _block_rng(seed + EXHAUSTIVE_RNG_OFFSET, block)
+        for at in range(lo, hi, CHUNK):
+            positions = np.arange(at, min(at + CHUNK, hi), dtype=np.uint64)
+            yield columns_of(positions if valid is None else valid[positions.astype(np.int64)], rng)
+    yield from _by_block(total if valid is None else len(valid), start, block_of)
 
 
 def _valid_sweep(routine: Routine, total: int) -> np.ndarray | None:
@@ -314,20 +362,21 @@ def _random_column(port: Port, rng: np.random.Generator, n: int) -> np.ndarray:
 
 # ---- random ------------------------------------------------------------------------------------------
 
-def _random(routine: Routine, seed: int, count: int) -> Iterator[Columns]:
-    rng = np.random.default_rng(seed)
+def _random(routine: Routine, seed: int, count: int, start: int = 0) -> Iterator[Columns]:
+    """The random part from case `start` on: per SEEK_BLOCK cases, from that block's generator
+    (`_block_rng`), the spec's random_generator called once per block, or uniform draws per CHUNK."""
     ports = routine.part_inputs("random")
-    done = 0
-    while done < count:
-        n = min(RANDOM_BLOCK, count - done)
+
+    def block_of(block: int, lo: int, hi: int) -> Iterator[Columns]:
+        rng, n = _block_rng(seed, block), hi - lo
         if routine.random_generator is not None:
             made = call_with(routine.random_generator, {"rng": rng, "count": n, "n": n, "seed": seed})
             yield from _function_blocks(routine, "cases.random_generator", made, expected=n)
-        else:
-            for start in range(0, n, CHUNK):
-                m = min(CHUNK, n - start)
-                yield [_random_column(port, rng, m) for port in ports]
-        done += n
+            return
+        for at in range(0, n, CHUNK):
+            m = min(CHUNK, n - at)
+            yield [_random_column(port, rng, m) for port in ports]
+    return _by_block(count, start, block_of)
 
 
 # ---- random cases inside the domain -------------------------------------------------------------------
@@ -353,6 +402,14 @@ class DomainDraw:
 
     def blocks(self) -> Iterator[Columns]:
         return self.lazy() if self.lazy is not None else iter(self.made)
+
+    @property
+    def seek(self) -> Callable[[int], Iterator[Columns]] | None:
+        """The cases from an index on: the drawn blocks passed over, the enumerated ones picked per
+        SEEK_BLOCK; None for very many cases drawn lazily by rejection (made from the first)."""
+        if self.method == "enumerated":
+            return self.lazy
+        return None if self.lazy is not None else lambda start: _skipped(self.made, start)
 
 
 def domain_draw(routine: Routine, seed: int, count: int) -> DomainDraw | None:
@@ -380,12 +437,13 @@ def domain_draw(routine: Routine, seed: int, count: int) -> DomainDraw | None:
             raise InputError(f"{routine.spec_path}: cases.where: none of the {total:,} combinations of the inputs' "
                              f"values lies inside the domain: nothing can be checked")
 
-        def enumerated() -> Iterator[Columns]:  # a fresh generator each time: the same cases
-            picks = np.random.default_rng(seed)
-            for start in range(0, count, CHUNK):
-                yield _combinations(box, valid[picks.integers(0, len(valid), size=min(CHUNK, count - start))])
-        return DomainDraw(True, share, count, count, "enumerated", ranges, total,
-                          lazy=enumerated)
+        def enumerated(start: int = 0) -> Iterator[Columns]:  # a fresh generator each time: the same cases
+            def block_of(block: int, lo: int, hi: int) -> Iterator[Columns]:
+                picks = _block_rng(seed, block)
+                for at in range(lo, hi, CHUNK):
+                    yield _combinations(box, valid[picks.integers(0, len(valid), size=min(CHUNK, hi - at))])
+            return _by_block(count, start, block_of)
+        return DomainDraw(True, share, count, count, "enumerated", ranges, total, lazy=enumerated)
     if count > EAGER_INSIDE:
         return DomainDraw(True, share, count, count, "rejection", ranges, 0,
                           lazy=lambda: _draw_inside(routine, box, seed, count, strict=True)[0])
@@ -468,17 +526,22 @@ def _draw_inside(routine: Routine, box: list[Port], seed: int, count: int, stric
     return blocks(), lambda: drawn[0]
 
 
-def _lazy_sweep(routine: Routine, seed: int) -> Iterator[Columns]:
-    yield from _function_blocks(routine, "cases.sweep", call_with(routine.sweep, {"seed": seed,
-                                                                               "rng": np.random.default_rng(seed)}))
+def _lazy_sweep(routine: Routine, seed: int, start: int = 0) -> Generator[Columns, None, int]:
+    """The spec's sweep function's cases from case `start` on: it runs from its start (a function can only
+    be run from there); the cases before `start` are counted, not checked nor converted. Returns how many
+    cases it made in all."""
+    made = call_with(routine.sweep, {"seed": seed, "rng": np.random.default_rng(seed)})
+    return (yield from _function_blocks(routine, "cases.sweep", made, skip=start))
 
 
 # ---- cases from users' functions ----------------------------------------------------------------------
 
-def _function_blocks(routine: Routine, key: str, made, expected: int | None = None) -> Iterator[Columns]:
+def _function_blocks(routine: Routine, key: str, made, expected: int | None = None,
+                     skip: int = 0) -> Generator[Columns, None, int]:
     """Cases from a spec's function as column blocks. The function returns (or yields) cases one by
     one (tuples in input order, or dicts by name), or column blocks: dicts of numpy arrays by input
-    name, one element per case (a table input: one row of bytes per case) - the fast form."""
+    name, one element per case (a table input: one row of bytes per case) - the fast form. The first
+    `skip` cases are passed over: counted, not checked (the run that makes them checks them)."""
     where = f"{routine.spec_path}: {key}"
     if isinstance(made, dict):
         made = [made]
@@ -493,17 +556,27 @@ def _function_blocks(routine: Routine, key: str, made, expected: int | None = No
     elif isinstance(first, dict) and any(isinstance(v, np.ndarray) for v in first.values()):
         produced = 0
         for block in chain([first], iterator):
+            if skip and isinstance(block, dict) and block:
+                n = len(next(iter(block.values())))
+                if produced + n <= skip:  # wholly before the first case wanted
+                    produced += n
+                    continue
             columns = _block_columns(routine, block, where)
+            if produced < skip:
+                columns = [column[skip - produced:] for column in columns]
+                produced = skip
             produced += len(columns[0])
             if len(columns[0]):
                 yield columns
     else:
-        produced = 0
-        for chunk in chunks(_checked(routine, key, chain([first], iterator))):
+        produced = sum(1 for _ in islice(iterator, skip - 1)) + 1 if skip else 0  # (`first` is one of them)
+        rest = chain([first], iterator) if not skip else iterator
+        for chunk in chunks(_checked(routine, key, rest)):
             produced += len(chunk)
             yield cases_to_columns(routine, chunk)
     if expected is not None and produced != expected:
         raise InputError(f"{where}: asked for {expected} cases, the function returned {produced}")
+    return produced
 
 
 def _block_columns(routine: Routine, block, where: str) -> Columns:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from itertools import chain, islice
 
@@ -135,12 +135,20 @@ class Sweep:
     start: SceneStart | None = None
 
     def parts(self) -> list[case_sets.Part]:
-        """The plan's parts, made once per process (the check's own process registers the ones it made)."""
+        """The plan's parts, made once per process (the check's own process registers the ones it made),
+        with the counts of those that did not say it (a sweep function's) once this process made them."""
         if self not in _PLANS:
             _PLANS.clear()  # one plan per worker at a time: memory stays bounded
             _PLANS[self] = case_sets.plan(routine_of(self.spec), exhaustive=self.exhaustive, seed=self.seed,
                                           random=self.random, bounded_product=self.bounded_product)
         return _PLANS[self]
+
+    def counted(self, index: int, count: int) -> None:
+        """Part `index` made `count` cases: later tasks pass over it by its count (a new list: the check's
+        own plan is left as it is)."""
+        parts = list(self.parts())
+        parts[index] = replace(parts[index], count=count)
+        _PLANS[self] = parts
 
     @cached_property
     def block(self) -> int:
@@ -180,7 +188,7 @@ def _blocks_from(sweep: Sweep, first: int) -> Iterator:
     position, blocks = _CURSORS.pop(sweep, (None, None))
     parts = sweep.parts()
     if blocks is None or position > first or case_sets.reachable(parts, first):
-        return case_sets.stream(parts, sweep.block, first)
+        return case_sets.stream(parts, sweep.block, first, sweep.counted)
     for _ in range((first - position) // sweep.block):  # another worker's tasks: made and dropped
         next(blocks, None)
     return blocks

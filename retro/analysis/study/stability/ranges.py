@@ -33,10 +33,12 @@ def range_rows(reduced: bool = False, progress=None, engine: str = "auto") -> li
     the domain the cases that break it and how many of those the assembly answers wrong (a condition
     with wrong answers is needed). The full run uses the exhaustive sweeps of `retro check --exhaustive`."""
     from retro.analysis.check import run_checks
+    from retro.workers import configured
 
     rows = []
     for check in run_checks(None, exhaustive=not reduced, random_count=RANGE_RANDOM_CASES[reduced],
-                            progress=progress, engine=engine):
+                            progress=progress, engine=engine,
+                            jobs=configured(None, None)):  # its sweeps on Dask: local, or $RETRO_SCHEDULER's
         t = check.totals
         stated = " and ".join(c.text for c in check.routine.domain) or "every input"
         rows.append(RangeRow(check.routine.name, f"inside the stated domain ({stated})", t.cases - t.outside,
