@@ -460,8 +460,6 @@ MUTANTS = [
            "back = (pc + 2) & WORD", "back = (pc + 3) & WORD", COMPILED_VECTOR_TESTS),
     Mutant("compiled-rts-without-plus-one", "retro/cpu/translate.py",
            'e.put("t = ((u << 8 | t) + 1) & 65535")', 'e.put("t = (u << 8 | t) & 65535")', COMPILED_VECTOR_TESTS),
-    Mutant("compiled-jmp-ind-page-wrap-fixed", "retro/cpu/translate.py",
-           "(pointer & PAGE_MASK) | ((pointer + 1) & BYTE)", "(pointer + 1) & WORD", COMPILED_VECTOR_TESTS),
 ]
 
 

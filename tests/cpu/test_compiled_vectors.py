@@ -15,7 +15,7 @@ Two runs, as the translator folds each instruction's operands into its code (one
 vector: about 0.5 s of CPU each, far too many for 118,000 vectors):
 - the generated source executed as Python (`python_function`: the very text numba compiles, with the
   same helpers of retro.cpu.compiled_ops): every vector with RETRO_EXHAUSTIVE=1, every 20th of each
-  opcode (all 500 of JMP (ind) $6C) otherwise;
+  opcode otherwise;
 - compiled by numba into a private cache (a real compile each): every supported opcode's first vector
   with D clear and first with D set with RETRO_EXHAUSTIVE=1; otherwise the first vector with D set of
   each opcode in NUMBA_SAMPLE, chosen to reach the translator's rules.
@@ -44,7 +44,6 @@ pytestmark = pytest.mark.skipif(numba_problem() is not None, reason=f"{numba_pro
 
 FULL = os.environ.get("RETRO_EXHAUSTIVE") == "1"
 SOURCE_STRIDE = 1 if FULL else 20  # every vector, or every 20th of each opcode (25 of 500)
-SOURCE_WHOLE = {0x6C}  # every vector even in CI: JMP (ind)'s page wrap needs a pointer at $xxFF (1 in 256)
 STOPPING = {0x00: "BRK", 0x40: "RTI"}  # left to the batched core (docs/compiled.md)
 SELF_LOOPS = {0x10, 0x30, 0x50, 0x70, 0x90, 0xB0, 0xD0, 0xF0, 0x4C, 0x6C}  # may return to their own address
 NOWHERE = 0x10000  # a return address no 16-bit PC equals
@@ -144,12 +143,12 @@ def assert_honest(outcomes: Counter, failures: list[str], chosen: dict[int, list
 
 @pytest.mark.parametrize("cpu", ["6510", "2a03"])
 def test_generated_source_runs_every_vector_exactly(vector_dir, figures, cpu):
-    chosen = {opcode: load(vector_dir, opcode)[::1 if opcode in SOURCE_WHOLE else SOURCE_STRIDE] for opcode in SUPPORTED}
+    chosen = {opcode: load(vector_dir, opcode)[::SOURCE_STRIDE] for opcode in SUPPORTED}
     with mock.patch.object(compiled, "_function", python_function):
         outcomes, failures = run_all(cpu, chosen)
     assert_honest(outcomes, failures, chosen)
     figures[f"compiled-source-{cpu}"] = (f"CPU vectors, compiled engine's generated source as Python, {cpu}: "
-                                         f"{summary(outcomes)} ({'every vector' if FULL else 'every 20th, all of $6C'} "
+                                         f"{summary(outcomes)} ({'every vector' if FULL else 'every 20th'} "
                                          f"of {len(SUPPORTED)} opcodes)")
 
 
