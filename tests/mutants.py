@@ -55,6 +55,7 @@ STABILITY_TESTS = ("tests/study/test_stability_pinned.py", "tests/study/test_sta
                    "tests/study/test_study_cli.py")
 FIELD_TESTS = ("tests/test_fields.py",)
 COMPILED_TESTS = ("tests/cpu/test_compiled.py",)
+COMPILED_VECTOR_TESTS = ("tests/cpu/test_compiled_vectors.py",)  # needs RETRO_CPU_VECTORS
 WORKER_TESTS = ("tests/test_workers.py",)
 STREAM_TESTS = ("tests/routines/test_case_stream.py",)
 FLOW_TESTS = ("tests/cpu/test_flow_values.py", "tests/routines/test_static_smc.py")
@@ -569,6 +570,20 @@ MUTANTS = [
            'lines.append(f"{SET_REGISTERS[what]} |= (cols[{column}][lane] >> {shift}) & 255")',
            'lines.append(f"{SET_REGISTERS[what]} |= cols[{column}][lane] & 255")',
            COMPILED_TESTS + ("tests/routines/test_compiled_check.py",)),
+    Mutant("compiled-taken-branch-cycle-dropped", "retro/cpu/translate.py",
+           "extra = BRANCH_TAKEN_CYCLES + (", "extra = 0 + (", COMPILED_VECTOR_TESTS),
+    Mutant("compiled-6510-decimal-ignored", "retro/cpu/translate.py",
+           'self.decimal = cpu == "6510"', 'self.decimal = False', COMPILED_VECTOR_TESTS),
+    Mutant("compiled-2a03-decimal-applied", "retro/cpu/translate.py",
+           'self.decimal = cpu == "6510"', 'self.decimal = cpu in ("6510", "2a03")', COMPILED_VECTOR_TESTS),
+    Mutant("compiled-lax-x-not-loaded", "retro/cpu/translate.py",
+           '                self.put("x = a")', '                pass', COMPILED_VECTOR_TESTS),
+    Mutant("compiled-compare-carry-inverted", "retro/cpu/translate.py",
+           'self.put("fc = ((t >> 8) & 1) ^ 1")', 'self.put("fc = (t >> 8) & 1")', COMPILED_VECTOR_TESTS),
+    Mutant("compiled-jsr-pushes-next-instruction", "retro/cpu/translate.py",
+           "back = (pc + 2) & WORD", "back = (pc + 3) & WORD", COMPILED_VECTOR_TESTS),
+    Mutant("compiled-rts-without-plus-one", "retro/cpu/translate.py",
+           'e.put("t = ((u << 8 | t) + 1) & 65535")', 'e.put("t = (u << 8 | t) & 65535")', COMPILED_VECTOR_TESTS),
 ]
 
 

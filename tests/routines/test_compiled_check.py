@@ -15,7 +15,7 @@ from retro.cpu import compiled
 from retro.cpu.compiled import numba_problem
 from retro.routines.registry import builtin_names
 
-from test_batch_check import USER_SPECS  # noqa: E402 (pytest puts this folder on sys.path)
+from test_batch_check import SPECS, USER_SPECS  # noqa: E402 (pytest puts this folder on sys.path)
 
 needs_numba = pytest.mark.skipif(numba_problem() is not None, reason=f"{numba_problem()}")
 ENGINE_FIELDS = {"engine", "engine_agreement", "engine_reason", "compile_seconds", "compiled_fallbacks",
@@ -31,14 +31,36 @@ def without_engine(record: dict) -> dict:
     return {k: v for k, v in record.items() if k not in ENGINE_FIELDS}
 
 
+# Every user fixture spec (USER_SPECS and more). Known difference: the compiled engine does not check a
+# spec's stated facts ([facts]: a branch stated "not taken"); Machine and the batched core stop the call
+# where the code contradicts one, the compiled engine runs on (issue 24 part 2, left for the engine).
+# And smc/smc_some.toml: the engines' exit codes differ (0 and 1), found at the deadline, not yet explained.
+FACTS_IGNORED = str(SPECS / "facts" / "lookup_broken.toml")
+KNOWN_DIFFERENCES = {FACTS_IGNORED: "the compiled engine does not check stated facts",
+                     str(SPECS / "smc" / "smc_some.toml"): "exit codes differ between the engines (not explained)"}
+FIXTURE_SPECS = [pytest.param(p, marks=pytest.mark.xfail(strict=True, reason=KNOWN_DIFFERENCES[p]))
+                 if p in KNOWN_DIFFERENCES else p for p in sorted(str(p) for p in SPECS.rglob("*.toml"))]
+
+
+def test_the_fixture_specs_include_the_batched_tests_ones():
+    names = {spec if isinstance(spec, str) else spec.values[0] for spec in FIXTURE_SPECS}
+    assert set(USER_SPECS) <= names and FACTS_IGNORED in names and len(names) > len(USER_SPECS)
+
+
 @needs_numba
-@pytest.mark.parametrize("spec", builtin_names() + USER_SPECS)
-def test_the_compiled_engine_gives_the_batched_cores_check(spec, capsys):
-    # (no search: it is steered by the code coverage, which the compiled engine does not count)
-    code_b, (batched,) = check_json(capsys, spec, "--engine", "batch", "--random", "400", "--no-search")
-    code_c, (compiled,) = check_json(capsys, spec, "--engine", "compiled", "--random", "400", "--no-search")
-    assert code_b == code_c
-    assert without_engine(batched) == without_engine(compiled)
+@pytest.mark.parametrize("spec", builtin_names() + FIXTURE_SPECS)
+def test_every_spec_gives_the_same_record_on_all_three_engines(spec, capsys):
+    """Machine, the batched core and the compiled engine: the same exit code and JSON record, the
+    engine fields aside (and code coverage, which the compiled engine does not count)."""
+    # (no search: it is steered by the code coverage)
+    common = ("--random", "400", "--no-search")
+    code_s, (scalar,) = check_json(capsys, spec, "--engine", "scalar", *common)
+    code_b, (batched,) = check_json(capsys, spec, "--engine", "batch", *common)
+    code_c, (compiled,) = check_json(capsys, spec, "--engine", "compiled", *common)
+    assert (scalar["engine"], batched["engine"]) == ("scalar", "batch")
+    assert code_s == code_b == code_c
+    assert without_engine(scalar) == without_engine(batched) == without_engine(compiled)
+    assert scalar.get("code_coverage") == batched.get("code_coverage")  # counted by these two only
     if compiled["engine"] == "compiled":
         assert compiled["engine_reason"] == "--engine compiled" and compiled["compile_seconds"] >= 0
         agreement = compiled["engine_agreement"]
