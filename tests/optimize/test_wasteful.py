@@ -183,3 +183,15 @@ def test_every_waste_at_once_goes(tmp_path):
         assert result.after["worst"] <= worst and result.after["bytes"] <= size
     check = check_routine(str(tmp_path / "aabb8_all_optimized.toml"), search_budget=0)
     assert not failed([check])
+
+
+def test_jumps_to_jumps_and_to_an_rts_are_shortened():
+    from retro.optimize.code import Instruction, Listing
+    from retro.optimize.flow import rewrites
+    listing = Listing(0xC000, (Instruction("BEQ", "rel", target="hop"), Instruction("JMP", "abs", target="out"),
+                               Instruction("LDA", "imm", 1), Instruction("RTS", "imp"),
+                               Instruction("JMP", "abs", target="far"), Instruction("LDA", "imm", 2),
+                               Instruction("RTS", "imp")), (("out", 3), ("hop", 4), ("far", 5)))
+    found = dict(rewrites(listing))
+    assert _names(found["a jump to a JMP sent to its target"])[0] == ("BEQ", "far")
+    assert _names(found["a JMP to an RTS made the RTS"])[1] == ("RTS", None)
