@@ -70,7 +70,15 @@ def optimize(spec: str, *, objective: str = "worst", no_slower: bool = False, bu
     outcome = search(routine, opts, progress)
     if outcome.program is None:
         raise RunError(f"{spec}: the new routine does not fit the old one's bytes (an internal error: never reported)")
-    new_routine = replace(routine, program=outcome.program, name=stem)
+    symbols = {n: a for n, a in routine.program.symbols.items()
+               if not outcome.original.origin <= a < outcome.original.origin + code_bytes(outcome.original)
+               or n in dict(outcome.original.labels) and n in dict(outcome.best.labels)}
+    symbols.update(_labels(outcome.best))
+    new_program = replace(outcome.program, symbols=symbols)  # labels moved with the code (loops' bounds too)
+    moved = {routine.program.symbols[label]: symbols[label] for label in routine.loop_bounds
+             if label in routine.program.symbols and label in symbols}
+    new_routine = replace(routine, program=new_program, name=stem,
+                          loop_addresses={moved.get(a, a): bound for a, bound in routine.loop_addresses.items()})
     exhaustive = routine.input_space() <= PROOF_SPACE
     checked = check_routine(new_routine, exhaustive=exhaustive, seed=outcome.routine.seed if seed is None else seed,
                             search_budget=0)
@@ -88,17 +96,13 @@ def optimize(spec: str, *, objective: str = "worst", no_slower: bool = False, bu
         names[address] = name
     source = format_source(outcome.best, syntax, names, f"{routine.name}, optimised by retro optimize ({opts.objective})")
     diff = listing_diff(plain_lines(outcome.original, original_names), plain_lines(outcome.best, names), routine.name)
-    symbols = {n: a for n, a in routine.program.symbols.items()
-               if not outcome.original.origin <= a < outcome.original.origin + code_bytes(outcome.original)
-               or n in dict(outcome.original.labels) and n in dict(outcome.best.labels)}
-    symbols.update(_labels(outcome.best))
     doc = new_spec(read_spec_document(routine.spec_path), routine.spec_path.parent, folder.resolve(),
                    stem + ".prg", stem + ".lbl", stem)
     proof = {**best.record(), "check": {"cases": checked.totals.cases, "mismatches": checked.mismatches,
                                         "exhaustive": exhaustive, "engine": checked.engine},
              "optimal": ("none cheaper among the windows searched (every window of up to "
                          f"{opts.window} instructions over the pruned instruction set)" if outcome.complete else None)}
-    outputs = {folder / files[0]: source, folder / files[1]: prg_bytes(replace(outcome.program, symbols=symbols)),
+    outputs = {folder / files[0]: source, folder / files[1]: prg_bytes(new_program),
                folder / files[2]: format_vice_labels(symbols), folder / files[3]: toml_text(doc),
                folder / files[4]: "\n".join(diff) + "\n"}
     written = write_all_atomic(outputs)

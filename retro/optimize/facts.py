@@ -16,7 +16,8 @@ intersected where paths join (`facts_before`), are:
   while none of them changes (so a CMP repeating a carry the code holds is seen as such);
 - N and Z of a register: `("nz", register)`: after a load, a transfer or an operation on it.
 Places are "A", "X", "Y", a flag letter, or an address; an immediate operand is `("#", value)`.
-Windows with indexed or indirect operands read memory the facts do not describe: they get no such
+A read indexed by X or Y from the routine's own tables (bytes of its program it never writes) reads
+the index over all its values and the table itself; other indexed or indirect reads get no such
 check (the caller decides what stands behind them).
 """
 
@@ -145,13 +146,18 @@ def entry_facts(entry_state: tuple) -> frozenset:
     return frozenset(facts)
 
 
-def _reads(instructions) -> set | None:
-    """Places read before being written by the sequence; None when it reads memory it cannot name."""
+def _reads(instructions, static=None) -> set | None:
+    """Places read before being written by the sequence; None when it reads memory it cannot name.
+    `static(low, high)`: whether those bytes are the same on every case and never written (the
+    routine's own tables): an absolute indexed read there reads the index and the call image."""
     read, written = set(), set()
     for instruction in instructions:
         if not known(instruction):
             return None
         reads, _, read_memory, _ = effects(instruction)
+        if ALL_MEMORY in read_memory and instruction.mode in ("abx", "aby") and static is not None and static(
+                instruction.operand, instruction.operand + 0xFF):
+            read_memory = frozenset()
         if ALL_MEMORY in read_memory:
             return None
         read |= (set(reads) | set(read_memory)) - written
@@ -159,9 +165,9 @@ def _reads(instructions) -> set | None:
     return read
 
 
-def local_places(window, replacement, live: frozenset) -> list | None:
+def local_places(window, replacement, live: frozenset, static=None) -> list | None:
     """The places whose entry values decide whether the two sequences agree on `live`."""
-    reads = [_reads(window), _reads(replacement)]
+    reads = [_reads(window, static), _reads(replacement, static)]
     if reads[0] is None or reads[1] is None:
         return None
     writes = set().union(*(_written(i) for i in tuple(window) + tuple(replacement)))
@@ -209,12 +215,13 @@ def allowed_states(places: list, facts: frozenset, seed: int = 0) -> tuple[dict,
     return {p: v[keep] for p, v in values.items()}, whole
 
 
-def window_agrees(executor, window, replacement, live: frozenset, facts: frozenset) -> bool | None:
+def window_agrees(executor, window, replacement, live: frozenset, facts: frozenset, static=None) -> bool | None:
     """Whether `replacement` leaves what is `live` as `window` does on every entry state the facts
     allow (see the module's docstring); None when the check cannot be made (indexed or indirect
-    operands, an instruction the effects table does not know)."""
+    operands outside the routine's own tables (`static`; the executor's image holds them), an
+    instruction the effects table does not know)."""
     from retro.optimize.search import FLAG_BITS, State, target_matches
-    places = local_places(window, replacement, live)
+    places = local_places(window, replacement, live, static)
     if places is None:
         return None
     values, _ = allowed_states(places, facts)

@@ -111,6 +111,19 @@ def direct_addresses(routine: Routine, listing: Listing) -> tuple[int, ...]:
     return tuple(sorted(found))
 
 
+def constant_bytes(routine: Routine, listing: Listing) -> frozenset[int]:
+    """The program's bytes that no instruction of the routine writes (directly; a routine writing
+    through an index has none) and no input sits on: the same on every case."""
+    if any(writes_through_index(i) for i in listing.instructions):
+        return frozenset()
+    program = routine.program
+    written = {i.operand for i in listing.instructions if i.mode in ("zpg", "abs") and i.target is None
+               and i.mnemonic in ("STA", "STX", "STY", "INC", "DEC", "ASL", "LSR", "ROL", "ROR")}
+    written.update(place.address for port in routine.inputs + routine.outputs for place in port.places
+                   if place.kind == "memory")
+    return frozenset(range(program.origin, program.origin + len(program.code))) - written
+
+
 def live_at_return(routine: Routine, preserve: tuple[str, ...]) -> frozenset:
     live = set(preserve)
     for port in routine.outputs:
@@ -174,6 +187,11 @@ class Search:
         self.kept_samples = None
         self.synthesised = False
         self.workers = Workers(options.jobs, options.scheduler)
+        self.constant = constant_bytes(routine, self.listing)
+
+    def static(self, low: int, high: int) -> bool:
+        """Whether bytes low..high are the routine's own tables: the same on every case, never written."""
+        return all(a in self.constant for a in range(low, high + 1))
 
     # ---- whole-routine runs --------------------------------------------------------------------
 
@@ -347,7 +365,7 @@ class Search:
             if kind == "window" and tuple(sequence) == tuple(window):
                 continue
             if kind == "window" and self.prover.kind != "exhaustive" and not window_agrees(
-                    executor, window, sequence, result.live, facts):
+                    executor, window, sequence, result.live, facts, self.static):
                 outcome.local_rejections += 1  # a sampled proof alone would not stand behind it
                 continue
             new = self.replaced(listing, start, stop, sequence)

@@ -234,6 +234,8 @@ def test_ophis_source_assembles_back_to_the_same_bytes(tmp_path):
     (["--window", "0"], "--window"),
     (["--preserve", "Q"], "--preserve"),
     (["--syntax", "masm"], "--syntax"),
+    (["--jobs", "0"], "--jobs"),
+    (["--jobs", "two"], "--jobs"),
 ])
 def test_bad_options_are_one_line_exit_2(tmp_path, capsys, args, message):
     code = cli_main(["optimize", str(EXAMPLES / "clamp.toml"), "--out", str(tmp_path)] + args)

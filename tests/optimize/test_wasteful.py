@@ -44,12 +44,14 @@ WASTES = [
     ("tile_tax", "a store and a load where TAX does"),
     ("tile_jmp", "a BCC over a JMP where a BCS falls through"),
     ("tile_cmp", "a CPY #0 repeating the flags LDY set"),
+    ("tile_box_ldx", "an LDX of the row X holds (a sampled proof: the facts see X = row)"),
+    ("tile_box_reload", "a table entry read again through X (an indexed window on a sampled proof)"),
 ]
 
 
 @pytest.mark.parametrize("name, waste", WASTES, ids=[w[0] for w in WASTES])
 def test_a_wasteful_routine_reaches_the_real_cost(tmp_path, name, waste):
-    worst, size = real_cost(name.split("_")[0])
+    worst, size = real_cost(name.rsplit("_", 1)[0])
     spec = WASTEFUL / f"{name}.toml"
     result = optimize_command(str(spec), budget=BUDGET, out=str(tmp_path))
     assert result.before["bytes"] > size, waste
@@ -181,3 +183,15 @@ def test_every_waste_at_once_goes(tmp_path):
         assert result.after["worst"] <= worst and result.after["bytes"] <= size
     check = check_routine(str(tmp_path / "aabb8_all_optimized.toml"), search_budget=0)
     assert not failed([check])
+
+
+def test_jumps_to_jumps_and_to_an_rts_are_shortened():
+    from retro.optimize.code import Instruction, Listing
+    from retro.optimize.flow import rewrites
+    listing = Listing(0xC000, (Instruction("BEQ", "rel", target="hop"), Instruction("JMP", "abs", target="out"),
+                               Instruction("LDA", "imm", 1), Instruction("RTS", "imp"),
+                               Instruction("JMP", "abs", target="far"), Instruction("LDA", "imm", 2),
+                               Instruction("RTS", "imp")), (("out", 3), ("hop", 4), ("far", 5)))
+    found = dict(rewrites(listing))
+    assert _names(found["a jump to a JMP sent to its target"])[0] == ("BEQ", "far")
+    assert _names(found["a JMP to an RTS made the RTS"])[1] == ("RTS", None)
