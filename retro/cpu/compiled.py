@@ -236,18 +236,19 @@ def _function(translation: Translation, columns: int) -> tuple[object, float, bo
 
 def compile_routine(image: bytes, entry: int, cpu: str, return_pc: int, inputs_at=(), columns: int = 0,
                     places: tuple = (), sets: tuple = (), lanes: tuple[int, ...] | None = None,
-                    outputs: tuple[int, ...] | None = None) -> CompiledRoutine:
+                    outputs: tuple[int, ...] | None = None, decimal_entry: bool = False) -> CompiledRoutine:
     """The routine at entry in this memory image, compiled (or loaded from the cache) for calls whose
     inputs come in `columns` case columns placed by `places` and `sets` rows (retro.cpu.translate's
     `_placing`; `CompiledRoutine.run`), and, when given, the `lane_addr` and `out_addr` every run
-    passes (`lanes`, `outputs`: one line each in the code instead of a loop); Untranslatable when the
+    passes (`lanes`, `outputs`: one line each in the code instead of a loop), and whether calls may
+    start with D set (`decimal_entry`: ADC and SBC then keep decimal mode); Untranslatable when the
     compiled engine does not take it (the message says why)."""
     problem = numba_problem()
     if problem is not None:
         raise Untranslatable(problem)
     translation = translate.translate(image.__getitem__, entry, cpu, return_pc, inputs_at, places, sets,
                                       None if lanes is None else tuple(lanes),
-                                      None if outputs is None else tuple(outputs))
+                                      None if outputs is None else tuple(outputs), decimal_entry)
     function, seconds, from_cache = _function(translation, columns)
     code_map = np.zeros(MEMORY, dtype=np.uint8)
     code_map[list(translation.code_bytes)] = 1

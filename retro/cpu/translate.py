@@ -38,7 +38,7 @@ from retro.cpu.timing import (
     branch_target,
 )
 
-TRANSLATOR_VERSION = 4  # part of every cache key: a change of the generated code's meaning bumps it
+TRANSLATOR_VERSION = 5  # part of every cache key: a change of the generated code's meaning bumps it
 # A call's status (the compiled function's per-call result): 0 returned, else why it stopped.
 RETURNED = 0
 BUDGET = 4  # the cycle budget was spent (retro.cpu.batch.LaneError.BUDGET)
@@ -145,6 +145,7 @@ class _Emitter:
         self.decimal = cpu == "6510"  # NMOS decimal mode; the 2A03 has none; the 65C02's own below
         self.cmos = cpu == WDC_65C02
         self.binary = False  # D is 0 throughout (`decimal_free`): ADC and SBC inline, binary only
+        self.adds = False  # an ADC or SBC was emitted: only then can D on entry make binary-only code wrong
         self.code_bytes = code_bytes
         self.read = read
         self.lines: list[str] = []
@@ -236,6 +237,7 @@ class _Emitter:
     def add(self, name: str, value: str) -> None:
         """ADC (or SBC: `name` "sbc") of value: one call of the helper for this CPU's decimal mode
         (retro.cpu.compiled_ops); the 2A03 has none, the 65C02 takes a cycle more with D set."""
+        self.adds = True
         if self.binary or not (self.decimal or self.cmos):
             operand = f"({value} ^ 255)" if name == "sbc" else value
             self.put(f"t = a + {operand} + fc")
@@ -659,11 +661,13 @@ def _lane_lines(lanes: tuple[int, ...] | None, outputs: tuple[int, ...] | None) 
 
 def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
               inputs_at: Iterable[int] = (), places: tuple = (), sets: tuple = (),
-              lanes: tuple[int, ...] | None = None, outputs: tuple[int, ...] | None = None) -> Translation:
+              lanes: tuple[int, ...] | None = None, outputs: tuple[int, ...] | None = None,
+              decimal_entry: bool = False) -> Translation:
     """The routine at entry (its bytes as `read` gives them: the memory every call starts from) as
     the source of one function (see the module docstring; `places` and `sets`: where the case
     columns go, `_placing`; `lanes` and `outputs`: the `lane_addr` and `out_addr` every run will
-    pass, when known, `_lane_lines`); Untranslatable when it certainly modifies its own code."""
+    pass, when known, `_lane_lines`; `decimal_entry`: calls may start with D set, so ADC and SBC
+    keep their decimal mode); Untranslatable when it certainly modifies its own code."""
     starts, instructions = find_blocks(read, entry, cpu, return_pc)
     code_bytes = frozenset((pc + k) & WORD for pc, op in instructions.items()
                            for k in range(MODE_LENGTH[op.mode] if op is not None else 1))
@@ -677,7 +681,7 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
     leaders = set(starts)
     e = _Emitter(cpu, code_bytes, read)
     e.inlined = inlined
-    e.binary = (e.decimal or e.cmos) and decimal_free(instructions.values(), sets)
+    e.binary = (e.decimal or e.cmos) and not decimal_entry and decimal_free(instructions.values(), sets)
 
     def emit_block(start: int) -> None:
         pc = start
@@ -709,7 +713,7 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
     restore = "\n".join(f"        mem[{address}] = image[{address}]" for address in sorted(e.fixed_writes))
     placing_lanes, copying = _lane_lines(lanes, outputs)
     source = _FUNCTION.format(name=name, entry_block=blocks[entry], body="\n".join(e.lines), budget_status=BUDGET,
-                              bad="fd * 2" if e.binary else "0", fallback_decimal=FALLBACK_DECIMAL,
+                              bad="fd * 2" if e.binary and e.adds else "0", fallback_decimal=FALLBACK_DECIMAL,
                               lane_placing=placing_lanes, out_copying=copying,
                               fallback_write=FALLBACK_WRITE, z_bit=_Z_BIT, restore=restore,
                               placing=_placing(places, sets))

@@ -168,13 +168,14 @@ def on_batch(cpu: str, code: bytes, registers, memory, watched=WATCHED) -> list:
              tuple(watched[i].tolist())) for i in range(n)]
 
 
-def on_compiled(cpu: str, code: bytes, registers, memory, watched=WATCHED, p: int | None = None) -> tuple[list, int]:
+def on_compiled(cpu: str, code: bytes, registers, memory, watched=WATCHED, p: int | None = None,
+                decimal_entry: bool = False) -> tuple[list, int]:
     """(results, calls left to the batched core); a call stopped by the budget is None. `p`: P the
     same for every call, in the base registers (no column sets P), registers[:, 3] ignored."""
     image = image_with(code)
     sp = push_return_trap(image)
     sets = ((0, 0, SET_A), (1, 0, SET_X), (2, 0, SET_Y)) + (((3, 0, SET_P),) if p is None else ())
-    routine = compile_routine(bytes(image), CODE, cpu, RETURN_TRAP, columns=4, sets=sets)
+    routine = compile_routine(bytes(image), CODE, cpu, RETURN_TRAP, columns=4, sets=sets, decimal_entry=decimal_entry)
     flags = ((registers[:, 3] | 0x20) & ~0x10).astype(np.int64)
     columns = (*(np.ascontiguousarray(registers[:, k], dtype=np.int64) for k in range(3)), flags)
     base = np.asarray([0, 0, 0, 0 if p is None else p], dtype=np.int64)
@@ -235,6 +236,28 @@ def test_code_that_cannot_set_d_runs_binary_and_leaves_a_call_entered_with_d_set
     decimal = clear | 0x08
     compiled, left = on_compiled(cpu, code, registers, memory, p=decimal)
     assert left == LANES and set(compiled) == {"fallback"}
+
+
+@pytest.mark.parametrize("cpu", ["6510", "65c02"])
+def test_code_compiled_for_calls_entered_with_d_set_keeps_decimal_mode(cpu, compiled_cache):
+    """The same code as above, compiled knowing calls start with D set (a spec whose P has D): ADC and
+    SBC keep decimal mode, the results equal the batched core's, and the calls are not left to it."""
+    code = random_program(cpu, 11, decimal=False)
+    registers, memory = random_states(5, LANES)
+    registers[:, 3] = 0x29  # carry and D set
+    compiled, left = on_compiled(cpu, code, registers, memory, p=0x29, decimal_entry=True)
+    problems = _differences("compiled vs batch", compiled, on_batch(cpu, code, registers, memory))
+    assert not problems, "\n".join(problems[:10])
+    assert left < LANES // 4
+
+
+def test_code_without_adc_or_sbc_runs_compiled_when_entered_with_d_set(compiled_cache):
+    """D matters only to ADC and SBC: code with neither is not left to the batched core for D."""
+    code = bytes([0xA9, 0x05, 0x09, 0x33, 0x60])  # LDA #$05 / ORA #$33 / RTS
+    registers, memory = random_states(6, 8)
+    registers[:, 3] = 0x28
+    compiled, left = on_compiled("6510", code, registers, memory, p=0x28)
+    assert left == 0 and compiled == on_batch("6510", code, registers, memory)
 
 
 def test_d_set_by_plp_is_decimal_mode_though_no_column_sets_p(compiled_cache):

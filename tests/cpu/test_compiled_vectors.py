@@ -82,7 +82,8 @@ def run_vector(cpu: str, opcode: int, vector: dict, expected: dict) -> tuple[str
         return "differs", [f"returns to its own address ${initial['pc']:04X}: not provided for"]
     return_pc, budget = (NOWHERE, cycles + 1) if loops else (expected["pc"], BUDGET_CYCLES)
     try:
-        routine = compile_routine(image, initial["pc"], cpu, return_pc)
+        routine = compile_routine(image, initial["pc"], cpu, return_pc,
+                                  decimal_entry=bool(initial["p"] & FLAG_D))
     except Untranslatable as refused:
         own_bytes = {(initial["pc"] + k) & 0xFFFF for k in range(3)}
         if writes_into(vector, own_bytes):
