@@ -42,12 +42,9 @@ def test_overall_chart(rows, scale):
 
 @pytest.mark.parametrize("scale", SCALES)
 def test_pairs_chart(rows, scale):
-    from retro.analysis.study.chart import pairs_figure, styles_of
+    from retro.analysis.study.chart import pairs_figure, pairs_size, styles_of
 
-    default = pairs_figure(rows, styles_of(BUILTIN))
-    size = tuple(default.get_size_inches())
-    plt.close(default)
-    fig = pairs_figure(rows, styles_of(BUILTIN), size=_scaled(size, scale))
+    fig = pairs_figure(rows, styles_of(BUILTIN), size=_scaled(pairs_size(rows), scale))
     assert problems(fig) == []
     panels = [ax for ax in fig.axes if ax.get_title()]
     assert len(panels) == 36

@@ -191,15 +191,26 @@ def pairs_chart(rows: list[FigureRow], styles: Styles, columns: int = 6) -> byte
     return _png(pairs_figure(rows, styles, columns))
 
 
-def pairs_figure(rows: list[FigureRow], styles: Styles, columns: int = 6, size: tuple[float, float] | None = None):
-    """A faceted grid, one small panel per shape pair, sharing the x range and the y range."""
+def _pairs_grid(rows: list[FigureRow], columns: int) -> tuple[list[str], int, int]:
+    """(the pairs, panels per line, lines) of the pairs chart."""
     scopes = [s for s in dict.fromkeys(r.scope for r in rows) if s != ALL]
     count = max(1, len(scopes))
     columns = min(columns, count)
-    lines = math.ceil(count / columns)
+    return scopes, columns, math.ceil(count / columns)
+
+
+def pairs_size(rows: list[FigureRow], columns: int = 6) -> tuple[float, float]:
+    """The pairs chart's size in inches when none is given: it grows with the pairs and the legend."""
+    _, columns, lines = _pairs_grid(rows, columns)
+    legend_rows = math.ceil((len(dict.fromkeys(r.method for r in rows)) + 2) / LEGEND_COLUMNS)
+    return max(2.5 * columns + 0.6, 11), 2.2 * lines + 1.0 + 0.3 * legend_rows
+
+
+def pairs_figure(rows: list[FigureRow], styles: Styles, columns: int = 6, size: tuple[float, float] | None = None):
+    """A faceted grid, one small panel per shape pair, sharing the x range and the y range."""
+    scopes, columns, lines = _pairs_grid(rows, columns)
     keys = list(dict.fromkeys(r.method for r in rows))
-    legend_rows = math.ceil((len(keys) + 2) / LEGEND_COLUMNS)
-    figsize = size or (max(2.5 * columns + 0.6, 11), 2.2 * lines + 1.0 + 0.3 * legend_rows)
+    figsize = size or pairs_size(rows, columns)
     fig, axes = plt.subplots(lines, columns, figsize=figsize, squeeze=False)
     pair_rows = [r for r in rows if r.scope != ALL]
     xlim, ylim = _x_limits(pair_rows), y_limits(pair_rows)
