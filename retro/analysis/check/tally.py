@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from retro.analysis.check.engines import CallBlock, disagreement
-from retro.analysis.check.entry_runs import EntryBlock, EntryFinding, changed_calls
+from retro.analysis.check.entry_runs import EntryBaseline, EntryBlock, EntryFinding, changed_calls, run_baselines
 from retro.analysis.check.reference import reference_answers
 from retro.analysis.check.results import Failure, describe_case, describe_outputs
 from retro.analysis.coverage_model import CodeCoverage
@@ -276,19 +276,36 @@ def _entry_figures(out: Tally, calls: _Calls, entry: EntryBlock) -> None:
     the calls that returned), and each variant's first."""
     n = calls.block.returned
     positions = entry.positions[entry.positions < n]
-    compared = calls.inside[positions]
+    baseline = EntryBaseline(entry.first, positions, [], [o[positions] for o in calls.block.outputs],
+                             calls.block.cycles[positions], calls.inside[positions])
+    _entry_counts(out, baseline, entry.runs, lambda k: calls.case(int(positions[k])))
+
+
+def entry_tally(variants: dict, baselines: list[EntryBaseline], seed: int) -> Tally:
+    """The entry-state figures of blocks whose rerun cases were held (`entry_baseline`), run together
+    on the batched core: the figures each block's own `count_block(..., entry=...)` would give."""
+    out = Tally()
+    for baseline, runs in zip(baselines, run_baselines(variants, baselines, seed)):
+        one = Tally()
+        _entry_counts(one, baseline, runs, baseline.case)
+        out.merge(one)
+    return out
+
+
+def _entry_counts(out: Tally, baseline: EntryBaseline, runs: dict, case_at) -> None:
+    compared = baseline.compared
     out.entry_cases = int(compared.sum())
-    any_changed = np.zeros(len(positions), dtype=bool)
-    for variant, run in entry.runs.items():
-        changed = changed_calls(calls.block.outputs, calls.block.cycles, compared, positions, run.head(len(positions)))
+    any_changed = np.zeros(len(compared), dtype=bool)
+    for variant, run in runs.items():
+        run = run.head(len(compared))
+        changed = changed_calls(baseline.outputs, baseline.cycles, compared, run)
         any_changed |= changed
         if changed.any():
             k = int(np.flatnonzero(changed)[0])
-            i = int(positions[k])
             varied = ((None, run.messages.get(k, "the call did not return")) if run.stopped[k]
                       else (row_of(run.outputs, k), int(run.cycles[k])))
-            out.entry_first[variant] = EntryFinding(variant, entry.first + i, calls.case(i),
-                                                    (calls.block.row(i), int(calls.block.cycles[i])), varied)
+            out.entry_first[variant] = EntryFinding(variant, baseline.first + int(baseline.positions[k]), case_at(k),
+                                                    (row_of(baseline.outputs, k), int(baseline.cycles[k])), varied)
     out.entry_changed = int(any_changed.sum())
 
 
