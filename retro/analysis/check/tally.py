@@ -224,17 +224,23 @@ def _calls(routine: Routine, block: CallBlock, columns: list, cases: list[tuple]
 def _cycle_figures(out: Tally, calls: _Calls, cpu: np.ndarray) -> None:
     """Fastest and slowest calls inside the domain (the first on a tie), the sum, CPU-only extremes."""
     block, n = calls.block, calls.block.returned
-    positions = np.flatnonzero(calls.inside)
+    everywhere = bool(calls.inside.all())  # (most blocks: no gather then)
+    positions = np.arange(n) if everywhere else np.flatnonzero(calls.inside)
     if not len(positions):
         return
-    cycles = block.cycles[:n][positions]
+    cycles = block.cycles[:n] if everywhere else block.cycles[:n][positions]
     low, high = int(np.argmin(cycles)), int(np.argmax(cycles))
     out.cycles_min, out.min_case = int(cycles[low]), calls.case(int(positions[low]))
     out.cycles_max, out.max_case = int(cycles[high]), calls.case(int(positions[high]))
     out.cycles_sum = int(cycles.sum())
     out.cycles_count = len(cycles)
-    out.cpu_min, out.cpu_max = int(cpu[positions].min()), int(cpu[positions].max())
-    out.stolen_max = int(block.stolen[:n][positions].max())
+    stolen = block.stolen[:n] if everywhere else block.stolen[:n][positions]
+    if not stolen.any():  # no stalls (no scene): the CPU's cycles are the cycles
+        out.cpu_min, out.cpu_max, out.stolen_max = out.cycles_min, out.cycles_max, 0
+        return
+    inside_cpu = cpu if everywhere else cpu[positions]
+    out.cpu_min, out.cpu_max = int(inside_cpu.min()), int(inside_cpu.max())
+    out.stolen_max = int(stolen.max())
 
 
 def _examples(out: Tally, calls: _Calls, wrong_inside: np.ndarray, cycle_wrong: np.ndarray, cpu: np.ndarray,
