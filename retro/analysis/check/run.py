@@ -36,7 +36,7 @@ from retro.analysis.check.entry_runs import (
 )
 from retro.analysis.check.results import PartRun, RoutineCheck
 from retro.analysis.check.search import DEFAULT_SEARCH, SearchResult, search
-from retro.analysis.check.tally import Tally, count_block, entry_tally
+from retro.analysis.check.tally import EXAMPLES_KEPT, Tally, count_block, entry_tally
 from retro.analysis.check.verdicts import bounds_violations, budget_violations, static_bounds
 from retro.analysis.row_check import RowsCheck, check_rows, merged_agreement, rows_only_static
 from retro.errors import InputError, RunError
@@ -82,12 +82,13 @@ def batch_chunk(spec: str, seed: int, columns: list, first: int = 0, every: int 
 
 
 def array_block(spec: str, seed: int, columns: list, first: int, every: int, engine: str,
-                start: SceneStart | None) -> tuple[Tally, EntryBaseline | None]:
+                start: SceneStart | None, outside_wanted: int = EXAMPLES_KEPT) -> tuple[Tally, EntryBaseline | None]:
     """A column block on an array engine, tallied, and its entry-state rerun cases held for
-    `held_entry_tally` (None: `every` is 0), so that a task's blocks rerun theirs together."""
+    `held_entry_tally` (None: `every` is 0), so that a task's blocks rerun theirs together;
+    `outside_wanted` as for count_block."""
     runner = runner_for(spec, seed, start)
     block = run_on_batched_core(runner, columns, engine=engine)
-    tally = count_block(runner.routine, block, columns, None, runner.memory_values)
+    tally = count_block(runner.routine, block, columns, None, runner.memory_values, outside_wanted=outside_wanted)
     if not every:
         return tally, None
     return tally, entry_baseline(runner.routine, block.outputs, block.cycles, block.returned, columns, first, every)
@@ -189,7 +190,7 @@ def sweep_task(sweep: Sweep, first: int, count: int) -> Tally:
         block = next(blocks, None)
         if block is None:
             break
-        tally, baseline = _block_tally(sweep, block, position)
+        tally, baseline = _block_tally(sweep, block, position, EXAMPLES_KEPT - len(totals.outside_examples))
         totals.merge(tally)
         if baseline is not None:
             held.append(baseline)
@@ -215,12 +216,12 @@ def _blocks_from(sweep: Sweep, first: int) -> Iterator:
     return blocks
 
 
-def _block_tally(sweep: Sweep, block: list, first: int) -> tuple[Tally, EntryBaseline | None]:
+def _block_tally(sweep: Sweep, block: list, first: int, outside_wanted: int) -> tuple[Tally, EntryBaseline | None]:
     """A block tallied, and on an array engine its entry-state rerun cases held (None: none)."""
     if sweep.engine == "scalar":
         return machine_chunk(sweep.spec, sweep.seed, case_sets.columns_to_cases(block), sweep.start, first,
                              sweep.every), None
-    return array_block(sweep.spec, sweep.seed, block, first, sweep.every, sweep.engine, sweep.start)
+    return array_block(sweep.spec, sweep.seed, block, first, sweep.every, sweep.engine, sweep.start, outside_wanted)
 
 
 def _tasks(sweep: Sweep, known: int, unknown: bool, ended: Callable[[], bool]) -> Iterator[tuple]:
