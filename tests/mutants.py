@@ -236,6 +236,12 @@ MUTANTS = [
     Mutant("engine-disagreement-not-counted", "retro/analysis/check/results.py",
            "found += self.agreement.engine_mismatches + self.agreement.cycle_mismatches", "found += 0",
            BATCH_TESTS),
+    Mutant("held-entry-reruns-dropped", "retro/analysis/check/run.py",
+           "        totals.merge(held_entry_tally(sweep.spec, sweep.seed, sweep.start, held))", "        pass",
+           ("tests/routines/test_entry_state.py",)),
+    Mutant("held-entry-reruns-given-the-first-blocks-runs", "retro/analysis/check/entry_runs.py",
+           "                part = slice(end - size, end)", "                part = slice(0, size)",
+           ("tests/routines/test_entry_state.py",)),
     Mutant("agreement-run-skipped", "retro/analysis/check/run.py",
            "agreement.merge(agreement_chunk(spec, seed, chunk, engine, start))", "pass", BATCH_TESTS),
     # ---- the parallel work (retro/workers.py) and a task's cases (retro/routines/cases.py) ------------
