@@ -189,6 +189,11 @@ MUTANTS = [
            "            stop, message = \"run\", str(exc)\n            continue", CHECK_TESTS),
     Mutant("stalls-counted-as-cpu-cycles", "retro/analysis/check/tally.py",
            "cpu = block.cycles[:n] - block.stolen[:n]", "cpu = block.cycles[:n]", CHECK_TESTS),
+    Mutant("cpu-extremes-taken-from-stalled-cycles", "retro/analysis/check/tally.py",
+           "    if not stalled:  # (no scene): the CPU's cycles are the cycles", "    if True:", CHECK_TESTS
+           + ("tests/routines/test_scene_batch.py",)),
+    Mutant("outside-examples-never-kept", "retro/analysis/check/tally.py",
+           "    if outside_wanted > 0 and out.outside_wrong:", "    if False:", ("tests/test_check_golden.py",)),
     # ---- routine specs and static analysis -------------------------------------------------------
     Mutant("jsr-callee-cost-dropped", "retro/cpu/flow.py",
            "return _Effect((cycles + callee.best, cycles + callee.worst), after=_returned(callee.exit))",
