@@ -10,7 +10,8 @@ start-up are in the slice's time: the extrapolation is on the safe side).
 
 With `--floor`: what one call of the sweep costs at least on the compiled engine, stage by stage, in
 this process on FLOOR_BLOCKS of the sweep's 65,536-case blocks (CPU ns a call, the best of FLOOR_ROUNDS
-rounds): making the block's int64 columns (the sweep function), the compiled function alone
+rounds): making the block's int64 columns (the sweep part's blocks as `retro.routines.cases` makes
+them for the check), the compiled function alone
 (`CompiledRoutine.run`), `run_compiled` around it (the outputs made from its rows), the domain
 (`in_domain`), the reference on the arrays (`reference_answers`), and a whole block through the check
 (`array_block`: run, reference, domain and tally; the entry-state reruns apart, `held_entry_tally` on
@@ -89,18 +90,15 @@ def floor() -> None:
     from retro.analysis.check.reference import reference_answers
     from retro.analysis.check.run import array_block, held_entry_tally
     from retro.routines.batch_runs import RETURN_TRAP, _lane_bytes, push_return_trap, return_s
-    from retro.routines.builtin_cases import aabb8_sweep
+    from retro.routines import cases as case_sets
     from retro.routines.cases import in_domain
 
     spec = str(SPEC)
     runner = runner_for(spec, 0, None)
     compiled, plan = runner.compiled(), runner.plan
-    names = runner.routine.input_names
-
-    def made(block) -> list:
-        return [np.asarray(block[name], dtype=np.int64) for name in names]
-    sweep = aabb8_sweep(range(2))
-    blocks = [made(b) for b in islice(sweep, FLOOR_BLOCKS)]
+    parts = [part for part in case_sets.plan(runner.routine, exhaustive=True, seed=0) if part.name == "sweep"]
+    sweep = case_sets.batches(parts, 1 << 16)  # the sweep's blocks as the check makes them
+    blocks = list(islice(sweep, FLOOR_BLOCKS))
     start = dict(plan.base_registers)
     base = np.asarray([start["a"], start["x"], start["y"], plan.base_flags], dtype=np.int64)
     image = bytearray(runner.call_image)
@@ -114,7 +112,7 @@ def floor() -> None:
                      lane_addr, lane_bytes)
 
     def making(_block) -> None:
-        made(next(sweep))
+        next(sweep)
     held: list = []
 
     def check(block) -> None:
