@@ -8,7 +8,19 @@ workers included, sampled from /proc), calls per CPU-second, the largest RSS of 
 and the full sweep's time extrapolated from the slice's rate (the boundary and random cases and the
 start-up are in the slice's time: the extrapolation is on the safe side).
 
+With `--floor`: what one call of the sweep costs at least on the compiled engine, stage by stage, in
+this process on FLOOR_BLOCKS of the sweep's 65,536-case blocks (CPU ns a call, the best of FLOOR_ROUNDS
+rounds): making the block's int64 columns (the sweep part's blocks as `retro.routines.cases` makes
+them for the check), the compiled function alone
+(`CompiledRoutine.run`), `run_compiled` around it (the outputs made from its rows), the domain
+(`in_domain`), the reference on the arrays (`reference_answers`), and a whole block through the check
+(`array_block`: run, reference, domain and tally; the entry-state reruns apart, `held_entry_tally` on
+the block's 1-in-64 cases). The sum of the stages a check cannot skip (making, the function, the
+reference) against the 3-minute goal's budget: 3 x 2^32 calls in 360 CPU seconds on 2 cores, 27.9 ns
+a call.
+
     python benchmarks/aabb8_sweep.py [K] [--jobs J] [--engine compiled|batch]
+    python benchmarks/aabb8_sweep.py --floor
 """
 
 from __future__ import annotations
@@ -54,7 +66,79 @@ def sliced_spec(folder: Path, starts: int) -> Path:
     return spec
 
 
+FLOOR_BLOCKS = 32
+FLOOR_ROUNDS = 3
+
+
+def _best(stage, blocks: list) -> float:
+    """CPU ns a call of `stage(block)` over the blocks, the best of FLOOR_ROUNDS rounds."""
+    best = float("inf")
+    for _ in range(FLOOR_ROUNDS):
+        began = time.process_time()
+        for block in blocks:
+            stage(block)
+        best = min(best, (time.process_time() - began) / (len(blocks) * len(blocks[0][0])))
+    return best * 1e9
+
+
+def floor() -> None:
+    from itertools import islice
+
+    import numpy as np
+
+    from retro.analysis.check.engines import runner_for
+    from retro.analysis.check.reference import reference_answers
+    from retro.analysis.check.run import array_block, held_entry_tally
+    from retro.routines.batch_runs import RETURN_TRAP, _lane_bytes, push_return_trap, return_s
+    from retro.routines import cases as case_sets
+    from retro.routines.cases import in_domain
+
+    spec = str(SPEC)
+    runner = runner_for(spec, 0, None)
+    compiled, plan = runner.compiled(), runner.plan
+    parts = [part for part in case_sets.plan(runner.routine, exhaustive=True, seed=0) if part.name == "sweep"]
+    sweep = case_sets.batches(parts, 1 << 16)  # the sweep's blocks as the check makes them
+    blocks = list(islice(sweep, FLOOR_BLOCKS))
+    start = dict(plan.base_registers)
+    base = np.asarray([start["a"], start["x"], start["y"], plan.base_flags], dtype=np.int64)
+    image = bytearray(runner.call_image)
+    sp = push_return_trap(image, runner.fixed_entry_s)
+    image = bytes(image)
+    out_addr = np.asarray(plan.output_addresses, dtype=np.int64)
+    lane_addr, lane_bytes = _lane_bytes(plan, blocks[0], len(blocks[0][0]))
+
+    def function(block) -> None:
+        compiled.run(image, tuple(block), base, sp, runner.limit, RETURN_TRAP, return_s(runner.fixed_entry_s), out_addr,
+                     lane_addr, lane_bytes)
+
+    def making(_block) -> None:
+        next(sweep)
+    held: list = []
+
+    def check(block) -> None:
+        held.append(array_block(spec, 0, block, len(held) * len(block[0]), 64, "compiled", None)[1])
+    stages = {"making the columns": _best(making, blocks),
+              "the compiled function": _best(function, blocks),
+              "run_compiled (function and outputs)": _best(runner.run_compiled, blocks),
+              "the domain (in_domain)": _best(lambda b: in_domain(runner.routine, b), blocks),
+              "the reference (reference_answers)": _best(
+                  lambda b: reference_answers(runner.routine, b, None, runner.memory_values), blocks),
+              "a block through the check (array_block)": _best(check, blocks)}
+    began = time.process_time()
+    held_entry_tally(spec, 0, None, held[:FLOOR_BLOCKS])
+    stages["entry-state reruns (1 in 64, 2 variants)"] = (time.process_time() - began) / (FLOOR_BLOCKS * len(blocks[0][0])) * 1e9
+    for name, ns in stages.items():
+        print(f"  {name:<44} {ns:6.1f} ns a call")
+    least = stages["making the columns"] + stages["the compiled function"] + stages["the reference (reference_answers)"]
+    budget = GOAL_SECONDS * 2 / FULL_CALLS * 1e9
+    print(f"  making + function + reference: {least:.1f} ns a call: the full sweep at least {least * FULL_CALLS / 1e9:,.0f} "
+          f"CPU s, {least * FULL_CALLS / 1e9 / 2 / 60:.1f} min on 2 cores (goal: {budget:.1f} ns a call)")
+
+
 def main(argv: list[str]) -> None:
+    if "--floor" in argv:
+        floor()
+        return
     parser = argparse.ArgumentParser()
     parser.add_argument("starts", nargs="?", type=int, default=16)
     parser.add_argument("--jobs", type=int, default=2)

@@ -10,15 +10,28 @@ exhaustive product, else its sweep: what a proof runs, the issue's measure); the
 and its load time from the cache, and from how many calls the compile pays for itself against the
 batched core (what `--engine auto`'s AUTO_COMPILED_CASES is set from).
 
-    python benchmarks/compiled_speed.py [ROUTINE ...]
+With `--checks`: whole checks instead, `retro check NAME --exhaustive --no-search --jobs 1 --json` in a
+fresh process per routine and engine (start-up, compile or cache load, the engine agreement on Machine,
+the entry-state reruns, the tally and the reference included: what a user waits for), CPU seconds of
+the process (getrusage of the child) on the batched core (`--engine batch`: today's engine) and on the
+compiled engine (its cache filled first: the compile is counted apart above), with the ratio per
+routine and for the whole set. aabb8's full sweep (3 x 2^32 calls) is too long to run twice here: its
+row is the same check with box A's position from the first AABB8_STARTS values only
+(benchmarks/aabb8_sweep.py's slice; 3 x 2^24 calls per value).
+
+    python benchmarks/compiled_speed.py [ROUTINE ...] [--checks]
 """
 
 from __future__ import annotations
 
+import json
 import os
+import resource
+import subprocess
 import sys
 import tempfile
 import time
+from pathlib import Path
 from itertools import islice
 
 import numpy as np
@@ -108,13 +121,69 @@ def row(name: str) -> None:
           f"{sweep} {cold:>9.2f} {load:>7.2f} {len(compiled.translation.blocks):>6} {pays}{goal}")
 
 
+ROOT = Path(__file__).resolve().parent.parent
+CHECK_ROUTINES = ["aabb8", "aabb_edges", "aabb_sprite", "circle", "circle_r", "mul8", "pixel", "sprite_edges",
+                  "tile", "tile_box"]  # every built-in with an --exhaustive run of its own (the prepare steps aside)
+AABB8_STARTS = 1
+OWN_KEYS = {"code_coverage"}  # the compiled engine counts no code coverage (docs/compiled.md)
+
+
+def _child_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def whole_check(target: str, engine: str) -> tuple[float, dict]:
+    """CPU seconds of `retro check TARGET --exhaustive` on `engine` in a fresh process, and its record."""
+    before = _child_cpu()
+    done = subprocess.run([sys.executable, "-m", "retro", "check", target, "--exhaustive", "--no-search", "--jobs", "1",
+                           "--engine", engine, "--json"], capture_output=True, text=True,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    spent = _child_cpu() - before
+    if done.returncode not in (0, 1) or not done.stdout.strip():
+        sys.exit(f"compiled_speed: retro check {target} --engine {engine} failed: {done.stderr.strip()[-300:]}")
+    return spent, json.loads(done.stdout)[0]
+
+
+def whole_checks(names: list[str]) -> None:
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from aabb8_sweep import sliced_spec
+
+    print("whole checks (--exhaustive --no-search --jobs 1), CPU seconds of the process; the compiled engine's "
+          "cache filled first")
+    print(f"{'routine':<24} {'calls':>15} {'batch (s)':>10} {'compiled (s)':>13} {'ratio':>7}  engine, fallbacks")
+    totals = [0.0, 0.0]
+    with tempfile.TemporaryDirectory() as folder:
+        for name in names:
+            target, label = name, name
+            if name == "aabb8":
+                target = str(sliced_spec(Path(folder), AABB8_STARTS))
+                label = f"aabb8 (slice, {AABB8_STARTS}/256)"
+            whole_check(target, "compiled")  # fills the cache: the compile is not the check's
+            batch, slow = whole_check(target, "batch")
+            fast, record = whole_check(target, "compiled")
+            differ = sorted(k for k in set(slow) | set(record) if not k.startswith(("engine", "compile"))
+                            and k not in OWN_KEYS and slow.get(k) != record.get(k))
+            totals[0] += batch
+            totals[1] += fast
+            print(f"{label:<24} {record['cases']:>15,} {batch:>10.1f} {fast:>13.1f} {batch / fast:>6.1f}x  "
+                  f"{record.get('engine')}, {record.get('compiled_fallbacks') or 0}"
+                  f"{'' if not differ else '  records differ: ' + ', '.join(differ)}")
+    print(f"{'all':<24} {'':>15} {totals[0]:>10.1f} {totals[1]:>13.1f} {totals[0] / totals[1]:>6.1f}x  "
+          "(issue 24: at least 4x)")
+
+
 def main(argv: list[str]) -> None:
     problem = numba_problem()
     if problem:
         sys.exit(f"compiled_speed: {problem}")
     import numba
 
-    names = [a for a in argv if not a.startswith("--")] or ROUTINES
+    names = [a for a in argv if not a.startswith("--")]
+    if "--checks" in argv:
+        whole_checks(names or CHECK_ROUTINES)
+        return
+    names = names or ROUTINES
     with tempfile.TemporaryDirectory() as cache:
         os.environ["RETRO_CACHE"] = cache  # an empty cache: the compile times are cold
         print(f"numpy {np.__version__}, numba {numba.__version__}; calls per CPU-second on {LANES:,} random cases "

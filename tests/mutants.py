@@ -189,6 +189,11 @@ MUTANTS = [
            "            stop, message = \"run\", str(exc)\n            continue", CHECK_TESTS),
     Mutant("stalls-counted-as-cpu-cycles", "retro/analysis/check/tally.py",
            "cpu = block.cycles[:n] - block.stolen[:n]", "cpu = block.cycles[:n]", CHECK_TESTS),
+    Mutant("cpu-extremes-taken-from-stalled-cycles", "retro/analysis/check/tally.py",
+           "    if not stalled:  # (no scene): the CPU's cycles are the cycles", "    if True:", CHECK_TESTS
+           + ("tests/routines/test_scene_batch.py",)),
+    Mutant("outside-examples-never-kept", "retro/analysis/check/tally.py",
+           "    if outside_wanted > 0 and out.outside_wrong:", "    if False:", ("tests/test_check_golden.py",)),
     # ---- routine specs and static analysis -------------------------------------------------------
     Mutant("jsr-callee-cost-dropped", "retro/cpu/flow.py",
            "return _Effect((cycles + callee.best, cycles + callee.worst), after=_returned(callee.exit))",
@@ -236,6 +241,12 @@ MUTANTS = [
     Mutant("engine-disagreement-not-counted", "retro/analysis/check/results.py",
            "found += self.agreement.engine_mismatches + self.agreement.cycle_mismatches", "found += 0",
            BATCH_TESTS),
+    Mutant("held-entry-reruns-dropped", "retro/analysis/check/run.py",
+           "        totals.merge(held_entry_tally(sweep.spec, sweep.seed, sweep.start, held))", "        pass",
+           ("tests/routines/test_entry_state.py",)),
+    Mutant("held-entry-reruns-given-the-first-blocks-runs", "retro/analysis/check/entry_runs.py",
+           "                part = slice(end - size, end)", "                part = slice(0, size)",
+           ("tests/routines/test_entry_state.py",)),
     Mutant("agreement-run-skipped", "retro/analysis/check/run.py",
            "agreement.merge(agreement_chunk(spec, seed, chunk, engine, start))", "pass", BATCH_TESTS),
     # ---- the parallel work (retro/workers.py) and a task's cases (retro/routines/cases.py) ------------

@@ -204,8 +204,10 @@ def run_compiled(runner: RoutineRunner, columns: list) -> BatchOutcome:
     outputs = port_values(runner.routine.outputs, {"a": done["a"], "x": done["x"], "y": done["y"]}, done["p"],
                           lambda address: out_bytes[column_of[address]].astype(np.int64), widen=_widen, table=_table)
     status = done["status"]
-    error = np.where(status == LaneError.BUDGET, LaneError.BUDGET, 0).astype(np.int8)
     cycles = done["cycles"]
+    if not n or not status.max():  # the common case: every call returned (one pass, no scan for the others)
+        return BatchOutcome(outputs, cycles, np.zeros(n, dtype=np.int8))
+    error = np.where(status == LaneError.BUDGET, LaneError.BUDGET, 0).astype(np.int8)
     _rerun_fallbacks(runner, columns, status, outputs, cycles, error)
     return BatchOutcome(outputs, cycles, error)
 

@@ -92,6 +92,16 @@ def test_both_engines_give_the_same_verdict(capsys, name):
     assert records[0]["mismatches"] == records[1]["mismatches"]
 
 
+def test_a_tasks_blocks_rerun_together_give_each_block_its_own_runs(capsys):
+    """The array engines hold a task's blocks' rerun cases and run them at once (entry_runs.EntryBaseline):
+    overlap8 --exhaustive with 2,000 random cases is two blocks of the batched core in one task, many of
+    Machine's; every figure, the first changed case of each variant included, is Machine's."""
+    records = [_check(capsys, ENTRY / "overlap8.toml", "--exhaustive", "--random", "2000", "--engine", engine)[1]
+               for engine in ENGINES]
+    assert records[0]["cases"] > 65_536 and records[0]["entry_dependence"]["changed"] > 0
+    assert records[0]["entry_dependence"] == records[1]["entry_dependence"]
+
+
 def test_the_text_report_names_the_dependence(capsys):
     main(["check", str(ENTRY / "index_x.toml"), "--jobs", "1"])
     text = capsys.readouterr().out

@@ -17,6 +17,7 @@ import numpy as np
 
 from retro.cpu.batch import LaneError
 from retro.errors import RunError
+from retro.routines.cases import case_of, in_domain
 from retro.routines.entry import VARIANTS, advice, memory_advice, stack_advice, variant_stack, variant_values
 from retro.routines.places import FLAGS
 from retro.routines.runner import RoutineRunner
@@ -99,21 +100,62 @@ def entry_block_on_machine(variants: dict[str, RoutineRunner], cases: list[tuple
     return EntryBlock(first, positions, runs)
 
 
-def entry_block_on_batched_core(variants: dict[str, RoutineRunner], columns: list, first: int, every: int,
-                                seed: int) -> EntryBlock:
-    positions = rerun_positions(first, len(columns[0]), every)
-    runs = {}
-    if len(positions):
-        subset = [c[positions] for c in columns]
-        for variant, runner in variants.items():
-            state = runner.entry_state
-            registers, bits = variant_values(state, variant, seed, positions + first)
-            outcome = runner.run_batch(subset, entry=(registers, bits, state.free_mask))
-            stopped = outcome.error != 0
-            messages = {int(k): f"the batched core stopped the call ({LaneError(int(outcome.error[k])).name})"
-                        for k in np.flatnonzero(stopped)[:1]}
-            runs[variant] = VariantRun(outcome.outputs, outcome.cycles, stopped, messages)
-    return EntryBlock(first, positions, runs)
+@dataclass(frozen=True)
+class EntryBaseline:
+    """A block's rerun cases (those that returned) as the check's own run left them, held until they run
+    with the entry state varied together with other blocks' (`run_baselines`): the batched core's cost
+    per call falls with its lanes (aabb8: about 670 ns a call per variant on one block's 1,024 rerun
+    cases, 250 ns from 4,096: benchmarks/compiled_speed.py), and the reruns are the same cases in the
+    same states, so the verdicts are the same."""
+
+    first: int  # the block's first case's index in the check
+    positions: np.ndarray  # the rerun cases' positions in the block
+    columns: list  # their inputs
+    outputs: list  # their outputs in the check's own run
+    cycles: np.ndarray
+    compared: np.ndarray  # inside the domain: the cases whose change counts
+
+    def case(self, k: int) -> tuple:
+        return case_of(self.columns, k)
+
+
+def entry_baseline(routine, outputs: list, cycles: np.ndarray, returned: int, columns: list, first: int,
+                   every: int) -> EntryBaseline:
+    """The rerun cases among a block's first `returned` calls (its cases `columns`, its first case's
+    index `first`) with what the check's run gave for them."""
+    positions = rerun_positions(first, returned, every)
+    subset = [c[positions] for c in columns]
+    return EntryBaseline(first, positions, subset, [o[positions] for o in outputs], cycles[positions],
+                         in_domain(routine, subset))
+
+
+def run_baselines(variants: dict[str, RoutineRunner], baselines: list[EntryBaseline],
+                  seed: int) -> list[dict[str, VariantRun]]:
+    """Every baseline's cases in every variant, all blocks' in one batched-core run per variant; per
+    baseline, its variants' runs (as a run of its block's cases alone would give them)."""
+    sizes = [len(b.positions) for b in baselines]
+    out: list[dict[str, VariantRun]] = [{} for _ in baselines]
+    if not sum(sizes):
+        return out
+    columns = [np.concatenate(parts) for parts in zip(*(b.columns for b in baselines))]
+    indexes = np.concatenate([b.positions + b.first for b in baselines])
+    ends = np.cumsum(sizes)
+    for variant, runner in variants.items():
+        state = runner.entry_state
+        registers, bits = variant_values(state, variant, seed, indexes)
+        outcome = runner.run_batch(columns, entry=(registers, bits, state.free_mask))
+        for k, (end, size) in enumerate(zip(ends.tolist(), sizes)):
+            if size:
+                part = slice(end - size, end)
+                out[k][variant] = _variant_run(outcome.outputs, outcome.cycles, outcome.error, part)
+    return out
+
+
+def _variant_run(outputs: list, cycles: np.ndarray, error: np.ndarray, part: slice) -> VariantRun:
+    stopped = error[part] != 0
+    messages = {int(k): f"the batched core stopped the call ({LaneError(int(error[part][k])).name})"
+                for k in np.flatnonzero(stopped)[:1]}
+    return VariantRun([o[part] for o in outputs], cycles[part], stopped, messages)
 
 
 def _columns(runner: RoutineRunner, answers: list) -> list[np.ndarray]:
@@ -128,14 +170,14 @@ def _columns(runner: RoutineRunner, answers: list) -> list[np.ndarray]:
     return columns
 
 
-def changed_calls(block_outputs: list, block_cycles: np.ndarray, compared: np.ndarray, positions: np.ndarray,
-                  run: VariantRun) -> np.ndarray:
-    """Which rerun cases (of those `compared`: returned in the check, inside the domain) changed."""
+def changed_calls(outputs: list, cycles: np.ndarray, compared: np.ndarray, run: VariantRun) -> np.ndarray:
+    """Which rerun cases (of those `compared`: returned in the check, inside the domain) changed, given
+    their `outputs` and `cycles` in the check's own run."""
     changed = run.stopped.copy()
-    for baseline, varied in zip(block_outputs, run.outputs):
-        differ = baseline[positions] != varied
+    for baseline, varied in zip(outputs, run.outputs):
+        differ = baseline != varied
         changed |= differ.any(axis=1) if differ.ndim == 2 else differ
-    changed |= block_cycles[positions] != run.cycles
+    changed |= cycles != run.cycles
     return changed & compared
 
 
@@ -216,6 +258,6 @@ def _memory_dependence(outcome, reference, baseline_image: bytes, varied_image: 
     return int(candidates[0])
 
 
-__all__ = ["ENTRY_SAMPLE", "VARIANTS", "EntryBlock", "EntryFinding", "VariantRun", "changed_calls",
-           "entry_block_on_batched_core", "entry_block_on_machine", "entry_every", "name_dependence",
-           "rerun_positions"]
+__all__ = ["ENTRY_SAMPLE", "VARIANTS", "EntryBaseline", "EntryBlock", "EntryFinding", "VariantRun", "changed_calls",
+           "entry_baseline", "entry_block_on_machine", "entry_every", "name_dependence",
+           "rerun_positions", "run_baselines"]

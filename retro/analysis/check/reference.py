@@ -116,6 +116,10 @@ def _answers_on_arrays(routine: Routine, columns: list, memory: dict,
     out, fitting = [], []
     for port, item in zip(routine.outputs, values):
         array = _output_array(port, item, n, where)
+        if _is_flags(item):  # 0 and 1 fit every output: no pass over the block
+            out.append(array)
+            fitting.append(np.ones(array.shape[:1], dtype=bool))
+            continue
         fits = (array >= 0) & (array < (1 << port.bits))
         if port.table:
             fits = fits.all(axis=1)
@@ -157,6 +161,10 @@ def _call_on_arrays(routine: Routine, columns: list, memory: dict, where: str) -
     return values
 
 
+def _is_flags(item) -> bool:
+    return isinstance(item, np.ndarray) and item.dtype == bool
+
+
 def _output_array(port, item, n: int, where: str) -> np.ndarray:
     """One output's answers as whole numbers of shape (n,) or (n, bytes) (a scalar stands for all)."""
     array = np.asarray(item)
@@ -168,4 +176,4 @@ def _output_array(port, item, n: int, where: str) -> np.ndarray:
     if array.shape != shape or not np.issubdtype(array.dtype, np.integer):
         raise InputError(f"{where} returned {array.dtype} of shape {array.shape} for {port.name}: expected "
                          f"whole numbers of shape {shape}")
-    return array.astype(np.int64)
+    return array.astype(np.int64, copy=not array.flags.writeable)  # (a broadcast scalar becomes an array)

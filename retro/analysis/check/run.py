@@ -28,14 +28,15 @@ from retro.analysis.check.engines import (
 from retro.analysis.check.coverage import completed, worst_path
 from retro.analysis.check.entry_runs import (
     VARIANTS,
-    entry_block_on_batched_core,
+    EntryBaseline,
+    entry_baseline,
     entry_block_on_machine,
     entry_every,
     name_dependence,
 )
 from retro.analysis.check.results import PartRun, RoutineCheck
 from retro.analysis.check.search import DEFAULT_SEARCH, SearchResult, search
-from retro.analysis.check.tally import Tally, count_block
+from retro.analysis.check.tally import EXAMPLES_KEPT, Tally, count_block, entry_tally
 from retro.analysis.check.verdicts import bounds_violations, budget_violations, static_bounds
 from retro.analysis.row_check import RowsCheck, check_rows, merged_agreement, rows_only_static
 from retro.errors import InputError, RunError
@@ -74,14 +75,28 @@ def batch_chunk(spec: str, seed: int, columns: list, first: int = 0, every: int 
     """A column block on an array engine ("batch" or "compiled"), tallied (run in worker processes);
     `first` and `every` as for machine_chunk (the entry-state runs are the batched core's); `start`:
     the scene, whose stalls the batched core applies per lane."""
+    tally, baseline = array_block(spec, seed, columns, first, every, engine, start)
+    if baseline is not None:
+        tally.merge(held_entry_tally(spec, seed, start, [baseline]))
+    return tally
+
+
+def array_block(spec: str, seed: int, columns: list, first: int, every: int, engine: str,
+                start: SceneStart | None, outside_wanted: int = EXAMPLES_KEPT) -> tuple[Tally, EntryBaseline | None]:
+    """A column block on an array engine, tallied, and its entry-state rerun cases held for
+    `held_entry_tally` (None: `every` is 0), so that a task's blocks rerun theirs together;
+    `outside_wanted` as for count_block."""
     runner = runner_for(spec, seed, start)
     block = run_on_batched_core(runner, columns, engine=engine)
-    entry = None
-    if every:
-        entry = entry_block_on_batched_core(_variants(spec, seed, start), [c[:block.calls] for c in columns], first,
-                                            every, seed)
-    return _named(spec, seed, start, count_block(runner.routine, block, columns, None, runner.memory_values,
-                                                 entry=entry))
+    tally = count_block(runner.routine, block, columns, None, runner.memory_values, outside_wanted=outside_wanted)
+    if not every:
+        return tally, None
+    return tally, entry_baseline(runner.routine, block.outputs, block.cycles, block.returned, columns, first, every)
+
+
+def held_entry_tally(spec: str, seed: int, start: SceneStart | None, held: list[EntryBaseline]) -> Tally:
+    """The held rerun cases of blocks run with the entry state varied on the batched core, all at once."""
+    return _named(spec, seed, start, entry_tally(_variants(spec, seed, start), held, seed))
 
 
 def _variants(spec: str, seed: int, start: SceneStart | None) -> dict[str, RoutineRunner]:
@@ -165,18 +180,25 @@ _CURSORS: dict[Sweep, tuple[int, Iterator]] = {}  # where this process's last ta
 
 def sweep_task(sweep: Sweep, first: int, count: int) -> Tally:
     """Cases first..first+count-1 of the sweep (fewer at its end: none past it), tallied block by
-    block; stops after a block with a run error."""
+    block; stops after a block with a run error. On an array engine the blocks' entry-state reruns
+    are held and run together at the end (retro.analysis.check.entry_runs.EntryBaseline)."""
     totals = Tally()
+    held: list = []
     blocks = _blocks_from(sweep, first)
     position = first
     while position < first + count:
         block = next(blocks, None)
         if block is None:
             break
-        totals.merge(_block_tally(sweep, block, position))
+        tally, baseline = _block_tally(sweep, block, position, EXAMPLES_KEPT - len(totals.outside_examples))
+        totals.merge(tally)
+        if baseline is not None:
+            held.append(baseline)
         position += len(block[0])
         if totals.run_errors:
             break
+    if held:
+        totals.merge(held_entry_tally(sweep.spec, sweep.seed, sweep.start, held))
     _CURSORS.clear()
     _CURSORS[sweep] = (position, blocks)
     return totals
@@ -194,11 +216,12 @@ def _blocks_from(sweep: Sweep, first: int) -> Iterator:
     return blocks
 
 
-def _block_tally(sweep: Sweep, block: list, first: int) -> Tally:
+def _block_tally(sweep: Sweep, block: list, first: int, outside_wanted: int) -> tuple[Tally, EntryBaseline | None]:
+    """A block tallied, and on an array engine its entry-state rerun cases held (None: none)."""
     if sweep.engine == "scalar":
         return machine_chunk(sweep.spec, sweep.seed, case_sets.columns_to_cases(block), sweep.start, first,
-                             sweep.every)
-    return batch_chunk(sweep.spec, sweep.seed, block, first, sweep.every, sweep.engine, sweep.start)
+                             sweep.every), None
+    return array_block(sweep.spec, sweep.seed, block, first, sweep.every, sweep.engine, sweep.start, outside_wanted)
 
 
 def _tasks(sweep: Sweep, known: int, unknown: bool, ended: Callable[[], bool]) -> Iterator[tuple]:

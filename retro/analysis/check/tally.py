@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from retro.analysis.check.engines import CallBlock, disagreement
-from retro.analysis.check.entry_runs import EntryBlock, EntryFinding, changed_calls
+from retro.analysis.check.entry_runs import EntryBaseline, EntryBlock, EntryFinding, changed_calls, run_baselines
 from retro.analysis.check.reference import reference_answers
 from retro.analysis.check.results import Failure, describe_case, describe_outputs
 from retro.analysis.coverage_model import CodeCoverage
@@ -137,13 +137,15 @@ class _Calls:
 
 def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[tuple] | None, memory: dict,
                 against: CallBlock | None = None, entry: EntryBlock | None = None,
-                row_keys: Sequence[str] | None = None) -> Tally:
+                row_keys: Sequence[str] | None = None, outside_wanted: int = EXAMPLES_KEPT) -> Tally:
     """Tally the calls of one block (either engine) against the reference's answers. `cases`: the
     block's cases as tuples when they are at hand (else made when the reference or a condition needs
     them); `against`: the batched core's block for the same calls, compared call for call; `entry`:
     the entry-state runs of some of its cases, compared with the block's own calls. `row_keys`: the
     calls are a spec's rows (retro.analysis.row_check), held to the timing model and to `against`
-    only, never to the reference or the domain; every example and failure names the row."""
+    only, never to the reference or the domain; every example and failure names the row.
+    `outside_wanted`: how many examples of cases outside the domain the caller can still keep (a sweep
+    task whose earlier blocks gave EXAMPLES_KEPT passes 0: the merge would drop these)."""
     calls = _calls(routine, block, columns, cases, memory, row_keys)
     out = Tally()
     n = block.returned
@@ -151,7 +153,8 @@ def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[t
     if block.coverage is not None:
         out.code_coverage = block.coverage
     out.fallbacks = dict(block.fallbacks or {})
-    cpu = block.cycles[:n] - block.stolen[:n]  # the timing model and the static bounds know no stalls
+    stalled = bool(block.stolen[:n].any())  # the timing model and the static bounds know no stalls
+    cpu = block.cycles[:n] - block.stolen[:n] if stalled else block.cycles[:n]
     cycle_wrong = (np.flatnonzero(block.modelled[:n] != cpu) if block.modelled is not None
                    else np.zeros(0, dtype=np.int64))
     out.cycle_mismatches = len(cycle_wrong)
@@ -165,8 +168,8 @@ def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[t
         out.engine_mismatches = len(engine_wrong)
     wrong_inside = np.zeros(0, dtype=np.int64)
     if row_keys is None:
-        wrong_inside = _reference_figures(out, calls)
-        _cycle_figures(out, calls, cpu)
+        wrong_inside = _reference_figures(out, calls, outside_wanted)
+        _cycle_figures(out, calls, cpu, stalled)
     _examples(out, calls, wrong_inside, cycle_wrong, cpu, engine_wrong)
     if entry is not None:
         _entry_figures(out, calls, entry)
@@ -176,21 +179,22 @@ def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[t
     return out
 
 
-def _reference_figures(out: Tally, calls: _Calls) -> np.ndarray:
+def _reference_figures(out: Tally, calls: _Calls, outside_wanted: int = EXAMPLES_KEPT) -> np.ndarray:
     """The returned calls against the reference and the domain: result mismatches inside it, the
     cases outside it (per condition they break, and those the routine gets wrong) with examples;
     the positions of the wrong calls inside the domain."""
     routine = calls.routine
-    inside = calls.inside
-    wrong_inside = np.flatnonzero(inside & ~calls.equal)
-    wrong_outside = ~inside & ~calls.equal & calls.answerable
+    outside, wrong = ~calls.inside, ~calls.equal
+    wrong_inside = np.flatnonzero(calls.inside & wrong)
+    wrong_outside = outside & wrong & calls.answerable
     out.result_mismatches = len(wrong_inside)
-    out.outside = int((~inside).sum())
-    out.outside_wrong = int(wrong_outside.sum())
+    out.outside = int(np.count_nonzero(outside))
+    out.outside_wrong = int(np.count_nonzero(wrong_outside))
     for condition, broken in zip(routine.domain, calls.broken_by):
-        out.constraint_cases[condition.text] = int(broken.sum())
-        out.constraint_wrong[condition.text] = int((broken & wrong_outside).sum())
-    _outside_examples(out, calls, wrong_outside)
+        out.constraint_cases[condition.text] = int(np.count_nonzero(broken))
+        out.constraint_wrong[condition.text] = int(np.count_nonzero(broken & wrong_outside)) if out.outside_wrong else 0
+    if outside_wanted > 0 and out.outside_wrong:
+        _outside_examples(out, calls, wrong_outside, outside_wanted)
     return wrong_inside
 
 
@@ -221,20 +225,26 @@ def _calls(routine: Routine, block: CallBlock, columns: list, cases: list[tuple]
     return _Calls(routine, block, columns, cases, broken_by, inside, expected, answerable, equal)
 
 
-def _cycle_figures(out: Tally, calls: _Calls, cpu: np.ndarray) -> None:
+def _cycle_figures(out: Tally, calls: _Calls, cpu: np.ndarray, stalled: bool) -> None:
     """Fastest and slowest calls inside the domain (the first on a tie), the sum, CPU-only extremes."""
     block, n = calls.block, calls.block.returned
-    positions = np.flatnonzero(calls.inside)
+    everywhere = bool(calls.inside.all())  # (most blocks: no gather then)
+    positions = np.arange(n) if everywhere else np.flatnonzero(calls.inside)
     if not len(positions):
         return
-    cycles = block.cycles[:n][positions]
+    cycles = block.cycles[:n] if everywhere else block.cycles[:n][positions]
     low, high = int(np.argmin(cycles)), int(np.argmax(cycles))
     out.cycles_min, out.min_case = int(cycles[low]), calls.case(int(positions[low]))
     out.cycles_max, out.max_case = int(cycles[high]), calls.case(int(positions[high]))
     out.cycles_sum = int(cycles.sum())
     out.cycles_count = len(cycles)
-    out.cpu_min, out.cpu_max = int(cpu[positions].min()), int(cpu[positions].max())
-    out.stolen_max = int(block.stolen[:n][positions].max())
+    if not stalled:  # (no scene): the CPU's cycles are the cycles
+        out.cpu_min, out.cpu_max, out.stolen_max = out.cycles_min, out.cycles_max, 0
+        return
+    stolen = block.stolen[:n] if everywhere else block.stolen[:n][positions]
+    inside_cpu = cpu if everywhere else cpu[positions]
+    out.cpu_min, out.cpu_max = int(inside_cpu.min()), int(inside_cpu.max())
+    out.stolen_max = int(stolen.max())
 
 
 def _examples(out: Tally, calls: _Calls, wrong_inside: np.ndarray, cycle_wrong: np.ndarray, cpu: np.ndarray,
@@ -262,9 +272,9 @@ def _examples(out: Tally, calls: _Calls, wrong_inside: np.ndarray, cycle_wrong: 
         out.failure = out.failure or failure
 
 
-def _outside_examples(out: Tally, calls: _Calls, wrong_outside: np.ndarray) -> None:
+def _outside_examples(out: Tally, calls: _Calls, wrong_outside: np.ndarray, wanted: int) -> None:
     routine = calls.routine
-    for i in np.flatnonzero(wrong_outside)[:EXAMPLES_KEPT].tolist():
+    for i in np.flatnonzero(wrong_outside)[:min(wanted, EXAMPLES_KEPT)].tolist():
         broken = [c.text for c, b in zip(routine.domain, calls.broken_by) if b[i]]
         out.outside_examples.append(
             f"{calls.described(i)}: returned {describe_outputs(routine, calls.block.row(i))}, "
@@ -276,19 +286,36 @@ def _entry_figures(out: Tally, calls: _Calls, entry: EntryBlock) -> None:
     the calls that returned), and each variant's first."""
     n = calls.block.returned
     positions = entry.positions[entry.positions < n]
-    compared = calls.inside[positions]
+    baseline = EntryBaseline(entry.first, positions, [], [o[positions] for o in calls.block.outputs],
+                             calls.block.cycles[positions], calls.inside[positions])
+    _entry_counts(out, baseline, entry.runs, lambda k: calls.case(int(positions[k])))
+
+
+def entry_tally(variants: dict, baselines: list[EntryBaseline], seed: int) -> Tally:
+    """The entry-state figures of blocks whose rerun cases were held (`entry_baseline`), run together
+    on the batched core: the figures each block's own `count_block(..., entry=...)` would give."""
+    out = Tally()
+    for baseline, runs in zip(baselines, run_baselines(variants, baselines, seed)):
+        one = Tally()
+        _entry_counts(one, baseline, runs, baseline.case)
+        out.merge(one)
+    return out
+
+
+def _entry_counts(out: Tally, baseline: EntryBaseline, runs: dict, case_at) -> None:
+    compared = baseline.compared
     out.entry_cases = int(compared.sum())
-    any_changed = np.zeros(len(positions), dtype=bool)
-    for variant, run in entry.runs.items():
-        changed = changed_calls(calls.block.outputs, calls.block.cycles, compared, positions, run.head(len(positions)))
+    any_changed = np.zeros(len(compared), dtype=bool)
+    for variant, run in runs.items():
+        run = run.head(len(compared))
+        changed = changed_calls(baseline.outputs, baseline.cycles, compared, run)
         any_changed |= changed
         if changed.any():
             k = int(np.flatnonzero(changed)[0])
-            i = int(positions[k])
             varied = ((None, run.messages.get(k, "the call did not return")) if run.stopped[k]
                       else (row_of(run.outputs, k), int(run.cycles[k])))
-            out.entry_first[variant] = EntryFinding(variant, entry.first + i, calls.case(i),
-                                                    (calls.block.row(i), int(calls.block.cycles[i])), varied)
+            out.entry_first[variant] = EntryFinding(variant, baseline.first + int(baseline.positions[k]), case_at(k),
+                                                    (row_of(baseline.outputs, k), int(baseline.cycles[k])), varied)
     out.entry_changed = int(any_changed.sum())
 
 
