@@ -60,7 +60,7 @@ def test_aabb8_sweep_is_every_input_of_each_axis_and_agrees_with_the_reference()
     test goes). Its blocks on the compiled engine (the batched core without numba) against the
     reference inside the domain (sizes >= 1): the full 3 x 2^32 runs with RETRO_EXHAUSTIVE=1 (`retro check aabb8 --exhaustive`), a
     slice here (one block in 64, of two positions of box A without it: 786,432 calls)."""
-    from itertools import islice
+    from itertools import chain, islice
 
     from retro.cpu.compiled import numba_problem
     from retro.routines.builtin_cases import AABB8_OVERLAPPING, aabb8_sweep
@@ -76,7 +76,7 @@ def test_aabb8_sweep_is_every_input_of_each_axis_and_agrees_with_the_reference()
     routine = get("aabb8")
     runner = RoutineRunner(routine, routine.seed)
     run = runner.run_batch if numba_problem() else runner.run_compiled
-    blocks = aabb8_sweep(starts)
+    blocks = chain.from_iterable(grid.blocks() for grid in aabb8_sweep(starts))  # 65,536 cases each
     seen = 0
     for section, (swept, position, other) in enumerate((("aw bw", "ax", "bx"), ("ah bh", "ay", "by"),
                                                          ("ah bh", "ay", "by"))):
