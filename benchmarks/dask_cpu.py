@@ -2,9 +2,10 @@
 (retro/workers.py), side by side, with the cluster's start apart; and the start time of the small runs
 that must not pay for Dask (`retro demo`, `retro check mul8`).
 
-    python benchmarks/dask_cpu.py [ROUTINE ...] [--engine batch] [--skip-small] [--before DIR]
+    python benchmarks/dask_cpu.py [ROUTINE ...] [--engine batch] [--repeat N] [--skip-small] [--before DIR]
 
-Each check runs in a fresh process (imports apart), once in one process and once on the workers.
+Each check runs in a fresh process (imports apart), in one process and on the workers, N times each
+(default 3, alternating): the medians are printed (a shared machine's load moves one run by 10-20%).
 
 Default: hit_slot, mul8 and tile with --exhaustive on the batched core. The CPU of the worker processes and
 of the server they are forked from is read from /proc (psutil) at the cluster's start and before it
@@ -17,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import statistics
 import subprocess
 import sys
 import time
@@ -127,6 +129,7 @@ def main() -> int:
     parser.add_argument("routines", nargs="*", default=[str(ROOT / "examples/object_table/hit_slot.toml"), "mul8",
                                                         "tile"])
     parser.add_argument("--engine", default="batch")
+    parser.add_argument("--repeat", type=int, default=3, metavar="N", help="runs of each, medians shown")
     parser.add_argument("--skip-small", action="store_true")
     parser.add_argument("--before", metavar="DIR", help="a checkout of earlier code, timed beside this one")
     parser.add_argument("--measure", choices=["one", "two"], help=argparse.SUPPRESS)  # (the fresh process's part)
@@ -155,12 +158,16 @@ def main() -> int:
     for name in args.routines:
         label = Path(name).name if name.endswith(".toml") else name
         for code, root in roots:
-            alone = measured(root, "one", name, args.engine)
-            two = measured(root, "two", name, args.engine)
-            if two["records"] != alone["records"]:
+            runs: dict[str, list[dict]] = {"one": [], "two": []}
+            for _ in range(args.repeat):
+                for how in runs:
+                    runs[how].append(measured(root, how, name, args.engine))
+            if any(run["records"] != runs["one"][0]["records"] for run in runs["one"] + runs["two"]):
                 print(f"{name}: the two-worker JSON differs from one process's ({code})", file=sys.stderr)
                 return 1
-            beyond = two["cpu"] - two["start"]
+            alone = {"cpu": statistics.median(run["cpu"] for run in runs["one"])}
+            two = {key: statistics.median(run[key] for run in runs["two"]) for key in ("cpu", "start")}
+            beyond = statistics.median(run["cpu"] - run["start"] for run in runs["two"])
             print(f"{label + ' (' + args.engine + ')':<24} {code:<7} {alone['cpu']:9.2f}s {two['cpu']:9.2f}s "
                   f"{two['start']:8.2f}s {two['cpu'] / alone['cpu']:6.2f}x {beyond / alone['cpu']:12.2f}x")
     return 0

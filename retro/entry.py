@@ -27,16 +27,9 @@ def main(argv: list[str] | None = None) -> int:
         except (OSError, ValueError, KeyboardInterrupt):
             pass
     if interrupts.stopping():
-        # Cleanup has run (temp files, workers): skip the interpreter's teardown of numpy, matplotlib
-        # and Dask, a second or more of the stop. The semaphores of multiprocessing (Dask's worker
-        # processes) are released first, else its resource tracker reports them as leaked.
-        _release_semaphores()
+        # Cleanup has run (temp files, workers, the embedded cluster closed: retro.workers): skip the
+        # interpreter's teardown of numpy, matplotlib and Dask, half a second or more of the stop.
         os._exit(code)
     interrupts.exit_now_on_signal()
     return code
 
-
-def _release_semaphores() -> None:
-    util = sys.modules.get("multiprocessing.util")
-    if util is not None:
-        util._run_finalizers(0)  # what multiprocessing's own exit handler runs first: semaphores unlinked

@@ -4,7 +4,7 @@ routine with aabb8's conventions: the full 3 x 2^32 calls run with RETRO_EXHAUST
 
 from __future__ import annotations
 
-from itertools import islice
+from itertools import chain, islice
 
 import numpy as np
 
@@ -23,7 +23,7 @@ def sweep_slice_mismatches(routine, starts, step: int) -> tuple[list, int]:
     (sizes >= 1), also checking each block is what the sweep promises."""
     runner = RoutineRunner(routine, routine.seed)
     run = runner.run_batch if numba_problem() else runner.run_compiled
-    blocks = aabb8_sweep(starts)
+    blocks = chain.from_iterable(grid.blocks() for grid in aabb8_sweep(starts))  # 65,536 cases each
     wrong_cases, seen = [], 0
     for section, (swept, position, other) in enumerate(SECTIONS):
         for k, block in enumerate(islice(blocks, len(starts) * 256)):

@@ -269,6 +269,13 @@ MUTANTS = [
            STREAM_TESTS),
     Mutant("stream-reaches-any-case", "retro/routines/cases.py",
            "return first == done or (part.seek is not None and not part.from_start)", "return True", STREAM_TESTS),
+    Mutant("grid-sweep-made-from-its-start", "retro/routines/cases.py",
+           "        lo = start\n        start = 0\n", "        lo = 0\n        start = 0\n", STREAM_TESTS),
+    Mutant("grid-first-axis-fastest", "retro/routines/grid.py",
+           "zip(reversed(self.names), reversed(self.values))", "zip(self.names, self.values)", STREAM_TESTS),
+    Mutant("stop-leaves-the-cluster-open", "retro/workers.py",
+           "            cluster.close(timeout=STOP_CLOSE_SECONDS)\n", "            pass\n",
+           ("tests/test_workers.py::test_ctrl_c_cancels_the_sweep_and_leaves_no_worker",)),
     # ---- the CPU's timeline on a C64: sprite DMA, Bad Lines, BA (retro/chips/vic) ------------------
     Mutant("sprite-dma-retriggers-while-on", "retro/chips/vic/model.py",
            "if (line % video.lines) & Y_COMPARE_MASK == y and line >= free_from:",

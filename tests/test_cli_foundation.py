@@ -158,7 +158,13 @@ def test_asm_output_is_replaced_in_one_rename(capsys, source, tmp_path, monkeypa
     assert oct(target.stat().st_mode & 0o777) != oct(0o600)  # not left private like a mkstemp file
 
 
-def test_demo_assembles_runs_and_names_its_folder(capsys, tmp_path):
+def test_demo_assembles_runs_and_names_its_folder(capsys, tmp_path, monkeypatch):
+    from retro import workers
+
+    def no_cluster(*args):  # Dask is imported only to start a cluster (retro/workers.py)
+        raise AssertionError("retro demo started a Dask cluster")
+    monkeypatch.setattr(workers, "_preload", no_cluster)
+    monkeypatch.setattr(workers, "_client", no_cluster)
     code, out, err = run_cli(capsys, "demo", "--out", tmp_path / "demo")
     assert code == 0, err
     # demo_sum(X=8) adds 200+100+50+25+12+6+3+1 = 397: one carry, so 11 + 12*8 + 3 cycles.

@@ -2,7 +2,8 @@
 `random_generator`), and the adapters their specs need.
 
 Cases are tuples in each spec's input order (the reference's argument order), or column blocks (dicts
-of numpy arrays by input name) where there are many:
+of numpy arrays by input name) where there are many; the sweeps are grids (retro.routines.grid: counted,
+entered at any case by the worker whose range it is):
 - boundary: touching, one apart, overlapping by one, 0, 255/256, maximum sizes, screen edges;
 - sweep (with --exhaustive): mul8 every product; tile every 9-bit X by every Y; pixel every (dx, dy)
   for three mask pairs; circle and circle_r every (dx, dy) of both signs at every radius sum;
@@ -22,6 +23,7 @@ import numpy as np
 from retro.chips.vic.constants import SPRITE_HEIGHT, SPRITE_WIDTH
 from retro.chips.vic.constants import SPRITE_X_POSITIONS as X_POSITIONS  # 9-bit X
 from retro.routines import reference
+from retro.routines.grid import Grid
 from retro.chips.vic.screen import SPRITE_ROW_BYTES
 
 BYTE = 256
@@ -78,17 +80,6 @@ def aabb8_random(rng: np.random.Generator, n: int) -> list[tuple]:
     return [tuple(int(v) for v in row) for row in cases]
 
 
-def _grid(*sizes: int) -> list[np.ndarray]:
-    """Every combination of 0..size-1 per axis (the last varies fastest), one column per axis."""
-    return [axis.ravel() for axis in np.meshgrid(*(np.arange(size) for size in sizes), indexing="ij")]
-
-
-def _block(names: str, **columns) -> dict[str, np.ndarray]:
-    """A column block: every named input, constants broadcast to the block's length."""
-    n = max(len(v) for v in columns.values() if isinstance(v, np.ndarray))
-    return {name: np.broadcast_to(np.asarray(columns[name], dtype=np.int64), (n,)).copy() for name in names.split()}
-
-
 AABB8_OVERLAPPING = {"x": (10, 5, 8, 5), "y_a_first": (10, 5, 12, 5), "y_b_first": (12, 5, 10, 5)}
 # (position, size, other position, other size) the axis not swept is held at: the boxes overlap there,
 # so the answer is the swept axis's. y is swept twice: the routine's y test has one copy for each way
@@ -96,22 +87,20 @@ AABB8_OVERLAPPING = {"x": (10, 5, 8, 5), "y_a_first": (10, 5, 12, 5), "y_b_first
 AABB8_AXIS_CALLS = BYTE ** 4  # every (position, size, other position, other size) of one axis
 
 
-def aabb8_sweep(starts: Iterable[int] = range(BYTE)) -> Iterator[dict]:
+def aabb8_sweep(starts: Iterable[int] = range(BYTE)) -> list[Grid]:
     """Every input of each axis: all 2^32 (ax, aw, bx, bw) with y overlapping, then all 2^32 (ay, ah,
-    by, bh) after each way the x test goes: 3 x 2^32 calls, in blocks of 65,536 (every size against
-    every other size for one pair of positions; never more than one block in memory). `starts`: the
-    positions of box A swept (a bounded form for tests: a few of them)."""
-    size, other_size = _grid(BYTE, BYTE)
-    names = "ax ay aw ah bx by bw bh"
+    by, bh) after each way the x test goes: 3 x 2^32 calls (every size against every other size for one
+    pair of positions per 65,536; grids: a worker makes only its range). `starts`: the positions of box A
+    swept (a bounded form for tests: a few of them)."""
     ay, ah, by, bh = AABB8_OVERLAPPING["x"]
-    for ax in starts:
-        for bx in range(BYTE):
-            yield _block(names, ax=ax, ay=ay, aw=size, ah=ah, bx=bx, by=by, bw=other_size, bh=bh)
+    grids = [Grid({"ax": list(starts), "bx": BYTE, "aw": BYTE, "bw": BYTE},
+                  lambda ax, bx, aw, bw: dict(ax=ax, ay=ay, aw=aw, ah=ah, bx=bx, by=by, bw=bw, bh=bh))]
     for held in ("y_a_first", "y_b_first"):
         ax, aw, bx, bw = AABB8_OVERLAPPING[held]
-        for ay in starts:
-            for by in range(BYTE):
-                yield _block(names, ax=ax, ay=ay, aw=aw, ah=size, bx=bx, by=by, bw=bw, bh=other_size)
+        grids.append(Grid({"ay": list(starts), "by": BYTE, "ah": BYTE, "bh": BYTE},
+                          lambda ay, by, ah, bh, ax=ax, aw=aw, bx=bx, bw=bw: dict(ax=ax, ay=ay, aw=aw, ah=ah, bx=bx,
+                                                                                 by=by, bw=bw, bh=bh)))
+    return grids
 
 
 # ---- aabb_sprite -------------------------------------------------------------------------------
@@ -152,11 +141,11 @@ def aabb_sprite_random(rng: np.random.Generator, n: int) -> list[tuple]:
     return out
 
 
-def aabb_sprite_sweep() -> Iterator[dict]:
+def aabb_sprite_sweep() -> Grid:
     """Every pair of 9-bit X positions with two fixed hitboxes (the 255/256 boundary included)."""
-    x1, x2 = _grid(X_POSITIONS, X_POSITIONS)
-    yield _block("x1 x1h y1 ox1 oy1 w1 h1 x2 x2h y2 ox2 oy2 w2 h2", x1=x1 & 0xFF, x1h=x1 >> 8, y1=100, ox1=4, oy1=3,
-                 w1=16, h1=15, x2=x2 & 0xFF, x2h=x2 >> 8, y2=104, ox2=0, oy2=0, w2=SPRITE_WIDTH, h2=SPRITE_HEIGHT)
+    return Grid({"x1": X_POSITIONS, "x2": X_POSITIONS},
+                lambda x1, x2: dict(x1=x1 & 0xFF, x1h=x1 >> 8, y1=100, ox1=4, oy1=3, w1=16, h1=15, x2=x2 & 0xFF,
+                                    x2h=x2 >> 8, y2=104, ox2=0, oy2=0, w2=SPRITE_WIDTH, h2=SPRITE_HEIGHT))
 
 
 # ---- circle ------------------------------------------------------------------------------------
@@ -196,20 +185,22 @@ def _apart(delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.maximum(delta, 0), np.maximum(-delta, 0)
 
 
-def circle_sweep() -> Iterator[dict]:
+SIGNED_BYTE_DELTAS = range(-(BYTE - 1), BYTE)  # a difference of two bytes
+CIRCLE_RADIUS_DELTAS = np.array([(0, 0), (200, 100), (-255, -255), (3, 4)])  # (dx, dy) of circle's (r1, r2) sweep
+
+
+def circle_sweep() -> list[Grid]:
     """Every (dx, dy) of both signs (-255..255 each) at every radius sum 0..255, split r1 = sum // 2;
     then every (r1, r2) pair (each 0..255) at a few deltas (the radius domain and its edge)."""
-    names = "x1 y1 r1 x2 y2 r2"
-    dy, radius_sum = _grid(2 * BYTE - 1, BYTE)
-    dy = dy - (BYTE - 1)
-    y1, y2 = _apart(dy)
-    for dx in range(-(BYTE - 1), BYTE):
-        x1, x2 = _apart(np.full(len(dy), dx))
-        yield _block(names, x1=x1, y1=y1, r1=radius_sum // 2, x2=x2, y2=y2, r2=radius_sum - radius_sum // 2)
-    r1, r2 = _grid(BYTE, BYTE)
-    for dx, dy_ in ((0, 0), (200, 100), (-255, -255), (3, 4)):
-        (x1, x2), (y1, y2) = _apart(np.array(dx)), _apart(np.array(dy_))
-        yield _block(names, x1=x1, y1=y1, r1=r1, x2=x2, y2=y2, r2=r2)
+    def by_sum(dx, dy, radius_sum):
+        (x1, x2), (y1, y2) = _apart(dx), _apart(dy)
+        return dict(x1=x1, y1=y1, r1=radius_sum // 2, x2=x2, y2=y2, r2=radius_sum - radius_sum // 2)
+
+    def by_radii(delta, r1, r2):
+        (x1, x2), (y1, y2) = _apart(CIRCLE_RADIUS_DELTAS[delta, 0]), _apart(CIRCLE_RADIUS_DELTAS[delta, 1])
+        return dict(x1=x1, y1=y1, r1=r1, x2=x2, y2=y2, r2=r2)
+    return [Grid({"dx": SIGNED_BYTE_DELTAS, "dy": SIGNED_BYTE_DELTAS, "radius_sum": BYTE}, by_sum),
+            Grid({"delta": len(CIRCLE_RADIUS_DELTAS), "r1": BYTE, "r2": BYTE}, by_radii)]
 
 
 # ---- mul8 ----------------------------------------------------------------------------------------
@@ -223,9 +214,8 @@ def mul8_random(rng: np.random.Generator, n: int) -> list[tuple]:
     return [tuple(int(v) for v in row) for row in _bytes(rng, n, 2)]
 
 
-def mul8_sweep() -> Iterator[dict]:
-    a, b = _grid(BYTE, BYTE)
-    yield {"a": a, "b": b}
+def mul8_sweep() -> Grid:
+    return Grid({"a": BYTE, "b": BYTE})
 
 
 # ---- tile and tile_box ---------------------------------------------------------------------------
@@ -243,10 +233,9 @@ def tile_random(rng: np.random.Generator, n: int) -> list[tuple]:
     return [(int(a) & 0xFF, int(a) >> 8, int(b)) for a, b in zip(x, y)]
 
 
-def tile_sweep() -> Iterator[dict]:
+def tile_sweep() -> Grid:
     """Every 9-bit X by every Y."""
-    x, y = _grid(X_POSITIONS, BYTE)
-    yield {"x": x & 0xFF, "xh": x >> 8, "y": y}
+    return Grid({"x": X_POSITIONS, "y": BYTE}, lambda x, y: {"x": x & 0xFF, "xh": x >> 8, "y": y})
 
 
 def tile_box_boundary() -> list[tuple]:
@@ -267,15 +256,13 @@ def tile_box_random(rng: np.random.Generator, n: int) -> list[tuple]:
     return [(int(a) & 0xFF, int(a) >> 8, int(b), int(c), int(d)) for a, b, c, d in zip(x, y, w, h)]
 
 
-def tile_box_sweep() -> Iterator[dict]:
+def tile_box_sweep() -> list[Grid]:
     """Every 9-bit X and every Y for a sprite-sized box; every width at a few heights and back."""
-    names = "x xh y w h"
-    x, y = _grid(X_POSITIONS, BYTE)
-    yield _block(names, x=x & 0xFF, xh=x >> 8, y=y, w=SPRITE_WIDTH, h=SPRITE_HEIGHT)
-    size = np.arange(BYTE)
-    for other in (0, 1, 8, 21, 255):
-        yield _block(names, x=20, xh=0, y=45, w=size, h=other)
-        yield _block(names, x=20, xh=0, y=45, w=other, h=size)
+    return [Grid({"x": X_POSITIONS, "y": BYTE},
+                 lambda x, y: dict(x=x & 0xFF, xh=x >> 8, y=y, w=SPRITE_WIDTH, h=SPRITE_HEIGHT)),
+            Grid({"other": (0, 1, 8, 21, 255), "height_varies": 2, "size": BYTE},
+                 lambda other, height_varies, size: dict(x=20, xh=0, y=45, w=np.where(height_varies, other, size),
+                                                         h=np.where(height_varies, size, other)))]
 
 
 # ---- pixel ---------------------------------------------------------------------------------------
@@ -379,24 +366,24 @@ def pixel_random(rng: np.random.Generator, n: int, seed: int = 0) -> dict:
     return {"dx": dx & 0xFF, "dy": dy & 0xFF, "mask_a": mask_a, "mask_b": mask_b}
 
 
-def pixel_sweep(seed: int = 0) -> Iterator[dict]:
+def pixel_sweep(seed: int = 0) -> Grid:
     """Every pair of offset bytes for every mask pair of the corpus."""
     masks = pixel_masks(seed)
-    dx, dy = _grid(BYTE, BYTE)
-    for pair in range(len(masks)):
-        mask_a, mask_b = _mask_columns(masks, np.full(len(dx), pair))
-        yield {"dx": dx, "dy": dy, "mask_a": mask_a, "mask_b": mask_b}
+
+    def with_masks(pair, dx, dy):
+        mask_a, mask_b = _mask_columns(masks, pair)
+        return {"dx": dx, "dy": dy, "mask_a": mask_a, "mask_b": mask_b}
+    return Grid({"pair": len(masks), "dx": BYTE, "dy": BYTE}, with_masks)
 
 
 # ---- circle_r ------------------------------------------------------------------------------------
 
-def circle_r_sweep() -> Iterator[dict]:
+def circle_r_sweep() -> Grid:
     """Every (dx, dy) of both signs (-255..255 each) at every radius sum 0..255."""
-    dy, radius = _grid(2 * BYTE - 1, BYTE)
-    y1, y2 = _apart(dy - (BYTE - 1))
-    for dx in range(-(BYTE - 1), BYTE):
-        x1, x2 = _apart(np.full(len(radius), dx))
-        yield _block("x1 y1 radius_sum x2 y2", x1=x1, y1=y1, radius_sum=radius, x2=x2, y2=y2)
+    def apart(dx, dy, radius_sum):
+        (x1, x2), (y1, y2) = _apart(dx), _apart(dy)
+        return dict(x1=x1, y1=y1, radius_sum=radius_sum, x2=x2, y2=y2)
+    return Grid({"dx": SIGNED_BYTE_DELTAS, "dy": SIGNED_BYTE_DELTAS, "radius_sum": BYTE}, apart)
 
 
 def circle_r_boundary() -> list[tuple]:

@@ -5,7 +5,8 @@ Parts, in order:
 - exhaustive: every combination of the values of the inputs named in `exhaustive` (the other inputs
   drawn at random per case). Without --exhaustive, all of it when it has at most BOUNDED_PRODUCT
   cases, else a seeded random sample of BOUNDED_SAMPLE of them;
-- sweep: the spec's `sweep` function (structured exhaustive slices), with --exhaustive only;
+- sweep: the spec's `sweep` function (structured exhaustive slices), with --exhaustive only: grids
+  (retro.routines.grid: counted, entered at any case) or the cases it yields;
 - random: `random` cases over every input (the spec's `random_generator`, or uniform over each
   input's values), at most RANDOM_BOUNDED without --exhaustive.
 A case is a tuple in the inputs' order: an int per number or flag, a tuple of bytes per table.
@@ -24,7 +25,8 @@ from itertools import chain, islice
 import numpy as np
 
 from retro.errors import InputError
-from retro.routines.sandbox import shown
+from retro.routines.grid import GRID_BLOCK, Grid
+from retro.routines.sandbox import guarded, shown
 from retro.routines.places import Values
 from retro.routines.spec import Port, Routine, call_with
 from retro.routines.where import input_ranges
@@ -121,8 +123,7 @@ def plan(routine: Routine, *, exhaustive: bool, seed: int | None = None, random:
             sample = min(BOUNDED_SAMPLE, bounded_product)
             parts.append(Part("exhaustive", sample, total, lambda: _product(routine, seed, sample)))
     if exhaustive and routine.sweep is not None:
-        parts.append(Part("sweep", None, 0, lambda: _lazy_sweep(routine, seed),
-                          seek=lambda start: _lazy_sweep(routine, seed, start), from_start=True))
+        parts.append(_sweep_part(routine, seed))
     count = random_count(routine, exhaustive, random)
     if count:
         draw = domain_draw(routine, seed, count)
@@ -526,11 +527,59 @@ def _draw_inside(routine: Routine, box: list[Port], seed: int, count: int, stric
     return blocks(), lambda: drawn[0]
 
 
-def _lazy_sweep(routine: Routine, seed: int, start: int = 0) -> Generator[Columns, None, int]:
-    """The spec's sweep function's cases from case `start` on: it runs from its start (a function can only
-    be run from there); the cases before `start` are counted, not checked nor converted. Returns how many
-    cases it made in all."""
-    made = call_with(routine.sweep, {"seed": seed, "rng": np.random.default_rng(seed)})
+def _sweep_part(routine: Routine, seed: int) -> Part:
+    """The spec's sweep: grids (retro.routines.grid) have a count and are entered at any case; cases a
+    function yields have neither (`_lazy_sweep`)."""
+    made = [call_with(routine.sweep, {"seed": seed, "rng": np.random.default_rng(seed)})]
+    grids = _grids(routine, made[0])
+    if grids is None:
+        def fresh():  # the first use takes what the plan made (a list is not made twice)
+            return made.pop() if made else call_with(routine.sweep, {"seed": seed, "rng": np.random.default_rng(seed)})
+        return Part("sweep", None, 0, lambda: _lazy_sweep(routine, fresh()),
+                    seek=lambda start: _lazy_sweep(routine, fresh(), start), from_start=True)
+    count = sum(grid.count for grid in grids)
+    return Part("sweep", count, count, lambda: _grid_blocks(routine, grids),
+                seek=lambda start: _grid_blocks(routine, grids, start))
+
+
+def _grids(routine: Routine, made) -> list[Grid] | None:
+    """The grids a sweep function returned (a Grid, or a list or tuple of them), else None."""
+    if isinstance(made, Grid):
+        return [made]
+    if isinstance(made, (list, tuple)) and made and any(isinstance(g, Grid) for g in made):
+        wrong = next((g for g in made if not isinstance(g, Grid)), None)
+        if wrong is not None:
+            raise InputError(f"{routine.spec_path}: cases.sweep: a list of Grids holds {_short(wrong)}: return "
+                             f"either Grids or cases (column blocks), not both")
+        return list(made)
+    return None
+
+
+def _grid_blocks(routine: Routine, grids: list[Grid], start: int = 0) -> Iterator[Columns]:
+    """The grids' cases from case `start` on (counted over all of them), as checked column blocks: the
+    combinations before it are never made."""
+    where = f"{routine.spec_path}: cases.sweep"
+    for number, grid in enumerate(grids, 1):
+        if start >= grid.count:
+            start -= grid.count
+            continue
+        make = None if grid.make is None else guarded(grid.make, f"{where} (Grid {number}'s make)", faults_only=False)
+        lo = start
+        start = 0
+        while lo < grid.count:
+            hi = min(grid.count, (lo // GRID_BLOCK + 1) * GRID_BLOCK)
+            try:
+                block = grid.block(lo, hi, make)
+            except ValueError as exc:
+                raise InputError(f"{where}: {exc}") from None
+            yield _block_columns(routine, block, f"{where} (Grid {number}, cases {lo:,}..{hi - 1:,})")
+            lo = hi
+
+
+def _lazy_sweep(routine: Routine, made, start: int = 0) -> Generator[Columns, None, int]:
+    """The cases a spec's sweep function made (`made`: what it returned) from case `start` on: it runs from
+    its start (a function can only be run from there); the cases before `start` are counted, not checked
+    nor converted. Returns how many cases it made in all."""
     return (yield from _function_blocks(routine, "cases.sweep", made, skip=start))
 
 

@@ -24,7 +24,9 @@ def _plan(name: str, exhaustive: bool, **kwargs):
     return case_sets.plan(load_spec(ROOT / name), exhaustive=exhaustive, seed=7, **kwargs)
 
 
-PLANS = [("asm/mul8.toml", True, {}),  # boundary, a sweep function (no count), random
+YIELDED = "tests/data/sweeps/mul8_yielded.toml"  # mul8 with a sweep function that yields its blocks: no count
+PLANS = [("asm/mul8.toml", True, {}),  # boundary, a grid sweep (counted, entered anywhere), random
+         (YIELDED, True, {}),  # boundary, a sweep function (no count), random
          ("examples/boxhit/boxhit.toml", False, {}),  # a product with inputs drawn per case: no seek
          ("tests/data/entry/overlap8.toml", False, {"random": 3_000})]  # every input swept: a seek
 
@@ -50,7 +52,8 @@ def test_a_stream_from_any_case_gives_the_cases_of_the_whole_run(name, exhaustiv
 def test_every_part_but_a_sweep_function_is_reached_without_making_the_cases_before():
     swept = _plan("tests/data/entry/overlap8.toml", False, random=3_000)
     drawn = _plan("examples/boxhit/boxhit.toml", False)
-    sweep = _plan("asm/mul8.toml", True)
+    sweep = _plan(YIELDED, True)
+    grid = _plan("asm/mul8.toml", True)
     product = next(p for p in swept if p.name == "exhaustive")
     before = sum(p.count for p in swept[:swept.index(product)])
     assert product.seek is not None and case_sets.reachable(swept, before + 12_345)
@@ -59,10 +62,12 @@ def test_every_part_but_a_sweep_function_is_reached_without_making_the_cases_bef
     after_sweep = sum(p.count or 0 for p in sweep[:[p.name for p in sweep].index("sweep")])
     assert case_sets.reachable(sweep, after_sweep) and not case_sets.reachable(sweep, after_sweep + 1)
     assert next(p for p in sweep if p.name == "sweep").from_start
+    assert next(p for p in grid if p.name == "sweep").count == 1 << 16 and case_sets.reachable(grid, after_sweep + 1)
 
 
 SPLIT = [("examples/object_table/hit_slot.toml", {"random": 150_000}),  # drawn inputs over 8 blocks; random 3
-         ("asm/mul8.toml", {"random": 140_000})]  # a sweep function, a random_generator called per block
+         ("asm/mul8.toml", {"random": 140_000}),  # a grid sweep, a random_generator called per block
+         (YIELDED, {"random": 140_000})]  # a sweep function
 
 
 @pytest.mark.parametrize("name, kwargs", SPLIT)
@@ -123,3 +128,52 @@ def test_a_seek_makes_the_same_cases_as_counting_from_the_start():
     everything = _joined(product.blocks())
     for start in (0, 1, 4_000, 65_535):
         assert all(np.array_equal(a, b[start:]) for a, b in zip(_joined(product.seek(start)), everything))
+
+
+def test_a_worker_makes_only_the_combinations_of_its_range_of_a_grid_sweep(monkeypatch):
+    """A grid sweep (retro.routines.grid) is entered at the range's first case: no combination before it
+    is made, whatever the range (inside a grid, at a grid's edge, in a later grid)."""
+    from retro.routines.grid import Grid
+
+    parts = _plan("asm/tile_box.toml", True, random=0)
+    sweep = next(p for p in parts if p.name == "sweep")
+    before = sum(p.count for p in parts[:parts.index(sweep)])
+    assert sweep.count == 512 * 256 + 5 * 2 * 256 and not sweep.from_start
+    everything = _joined(case_sets.stream(parts, 4_096))
+    made = []
+    real = Grid.columns
+    monkeypatch.setattr(Grid, "columns", lambda grid, lo, hi: made.append((grid.count, lo, hi)) or real(grid, lo, hi))
+    for start in (70_001, 512 * 256, 512 * 256 + 700):
+        made.clear()
+        block = next(case_sets.stream(parts, 1_000, before + start))
+        assert all(np.array_equal(a, b[before + start:before + start + 1_000]) for a, b in zip(block, everything))
+        inside = start if start < 512 * 256 else start - 512 * 256
+        assert made and made[0][1] == inside and all(lo >= inside for _, lo, _ in made), (start, made)
+
+
+def test_a_grid_is_every_combination_in_order_and_its_faults_are_one_line(tmp_path):
+    from retro.errors import InputError
+    from retro.routines.grid import Grid
+
+    grid = Grid({"a": [5, 7], "b": 3}, lambda a, b: {"x": a * 10 + b, "y": 1})
+    assert grid.count == 6
+    assert [list(c) for c in grid.block(0, 6).values()] == [[50, 51, 52, 70, 71, 72], [1] * 6]
+    assert [list(b["x"]) for b in grid.blocks(1, size=4)] == [[51, 52, 70], [71, 72]]  # cut where a whole run cuts
+    for axes, says in (({}, "non-empty"), ({"a b": 2}, "identifier"), ({"a": -1}, "negative"),
+                       ({"a": [1.5]}, "whole numbers")):
+        with pytest.raises(ValueError, match=says):
+            Grid(axes)
+    spec = (ROOT / YIELDED).read_text().replace('file = "../../../asm/mul8.s"', f'file = "{ROOT / "asm/mul8.s"}"')
+    for number, (body, says) in enumerate((('return [Grid({"a": 256, "b": 256}), {"a": [1], "b": [2]}]', "not both"),
+                       ('return Grid({"a": 256, "b": 256}, lambda a, b: a)', "make must return a dict"),
+                       ('return Grid({"a": 256, "b": 256}, lambda a, b: {"a": a, "b": b + 1 // 0})',
+                        "(Grid 1's make) raised ZeroDivisionError"),
+                       ('return Grid({"a": 256, "c": 256})', "lacks 'b'"),
+                       ('return Grid({"a": 256, "b": 257})', "does not fit"))):
+        folder = tmp_path / str(number)  # (a module of its own each: none is cached under another's name)
+        folder.mkdir()
+        (folder / "yielded.py").write_text(f"from retro.routines.grid import Grid\ndef sweep():\n    {body}\n")
+        (folder / "spec.toml").write_text(spec)
+        with pytest.raises(InputError, match="cases.sweep") as caught:
+            list(case_sets.stream(case_sets.plan(load_spec(folder / "spec.toml"), exhaustive=True, seed=1), 4_096))
+        assert says in str(caught.value) and "\n" not in str(caught.value), str(caught.value)

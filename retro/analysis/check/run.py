@@ -165,6 +165,11 @@ class Sweep:
         parts[index] = replace(parts[index], count=count)
         _PLANS[self] = parts
 
+    @property
+    def task_cases(self) -> int:
+        """Cases per task: TASK_BLOCKS blocks (COMPILED_TASK_FACTOR times more on the compiled engine)."""
+        return TASK_BLOCKS * self.block * (COMPILED_TASK_FACTOR if self.engine == "compiled" else 1)
+
     @cached_property
     def block(self) -> int:
         """Cases per block: the batched core's lanes (fewer for table inputs), a CHUNK on Machine."""
@@ -174,6 +179,8 @@ class Sweep:
 
 
 TASK_BLOCKS = 4  # blocks per task: a few seconds of work at most, many tasks for an even spread
+COMPILED_TASK_FACTOR = 8  # ... times this on the compiled engine, whose block is ~10 ms of work: a task costs
+# about 5 ms of the parent's CPU (the scheduler, the client) and a worker's, measured on aabb8's sweep
 _PLANS: dict[Sweep, list] = {}
 _CURSORS: dict[Sweep, tuple[int, Iterator]] = {}  # where this process's last task of a sweep stopped
 
@@ -227,7 +234,7 @@ def _block_tally(sweep: Sweep, block: list, first: int, outside_wanted: int) -> 
 def _tasks(sweep: Sweep, known: int, unknown: bool, ended: Callable[[], bool]) -> Iterator[tuple]:
     """(sweep, first, count) in case order: up to the planned count, or, with a sweep function whose count
     is unknown, until a task comes back short."""
-    size = TASK_BLOCKS * sweep.block
+    size = sweep.task_cases
     first = 0
     while (first < known) if not unknown else not ended():
         yield sweep, first, size
@@ -238,7 +245,7 @@ def _run_sweep(sweep: Sweep, plan: "_Plan", workers: Workers | int, totals: Tall
                report: Callable[[Tally], None]) -> None:
     """The planned cases as tasks on `workers` (this process when the check is small), merged in order;
     stops at the first run error."""
-    size = TASK_BLOCKS * sweep.block
+    size = sweep.task_cases
     ended = False
 
     def merged(result: Tally) -> bool:
