@@ -23,3 +23,7 @@ def sum_x(a, b):
 
 def copy_b(b):
     return b
+
+
+def sum3(a, b, c):
+    return (a + b + c) & 0xFF

@@ -50,9 +50,9 @@ def _labels(listing: Listing) -> dict[str, int]:
 @all_or_nothing
 def optimize(spec: str, *, objective: str = "worst", no_slower: bool = False, budget: float = 30.0,
              window: int = DEFAULT_WINDOW, seed: int | None = None, preserve: tuple[str, ...] = (),
-             syntax: str = "acme", out: str = "optimized", progress=None) -> Optimized:
+             syntax: str = "acme", out: str = "optimized", progress=None, smt: bool = True) -> Optimized:
     """Search for a faster routine for `spec`; every result is proven before it is reported."""
-    opts = Options(objective, no_slower, budget, window, seed, tuple(p.upper() for p in preserve))
+    opts = Options(objective, no_slower, budget, window, seed, tuple(p.upper() for p in preserve), smt=smt)
     check_options(opts)
     if syntax not in SYNTAXES:
         raise InputError(f"--syntax: {syntax!r} is not one of {', '.join(SYNTAXES)}")
@@ -106,10 +106,15 @@ def lines(result: Optimized) -> list[str]:
            f"({o.failed_proofs} failed, {o.counterexamples} counterexamples added)"]
     out += cost_table(result.before, result.after, o.routine.machine)
     p = result.proof
-    kind = {"exhaustive": "exhaustive: every input of the space", "sampled": "sampled: random and boundary cases only"}
+    kind = {"exhaustive": "exhaustive: every input of the space",
+            "smt": "smt: z3 proved every change equal on the outputs from every entry state, and the spec's cases ran",
+            "sampled": "sampled: random and boundary cases only"}
     out.append(f"proof: {kind.get(p['kind'], p['kind'])} ({p['cases']:,} cases, {p['calls']:,} calls on the "
                f"{p['engine']} engine, free entry state random per case); retro check: {p['check']['cases']:,} cases, "
                f"{p['check']['mismatches']} mismatches")
+    for record in p.get("smt") or ():
+        out.append(f"z3 ({record['scope']}): {record['status']} in {record['seconds']:.2f} s"
+                   + (f" ({record['reason']})" if record["reason"] else ""))
     out.append(f"optimal: {p['optimal']}" if p["optimal"] else "optimal: not claimed (the budget ran out before every "
                                                                 "window was searched)")
     out += result.diff or ["(no change)"]
@@ -143,6 +148,8 @@ def add_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=int, default=None, help="seed of the samples and entry states (default: the spec's)")
     p.add_argument("--preserve", default="", metavar="REGS",
                    help="registers and flags left as the original leaves them, e.g. X,Y,C (default: only the outputs)")
+    p.add_argument("--no-smt", action="store_true",
+                   help="past the sweep's reach, leave changes to the spec's cases (no z3 proof)")
     p.add_argument("--syntax", default="acme", help=f"source syntax: {', '.join(SYNTAXES)} (default acme)")
     options.out(p, "optimized")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
@@ -152,6 +159,7 @@ def main(args: argparse.Namespace) -> int:
     preserve = tuple(part.strip() for part in args.preserve.replace(" ", ",").split(",") if part.strip())
     result = optimize(args.spec, objective=args.objective, no_slower=args.no_slower, budget=args.budget,
                       window=args.window, seed=args.seed, preserve=preserve, syntax=args.syntax, out=args.out,
+                      smt=not args.no_smt,
                       progress=lambda line: print(f"retro optimize: {line}", file=sys.stderr))
     options.show(lines, as_json if args.json else None, result, indent=1)
     return 0

@@ -14,7 +14,7 @@ from retro.cpu.batch import LaneError
 from retro.errors import InputError, RunError
 from retro.optimize.code import Instruction, Listing, assemble, code_bytes, program_with, read_listing
 from retro.optimize.effects import ALL_MEMORY, live_after, windowable
-from retro.optimize.evaluate import LaneRunner, Proof, Prover, outputs_equal, sample_cases, scratch_of
+from retro.optimize.evaluate import LaneRunner, Proof, Prover, answered, outputs_equal, sample_cases, scratch_of
 from retro.optimize.stochastic import rewrite
 from retro.optimize.search import (BRANCHES, BRK, END, FLAG_BITS, Executor, cycles_of, enumerate_window,
                                    instruction_pool, rank, state_of, state_ports)
@@ -28,6 +28,7 @@ WINDOW_SHARE = 8  # a window's enumeration takes at most 1/this of the budget (s
 MIN_WINDOW_SECONDS = 0.5  # ... but at least this long
 SYNTHESIS_LENGTH = 6
 STOCHASTIC_MIN_LIMIT = 200  # cycles a rewrite's call may take at least (else 4 x the best's worst case)
+PINNED_INDEX = 1 << 40  # the case numbers of SMT counterexamples (their entry state is their own)
 SYNTHESIS_LANES = 64  # sample cases the synthesis enumerates on (it searches deeper, on more states)  # a routine of at most this many instructions (before its RTS) is also searched whole
 
 
@@ -42,6 +43,7 @@ class Options:
     synthesis: bool = True
     windows: bool = True  # the enumerative window search (off: only synthesis and stochastic rewriting)
     stochastic: bool = True  # rewrite at random for the budget the windows leave
+    smt: bool = True  # past the sweep's reach, prove each change with z3 (retro.optimize.formal)
 
 
 def check_options(options: Options) -> None:
@@ -85,6 +87,7 @@ class Outcome:
     windows: int = 0
     rewrites: int = 0  # stochastic moves tried
     program: object = None  # the new Program
+    smt_seconds: float = 0.0  # CPU seconds in z3
 
 
 def preserved_ports(names: tuple[str, ...]) -> tuple[Port, ...]:
@@ -162,12 +165,13 @@ class Search:
         self.at_return = live_at_return(routine, options.preserve)
         self.kept_samples = None
         self.synthesised = False
+        self.formal = None  # made when a change needs it (retro.optimize.formal)
 
     # ---- whole-routine runs --------------------------------------------------------------------
 
     def sample_ok(self, code: bytes) -> bool:
         s = self.samples
-        outcome = self.lanes.run(code, self.routine.entry_address, s.columns, s.indices)
+        outcome = self.lanes.run(code, self.routine.entry_address, s.columns, s.indices, s.pinned)
         ok = outputs_equal(outcome, s.expected)
         if self.preserve:
             kept = self.kept_samples
@@ -177,7 +181,7 @@ class Search:
     def refresh_kept(self, code: bytes) -> None:
         if self.preserve:
             s = self.samples
-            outcome = self.lanes.run(code, self.routine.entry_address, s.columns, s.indices)
+            outcome = self.lanes.run(code, self.routine.entry_address, s.columns, s.indices, s.pinned)
             self.kept_samples = outcome.outputs[-len(self.preserve):]
 
     def window_states(self, code: bytes, start_address: int):
@@ -188,7 +192,7 @@ class Search:
         patched = bytearray(code)
         patched[start_address - self.routine.entry_address] = BRK
         s = self.samples
-        outcome = runner.run(bytes(patched), self.routine.entry_address, s.columns, s.indices)
+        outcome = runner.run(bytes(patched), self.routine.entry_address, s.columns, s.indices, s.pinned)
         lanes = np.flatnonzero(outcome.error == LaneError.BRK)
         return state_of(outcome.outputs, self.addresses, lanes), lanes, runner
 
@@ -232,6 +236,7 @@ class Search:
         if self.options.stochastic and time.monotonic() < deadline:
             self.rewrite(outcome, deadline)
         outcome.seconds = time.monotonic() - began
+        outcome.best_proof = chained(outcome)
         outcome.program = program_with(routine.program, outcome.best, routine.cpu, self.size)
         return outcome
 
@@ -246,7 +251,7 @@ class Search:
 
         def cost(code: bytes):
             s = self.samples
-            run = lanes.run(code, routine.entry_address, s.columns, s.indices)
+            run = lanes.run(code, routine.entry_address, s.columns, s.indices, s.pinned)
             ok = outputs_equal(run, s.expected)
             if self.preserve:
                 ok &= outputs_equal(run, [None] * len(routine.outputs) + list(self.kept_samples), skip=True)
@@ -260,7 +265,7 @@ class Search:
         def found(listing: Listing, code: bytes) -> bool:
             if not self.sample_ok(code):
                 return False
-            proof = self.proven(code, outcome)
+            proof = self.proven(code, outcome, outcome.best, listing)
             if not proof.passed or (self.options.no_slower and proof.slower):
                 return False
             new_score = score(objective, proof, len(code))
@@ -345,7 +350,7 @@ class Search:
             outcome.routine_tests += 1
             if not self.sample_ok(new_code):
                 continue
-            proof = self.proven(new_code, outcome)
+            proof = self.proven(new_code, outcome, listing, new)
             if not proof.passed:
                 continue
             if self.options.no_slower and proof.slower:
@@ -355,19 +360,51 @@ class Search:
                 return new, new_score, Change(start, tuple(window), tuple(sequence), kind, proof)
         return None
 
-    def proven(self, code: bytes, outcome: Outcome) -> Proof:
-        """The proof of a candidate; a counterexample joins the samples."""
+    def proven(self, code: bytes, outcome: Outcome, old: Listing | None = None, new: Listing | None = None) -> Proof:
+        """The proof of a candidate (`new` in place of `old`); a counterexample joins the samples."""
         began = time.process_time()
         proof = self.prover.prove(code, self.routine.entry_address)
+        if proof.passed and proof.kind == "sampled" and self.options.smt and old is not None:
+            proof = self.proven_formally(proof, code, old, new, outcome)
         outcome.prove_seconds += time.process_time() - began
         outcome.proofs += 1
-        if not proof.passed:
+        if not proof.passed and proof.counterexample is not None:
             outcome.failed_proofs += 1
             outcome.counterexamples += 1
             columns, expected, index = proof.counterexample
             self.samples.add(columns, expected, index)
             self.refresh_kept(assemble(self.listing, self.routine.cpu))
         return proof
+
+    def proven_formally(self, proof: Proof, code: bytes, old: Listing, new: Listing, outcome: Outcome) -> Proof:
+        """A change the spec's cases passed, proven by z3 (kind "smt"); a counterexample of the whole
+        routine replayed on the batched core, and kept when the candidate fails it there."""
+        from retro.optimize.formal import Formal  # z3 loads only when a proof needs it
+        if self.formal is None:
+            self.formal = Formal(self.routine, self.prover.baseline.runner.call_image, self.size, self.at_return)
+        verdict = self.formal.prove(old, new)
+        if verdict is None:
+            return proof
+        result = verdict.result
+        outcome.smt_seconds += result.seconds
+        if result.status == "proven":
+            return replace(proof, kind="smt", smt=[verdict.record()],
+                           note=f"z3 proved the {verdict.scope} equal on the outputs from every entry state")
+        witness = verdict.counterexample
+        if witness is not None:
+            columns = [np.asarray([v], dtype=np.int64) for v in witness.inputs]
+            expected, counted = answered(self.routine, columns, self.lanes.runner.memory_values)
+            if counted.all():
+                index = PINNED_INDEX + len(self.samples.pinned)
+                self.samples.add(columns, expected, index, witness)
+                outcome.counterexamples += 1
+                self.refresh_kept(assemble(self.listing, self.routine.cpu))
+                if not self.sample_ok(code):
+                    outcome.failed_proofs += 1
+                    return replace(proof, passed=False, smt=[verdict.record()],
+                                   note="z3's counterexample fails on the batched core")
+        return replace(proof, smt=[verdict.record()], note=f"random and boundary cases only (z3: {result.status}"
+                       f"{': ' + result.reason if result.reason else ''})")
 
     @staticmethod
     def replaced(listing: Listing, start: int, stop: int, sequence) -> Listing:
@@ -418,6 +455,19 @@ def _first_lanes(state, lanes: np.ndarray, count: int):
         return state, lanes
     return (type(state)(state.a[:count], state.x[:count], state.y[:count], state.p[:count],
                         {a: v[:count] for a, v in state.memory.items()}), lanes[:count])
+
+
+def chained(outcome: Outcome) -> Proof:
+    """The proof of the best routine against the original: "smt" only when every change on the way
+    was proven by z3 (each step equal to the one before it), else as its own cases have it."""
+    best = outcome.best_proof
+    if best.kind != "smt":
+        return best
+    records = [record for change in outcome.changes for record in change.proof.smt]
+    if all(change.proof.kind == "smt" for change in outcome.changes):
+        return replace(best, smt=records)
+    return replace(best, kind="sampled", smt=records,
+                   note="random and boundary cases only (an earlier change was not proven by z3)")
 
 
 def optimize(routine: Routine, options: Options, progress: Callable[[str], None] | None = None) -> Outcome:
