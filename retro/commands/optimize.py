@@ -50,9 +50,11 @@ def _labels(listing: Listing) -> dict[str, int]:
 @all_or_nothing
 def optimize(spec: str, *, objective: str = "worst", no_slower: bool = False, budget: float = 30.0,
              window: int = DEFAULT_WINDOW, seed: int | None = None, preserve: tuple[str, ...] = (),
-             syntax: str = "acme", out: str = "optimized", progress=None, smt: bool = True) -> Optimized:
+             syntax: str = "acme", out: str = "optimized", progress=None, smt: bool = True,
+             tables: tuple[str, ...] = ()) -> Optimized:
     """Search for a faster routine for `spec`; every result is proven before it is reported."""
-    opts = Options(objective, no_slower, budget, window, seed, tuple(p.upper() for p in preserve), smt=smt)
+    opts = Options(objective, no_slower, budget, window, seed, tuple(p.upper() for p in preserve), smt=smt,
+                   tables=tuple(tables))
     check_options(opts)
     if syntax not in SYNTAXES:
         raise InputError(f"--syntax: {syntax!r} is not one of {', '.join(SYNTAXES)}")
@@ -72,9 +74,9 @@ def optimize(spec: str, *, objective: str = "worst", no_slower: bool = False, bu
                        f"reported (the search never admits a routine a check fails)")
     first, best = outcome.original_proof, outcome.best_proof
     before = cost_row(first.cycles["max"], first.cycles["mean"], first.cycles["min"], code_bytes(outcome.original),
-                      routine.machine)
+                      routine.machine, outcome.table_bytes[0])
     after = cost_row(best.cycles["max"], best.cycles["mean"], best.cycles["min"], code_bytes(outcome.best),
-                     routine.machine)
+                     routine.machine, outcome.table_bytes[1])
     original_names = address_names(routine.program.symbols)
     names = dict(original_names)
     for name, address in _labels(outcome.best).items():
@@ -148,6 +150,8 @@ def add_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=int, default=None, help="seed of the samples and entry states (default: the spec's)")
     p.add_argument("--preserve", default="", metavar="REGS",
                    help="registers and flags left as the original leaves them, e.g. X,Y,C (default: only the outputs)")
+    p.add_argument("--tables", default="", metavar="NAMES",
+                   help="[memory] blocks a candidate may read with an index, e.g. times3,sqr_lo (their bytes count)")
     p.add_argument("--no-smt", action="store_true",
                    help="past the sweep's reach, leave changes to the spec's cases (no z3 proof)")
     p.add_argument("--syntax", default="acme", help=f"source syntax: {', '.join(SYNTAXES)} (default acme)")
@@ -157,9 +161,10 @@ def add_options(p: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     preserve = tuple(part.strip() for part in args.preserve.replace(" ", ",").split(",") if part.strip())
+    tables = tuple(part.strip() for part in args.tables.split(",") if part.strip())
     result = optimize(args.spec, objective=args.objective, no_slower=args.no_slower, budget=args.budget,
                       window=args.window, seed=args.seed, preserve=preserve, syntax=args.syntax, out=args.out,
-                      smt=not args.no_smt,
+                      smt=not args.no_smt, tables=tables,
                       progress=lambda line: print(f"retro optimize: {line}", file=sys.stderr))
     options.show(lines, as_json if args.json else None, result, indent=1)
     return 0

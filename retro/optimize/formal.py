@@ -67,7 +67,8 @@ def _reach(instructions) -> list[tuple[int, int]] | None:
 class Formal:
     """The SMT side of a search: the spec's entry facts and the bytes a call starts with, computed once."""
 
-    def __init__(self, routine: Routine, image, size: int, at_return: frozenset) -> None:
+    def __init__(self, routine: Routine, image, size: int, at_return: frozenset, contents: dict) -> None:
+        """`image`: memory as a call starts (the baseline's); `contents`: each [memory] block's bytes."""
         self.routine, self.cpu, self.size, self.at_return = routine, routine.cpu, size, at_return
         entry = EntryState.of(routine.entry_state, routine.inputs)
         taken = {p.register for port in routine.inputs for p in port.places if p.kind == "register"}
@@ -78,8 +79,7 @@ class Formal:
         program = routine.program
         inputs = {p.address for port in routine.inputs for p in port.places if p.kind == "memory" and port.via is None}
         code = range(routine.entry_address, routine.entry_address + size)
-        spans = [(program.origin, program.end)] + [(b.address, b.address + (len(b.data) if b.data is not None else b.size))
-                                                   for b in routine.memory]
+        spans = [(program.origin, program.end)] + [(b.address, b.address + len(contents[b.name])) for b in routine.memory]
         self.starts_with = {a: int(image[a]) for lo, hi in spans for a in range(lo, min(hi, 0x10000))
                             if a not in code and a not in inputs}
         self.code_range = (routine.entry_address, routine.entry_address + size)

@@ -16,6 +16,7 @@ from retro.optimize.code import Instruction, Listing, assemble, code_bytes, prog
 from retro.optimize.effects import ALL_MEMORY, live_after, windowable
 from retro.optimize.evaluate import LaneRunner, Proof, Prover, answered, outputs_equal, sample_cases, scratch_of
 from retro.optimize.stochastic import rewrite
+from retro.optimize.tables import allowed_tables, table_bytes, table_pool
 from retro.optimize.search import (BRANCHES, BRK, END, FLAG_BITS, Executor, cycles_of, enumerate_window,
                                    instruction_pool, rank, state_of, state_ports)
 from retro.routines.places import FLAGS, Place, Port
@@ -44,6 +45,7 @@ class Options:
     windows: bool = True  # the enumerative window search (off: only synthesis and stochastic rewriting)
     stochastic: bool = True  # rewrite at random for the budget the windows leave
     smt: bool = True  # past the sweep's reach, prove each change with z3 (retro.optimize.formal)
+    tables: tuple[str, ...] = ()  # [memory] blocks a candidate may read, their bytes counted (retro.optimize.tables)
 
 
 def check_options(options: Options) -> None:
@@ -88,6 +90,7 @@ class Outcome:
     rewrites: int = 0  # stochastic moves tried
     program: object = None  # the new Program
     smt_seconds: float = 0.0  # CPU seconds in z3
+    table_bytes: tuple = (0, 0)  # bytes of the allowed tables the original and the best routine read
 
 
 def preserved_ports(names: tuple[str, ...]) -> tuple[Port, ...]:
@@ -166,6 +169,12 @@ class Search:
         self.kept_samples = None
         self.synthesised = False
         self.formal = None  # made when a change needs it (retro.optimize.formal)
+        self.tables = allowed_tables(routine, options.tables, self.lanes.runner.memory_values)
+        self.table_pool = table_pool(routine.cpu, self.tables)
+
+    def weight(self, listing: Listing) -> int:
+        """A routine's size: its code's bytes and those of every allowed table it reads."""
+        return code_bytes(listing) + table_bytes(listing, self.tables)
 
     # ---- whole-routine runs --------------------------------------------------------------------
 
@@ -214,7 +223,7 @@ class Search:
         self.refresh_kept(code)
         outcome = Outcome(routine, self.listing, self.listing, first, first, proofs=1,
                           prove_seconds=time.process_time() - began_cpu)
-        best_score = score(self.options.objective, first, self.size)
+        best_score = score(self.options.objective, first, self.weight(self.listing))
         current = self.listing
         improved = True
         while improved and self.options.windows and time.monotonic() < deadline:
@@ -237,6 +246,7 @@ class Search:
             self.rewrite(outcome, deadline)
         outcome.seconds = time.monotonic() - began
         outcome.best_proof = chained(outcome)
+        outcome.table_bytes = (table_bytes(self.listing, self.tables), table_bytes(outcome.best, self.tables))
         outcome.program = program_with(routine.program, outcome.best, routine.cpu, self.size)
         return outcome
 
@@ -247,7 +257,7 @@ class Search:
         limit = max(4 * outcome.best_proof.cycles["max"], STOCHASTIC_MIN_LIMIT)
         lanes = LaneRunner(replace(routine, limit=limit, outputs=routine.outputs + self.preserve), self.seed,
                            self.scratch)
-        best_score = [score(objective, outcome.best_proof, code_bytes(outcome.best))]
+        best_score = [score(objective, outcome.best_proof, self.weight(outcome.best))]
 
         def cost(code: bytes):
             s = self.samples
@@ -268,7 +278,7 @@ class Search:
             proof = self.proven(code, outcome, outcome.best, listing)
             if not proof.passed or (self.options.no_slower and proof.slower):
                 return False
-            new_score = score(objective, proof, len(code))
+            new_score = score(objective, proof, self.weight(listing))
             if new_score >= best_score[0]:
                 return False
             best_score[0] = new_score
@@ -278,7 +288,7 @@ class Search:
                           f"{len(code)} bytes")
             return True
 
-        pool = instruction_pool(routine.cpu, outcome.best, (), self.addresses)
+        pool = instruction_pool(routine.cpu, outcome.best, (), self.addresses) + self.table_pool
         outcome.rewrites += rewrite(outcome.best, cost, pool, routine.cpu, self.size, deadline, self.seed, found)
 
     def windows(self, listing: Listing):
@@ -313,7 +323,7 @@ class Search:
             return None
         window = listing.instructions[start:stop]
         executor = Executor(cpu, bytes(probe.runner.call_image), len(lanes), addresses[start])
-        pool = instruction_pool(cpu, listing, window, self.addresses)
+        pool = instruction_pool(cpu, listing, window, self.addresses) + self.table_pool
         if kind == "synthesis":
             state, lanes = _first_lanes(state, lanes, SYNTHESIS_LANES)
             target, live = self.synthesis_target(state, lanes)
@@ -355,7 +365,7 @@ class Search:
                 continue
             if self.options.no_slower and proof.slower:
                 continue
-            new_score = score(objective, proof, len(new_code))
+            new_score = score(objective, proof, self.weight(new))
             if new_score < best_score:
                 return new, new_score, Change(start, tuple(window), tuple(sequence), kind, proof)
         return None
@@ -381,7 +391,8 @@ class Search:
         routine replayed on the batched core, and kept when the candidate fails it there."""
         from retro.optimize.formal import Formal  # z3 loads only when a proof needs it
         if self.formal is None:
-            self.formal = Formal(self.routine, self.prover.baseline.runner.call_image, self.size, self.at_return)
+            runner = self.prover.baseline.runner
+            self.formal = Formal(self.routine, runner.call_image, self.size, self.at_return, runner.memory_values)
         verdict = self.formal.prove(old, new)
         if verdict is None:
             return proof

@@ -310,7 +310,7 @@ def test_the_fragment_is_proven_when_the_whole_routine_is_out_of_reach():
     jsr = Instruction("JSR", "abs", None, 0xFFD2)
     old = Listing(old.origin, (jsr,) + old.instructions, tuple((n, k + 1 if k else 0) for n, k in old.labels))
     new = old.with_window(1, 3, (_i("TXA"),))
-    formal = Formal(routine, bytearray(0x10000), 16, frozenset({"A"}))  # the block before b_val
+    formal = Formal(routine, bytearray(0x10000), 16, frozenset({"A"}), {})  # the block before b_val
     verdict = formal.prove(old, new)
     assert verdict.scope == "fragment" and verdict.result.status == "proven", verdict.result
     wrong = old.with_window(1, 3, (_i("TYA"),))
