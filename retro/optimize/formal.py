@@ -78,10 +78,12 @@ class Formal:
                       if n not in entry.free_flags and n not in taken_flags and n in smt.FLAG_NAMES}
         program = routine.program
         inputs = {p.address for port in routine.inputs for p in port.places if p.kind == "memory" and port.via is None}
+        # an output's bytes are random on entry in the search's runs (evaluate.scratch_of): never assumed
+        outputs = {p.address for port in routine.outputs for p in port.places if p.kind == "memory"}
         code = range(routine.entry_address, routine.entry_address + size)
         spans = [(program.origin, program.end)] + [(b.address, b.address + len(contents[b.name])) for b in routine.memory]
         self.starts_with = {a: int(image[a]) for lo, hi in spans for a in range(lo, min(hi, 0x10000))
-                            if a not in code and a not in inputs}
+                            if a not in code and a not in inputs and a not in outputs}
         self.code_range = (routine.entry_address, routine.entry_address + size)
         self.shown = tuple(sorted(inputs))
 

@@ -289,17 +289,23 @@ def test_a_wrong_candidate_the_cases_miss_is_refuted_and_its_counterexample_join
     assert not search.sample_ok(code)  # the test set now holds the case it fails
 
 
-def test_the_counterexample_fails_on_the_machine(tmp_path):
+def test_z3s_counterexample_of_the_whole_routine_fails_on_the_machine(tmp_path):
+    """The inputs and entry state z3 gives, run on the Machine: the candidate's A is not the reference's."""
+    from retro.optimize.formal import Formal
     routine = _roomy_sum3(tmp_path)
-    _, new = _rare_wrong(routine)
+    old, new = _rare_wrong(routine)
+    formal = Formal(routine, bytearray(0x10000), sum(i.length for i in old.instructions), frozenset({"A"}), {})
+    verdict = formal.prove(old, new)
+    assert (verdict.scope, verdict.result.status) == ("routine", "refuted")
+    x, b, c = verdict.counterexample.inputs
     machine = RealMachine("6510")
-    code = assemble(new, routine.cpu)
-    for k, value in enumerate(code):
+    for k, value in enumerate(assemble(new, routine.cpu)):
         machine.mpu.memory[new.origin + k] = value
-    machine.poke(routine.program.symbols["b_val"], [0x42])
-    machine.poke(routine.program.symbols["c_val"], [0x99])
-    got = machine.call(new.origin, x=0x37).a
-    assert got != (0x37 + 0x42 + 0x99) & 0xFF
+    machine.poke(routine.program.symbols["b_val"], [b])
+    machine.poke(routine.program.symbols["c_val"], [c])
+    registers = verdict.counterexample.registers
+    got = machine.call(new.origin, a=registers["a"], x=x, y=registers["y"], p=verdict.counterexample.bits | 0x20).a
+    assert got != (x + b + c) & 0xFF and (x, b, c) == (0x37, 0x42, 0x99)
 
 
 def test_the_fragment_is_proven_when_the_whole_routine_is_out_of_reach():
