@@ -239,7 +239,7 @@ class Search:
                     outcome.best, outcome.best_proof = current, change.proof
                     self.progress(f"{kind} at instruction {start}: {len(change.removed)} -> {len(change.added)} "
                                   f"instructions; worst {change.proof.cycles['max']}, mean "
-                                  f"{change.proof.cycles['mean']:.2f}, {code_bytes(current)} bytes")
+                                  f"{change.proof.cycles['mean']:.2f}, {self.weight(current)} bytes")
                     improved = True
                     break
         if self.options.stochastic and time.monotonic() < deadline:

@@ -390,7 +390,7 @@ class Result:
 
     def record(self) -> dict:
         return {"status": self.status, "reason": self.reason, "seconds": round(self.seconds, 3),
-                "fragment_cycles": list(self.cycles) if self.cycles else None, "no_slower": self.no_slower}
+                "worst_cycles": list(self.cycles) if self.cycles else None, "no_slower": self.no_slower}
 
 
 def _differs(before: Machine, after: Machine, live: frozenset, code_range: tuple[int, int]) -> z3.BoolRef:
