@@ -6,6 +6,7 @@ from __future__ import annotations
 import random
 from pathlib import Path
 
+import numpy as np
 import pytest
 import z3
 
@@ -335,3 +336,53 @@ def test_the_result_is_smt_only_when_every_change_on_the_way_was():
     assert chained(outcome).kind == "sampled"
     outcome.changes[0] = Change(0, (), (), "window", changed(proven))
     assert chained(outcome).kind == "smt" and len(chained(outcome).smt) == 2
+
+
+def test_z3_proves_and_refutes_changes_of_aabb8_whose_space_no_sweep_reaches():
+    """aabb8: 30 instructions, 5 forward branches, 4 RTS, 2^64 inputs. Swapping two independent
+    instructions is proven; dropping a CLC is refuted, and the entry state z3 gives makes the
+    batched core's run of the candidate miss the reference's answer."""
+    from retro.optimize.evaluate import LaneRunner, Prover, answered, outputs_equal
+    from retro.optimize.formal import Formal
+    from retro.optimize.code import read_listing
+    from retro.paths import ASM_DIR
+    routine = load_spec(ASM_DIR / "aabb8.toml")
+    old = read_listing(routine.program, routine.entry_address, routine.cpu)
+    assert [i.mnemonic for i in old.instructions[8:10]] == ["EOR", "CLC"]
+    runner = Prover(routine, routine.seed, ()).baseline.runner
+    size = sum(i.length for i in old.instructions)
+    formal = Formal(routine, runner.call_image, size, frozenset({"C"}), runner.memory_values)
+    swapped = old.with_window(8, 10, (old.instructions[9], old.instructions[8]))
+    proven = formal.prove(old, swapped)
+    assert (proven.scope, proven.result.status) == ("routine", "proven"), proven.result
+    dropped = old.with_window(9, 10, ())
+    refuted = formal.prove(old, dropped)
+    assert (refuted.scope, refuted.result.status) == ("routine", "refuted")
+    witness = refuted.counterexample
+    columns = [np.asarray([v], dtype=np.int64) for v in witness.inputs]
+    expected, counted = answered(routine, columns, runner.memory_values)
+    lanes = LaneRunner(routine, routine.seed, ())
+    run = lanes.run(assemble(dropped, routine.cpu), routine.entry_address, columns, np.asarray([1 << 40]),
+                    {1 << 40: witness})
+    assert counted.all() and not outputs_equal(run, expected).all()
+
+
+def test_a_change_slower_on_one_input_in_2_to_the_16_is_slower_by_z3_though_no_case_shows_it(tmp_path):
+    """--no-slower past the sweep: the cases' cycles miss a path taken on X = $37, b = $42 only;
+    z3's cycle model of the whole routine does not."""
+    from retro.optimize.optimizer import Outcome, Search
+    from retro.optimize.optimizer import Options as SearchOptions
+    routine = _roomy_sum3(tmp_path)
+    b, c = routine.program.symbols["b_val"], routine.program.symbols["c_val"]
+    body = (_i("TXA"), _i("CLC"), Instruction("ADC", "abs", b), _i("CLC"), Instruction("ADC", "abs", c),
+            _i("CPX #$37"), Instruction("BNE", "rel", None, "done"), Instruction("LDY", "abs", b),
+            _i("CPY #$42"), Instruction("BNE", "rel", None, "done"))
+    old = Listing(routine.entry_address, body + (_i("RTS"),), (("done", len(body)), ("sum3", 0)))
+    new = Listing(routine.entry_address, body + (_i("NOP"), _i("RTS")), (("done", len(body) + 1), ("sum3", 0)))
+    search = Search(routine, SearchOptions(budget=1))
+    search.prover.reference_cycles = search.prover.prove(assemble(old, routine.cpu), routine.entry_address).per_case
+    outcome = Outcome(routine, old, old, None, None)
+    cases_only = search.prover.prove(assemble(new, routine.cpu), routine.entry_address)
+    assert cases_only.passed and not cases_only.slower
+    proof = search.proven(assemble(new, routine.cpu), outcome, old, new)
+    assert proof.kind == "smt" and proof.slower and proof.smt[0]["no_slower"] is False
