@@ -23,7 +23,7 @@ def _reads_table(source_lines) -> bool:
 
 
 def test_the_lookup_is_found_when_the_table_is_allowed_and_its_bytes_are_counted(tmp_path):
-    data = as_json(optimize_command(SPEC, budget=15, tables=("times3",), out=str(tmp_path / "t")))
+    data = as_json(optimize_command(SPEC, budget=10, tables=("times3",), out=str(tmp_path / "t")))
     assert (data["before"]["worst"], data["before"]["bytes"]) == (16, 7)  # STA t / ASL / CLC / ADC t / RTS
     assert data["after"]["worst"] == 12  # TAX (or TAY) / LDA times3_table,X / RTS: 2 + 4 + 6
     assert data["after"]["table_bytes"] == 256 and data["after"]["bytes"] == 5 + 256
