@@ -36,7 +36,7 @@ from retro.optimize.effects import ALL_MEMORY
 CPUS = ("6510", "2a03")  # the variants translated (the 65C02's decimal flags and opcodes are not)
 DECIMAL_CPUS = ("6510",)
 FLAG_NAMES = ("N", "V", "D", "I", "Z", "C")
-TIMEOUT_MS = 20_000  # one solver call; past it the fragment stays unproven ("unknown")
+TIMEOUT_MS = 5_000  # one solver call; past it the change stays unproven ("unknown"): proofs come on top of the budget
 BRANCH_FLAGS = {"BCC": ("C", False), "BCS": ("C", True), "BEQ": ("Z", True), "BNE": ("Z", False),
                 "BMI": ("N", True), "BPL": ("N", False), "BVC": ("V", False), "BVS": ("V", True)}
 LOADS = {"LDA": "a", "LDX": "x", "LDY": "y"}
