@@ -9,7 +9,7 @@ joins the test set. When the whole routine is out of the translation's reach (a 
 stack), the changed fragment alone, from every state at its start (the bytes a call starts with
 and D only when nothing in the routine can change them), equal on what is live after it; its
 counterexample is a state inside the routine, which proves nothing about the routine's inputs and
-joins nothing."""
+joins nothing, unless the fragment starts at the entry (then it is an entry state, replayed as above)."""
 
 from __future__ import annotations
 
@@ -108,7 +108,9 @@ class Formal:
             result = smt.prove_equivalent(before, after, self.at_return, assumptions, shown=self.shown)
             if result.status != "unsupported":
                 return Verdict("routine", result, self._counterexample(result))
-        return Verdict("fragment", self._prove_fragment(old, new, span))
+        result = self._prove_fragment(old, new, span)
+        # a fragment at the entry starts from the routine's entry state: its counterexample is one
+        return Verdict("fragment", result, self._counterexample(result) if span[0] == 0 else None)
 
     def _prove_fragment(self, old: Listing, new: Listing, span: tuple[int, int, int]) -> smt.Result:
         start, stop_old, stop_new = span
@@ -130,7 +132,7 @@ class Formal:
             assumptions = smt.Assumptions(self._fixed(before.instructions + after.instructions), flags=flags,
                                           code_range=self.code_range)
         live = live_after(old, self.at_return)[stop_old - 1]
-        return smt.prove_equivalent(before, after, live, assumptions)
+        return smt.prove_equivalent(before, after, live, assumptions, shown=self.shown)
 
     def _counterexample(self, result: smt.Result) -> Counterexample | None:
         """The model as the routine's entry state (inputs by port), when every input is a plain

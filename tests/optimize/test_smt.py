@@ -325,7 +325,14 @@ def test_the_fragment_is_proven_when_the_whole_routine_is_out_of_reach():
     verdict = formal.prove(old, new)
     assert verdict.scope == "fragment" and verdict.result.status == "proven", verdict.result
     wrong = old.with_window(1, 3, (_i("TYA"),))
-    assert formal.prove(old, wrong).result.status == "refuted"
+    refuted = formal.prove(old, wrong)
+    assert refuted.result.status == "refuted" and refuted.counterexample is None  # a state after the JSR
+    at_entry = Listing(old.origin, old.instructions[1:] + (jsr,), tuple((n, k - 1 if k else 0) for n, k in old.labels))
+    entry_wrong = at_entry.with_window(0, 2, (_i("TYA"),))
+    verdict = formal.prove(at_entry, entry_wrong)
+    assert (verdict.scope, verdict.result.status) == ("fragment", "refuted")
+    x = verdict.counterexample.inputs[0]
+    assert verdict.counterexample.registers["y"] != x  # TYA for X: they differ in the entry state z3 gives
 
 
 def test_the_result_is_smt_only_when_every_change_on_the_way_was():
