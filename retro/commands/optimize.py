@@ -130,7 +130,7 @@ def as_json(result: Optimized) -> dict:
             "changes": [{"at": c.start, "removed": len(c.removed), "added": len(c.added), "kind": c.kind}
                         for c in o.changes],
             "proof": result.proof, "tested": o.tested, "routine_tests": o.routine_tests, "proofs": o.proofs,
-            "failed_proofs": o.failed_proofs, "seconds": round(o.seconds, 3), "source": result.source,
+            "failed_proofs": o.failed_proofs, "seconds": round(o.seconds, 3), "smt_seconds": round(o.smt_seconds, 3), "source": result.source,
             "diff": result.diff, "written": result.written}
 
 
