@@ -21,6 +21,7 @@ from retro.optimize.effects import ALL_MEMORY, READ_MODIFY_WRITE, STORES, effect
 from retro.routines.entry import EntryState
 from retro.routines.places import FLAGS
 from retro.routines.spec import Routine
+from retro.routines.where import input_ranges
 
 FIXED_LIMIT = 4096  # bytes a call starts with that a proof assumes at most (past it: none, still sound)
 FLAG_NAME = {bit: name for name, bit in FLAGS.items()}
@@ -86,6 +87,7 @@ class Formal:
                             if a not in code and a not in inputs and a not in outputs}
         self.code_range = (routine.entry_address, routine.entry_address + size)
         self.shown = tuple(sorted(inputs))
+        self.inputs = _input_facts(routine)
 
     def _fixed(self, instructions) -> dict:
         reach = _reach(instructions)
@@ -104,7 +106,7 @@ class Formal:
         after = smt.Fragment(new.instructions, new.origin, dict(new.labels), self.cpu, returns=True)
         if all(smt.supported(i, self.cpu) or i.mnemonic == "RTS" for i in old.instructions + new.instructions):
             assumptions = smt.Assumptions(self._fixed(old.instructions + new.instructions), dict(self.registers),
-                                          dict(self.flags), self.code_range)
+                                          dict(self.flags), self.inputs, self.code_range)
             result = smt.prove_equivalent(before, after, self.at_return, assumptions, shown=self.shown)
             if result.status != "unsupported":
                 return Verdict("routine", result, self._counterexample(result))
@@ -119,18 +121,16 @@ class Formal:
             after = smt.fragment_of(new, start, stop_new, self.cpu)
         except smt.Unsupported as exc:
             return smt.Result("unsupported", str(exc))
-        outside = old.instructions[:start] + old.instructions[stop_old:]
-        stable = all(known(i) and i.mnemonic not in ("JSR", "JMP", "RTI", "BRK") and _stores_known(i, self.starts_with,
-                                                                                                   self.code_range)
-                     for i in outside if i.mnemonic != "RTS")
+        # what holds at the fragment's start on every arrival: a loop may come back to it after the
+        # fragment itself ran, so its own instructions (old and new) count with the rest of the routine
+        everything = old.instructions + after.instructions
+        stable = all(known(i) and i.mnemonic not in ("JSR", "JMP", "RTI", "BRK")
+                     and _stores_known(i, self.starts_with, self.code_range) for i in everything if i.mnemonic != "RTS")
         flags = {}
-        if "D" in self.flags and not any(i.mnemonic in WRITES_D or not known(i) or i.mnemonic == "JSR" for i in outside):
+        if "D" in self.flags and not any(i.mnemonic in WRITES_D or not known(i) or i.mnemonic == "JSR" for i in everything):
             flags["D"] = self.flags["D"]
-        if not stable:  # a store somewhere may have changed any byte: assume none, and never read the code
-            assumptions = smt.Assumptions(flags=flags, code_range=self.code_range)
-        else:
-            assumptions = smt.Assumptions(self._fixed(before.instructions + after.instructions), flags=flags,
-                                          code_range=self.code_range)
+        fixed = self._fixed(before.instructions + after.instructions) if stable else {}  # else any byte may have changed
+        assumptions = smt.Assumptions(fixed, flags=flags, code_range=self.code_range)
         live = live_after(old, self.at_return)[stop_old - 1]
         return smt.prove_equivalent(before, after, live, assumptions, shown=self.shown)
 
@@ -160,6 +160,32 @@ class Formal:
         bits = sum(FLAGS[n] for n in smt.FLAG_NAMES if model[n])
         memory = {a: v for a, v in model["memory"].items() if a not in self.shown}
         return Counterexample(values, registers, bits, memory)
+
+
+LISTED_LIMIT = 256  # an input's listed values given to z3 one by one at most (past it: their range)
+
+
+def _input_facts(routine: Routine) -> tuple:
+    """The inputs' values as the spec's domain narrows them to ranges (retro.routines.where): z3
+    proves the routine on them, as `retro check` does (a condition that is not a range is left out:
+    the proof then covers more than the domain)."""
+    plain = [p for p in routine.inputs if not p.table and p.via is None and p.values is not None
+             and all(place.kind in ("register", "flag", "memory") for place in p.places)]
+    ranges = input_ranges(routine.domain, {p.name: (p.values.lo, p.values.hi) for p in plain})
+    facts = []
+    for port in plain:
+        lo, hi = ranges[port.name]
+        listed = port.values.listed
+        if listed is not None:
+            listed = tuple(v for v in listed if lo <= v <= hi)
+            if len(listed) > LISTED_LIMIT:
+                lo, hi, listed = min(listed), max(listed), None
+        if lo > hi or listed == ():
+            continue  # an empty domain: the check has no case there either, and z3 needs no fact
+        places = tuple(("register", p.register) if p.kind == "register" else ("flag", FLAG_NAME[p.bit])
+                       if p.kind == "flag" else ("memory", p.address) for p in port.places)
+        facts.append((places, lo, hi, listed))
+    return tuple(facts)
 
 
 def _stores_known(instruction: Instruction, starts_with: dict, code_range: tuple[int, int]) -> bool:

@@ -373,6 +373,9 @@ class Assumptions:
     fixed: dict = field(default_factory=dict)
     registers: dict = field(default_factory=dict)  # "a"/"x"/"y" -> its byte on entry (the rest free)
     flags: dict = field(default_factory=dict)  # flag name -> its value on entry (the rest free)
+    # the inputs' values: (places, lo, hi, listed values or None); a place is ("register", "a"),
+    # ("flag", "C") or ("memory", address), low byte first (the spec's domain, as far as it is ranges)
+    inputs: tuple = ()
     code_range: tuple[int, int] = (0, 0)  # [start, end): the code block, which no fragment may read or write
 
 
@@ -475,7 +478,27 @@ def _entry_facts(entry: Machine, assumptions: Assumptions) -> z3.BoolRef:
     facts = [getattr(entry, name) == byte(value) for name, value in assumptions.registers.items()]
     facts += [z3.Select(entry.memory, word(address)) == byte(value) for address, value in assumptions.fixed.items()]
     facts += [entry.flags[name] == z3.BoolVal(value) for name, value in assumptions.flags.items()]
+    for places, lo, hi, listed in assumptions.inputs:
+        value = _input_value(entry, places)
+        if listed is not None:
+            facts.append(z3.Or([value == v for v in listed]))
+        else:
+            facts += [z3.UGE(value, lo), z3.ULE(value, hi)]
     return z3.And(facts)
+
+
+def _input_value(entry: Machine, places: tuple) -> z3.BitVecRef:
+    """An input's value on entry from its places, low byte first (a flag is one bit, widened)."""
+    parts = []
+    for kind, key in places:
+        if kind == "register":
+            parts.append(getattr(entry, key))
+        elif kind == "flag":
+            parts.append(_bit(entry.flags[key], 8))
+        else:
+            parts.append(z3.Select(entry.memory, word(key)))
+    value = parts[0] if len(parts) == 1 else z3.Concat(*reversed(parts))
+    return z3.ZeroExt(64 - value.size(), value) if value.size() < 64 else value
 
 
 def _cycles(end_before: Machine, end_after: Machine, entry: Machine, assumptions: Assumptions, timeout_ms: int):

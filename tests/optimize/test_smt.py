@@ -397,3 +397,23 @@ def test_a_change_slower_on_one_input_in_2_to_the_16_is_slower_by_z3_though_no_c
     assert cases_only.passed and not cases_only.slower
     proof = search.proven(assemble(new, routine.cpu), outcome, old, new)
     assert proof.kind == "smt" and proof.slower and proof.smt[0]["no_slower"] is False
+
+
+def test_z3_proves_on_the_specs_domain_not_past_it(tmp_path):
+    """sum3 with `where = "a <= 100"`: a candidate wrong only for X > 200 is proven (the check never
+    runs such a case); without the domain it is refuted with X > 200."""
+    from retro.optimize.formal import Formal
+    routine = _roomy_sum3(tmp_path)
+    old, _ = _rare_wrong(routine)
+    b, c = routine.program.symbols["b_val"], routine.program.symbols["c_val"]
+    body = (_i("TXA"), _i("CLC"), Instruction("ADC", "abs", b), _i("CLC"), Instruction("ADC", "abs", c),
+            _i("CPX #$C8"), Instruction("BCC", "rel", None, "done"), _i("LDA #$00"), _i("RTS"))
+    new = Listing(old.origin, body, (("done", len(body) - 1), ("sum3", 0)))
+    size = sum(i.length for i in old.instructions)
+    anywhere = Formal(routine, bytearray(0x10000), size, frozenset({"A"}), {}).prove(old, new)
+    assert anywhere.result.status == "refuted" and anywhere.counterexample.inputs[0] >= 0xC8
+    spec = tmp_path / "sum3.toml"
+    spec.write_text(spec.read_text() + '\n[cases]\nwhere = "a <= 100"\n')
+    narrowed = load_spec(spec)
+    inside = Formal(narrowed, bytearray(0x10000), size, frozenset({"A"}), {}).prove(old, new)
+    assert inside.result.status == "proven", inside.result
