@@ -68,7 +68,8 @@ def main() -> None:
                 assert prover.prove(code, routine.entry_address).passed
             sweep_seconds = (time.process_time() - began) / args.repeat
             sweep, ratio = f"{sweep_seconds:.3f}", f"{z3_seconds / sweep_seconds:.2f}x"
-        print(f"{name:<42}{z3_seconds:>10.3f}{verdict.result.status:>10}{sweep:>10}{routine.input_space():>28,}{ratio:>12}")
+        print(f"{name:<42}{z3_seconds:>10.3f}{verdict.result.status:>10}{sweep:>10}{routine.input_space():>28,}"
+              f"{ratio:>12}")
 
 
 if __name__ == "__main__":

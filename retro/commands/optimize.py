@@ -109,7 +109,8 @@ def lines(result: Optimized) -> list[str]:
     out += cost_table(result.before, result.after, o.routine.machine)
     p = result.proof
     kind = {"exhaustive": "exhaustive: every input of the space",
-            "smt": "smt: z3 proved every change equal on the outputs from every entry state, and the spec's cases ran",
+            "smt": "smt: z3 proved every change equal on the outputs from every entry state in the domain, "
+                   "and the spec's cases ran",
             "sampled": "sampled: random and boundary cases only"}
     out.append(f"proof: {kind.get(p['kind'], p['kind'])} ({p['cases']:,} cases, {p['calls']:,} calls on the "
                f"{p['engine']} engine, free entry state random per case); retro check: {p['check']['cases']:,} cases, "
@@ -130,7 +131,8 @@ def as_json(result: Optimized) -> dict:
             "changes": [{"at": c.start, "removed": len(c.removed), "added": len(c.added), "kind": c.kind}
                         for c in o.changes],
             "proof": result.proof, "tested": o.tested, "routine_tests": o.routine_tests, "proofs": o.proofs,
-            "failed_proofs": o.failed_proofs, "seconds": round(o.seconds, 3), "smt_seconds": round(o.smt_seconds, 3), "source": result.source,
+            "failed_proofs": o.failed_proofs, "seconds": round(o.seconds, 3), "smt_seconds": round(o.smt_seconds, 3),
+            "source": result.source,
             "diff": result.diff, "written": result.written}
 
 

@@ -82,7 +82,8 @@ class Formal:
         # an output's bytes are random on entry in the search's runs (evaluate.scratch_of): never assumed
         outputs = {p.address for port in routine.outputs for p in port.places if p.kind == "memory"}
         code = range(routine.entry_address, routine.entry_address + size)
-        spans = [(program.origin, program.end)] + [(b.address, b.address + len(contents[b.name])) for b in routine.memory]
+        spans = [(program.origin, program.end)]
+        spans += [(b.address, b.address + len(contents[b.name])) for b in routine.memory]
         self.starts_with = {a: int(image[a]) for lo, hi in spans for a in range(lo, min(hi, 0x10000))
                             if a not in code and a not in inputs and a not in outputs}
         self.code_range = (routine.entry_address, routine.entry_address + size)
@@ -127,9 +128,11 @@ class Formal:
         stable = all(known(i) and i.mnemonic not in ("JSR", "JMP", "RTI", "BRK")
                      and _stores_known(i, self.starts_with, self.code_range) for i in everything if i.mnemonic != "RTS")
         flags = {}
-        if "D" in self.flags and not any(i.mnemonic in WRITES_D or not known(i) or i.mnemonic == "JSR" for i in everything):
+        if "D" in self.flags and not any(i.mnemonic in WRITES_D or not known(i) or i.mnemonic == "JSR"
+                                         for i in everything):
             flags["D"] = self.flags["D"]
-        fixed = self._fixed(before.instructions + after.instructions) if stable else {}  # else any byte may have changed
+        # unstable: a store somewhere may have changed any byte, so none is assumed
+        fixed = self._fixed(before.instructions + after.instructions) if stable else {}
         assumptions = smt.Assumptions(fixed, flags=flags, code_range=self.code_range)
         live = live_after(old, self.at_return)[stop_old - 1]
         return smt.prove_equivalent(before, after, live, assumptions, shown=self.shown)

@@ -402,7 +402,8 @@ class Search:
             # the whole routine's cycles are z3's too: slower on some entry state the cases may have missed
             slower = proof.slower or (verdict.scope == "routine" and result.no_slower is False)
             return replace(proof, kind="smt", smt=[verdict.record()], slower=slower,
-                           note=f"z3 proved the {verdict.scope} equal on the outputs from every entry state")
+                           note=f"z3 proved the {verdict.scope} equal on the outputs from every entry state "
+                                "in the domain")
         witness = verdict.counterexample
         if witness is not None:
             columns = [np.asarray([v], dtype=np.int64) for v in witness.inputs]

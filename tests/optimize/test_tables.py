@@ -44,7 +44,8 @@ def test_a_table_does_not_pay_for_itself_in_bytes(tmp_path):
 
 
 def test_an_unknown_table_is_one_line_exit_2(tmp_path, capsys):
-    with pytest.raises(InputError, match=r"--tables: 'squares' is not a \[memory\] block of .*times3.toml \(its blocks: times3\)"):
+    wanted = r"--tables: 'squares' is not a \[memory\] block of .*times3.toml \(its blocks: times3\)"
+    with pytest.raises(InputError, match=wanted):
         optimize_command(SPEC, budget=1, tables=("squares",), out=str(tmp_path / "t"))
     assert cli_main(["optimize", SPEC, "--tables", "squares", "--budget", "1", "--out", str(tmp_path / "u")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
