@@ -259,7 +259,8 @@ def test_json_output_names_the_proof(tmp_path, capsys):
     code = cli_main(["optimize", str(EXAMPLES / "clamp.toml"), "--budget", "1", "--json", "--out", str(tmp_path)])
     data = json.loads(capsys.readouterr().out)
     assert code == 0 and data["proof"]["kind"] == "exhaustive" and data["proof"]["space"] == 256
-    assert set(data["before"]) == {"worst", "mean", "best", "bytes", "raster"}
+    assert set(data["before"]) == {"worst", "mean", "best", "bytes", "table_bytes", "raster"}
+    assert data["proof"]["smt"] == [] and data["before"]["table_bytes"] == 0  # a sweep: no z3; no table allowed
 
 
 # ---- the sources assemble back to the routine's bytes with the real assemblers --------------------
