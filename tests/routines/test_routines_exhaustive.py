@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import os
 
-import numpy as np
 import pytest
 
 from retro.analysis.check import run_checks, static_bounds
@@ -60,39 +59,16 @@ def test_aabb8_sweep_is_every_input_of_each_axis_and_agrees_with_the_reference()
     test goes). Its blocks on the compiled engine (the batched core without numba) against the
     reference inside the domain (sizes >= 1): the full 3 x 2^32 runs with RETRO_EXHAUSTIVE=1 (`retro check aabb8 --exhaustive`), a
     slice here (one block in 64, of two positions of box A without it: 786,432 calls)."""
-    from itertools import islice
+    from aabb8_slice import sweep_slice_mismatches
 
-    from retro.cpu.compiled import numba_problem
-    from retro.routines.builtin_cases import AABB8_OVERLAPPING, aabb8_sweep
-    from retro.routines.runner import RoutineRunner
+    from retro.routines.builtin_cases import AABB8_OVERLAPPING
 
-    names = "ax ay aw ah bx by bw bh".split()
     x_held, a_first, b_first = (AABB8_OVERLAPPING[k] for k in ("x", "y_a_first", "y_b_first"))
     assert reference.aabb8(10, x_held[0], 5, x_held[1], 12, x_held[2], 5, x_held[3])  # y overlaps
     assert a_first[0] < a_first[2] and b_first[0] >= b_first[2]  # each way of the x test's CMP
     assert all(reference.aabb8(h[0], 10, h[1], 5, h[2], 12, h[3], 5) for h in (a_first, b_first))
     starts = range(256) if FULL else (0, 255)
     step = 64  # the full sweep: test_check_of_each_routine_finds_no_mismatch with RETRO_EXHAUSTIVE=1
-    routine = get("aabb8")
-    runner = RoutineRunner(routine, routine.seed)
-    run = runner.run_batch if numba_problem() else runner.run_compiled
-    blocks = aabb8_sweep(starts)
-    seen = 0
-    for section, (swept, position, other) in enumerate((("aw bw", "ax", "bx"), ("ah bh", "ay", "by"),
-                                                         ("ah bh", "ay", "by"))):
-        for k, block in enumerate(islice(blocks, len(starts) * 256)):
-            if k % step:
-                continue
-            size, other_size = (block[name] for name in swept.split())
-            assert len(size) == 1 << 16 and len(set((size * 256 + other_size).tolist())) == 1 << 16
-            assert block[position][0] == starts[k // 256] and block[other][0] == k % 256
-            columns = [block[name] for name in names]
-            outcome = run(columns)
-            assert not outcome.error.any()
-            expected = reference.aabb8(*columns).astype(np.int64)
-            inside = np.logical_and.reduce([block[name] >= 1 for name in ("aw", "ah", "bw", "bh")])  # `where`
-            wrong = np.flatnonzero((outcome.outputs[0] != expected) & inside)
-            assert not len(wrong), (section, [int(c[wrong[0]]) for c in columns])
-            seen += len(size)
-    assert next(blocks, None) is None
+    wrong, seen = sweep_slice_mismatches(get("aabb8"), starts, step)
+    assert not wrong, wrong
     assert seen == 3 * len(starts) * 256 * (1 << 16) // step
