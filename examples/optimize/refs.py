@@ -5,6 +5,10 @@ def umax(a, m):
     return max(a, m)
 
 
+def umin(a, m):
+    return min(a, m)
+
+
 def absdiff(a, m):
     return abs(a - m)
 
