@@ -105,7 +105,8 @@ class Formal:
             return None
         before = smt.Fragment(old.instructions, old.origin, dict(old.labels), self.cpu, returns=True)
         after = smt.Fragment(new.instructions, new.origin, dict(new.labels), self.cpu, returns=True)
-        if all(smt.supported(i, self.cpu) or i.mnemonic == "RTS" for i in old.instructions + new.instructions):
+        if all(smt.supported(i, self.cpu) or i.mnemonic == "RTS" or smt.jumps_ahead(i)
+               for i in old.instructions + new.instructions):
             assumptions = smt.Assumptions(self._fixed(old.instructions + new.instructions), dict(self.registers),
                                           dict(self.flags), self.inputs, self.code_range)
             result = smt.prove_equivalent(before, after, self.at_return, assumptions, shown=self.shown)

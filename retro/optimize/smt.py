@@ -9,8 +9,9 @@ page, a branch's +1 taken and +1 more into another page: retro.cpu.opcodes, retr
 Decimal mode is the NMOS 6510's (64doc: ADC's Z from the binary sum, N and V from the half-adjusted
 result, C from the adjusted high nybble; SBC's flags all from the binary difference, the accumulator
 adjusted per nybble), and the 2A03 ignores D, as retro.cpu.mpu has them. The 65C02, the stack
-(PHA, PLA, PHP, PLP, TSX, TXS), JMP, JSR, RTS, RTI, BRK and the undocumented opcodes are not
-translated: a fragment holding one is `unsupported`, never proven.
+(PHA, PLA, PHP, PLP, TSX, TXS), JSR, RTS, RTI, BRK, JMP other than to a label ahead in the
+fragment (`jumps_ahead`: an edge always taken, its 3 cycles counted) and the undocumented opcodes are
+not translated: a fragment holding one is `unsupported`, never proven.
 
 Entry state: every register, flag and memory byte is a free variable, except what the caller can
 stand behind (`Assumptions`): the code block's bytes (each side its own), the bytes of the program
@@ -212,6 +213,12 @@ def supported(instruction: Instruction, cpu: str) -> bool:
             and (instruction.mode != "rel" or isinstance(instruction.target, str)))
 
 
+def jumps_ahead(instruction: Instruction) -> bool:
+    """A JMP absolute to a label: `run` follows it as an edge when the label is ahead in the
+    fragment (a jump back, a loop, stays unsupported)."""
+    return instruction.mnemonic == "JMP" and instruction.mode == "abs" and isinstance(instruction.target, str)
+
+
 def step(state: Machine, instruction: Instruction, cpu: str) -> Machine:
     """The state after one non-branch instruction (branches: `run`)."""
     name, mode = instruction.mnemonic, instruction.mode
@@ -320,8 +327,8 @@ class Fragment:
 
 
 def run(fragment: Fragment, state: Machine) -> Machine:
-    """The state after the fragment: forward branches to a label inside it or just after it are
-    followed as paths and joined where they meet; anything else is Unsupported."""
+    """The state after the fragment: forward branches and JMPs to a label inside it or just after it
+    are followed as paths and joined where they meet; anything else is Unsupported."""
     instructions = fragment.instructions
     n = len(instructions)
     rts = _op(fragment.cpu, "RTS", "imp") if fragment.returns else None
@@ -337,6 +344,14 @@ def run(fragment: Fragment, state: Machine) -> Machine:
             here = here.copy()
             here.cycles = here.cycles + rts.cycles
             arrivals.setdefault(n, []).append((guard, here))
+            continue
+        if jumps_ahead(instruction):
+            target = fragment.labels.get(instruction.target)
+            if target is None or target <= k:
+                raise Unsupported(f"JMP {instruction.target}: a jump out of the fragment or back")
+            went = here.copy()
+            went.cycles = here.cycles + _op(fragment.cpu, "JMP", "abs").cycles
+            arrivals.setdefault(target, []).append((guard, went))
             continue
         if instruction.mode != "rel":
             arrivals.setdefault(k + 1, []).append((guard, step(here, instruction, fragment.cpu)))
