@@ -458,10 +458,15 @@ class Search:
                 self.samples.add(columns, expected, index, witness)
                 outcome.counterexamples += 1
                 self.refresh_kept(assemble(self.listing, self.routine.cpu))
-                if not self.sample_ok(code):
+                fails = not self.sample_ok(code)
+                # z3 refuted the whole routine on an entry state in the domain: refused even when the
+                # core's run of that state passes (z3 and the core disagree: trust neither to admit it)
+                if fails or verdict.scope == "routine":
                     outcome.failed_proofs += 1
                     return replace(proof, passed=False, smt=[verdict.record()],
-                                   note="z3's counterexample fails on the batched core")
+                                   note="z3's counterexample fails on the batched core" if fails else
+                                   "z3 refuted the routine on an entry state in the domain (its run on the "
+                                   "batched core passed: refused all the same)")
         return replace(proof, smt=[verdict.record()], note=f"random and boundary cases only (z3: {result.status}"
                        f"{': ' + result.reason if result.reason else ''})")
 

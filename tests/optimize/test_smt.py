@@ -295,6 +295,34 @@ def test_a_wrong_candidate_the_cases_miss_is_refuted_and_its_counterexample_join
     assert not search.sample_ok(code)  # the test set now holds the case it fails
 
 
+def test_a_routine_z3_refutes_in_the_domain_is_refused_though_the_core_passes_it(tmp_path):
+    """z3 and the batched core disagree (here: a refutation put in z3's mouth for a right change,
+    STX t / LDA t -> TXA, with an entry state in the domain): the change is refused, never admitted
+    on the cases alone; the state still joins the samples."""
+    from retro.optimize.code import read_listing
+    from retro.optimize.formal import Counterexample, Verdict
+    from retro.optimize.optimizer import Options as SearchOptions
+    from retro.optimize.optimizer import Outcome, Search
+    routine = _roomy_sum3(tmp_path)
+    search = Search(routine, SearchOptions(budget=1))
+    old = read_listing(routine.program, routine.entry_address, routine.cpu)
+    new = old.with_window(0, 2, (_i("TXA"),))
+    code = assemble(new, routine.cpu)
+    witness = Counterexample([0x12, 0x34, 0x56], {"a": 0, "x": 0x12, "y": 0}, 0, {})
+
+    class Disagreeing:
+        def prove(self, before, after):
+            return Verdict("routine", smt.Result("refuted", model={}), witness)
+
+    search.formal = Disagreeing()
+    outcome = Outcome(routine, old, old, None, None)
+    before = len(search.samples)
+    proof = search.proven(code, outcome, old, new)
+    assert search.sample_ok(code)  # the core's run of z3's state passes
+    assert not proof.passed and "refused all the same" in proof.note and outcome.failed_proofs == 1
+    assert len(search.samples) == before + 1
+
+
 def test_z3s_counterexample_of_the_whole_routine_fails_on_the_machine(tmp_path):
     """The inputs and entry state z3 gives, run on the Machine: the candidate's A is not the reference's."""
     from retro.optimize.formal import Formal
