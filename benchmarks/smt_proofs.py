@@ -2,7 +2,8 @@
 batched core's exhaustive sweep of the same routine where one is possible: CPU seconds per proof
 and the ratio. The pairs are the docs' results: |A - m| (the textbook routine and the better one,
 branches joined), sum3's store-and-load to a transfer, two independent instructions of aabb8
-swapped (30 instructions, 5 branches, 2^64 inputs), and times3's table lookup (256 table bytes
+swapped (30 instructions, 5 branches, 2^64 inputs), a wasteful aabb8's branch over a JMP made one
+branch (the JMP an edge z3 follows), and times3's table lookup (256 table bytes
 assumed).
 
     PYTHONPATH=. python benchmarks/smt_proofs.py [--repeat 3]
@@ -16,6 +17,7 @@ from pathlib import Path
 
 from retro.optimize.code import Instruction, Listing, assemble, read_listing
 from retro.optimize.evaluate import PROOF_SPACE, Prover, scratch_of
+from retro.optimize.flow import rewrites
 from retro.optimize.formal import Formal
 from retro.optimize.optimizer import direct_addresses, live_at_return
 from retro.routines.spec import load_spec
@@ -38,6 +40,9 @@ def _pairs():
     aabb8 = load_spec(ROOT / "asm" / "aabb8.toml")
     old = read_listing(aabb8.program, aabb8.entry_address, aabb8.cpu)
     yield "aabb8 (5 branches): EOR / CLC swapped", aabb8, old, old.with_window(8, 10, old.instructions[9:7:-1])
+    aabb8_jmp = load_spec(ROOT / "tests" / "optimize" / "wasteful" / "aabb8_jmp.toml")
+    old = read_listing(aabb8_jmp.program, aabb8_jmp.entry_address, aabb8_jmp.cpu)
+    yield "aabb8_jmp: BCC over JMP -> BCS", aabb8_jmp, old, dict(rewrites(old))["a branch over a JMP inverted"]
     times3 = load_spec(EXAMPLES / "times3.toml")
     old = read_listing(times3.program, times3.entry_address, times3.cpu)
     table = times3.program.symbols["times3_table"]
