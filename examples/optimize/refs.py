@@ -5,6 +5,10 @@ def umax(a, m):
     return max(a, m)
 
 
+def umin(a, m):
+    return min(a, m)
+
+
 def absdiff(a, m):
     return abs(a - m)
 
@@ -23,3 +27,15 @@ def sum_x(a, b):
 
 def copy_b(b):
     return b
+
+
+def sum3(a, b, c):
+    return (a + b + c) & 0xFF
+
+
+def times3(a):
+    return (3 * a) & 0xFF
+
+
+def times3_table():
+    return bytes(times3(a) for a in range(256))

@@ -54,12 +54,12 @@ def _labels(listing: Listing) -> dict[str, int]:
 def optimize(spec: str, *, objective: str = "worst", no_slower: bool = False, budget: float = 30.0,
              window: int = DEFAULT_WINDOW, seed: int | None = None, preserve: tuple[str, ...] = (),
              syntax: str = "acme", out: str = "optimized", progress=None, jobs: int = 1,
-             scheduler: str | None = None) -> Optimized:
+             scheduler: str | None = None, smt: bool = True, tables: tuple[str, ...] = ()) -> Optimized:
     """Search for a faster routine for `spec`; every result is proven before it is reported. The
     search's work units run in this process (`jobs` 1), on `jobs` local Dask workers, or on the
     cluster at `scheduler` (retro.workers)."""
     opts = Options(objective, no_slower, budget, window, seed, tuple(p.upper() for p in preserve), jobs=jobs,
-                   scheduler=scheduler)
+                   scheduler=scheduler, smt=smt, tables=tuple(tables))
     check_options(opts)
     if syntax not in SYNTAXES:
         raise InputError(f"--syntax: {syntax!r} is not one of {', '.join(SYNTAXES)}")
@@ -87,9 +87,9 @@ def optimize(spec: str, *, objective: str = "worst", no_slower: bool = False, bu
                        f"reported (the search never admits a routine a check fails)")
     first, best = outcome.original_proof, outcome.best_proof
     before = cost_row(first.cycles["max"], first.cycles["mean"], first.cycles["min"], code_bytes(outcome.original),
-                      routine.machine)
+                      routine.machine, outcome.table_bytes[0])
     after = cost_row(best.cycles["max"], best.cycles["mean"], best.cycles["min"], code_bytes(outcome.best),
-                     routine.machine)
+                     routine.machine, outcome.table_bytes[1])
     original_names = address_names(routine.program.symbols)
     names = dict(original_names)
     for name, address in _labels(outcome.best).items():
@@ -117,10 +117,16 @@ def lines(result: Optimized) -> list[str]:
            f"({o.failed_proofs} failed, {o.counterexamples} counterexamples added)"]
     out += cost_table(result.before, result.after, o.routine.machine)
     p = result.proof
-    kind = {"exhaustive": "exhaustive: every input of the space", "sampled": "sampled: random and boundary cases only"}
+    kind = {"exhaustive": "exhaustive: every input of the space",
+            "smt": "smt: z3 proved every change equal on the outputs from every entry state in the domain, "
+                   "and the spec's cases ran",
+            "sampled": "sampled: random and boundary cases only"}
     out.append(f"proof: {kind.get(p['kind'], p['kind'])} ({p['cases']:,} cases, {p['calls']:,} calls on the "
                f"{p['engine']} engine, free entry state random per case); retro check: {p['check']['cases']:,} cases, "
                f"{p['check']['mismatches']} mismatches")
+    for record in p.get("smt") or ():
+        out.append(f"z3 ({record['scope']}): {record['status']} in {record['seconds']:.2f} s"
+                   + (f" ({record['reason']})" if record["reason"] else ""))
     out.append(f"optimal: {p['optimal']}" if p["optimal"] else "optimal: not claimed (the budget ran out before every "
                                                                 "window was searched)")
     out += result.diff or ["(no change)"]
@@ -134,7 +140,8 @@ def as_json(result: Optimized) -> dict:
             "changes": [{"at": c.start, "removed": len(c.removed), "added": len(c.added), "kind": c.kind}
                         for c in o.changes],
             "proof": result.proof, "tested": o.tested, "routine_tests": o.routine_tests, "proofs": o.proofs,
-            "failed_proofs": o.failed_proofs, "seconds": round(o.seconds, 3), "source": result.source,
+            "failed_proofs": o.failed_proofs, "seconds": round(o.seconds, 3), "smt_seconds": round(o.smt_seconds, 3),
+            "source": result.source,
             "diff": result.diff, "written": result.written}
 
 
@@ -154,6 +161,10 @@ def add_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=int, default=None, help="seed of the samples and entry states (default: the spec's)")
     p.add_argument("--preserve", default="", metavar="REGS",
                    help="registers and flags left as the original leaves them, e.g. X,Y,C (default: only the outputs)")
+    p.add_argument("--tables", default="", metavar="NAMES",
+                   help="[memory] blocks a candidate may read with an index, e.g. times3,sqr_lo (their bytes count)")
+    p.add_argument("--no-smt", action="store_true",
+                   help="past the sweep's reach, leave changes to the spec's cases (no z3 proof)")
     p.add_argument("--syntax", default="acme", help=f"source syntax: {', '.join(SYNTAXES)} (default acme)")
     options.out(p, "optimized")
     options.jobs(p, 1)
@@ -163,10 +174,12 @@ def add_options(p: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     preserve = tuple(part.strip() for part in args.preserve.replace(" ", ",").split(",") if part.strip())
+    tables = tuple(part.strip() for part in args.tables.split(",") if part.strip())
     result = optimize(args.spec, objective=args.objective, no_slower=args.no_slower, budget=args.budget,
                       window=args.window, seed=args.seed, preserve=preserve, syntax=args.syntax, out=args.out,
                       jobs=parse_int(args.jobs, field="--jobs", lo=1, hi=MAX_WORKERS),
                       scheduler=args.scheduler or os.environ.get(SCHEDULER_ENV) or None,
+                      smt=not args.no_smt, tables=tables,
                       progress=lambda line: print(f"retro optimize: {line}", file=sys.stderr))
     options.show(lines, as_json if args.json else None, result, indent=1)
     return 0

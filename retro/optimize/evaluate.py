@@ -64,8 +64,10 @@ class LaneRunner:
         self.runner.plan = replace(plan, bytes=plan.bytes + tuple((extra + k, a, 0) for k, a in enumerate(self.scratch)))
         self.origin = routine.program.origin
 
-    def run(self, code: bytes, at: int, columns: list, indices: np.ndarray) -> BatchOutcome:
-        """Run the cases (`indices`: their numbers, which fix their entry state) with `code` at `at`."""
+    def run(self, code: bytes, at: int, columns: list, indices: np.ndarray, pinned: dict | None = None) -> BatchOutcome:
+        """Run the cases (`indices`: their numbers, which fix their entry state) with `code` at `at`;
+        `pinned`: index -> an entry state of its own (`registers`, P `bits`, scratch `memory`), as an
+        SMT counterexample gives it."""
         image = self.runner.call_image
         kept = bytes(image[at:at + len(code)])
         image[at:at + len(code)] = code
@@ -79,6 +81,14 @@ class LaneRunner:
             if self.scratch:
                 rng = np.random.default_rng([self.seed + SCRATCH_SALT, int(indices[0]) if len(indices) else 0])
                 extra = [rng.integers(0, 256, len(indices), dtype=np.int64) for _ in self.scratch]
+            for lane, index in enumerate(indices.tolist()) if pinned and self.fill is not None else ():
+                if index in pinned:
+                    state = pinned[index]
+                    for name, values in registers.items():
+                        values[lane] = state.registers[name]
+                    bits[lane] = state.bits & entry[2]
+                    for k, address in enumerate(self.scratch):
+                        extra[k][lane] = state.memory.get(address, extra[k][lane])
             return self.runner.run_batch(list(columns) + extra, entry=entry)
         finally:
             image[at:at + len(code)] = kept
@@ -103,11 +113,14 @@ class Samples:
     indices: np.ndarray
     expected: list
     added: int = 0  # counterexamples added by proofs
+    pinned: dict = field(default_factory=dict)  # index -> its own entry state (LaneRunner.run)
 
     def __len__(self) -> int:
         return len(self.indices)
 
-    def add(self, columns: list, expected: list, index: int) -> None:
+    def add(self, columns: list, expected: list, index: int, entry=None) -> None:
+        if entry is not None:
+            self.pinned[index] = entry
         self.columns = [np.concatenate([c, extra]) for c, extra in zip(self.columns, columns)]
         self.expected = [np.concatenate([e, extra]) for e, extra in zip(self.expected, expected)]
         self.indices = np.concatenate([self.indices, np.asarray([index], dtype=np.int64)])
@@ -153,7 +166,8 @@ def sample_cases(routine: Routine, seed: int, memory: dict, size: int = SAMPLE) 
 @dataclass
 class Proof:
     """What stands behind a routine: `kind` "exhaustive" (every input of the space, each with the
-    baseline and a random entry state), "sampled" (the spec's random and boundary cases only);
+    baseline and a random entry state), "smt" (the spec's cases, and every change from the original
+    proven by z3: retro.optimize.formal), "sampled" (the spec's random and boundary cases only);
     calls run, the engine, and the first counterexample when it failed."""
 
     kind: str
@@ -167,10 +181,11 @@ class Proof:
     cycles: dict = field(default_factory=dict)  # min, mean, max over the proof's cases (the baseline run)
     note: str = ""
     per_case: list = field(default_factory=list)  # the baseline run's cycles per block (for --no-slower)
+    smt: list = field(default_factory=list)  # kind "smt": the z3 proofs of the changes (retro.optimize.formal)
 
     def record(self) -> dict:
         return {"kind": self.kind, "space": self.space, "cases": self.cases, "calls": self.calls,
-                "engine": self.engine, "passed": self.passed, "note": self.note}
+                "engine": self.engine, "passed": self.passed, "note": self.note, "smt": self.smt}
 
 
 def proof_parts(routine: Routine, seed: int) -> tuple[str, int, list]:

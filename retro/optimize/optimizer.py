@@ -8,14 +8,17 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
+import numpy as np
+
 from retro.errors import InputError, RunError
 from retro.optimize.code import Instruction, Listing, assemble, code_bytes, program_with, read_listing
 from retro.optimize.effects import ALL_MEMORY, windowable, writes_through_index
-from retro.optimize.evaluate import LaneRunner, Proof, Prover, outputs_equal, sample_cases, scratch_of
+from retro.optimize.evaluate import LaneRunner, Proof, Prover, answered, outputs_equal, sample_cases, scratch_of
 from retro.optimize.facts import entry_facts, facts_before, window_agrees
 from retro.optimize.flow import rewrites as flow_rewrites
 from retro.optimize.search import BRANCHES, END, FLAG_BITS, Executor
 from retro.optimize.stochastic import WALK_MOVES
+from retro.optimize.tables import allowed_tables, table_bytes, table_pool
 from retro.optimize.units import SearchContext, WalkResult, WindowResult, run_walk, run_window
 from retro.routines.places import FLAGS, Place, Port
 from retro.routines.spec import Routine
@@ -29,6 +32,7 @@ MIN_WINDOW_SECONDS = 0.5  # ... but at least this long
 SYNTHESIS_LENGTH = 6
 STOCHASTIC_MIN_LIMIT = 200  # cycles a rewrite's call may take at least (else 4 x the best's worst case)
 WALKS_PER_ROUND = 4  # stochastic walks run from the same best routine before the results are looked at
+PINNED_INDEX = 1 << 40  # the case numbers of SMT counterexamples (their entry state is their own)
 
 
 @dataclass(frozen=True)
@@ -44,6 +48,8 @@ class Options:
     stochastic: bool = True  # rewrite at random for the budget the windows leave
     jobs: int = 1  # local worker processes for the work units (1: this process)
     scheduler: str | None = None  # a Dask scheduler's address: the work units run on that cluster
+    smt: bool = True  # past the sweep's reach, prove each change with z3 (retro.optimize.formal)
+    tables: tuple[str, ...] = ()  # [memory] blocks a candidate may read, their bytes counted (retro.optimize.tables)
 
 
 def check_options(options: Options) -> None:
@@ -91,6 +97,8 @@ class Outcome:
     rewrites: int = 0  # stochastic moves tried
     local_rejections: int = 0  # window changes that differ from the window on an entry state the facts allow
     program: object = None  # the new Program
+    smt_seconds: float = 0.0  # CPU seconds in z3
+    table_bytes: tuple = (0, 0)  # bytes of the allowed tables the original and the best routine read
 
 
 def preserved_ports(names: tuple[str, ...]) -> tuple[Port, ...]:
@@ -188,6 +196,13 @@ class Search:
         self.synthesised = False
         self.workers = Workers(options.jobs, options.scheduler)
         self.constant = constant_bytes(routine, self.listing)
+        self.formal = None  # made when a change needs it (retro.optimize.formal)
+        self.tables = allowed_tables(routine, options.tables, self.lanes.runner.memory_values)
+        self.table_pool = table_pool(routine.cpu, self.tables)
+
+    def weight(self, listing: Listing) -> int:
+        """A routine's size: its code's bytes and those of every allowed table it reads."""
+        return code_bytes(listing) + table_bytes(listing, self.tables)
 
     def static(self, low: int, high: int) -> bool:
         """Whether bytes low..high are the routine's own tables: the same on every case, never written."""
@@ -197,7 +212,7 @@ class Search:
 
     def sample_ok(self, code: bytes) -> bool:
         s = self.samples
-        outcome = self.lanes.run(code, self.routine.entry_address, s.columns, s.indices)
+        outcome = self.lanes.run(code, self.routine.entry_address, s.columns, s.indices, s.pinned)
         ok = outputs_equal(outcome, s.expected)
         if self.preserve:
             kept = self.kept_samples
@@ -207,7 +222,7 @@ class Search:
     def refresh_kept(self, code: bytes) -> None:
         if self.preserve:
             s = self.samples
-            outcome = self.lanes.run(code, self.routine.entry_address, s.columns, s.indices)
+            outcome = self.lanes.run(code, self.routine.entry_address, s.columns, s.indices, s.pinned)
             self.kept_samples = outcome.outputs[-len(self.preserve):]
 
     # ---- the loop ------------------------------------------------------------------------------
@@ -228,7 +243,7 @@ class Search:
         self.refresh_kept(code)
         outcome = Outcome(routine, self.listing, self.listing, first, first, proofs=1,
                           prove_seconds=time.process_time() - began_cpu)
-        best_score = score(self.options.objective, first, self.size)
+        best_score = score(self.options.objective, first, self.weight(self.listing))
         current = self.listing
         improved = True
         with session():  # one cluster for every pass (when the units run on one)
@@ -244,11 +259,13 @@ class Search:
                     what = change.what or (f"{change.kind} at instruction {change.start}: {len(change.removed)} -> "
                                            f"{len(change.added)} instructions")
                     self.progress(f"{what}; worst {change.proof.cycles['max']}, mean "
-                                  f"{change.proof.cycles['mean']:.2f}, {code_bytes(current)} bytes")
+                                  f"{change.proof.cycles['mean']:.2f}, {self.weight(current)} bytes")
                     improved = True
             if self.options.stochastic and time.monotonic() < deadline:
                 self.rewrite(outcome, deadline)
         outcome.seconds = time.monotonic() - began
+        outcome.best_proof = chained(outcome)
+        outcome.table_bytes = (table_bytes(self.listing, self.tables), table_bytes(outcome.best, self.tables))
         outcome.program = program_with(routine.program, outcome.best, routine.cpu, self.size)
         return outcome
 
@@ -256,7 +273,7 @@ class Search:
         """What the work units share (retro.optimize.units), as of now (samples grow by counterexamples)."""
         return SearchContext(str(self.routine.spec_path.resolve()), self.seed, self.options.objective, self.scratch,
                              self.addresses, self.at_return, self.preserve, self.samples, self.kept_samples,
-                             self.routine)
+                             self.routine, tuple(self.table_pool))
 
     def rewrite(self, outcome: Outcome, deadline: float) -> None:
         """Stochastic rewriting of the best routine for the rest of the budget (retro.optimize.stochastic):
@@ -264,7 +281,7 @@ class Search:
         seed; their rewrites are proven here in task order and the best proven one is kept."""
         objective = self.options.objective
         limit = max(4 * outcome.best_proof.cycles["max"], STOCHASTIC_MIN_LIMIT)
-        best_score = [score(objective, outcome.best_proof, code_bytes(outcome.best))]
+        best_score = [score(objective, outcome.best_proof, self.weight(outcome.best))]
         walks = [0]
 
         def report(result: WalkResult) -> bool:
@@ -273,14 +290,14 @@ class Search:
             for listing in result.candidates:
                 if time.monotonic() > deadline:
                     return True
-                better = self.better(listing, outcome, best_score[0])
+                better = self.better(outcome.best, listing, outcome, best_score[0])
                 if better is not None:
                     best_score[0] = better[0]
                     outcome.changes.append(Change(0, outcome.best.instructions, listing.instructions, "stochastic",
                                                   better[1]))
                     outcome.best, outcome.best_proof = listing, better[1]
                     self.progress(f"stochastic rewrite: worst {better[1].cycles['max']}, mean "
-                                  f"{better[1].cycles['mean']:.2f}, {code_bytes(listing)} bytes")
+                                  f"{better[1].cycles['mean']:.2f}, {self.weight(listing)} bytes")
             return time.monotonic() > deadline
 
         while time.monotonic() < deadline:
@@ -369,13 +386,13 @@ class Search:
                 outcome.local_rejections += 1  # a sampled proof alone would not stand behind it
                 continue
             new = self.replaced(listing, start, stop, sequence)
-            better = self.better(new, outcome, best_score)
+            better = self.better(listing, new, outcome, best_score)
             if better is not None:
                 return new, better[0], Change(start, tuple(window), tuple(sequence), kind, better[1])
         return None
 
-    def better(self, new: Listing, outcome: Outcome, best_score: tuple) -> tuple[tuple, Proof] | None:
-        """(score, proof) of a candidate listing that fits, passes the samples and its proof (and
+    def better(self, old: Listing, new: Listing, outcome: Outcome, best_score: tuple) -> tuple[tuple, Proof] | None:
+        """(score, proof) of a candidate listing (`new` in place of `old`) that fits, passes the samples and its proof (and
         --no-slower) with a better score than `best_score`; else None."""
         new_code = assemble(new, self.routine.cpu)
         if new_code is None or len(new_code) > self.size:
@@ -383,34 +400,75 @@ class Search:
         outcome.routine_tests += 1
         if not self.sample_ok(new_code):
             return None
-        proof = self.proven(new_code, outcome)
+        proof = self.proven(new_code, outcome, old, new)
         if not proof.passed or (self.options.no_slower and proof.slower):
             return None
-        new_score = score(self.options.objective, proof, len(new_code))
+        new_score = score(self.options.objective, proof, self.weight(new))
         return (new_score, proof) if new_score < best_score else None
 
     def flow_change(self, listing: Listing, outcome: Outcome, best_score: tuple):
         """The first control-flow rewrite (retro.optimize.flow) that is proven and better, as
         (listing, score, change), or None."""
         for what, new in flow_rewrites(listing):
-            better = self.better(new, outcome, best_score)
+            better = self.better(listing, new, outcome, best_score)
             if better is not None:
                 return new, better[0], Change(0, listing.instructions, new.instructions, "flow", better[1], what)
         return None
 
-    def proven(self, code: bytes, outcome: Outcome) -> Proof:
-        """The proof of a candidate; a counterexample joins the samples."""
+    def proven(self, code: bytes, outcome: Outcome, old: Listing | None = None, new: Listing | None = None) -> Proof:
+        """The proof of a candidate (`new` in place of `old`); a counterexample joins the samples."""
         began = time.process_time()
         proof = self.prover.prove(code, self.routine.entry_address)
+        if proof.passed and proof.kind == "sampled" and self.options.smt and old is not None:
+            proof = self.proven_formally(proof, code, old, new, outcome)
         outcome.prove_seconds += time.process_time() - began
         outcome.proofs += 1
-        if not proof.passed:
+        if not proof.passed and proof.counterexample is not None:
             outcome.failed_proofs += 1
             outcome.counterexamples += 1
             columns, expected, index = proof.counterexample
             self.samples.add(columns, expected, index)
             self.refresh_kept(assemble(self.listing, self.routine.cpu))
         return proof
+
+    def proven_formally(self, proof: Proof, code: bytes, old: Listing, new: Listing, outcome: Outcome) -> Proof:
+        """A change the spec's cases passed, proven by z3 (kind "smt"); a counterexample of the whole
+        routine replayed on the batched core, and kept when the candidate fails it there."""
+        from retro.optimize.formal import Formal  # z3 loads only when a proof needs it
+        if self.formal is None:
+            runner = self.prover.baseline.runner
+            self.formal = Formal(self.routine, runner.call_image, self.size, self.at_return, runner.memory_values)
+        verdict = self.formal.prove(old, new)
+        if verdict is None:
+            return proof
+        result = verdict.result
+        outcome.smt_seconds += result.seconds
+        if result.status == "proven":
+            # the whole routine's cycles are z3's too: slower on some entry state the cases may have missed
+            slower = proof.slower or (verdict.scope == "routine" and result.no_slower is False)
+            return replace(proof, kind="smt", smt=[verdict.record()], slower=slower,
+                           note=f"z3 proved the {verdict.scope} equal on the outputs from every entry state "
+                                "in the domain")
+        witness = verdict.counterexample
+        if witness is not None:
+            columns = [np.asarray([v], dtype=np.int64) for v in witness.inputs]
+            expected, counted = answered(self.routine, columns, self.lanes.runner.memory_values)
+            if counted.all():
+                index = PINNED_INDEX + len(self.samples.pinned)
+                self.samples.add(columns, expected, index, witness)
+                outcome.counterexamples += 1
+                self.refresh_kept(assemble(self.listing, self.routine.cpu))
+                fails = not self.sample_ok(code)
+                # z3 refuted the whole routine on an entry state in the domain: refused even when the
+                # core's run of that state passes (z3 and the core disagree: trust neither to admit it)
+                if fails or verdict.scope == "routine":
+                    outcome.failed_proofs += 1
+                    return replace(proof, passed=False, smt=[verdict.record()],
+                                   note="z3's counterexample fails on the batched core" if fails else
+                                   "z3 refuted the routine on an entry state in the domain (its run on the "
+                                   "batched core passed: refused all the same)")
+        return replace(proof, smt=[verdict.record()], note=f"random and boundary cases only (z3: {result.status}"
+                       f"{': ' + result.reason if result.reason else ''})")
 
     @staticmethod
     def replaced(listing: Listing, start: int, stop: int, sequence) -> Listing:
@@ -424,6 +482,19 @@ class Search:
         sequence = tuple(replace(i, target=name) if i.target == END else i for i in sequence)
         labels = listing.labels if names else listing.labels + ((name, stop),)
         return replace(listing, labels=labels).with_window(start, stop, sequence)
+
+
+def chained(outcome: Outcome) -> Proof:
+    """The proof of the best routine against the original: "smt" only when every change on the way
+    was proven by z3 (each step equal to the one before it), else as its own cases have it."""
+    best = outcome.best_proof
+    if best.kind != "smt":
+        return best
+    records = [record for change in outcome.changes for record in change.proof.smt]
+    if all(change.proof.kind == "smt" for change in outcome.changes):
+        return replace(best, smt=records)
+    return replace(best, kind="sampled", smt=records,
+                   note="random and boundary cases only (an earlier change was not proven by z3)")
 
 
 def optimize(routine: Routine, options: Options, progress: Callable[[str], None] | None = None) -> Outcome:

@@ -45,6 +45,7 @@ class SearchContext:
     samples: Samples
     kept: list | None = None  # the original's preserved outputs on the samples
     routine: Routine | None = field(default=None, compare=False, repr=False)
+    table_pool: tuple[Instruction, ...] = ()  # reads of the [memory] tables the user allows (retro.optimize.tables)
 
     def __getstate__(self) -> dict:
         state = dict(self.__dict__)
@@ -85,7 +86,7 @@ def window_states(context: SearchContext, code: bytes, start_address: int):
     patched = bytearray(code)
     patched[start_address - routine.entry_address] = BRK
     s = context.samples
-    outcome = runner.run(bytes(patched), routine.entry_address, s.columns, s.indices)
+    outcome = runner.run(bytes(patched), routine.entry_address, s.columns, s.indices, s.pinned)
     lanes = np.flatnonzero(outcome.error == LaneError.BRK)
     return state_of(outcome.outputs, context.addresses, lanes), lanes, runner
 
@@ -147,7 +148,7 @@ def run_window(context: SearchContext, listing: Listing, start: int, stop: int, 
         return result
     window = listing.instructions[start:stop]
     executor = Executor(cpu, bytes(probe.runner.call_image), len(lanes), addresses[start])
-    pool = instruction_pool(cpu, listing, window, context.addresses)
+    pool = instruction_pool(cpu, listing, window, context.addresses) + list(context.table_pool)
     if kind == "synthesis":
         state, lanes = _first_lanes(state, lanes, SYNTHESIS_LANES)
         target, live = synthesis_target(context, state, lanes)
@@ -204,7 +205,7 @@ def run_walk(context: SearchContext, start: Listing, limit: int, size_limit: int
 
     def cost(code: bytes):
         s = context.samples
-        run = lanes.run(code, routine.entry_address, s.columns, s.indices)
+        run = lanes.run(code, routine.entry_address, s.columns, s.indices, s.pinned)
         ok = outputs_equal(run, s.expected)
         if context.preserve:
             ok &= outputs_equal(run, [None] * len(routine.outputs) + list(context.kept), skip=True)
@@ -215,6 +216,6 @@ def run_walk(context: SearchContext, start: Listing, limit: int, size_limit: int
         value = {"worst": float(cycles.max()), "mean": float(cycles.mean()), "bytes": float(len(code))}[objective]
         return int((~ok).sum()), value
 
-    pool = instruction_pool(routine.cpu, start, (), context.addresses)
+    pool = instruction_pool(routine.cpu, start, (), context.addresses) + list(context.table_pool)
     result.candidates, result.tried = walk(start, cost, pool, routine.cpu, size_limit, moves, seed)
     return result

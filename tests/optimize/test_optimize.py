@@ -14,11 +14,12 @@ import pytest
 from retro.analysis.check import check_routine
 from retro.cli import main as cli_main
 from retro.commands.check import failed
+from retro.commands.optimize import lines as report_lines
 from retro.commands.optimize import optimize as optimize_command
 from retro.errors import InputError
 from retro.optimize.code import Instruction, Listing, assemble, read_listing
 from retro.optimize.effects import live_after
-from retro.optimize.evaluate import LaneRunner, Prover, outputs_equal, sample_cases, scratch_of
+from retro.optimize.evaluate import PROOF_SPACE, LaneRunner, Prover, outputs_equal, sample_cases, scratch_of
 from retro.optimize.optimizer import Options, optimize
 from retro.optimize.syntax import SYNTAXES, format_source
 from retro.paths import ASM_DIR
@@ -168,9 +169,10 @@ def test_stochastic_rewriting_alone_drops_the_waste_and_proves_it():
     assert not failed([check]) and check.totals.cycles_max == outcome.best_proof.cycles["max"]
 
 
-@pytest.mark.parametrize("name, textbook_worst", [("umax", 14), ("absdiff", 17), ("clamp", 12), ("overlap8", 20)])
+@pytest.mark.parametrize("name, textbook_worst", [("umax", 14), ("umin", 14), ("absdiff", 17), ("clamp", 12),
+                                                 ("overlap8", 20)])
 def test_short_specs_end_at_least_as_fast_as_the_textbook(tmp_path, name, textbook_worst):
-    result = optimize_command(str(EXAMPLES / f"{name}.toml"), budget=6, out=str(tmp_path))
+    result = optimize_command(str(EXAMPLES / f"{name}.toml"), budget=4, out=str(tmp_path))
     assert result.before["worst"] == textbook_worst  # measured: the textbook routine as written
     assert result.after["worst"] <= textbook_worst
     assert not failed([check_routine(str(tmp_path / f"{name}_optimized.toml"), exhaustive=True)])
@@ -204,6 +206,20 @@ def test_no_builtin_routine_comes_back_failing_its_check(tmp_path, spec):
     check = check_routine(str(tmp_path / f"{result.outcome.routine.name}_optimized.toml"), search_budget=0)
     assert not failed([check])
     assert result.after["worst"] <= result.before["worst"]
+    _assert_the_proof_says_what_stands_behind_it(result)
+
+
+def _assert_the_proof_says_what_stands_behind_it(result) -> None:
+    """One of the three kinds, the one the space and the changes allow, in the JSON and the report."""
+    proof, changes = result.proof, result.outcome.changes
+    assert proof["passed"] and proof["kind"] in ("exhaustive", "smt", "sampled")
+    assert (proof["kind"] == "exhaustive") == (proof["space"] <= PROOF_SPACE)
+    if proof["kind"] == "smt":  # every change on the way proven by z3
+        assert changes and all(c.proof.kind == "smt" for c in changes)
+        assert len(proof["smt"]) == len(changes) and all(r["status"] == "proven" for r in proof["smt"])
+    if proof["kind"] == "sampled":
+        assert not changes or any(c.proof.kind == "sampled" for c in changes)
+    assert any(line.startswith(f"proof: {proof['kind']}: ") for line in report_lines(result))
 
 
 @pytest.mark.parametrize("syntax", SYNTAXES)
@@ -259,7 +275,8 @@ def test_json_output_names_the_proof(tmp_path, capsys):
     code = cli_main(["optimize", str(EXAMPLES / "clamp.toml"), "--budget", "1", "--json", "--out", str(tmp_path)])
     data = json.loads(capsys.readouterr().out)
     assert code == 0 and data["proof"]["kind"] == "exhaustive" and data["proof"]["space"] == 256
-    assert set(data["before"]) == {"worst", "mean", "best", "bytes", "raster"}
+    assert set(data["before"]) == {"worst", "mean", "best", "bytes", "table_bytes", "raster"}
+    assert data["proof"]["smt"] == [] and data["before"]["table_bytes"] == 0  # a sweep: no z3; no table allowed
 
 
 # ---- the sources assemble back to the routine's bytes with the real assemblers --------------------

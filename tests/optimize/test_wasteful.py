@@ -58,6 +58,14 @@ def test_a_wasteful_routine_reaches_the_real_cost(tmp_path, name, waste):
     assert result.after["worst"] <= worst and result.after["bytes"] <= size, waste
     check = check_routine(str(tmp_path / f"{name}_optimized.toml"), search_budget=0)
     assert not failed([check]) and check.totals.cycles_max <= result.after["worst"]
+    proof = result.proof
+    if proof["kind"] == "smt":  # every change proven by z3, none left to the cases
+        assert proof["smt"] and all(r["status"] == "proven" for r in proof["smt"]), proof["smt"]
+    if name.startswith("aabb8"):  # past the sweep's reach: z3 or the cases stand behind it; a slice checks
+        from aabb8_slice import sweep_slice_mismatches
+        assert proof["kind"] in ("smt", "sampled")
+        wrong, _ = sweep_slice_mismatches(load_spec(tmp_path / f"{name}_optimized.toml"), (0, 255), 64)
+        assert not wrong, wrong
 
 
 # ---- the control-flow rewrites (retro.optimize.flow) ----------------------------------------------
@@ -145,13 +153,14 @@ def test_a_window_change_wrong_on_an_unsampled_state_is_refused():
 
 @pytest.mark.exhaustive
 def test_a_wasteful_aabb8_result_passes_the_exhaustive_sweep(tmp_path):
-    """The windows' changes on aabb8 stand on a sampled proof: the facts check must keep out the
-    ones the sweep (`retro check --exhaustive`, 3 x 2^32 calls) would fail. CI runs a slice of the
-    sweep (tests/aabb8_slice.py); RETRO_EXHAUSTIVE=1 the whole check."""
+    """Without z3 (--no-smt) the windows' changes on aabb8 stand on a sampled proof: the facts check
+    must keep out the ones the sweep (`retro check --exhaustive`, 3 x 2^32 calls) would fail. CI runs
+    a slice of the sweep (tests/aabb8_slice.py); RETRO_EXHAUSTIVE=1 the whole check. (With z3 the
+    same change is proven on the whole routine: test_a_wasteful_routine_reaches_the_real_cost.)"""
     from aabb8_slice import sweep_slice_mismatches
 
-    result = optimize_command(str(WASTEFUL / "aabb8_sec.toml"), budget=BUDGET, out=str(tmp_path))
-    assert result.proof["kind"] == "sampled"
+    result = optimize_command(str(WASTEFUL / "aabb8_sec.toml"), budget=BUDGET, out=str(tmp_path), smt=False)
+    assert result.proof["kind"] == "sampled" and not result.proof["smt"]
     optimized = tmp_path / "aabb8_sec_optimized.toml"
     if FULL:
         check = check_routine(str(optimized), exhaustive=True, search_budget=0)
