@@ -227,6 +227,10 @@ def _close(client, cluster, pids: list[int]) -> None:
     ends with os._exit, which runs no finalizer: else multiprocessing's resource tracker reports them
     as leaked)."""
     if interrupts.stopping():
+        # the teardown cuts the cluster's connections on purpose: distributed's loggers would print each
+        # cut as a traceback (its comms log from their own threads until the process ends), so they are
+        # silenced for the rest of this process (retro itself does not log)
+        logging.disable(logging.CRITICAL)
         for nanny in cluster.workers.values():
             nanny.close_gracefully(reason="retro-stop")  # else a nanny restarts a worker that dies
         _kill(pids)
