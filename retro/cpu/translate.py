@@ -27,6 +27,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
+from retro.cpu.mpu import FLAG_D
 from retro.cpu.opcodes import DOCUMENTED, MODE_LENGTH, OPCODE_TABLE, OPCODE_TABLE_65C02, RESERVED, STABLE, Op
 from retro.cpu.timing import (
     BRANCH_CONDITIONS,
@@ -626,10 +627,7 @@ def decimal_free(instructions: Iterable[Op | None], sets: tuple) -> bool:
     P: then a call entered with D clear runs in binary mode throughout, and ADC and SBC are translated
     for binary mode only (a call entered with D set falls back: FALLBACK_DECIMAL)."""
     return (not any(op is not None and op.mnemonic in ("SED", "PLP") for op in instructions)
-            and not any(what == SET_P or (what == SET_FLAG and shift == DECIMAL_BIT) for _, shift, what in sets))
-
-
-DECIMAL_BIT = 0x08  # P's D flag
+            and not any(what == SET_P or (what == SET_FLAG and shift == FLAG_D) for _, shift, what in sets))
 
 
 def _placing(places: tuple, sets: tuple) -> str:

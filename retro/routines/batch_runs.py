@@ -148,7 +148,7 @@ def compiled_routine(runner: RoutineRunner):
     """The routine compiled (`retro.cpu.compiled`), made on first use and again when the code bytes
     changed (set_memory); Untranslatable when the compiled engine does not take it."""
     from retro.cpu.compiled import SET_FLAG, SET_REGISTERS, compile_routine
-    from retro.cpu.translate import DECIMAL_BIT
+    from retro.cpu.mpu import FLAG_D
 
     image = bytes(runner.call_image)
     held = runner._compiled
@@ -165,7 +165,7 @@ def compiled_routine(runner: RoutineRunner):
                               len(runner.routine.inputs), places, sets,
                               lanes=tuple(a for _, addresses in plan.tables for a in addresses),
                               outputs=tuple(int(a) for a in plan.output_addresses),
-                              decimal_entry=bool(plan.base_flags & DECIMAL_BIT))
+                              decimal_entry=bool(plan.base_flags & FLAG_D))
     runner._compiled = (routine, [(a, image[a]) for a in sorted(routine.translation.code_bytes)], image)
     return routine
 
