@@ -58,6 +58,7 @@ COMPILED_TESTS = ("tests/cpu/test_compiled.py",)
 COMPILED_VECTOR_TESTS = ("tests/cpu/test_compiled_vectors.py",)  # needs RETRO_CPU_VECTORS
 WORKER_TESTS = ("tests/test_workers.py",)
 STREAM_TESTS = ("tests/routines/test_case_stream.py",)
+GRID_TESTS = ("tests/routines/test_grid_columns.py", "tests/routines/test_case_stream.py")
 FLOW_TESTS = ("tests/cpu/test_flow_values.py", "tests/routines/test_static_smc.py")
 COMMAND_TESTS = ("tests/test_commands.py", "tests/test_cli_foundation.py", "tests/routines/test_routines_cli.py")
 
@@ -272,7 +273,20 @@ MUTANTS = [
     Mutant("grid-sweep-made-from-its-start", "retro/routines/cases.py",
            "        lo = start\n        start = 0\n", "        lo = 0\n        start = 0\n", STREAM_TESTS),
     Mutant("grid-first-axis-fastest", "retro/routines/grid.py",
-           "zip(reversed(self.names), reversed(self.values))", "zip(self.names, self.values)", STREAM_TESTS),
+           "for index in reversed(range(len(self.values))):", "for index in range(len(self.values)):", GRID_TESTS),
+    Mutant("grid-first-run-cut-at-the-end", "retro/routines/grid.py",
+           "runs[0] -= lo - first * stride", "runs[-1] -= lo - first * stride", GRID_TESTS),
+    Mutant("grid-period-from-its-start", "retro/routines/grid.py",
+           "made.append(self._periodic(index, stride, lo % period, n))", "made.append(self._periodic(index, stride, 0, n))",
+           GRID_TESTS),
+    Mutant("grid-kept-period-without-its-phase", "retro/routines/grid.py",
+           "key = (index, phase, n)", "key = (index, n)", GRID_TESTS),
+    Mutant("grid-make-writes-the-shared-columns", "retro/routines/grid.py",
+           "view = _read_only(axis.array)", "view = axis.array", GRID_TESTS),
+    Mutant("grid-known-column-negative-passes", "retro/routines/cases.py",
+           "if extremes[0] < 0 or extremes[1] >= limit:", "if extremes[1] >= limit:", GRID_TESTS),
+    Mutant("column-fits-without-negatives", "retro/routines/cases.py",
+           "column.view(np.uint64).max() < limit", "column.max() < limit", GRID_TESTS),
     Mutant("stop-leaves-the-cluster-open", "retro/workers.py",
            "            cluster.close(timeout=STOP_CLOSE_SECONDS)\n", "            pass\n",
            ("tests/test_workers.py::test_ctrl_c_cancels_the_sweep_and_leaves_no_worker",)),

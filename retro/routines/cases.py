@@ -146,8 +146,9 @@ def chunks(cases: Iterable[tuple], size: int = CHUNK) -> Iterator[list[tuple]]:
 
 def batches(parts: list[Part], size: int) -> Iterator[Columns]:
     """The parts' cases as column blocks of `size` cases (the last one shorter), in case order; fewer
-    when a case holds many values (table inputs), so that a block stays within BLOCK_BYTES. Each block
-    is a fresh copy: the parts' blocks are let go as soon as they are used up."""
+    when a case holds many values (table inputs), so that a block stays within BLOCK_BYTES. The parts'
+    blocks are let go as soon as they are used up; a block's columns are read, never written (a grid's
+    may be shared with other blocks)."""
     blocks = chain.from_iterable(part.blocks() for part in parts)
     first = next(blocks, None)
     if first is not None:
@@ -203,7 +204,8 @@ def _cases_from(parts: list[Part], first: int, counted: Callable[[int, int], Non
 
 
 def rechunked(blocks: Iterable[Columns], size: int) -> Iterator[Columns]:
-    """Column blocks cut and joined into blocks of `size` cases (the last one shorter), each a fresh copy."""
+    """Column blocks cut and joined into blocks of `size` cases (the last one shorter): a contiguous block
+    of `size` cases passed on as it is, the others copied."""
     pending: deque[Columns] = deque()
     offset = count = 0  # where the first pending block's unused cases start; cases pending in all
     for block in blocks:
@@ -218,7 +220,12 @@ def rechunked(blocks: Iterable[Columns], size: int) -> Iterator[Columns]:
 
 
 def _take(pending: deque, offset: int, size: int) -> tuple[Columns, int]:
-    """`size` cases from the front of `pending` (the first block from `offset`), copied; the new offset."""
+    """`size` cases from the front of `pending` (the first block from `offset`; a whole contiguous block as it
+    is, else copied); the new offset."""
+    block = pending[0]
+    if not offset and len(block[0]) == size and all(column.flags.c_contiguous for column in block):  # passed on
+        pending.popleft()
+        return block, 0
     pieces = []
     while size:
         block = pending[0]
@@ -569,10 +576,10 @@ def _grid_blocks(routine: Routine, grids: list[Grid], start: int = 0) -> Iterato
         while lo < grid.count:
             hi = min(grid.count, (lo // GRID_BLOCK + 1) * GRID_BLOCK)
             try:
-                block = grid.block(lo, hi, make)
+                block, known = grid.made_block(lo, hi, make)
             except ValueError as exc:
                 raise InputError(f"{where}: {exc}") from None
-            yield _block_columns(routine, block, f"{where} (Grid {number}, cases {lo:,}..{hi - 1:,})")
+            yield _block_columns(routine, block, f"{where} (Grid {number}, cases {lo:,}..{hi - 1:,})", known)
             lo = hi
 
 
@@ -628,8 +635,9 @@ def _function_blocks(routine: Routine, key: str, made, expected: int | None = No
     return produced
 
 
-def _block_columns(routine: Routine, block, where: str) -> Columns:
-    """One column block (a dict of arrays by input name), checked: every input, one length, widths."""
+def _block_columns(routine: Routine, block, where: str, known: dict[str, tuple[int, int]] | None = None) -> Columns:
+    """One column block (a dict of arrays by input name), checked: every input, one length, widths (`known`:
+    the least and greatest value of the columns whose values the caller knows, by name: a grid's)."""
     if not isinstance(block, dict):
         raise InputError(f"{where}: after a column block (a dict of arrays) every item must be one, got "
                          f"{type(block).__name__}")
@@ -642,8 +650,8 @@ def _block_columns(routine: Routine, block, where: str) -> Columns:
         if columns and len(column) != len(columns[0]):
             raise InputError(f"{where}: column {port.name} has {len(column)} cases, {routine.inputs[0].name} "
                              f"{len(columns[0])}")
-        _check_column_fits(port, column, where)
-        columns.append(column.astype(np.int64, copy=False))
+        _check_column_fits(port, column, where, None if known is None else known.get(port.name))
+        columns.append(column if column.dtype == np.int64 else column.astype(np.int64))
     return columns
 
 
@@ -671,10 +679,17 @@ def _port_column(port: Port, values, where: str) -> np.ndarray:
     return column
 
 
-def _check_column_fits(port: Port, column: np.ndarray, where: str) -> None:
+def _check_column_fits(port: Port, column: np.ndarray, where: str, extremes: tuple[int, int] | None = None) -> None:
+    """Every value of the column within the port's width (`extremes`: its least and greatest value, known)."""
     limit = 1 << (8 if port.table else port.bits)
-    if column.size and (column.min() < 0 or column.max() >= limit):
-        bad = column.min() if column.min() < 0 else column.max()
+    if not column.size:
+        return
+    if extremes is None:
+        if column.dtype == np.int64 and column.view(np.uint64).max() < limit:  # one pass: a negative is huge there
+            return
+        extremes = (column.min(), column.max())
+    if extremes[0] < 0 or extremes[1] >= limit:
+        bad = extremes[0] if extremes[0] < 0 else extremes[1]
         raise InputError(f"{where}: column {port.name} holds {int(bad)}, which does not fit in {port.describe()} "
                          f"(0..{limit - 1})")
 

@@ -16,6 +16,7 @@ Only numpy here: the specs' own modules import it.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -36,30 +37,67 @@ class Grid:
         self.values = tuple(_axis(name, axis) for name, axis in axes.items())
         self.make = make
         self.count = int(np.prod([len(v) for v in self.values], dtype=object))
+        self._kept: dict[tuple[int, int, int], _Column] = {}  # periodic columns by (axis, phase, length)
+        self._kept_bytes = 0
+        self._writes_inputs = False  # make writes into its columns: it gets copies
 
     def __repr__(self) -> str:
         return f"Grid({', '.join(f'{n}: {len(v)}' for n, v in zip(self.names, self.values))})"
 
     def columns(self, lo: int, hi: int) -> dict[str, np.ndarray]:
-        """The axes' columns of combinations lo..hi-1, by axis name."""
-        rest = np.arange(lo, hi, dtype=np.uint64)
-        columns = {}
-        for name, values in zip(reversed(self.names), reversed(self.values)):
-            radix = np.uint64(len(values))
-            columns[name] = values[(rest % radix).astype(np.int64)]
-            rest //= radix
-        return {name: columns[name] for name in self.names}
+        """The axes' columns of combinations lo..hi-1, by axis name (read-only views: a column may be shared
+        with other blocks)."""
+        return {name: _read_only(axis.array) for name, axis in zip(self.names, self._axis_columns(lo, hi))}
 
     def block(self, lo: int, hi: int, make: Callable[..., Mapping] | None = None) -> dict[str, np.ndarray]:
         """The column block of combinations lo..hi-1: `make` (default: the grid's own, which a caller may
         pass guarded) over the axes' columns, constants broadcast to the block's length."""
-        columns = self.columns(lo, hi)
+        return self.made_block(lo, hi, make)[0]
+
+    def made_block(self, lo: int, hi: int, make: Callable[..., Mapping] | None = None
+                   ) -> tuple[dict[str, np.ndarray], dict[str, tuple[int, int]]]:
+        """`block`, and the least and greatest value of each of its columns that holds only values the grid
+        chose (an axis's column passed through `make` unchanged, or a constant): the values of the other
+        columns are the caller's to check. `make` gets read-only columns (shared between blocks); one that
+        writes into them gets its own writable copies from then on (called again for this block)."""
+        made_columns = self._axis_columns(lo, hi)
         make = make or self.make
-        made = columns if make is None else make(**columns)
+        if make is None:
+            return ({name: axis.array for name, axis in zip(self.names, made_columns)},
+                    {name: axis.extremes for name, axis in zip(self.names, made_columns)})
+        given = {}  # id of the array make got -> (that array, the column it stands for)
+        if not self._writes_inputs:
+            arguments = {}
+            for name, axis in zip(self.names, made_columns):
+                view = _read_only(axis.array)
+                arguments[name] = view
+                given[id(view)] = (view, axis)
+            try:
+                made = make(**arguments)
+            except Exception as exc:  # (a guarded make raises UserCodeError)
+                if "read-only" not in str(exc):
+                    raise
+                self._writes_inputs = True
+        if self._writes_inputs:
+            given = {}
+            made = make(**{name: axis.array.copy() for name, axis in zip(self.names, made_columns)})
         if not isinstance(made, Mapping):
             raise ValueError(f"Grid: make must return a dict of columns by input name, got {type(made).__name__}")
-        return {name: np.full(hi - lo, value) if np.ndim(value) == 0 else np.asarray(value)
-                for name, value in made.items()}
+        n = hi - lo
+        block, known = {}, {}
+        for name, value in made.items():
+            entry = given.get(id(value))
+            if entry is not None and entry[0] is value:  # an axis's column, unchanged (make could not write it)
+                block[name], known[name] = entry[1].array, entry[1].extremes
+            elif np.ndim(value) == 0:
+                constant = _constant(value, n)
+                if constant is None:
+                    block[name] = np.full(n, value)
+                else:
+                    block[name], known[name] = constant, (int(value), int(value))
+            else:
+                block[name] = np.asarray(value)
+        return block, known
 
     def blocks(self, start: int = 0, size: int = GRID_BLOCK) -> Iterator[dict[str, np.ndarray]]:
         """Column blocks of combinations start..count-1, `size` at a time (cut at multiples of `size`,
@@ -69,6 +107,102 @@ class Grid:
             hi = min(self.count, (lo // size + 1) * size)
             yield self.block(lo, hi)
             lo = hi
+
+    def _axis_columns(self, lo: int, hi: int) -> list[_Column]:
+        """Each axis's column of combinations lo..hi-1. Axis k's digit of combination i is (i // s) % r,
+        s the product of the later axes' lengths (its stride), r its own length: over a range of i, runs
+        of s equal digits, the digits counting up modulo r; the column repeats every r * s combinations.
+        A column whose period fits in the block is made from one period (and kept: the next block with
+        the same phase reuses it), a longer one from its runs."""
+        n = hi - lo
+        if not 0 <= lo <= hi <= self.count:
+            raise ValueError(f"Grid: combinations {lo}..{hi - 1} are not within 0..{self.count - 1}")
+        if not n:
+            return [_Column(np.zeros(0, dtype=np.int64), (0, 0)) for _ in self.values]
+        made = []
+        stride = 1
+        for index in reversed(range(len(self.values))):
+            values = self.values[index]
+            radix = len(values)
+            period = radix * stride
+            if period <= n:
+                made.append(self._periodic(index, stride, lo % period, n))
+            else:
+                first, last = lo // stride, (hi - 1) // stride  # the runs' numbers (Python ints: no overflow)
+                digits = (first % radix + np.arange(last - first + 1, dtype=np.int64)) % radix
+                held = values[digits]
+                if len(held) == 1:
+                    made.append(_Column(_constant_column(int(held[0]), n), (int(held[0]),) * 2))
+                else:
+                    runs = np.full(len(held), stride, dtype=np.int64)
+                    runs[0] -= lo - first * stride
+                    runs[-1] -= (last + 1) * stride - hi
+                    made.append(_Column(np.repeat(held, runs) if stride > 1 else held,
+                                        (int(held.min()), int(held.max()))))
+            stride = period
+        return made[::-1]
+
+    def _periodic(self, index: int, stride: int, phase: int, n: int) -> _Column:
+        """Axis `index`'s column of n combinations from `phase` into its period (one period fits in n)."""
+        key = (index, phase, n)
+        column = self._kept.get(key)
+        if column is None:
+            values = self.values[index]
+            period = np.repeat(values, stride) if stride > 1 else values
+            array = np.empty(n, dtype=np.int64)
+            head = min(n, len(period) - phase)
+            array[:head] = period[phase:phase + head]
+            array[head:min(n, len(period))] = period[:min(n, len(period)) - head]
+            filled = min(n, len(period))
+            while filled < n:  # doubling: whole periods copied from the start
+                more = min(filled, n - filled)
+                array[filled:filled + more] = array[:more]
+                filled += more
+            column = _Column(array, (int(values.min()), int(values.max())) if len(values) else (0, 0))
+            self._kept[key] = column
+            self._kept_bytes += array.nbytes
+            while self._kept_bytes > KEPT_BYTES and len(self._kept) > 1:
+                self._kept_bytes -= self._kept.pop(next(iter(self._kept))).array.nbytes
+        return column
+
+
+@dataclass(frozen=True)
+class _Column:
+    array: np.ndarray  # int64; shared with other blocks (kept, or a constant): read, never written
+    extremes: tuple[int, int]  # its least and greatest value
+
+
+KEPT_BYTES = 16 << 20  # a grid's periodic columns kept for the blocks after (several axes, a few phases each)
+CONSTANTS_KEPT = 16  # constant columns kept (a make's constants, an axis held for a block: the same in the next ones)
+_constants: dict[tuple[int, int], np.ndarray] = {}
+
+
+def _constant(value, n: int) -> np.ndarray | None:
+    """The int64 column of n copies of `value`, when it is a whole number within int64 (else None: made as
+    numpy makes it, for the caller's checks to report)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        return None
+    if not -(1 << 63) <= int(value) < 1 << 63:
+        return None
+    return _constant_column(int(value), n)
+
+
+def _constant_column(value: int, n: int) -> np.ndarray:
+    key = (value, n)
+    column = _constants.pop(key, None)  # (put back last: the most recently used go last)
+    if column is None:
+        column = np.full(n, value, dtype=np.int64)
+        while len(_constants) >= CONSTANTS_KEPT:
+            _constants.pop(next(iter(_constants)))
+    _constants[key] = column
+    return column
+
+
+def _read_only(array: np.ndarray) -> np.ndarray:
+    """A read-only view of `array`."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
 
 
 def _axis(name: str, axis: int | Sequence[int]) -> np.ndarray:

@@ -141,8 +141,8 @@ def test_a_worker_makes_only_the_combinations_of_its_range_of_a_grid_sweep(monke
     assert sweep.count == 512 * 256 + 5 * 2 * 256 and not sweep.from_start
     everything = _joined(case_sets.stream(parts, 4_096))
     made = []
-    real = Grid.columns
-    monkeypatch.setattr(Grid, "columns", lambda grid, lo, hi: made.append((grid.count, lo, hi)) or real(grid, lo, hi))
+    real = Grid._axis_columns
+    monkeypatch.setattr(Grid, "_axis_columns", lambda grid, lo, hi: made.append((grid.count, lo, hi)) or real(grid, lo, hi))
     for start in (70_001, 512 * 256, 512 * 256 + 700):
         made.clear()
         block = next(case_sets.stream(parts, 1_000, before + start))

@@ -1,0 +1,136 @@
+"""A grid's columns (retro.routines.grid) against a plain computation of the mixed-radix digits, one
+combination at a time: any range (odd starts and lengths, ranges across block edges and across a run's or a
+period's end), axes of any length and of listed values; and the checks of what a grid's `make` returns."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from retro.errors import InputError
+from retro.routines import cases as case_sets
+from retro.routines.grid import GRID_BLOCK, Grid
+from retro.routines.spec import load_spec
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _digits(lengths: list[int], index: int) -> list[int]:
+    """The plain rule: combination `index`'s digit on each axis, the last axis varying fastest."""
+    digits = []
+    for length in reversed(lengths):
+        index, digit = divmod(index, length)
+        digits.append(digit)
+    return digits[::-1]
+
+
+def _expected(axes: dict, lo: int, hi: int) -> dict[str, list[int]]:
+    values = [list(range(a)) if isinstance(a, int) else list(a) for a in axes.values()]
+    rows = [[v[d] for v, d in zip(values, _digits([len(v) for v in values], i))] for i in range(lo, hi)]
+    return {name: [row[k] for row in rows] for k, name in enumerate(axes)}
+
+
+GRIDS = [{"a": 3, "b": 5, "c": 7},  # no power of two: every run and period ends at an odd place
+         {"x": [9, 4, 250, 4], "y": 2, "z": [100, 3, 77]},  # listed values (out of order, one repeated)
+         {"ax": [0, 17], "bx": 256, "aw": 256, "bw": 256},  # aabb8's shape: runs longer than a block
+         {"p": 1, "q": 70_001},  # an axis longer than a block, varying fastest
+         {"u": 13, "v": 1, "w": 4_099}]  # a one-value axis between
+
+
+@pytest.mark.parametrize("axes", GRIDS)
+def test_a_grid_s_columns_are_the_mixed_radix_digits_of_any_range(axes):
+    grid = Grid(axes)
+    edges = [0, 1, grid.count - 1, grid.count] + [k * GRID_BLOCK + d for k in (1, 2) for d in (-3, 0, 5)]
+    rng = np.random.default_rng(11)
+    ranges = [(lo, min(grid.count, lo + n)) for lo in edges if lo <= grid.count for n in (0, 1, 2, 37, 1_000, 70_000)]
+    ranges += [tuple(sorted(rng.integers(0, grid.count + 1, size=2))) for _ in range(6)]
+    for lo, hi in ranges:
+        if hi - lo > 5_000:  # (the plain rule over a few stretches of a long range: its ends and its middle)
+            made = grid.columns(lo, hi)
+            for at in (lo, (lo + hi) // 2, hi - 1_000):
+                expected = _expected(axes, at, at + 1_000)
+                assert {n: made[n][at - lo:at - lo + 1_000].tolist() for n in axes} == expected, (axes, lo, hi, at)
+        else:
+            assert {n: c.tolist() for n, c in grid.columns(lo, hi).items()} == _expected(axes, lo, hi), (axes, lo, hi)
+
+
+def test_a_grid_s_blocks_are_the_same_made_again_and_in_any_order():
+    """The columns a grid keeps for the next blocks (a period, a constant) are the same as made anew."""
+    axes = {"a": 3, "b": [5, 6], "c": 1_000}
+    kept = Grid(axes)
+    order = [(0, 6_000), (6_000, 6_000), (1, 4), (2_999, 3_001), (0, 6_000), (1_000, 3_000), (1, 4), (5_999, 6_000)]
+    for lo, hi in order:
+        assert {n: c.tolist() for n, c in kept.columns(lo, hi).items()} == _expected(axes, lo, hi)
+    fresh = Grid(axes)
+    assert [c.tolist() for c in fresh.columns(1_000, 3_000).values()] == [c.tolist() for c in kept.columns(1_000, 3_000).values()]
+
+
+def test_make_gets_read_only_columns_and_one_that_writes_into_them_gets_copies():
+    """Columns are shared between blocks: a make that writes into its own gets writable copies (the same
+    cases as before), and the next blocks' columns are unchanged."""
+    calls = []
+
+    def writes(a, b):
+        calls.append(a.flags.writeable)
+        a += 1
+        return {"a": a, "b": b}
+    grid = Grid({"a": 4, "b": 3}, writes)
+    assert [c.tolist() for c in grid.block(0, 12).values()] == [[1, 1, 1, 2, 2, 2, 3, 3, 3, 4, 4, 4], [0, 1, 2] * 4]
+    assert [c.tolist() for c in grid.block(0, 12).values()] == [[1, 1, 1, 2, 2, 2, 3, 3, 3, 4, 4, 4], [0, 1, 2] * 4]
+    assert calls == [False, True, True]
+    seen = Grid({"a": 4, "b": 3}, lambda a, b: {"a": a, "b": b, "w": a.flags.writeable})
+    assert not seen.block(0, 12)["w"].any()
+    assert seen.columns(0, 12)["b"].flags.writeable is False
+
+
+def test_a_block_s_columns_are_each_axis_s_values_and_constants_of_every_kind():
+    grid = Grid({"a": [7, 3], "b": 3}, lambda a, b: {"x": a, "y": b * 2, "k": 5, "u": np.uint8(200), "big": 2 ** 70})
+    block = grid.block(1, 5)
+    assert block["x"].tolist() == [7, 7, 3, 3] and block["y"].tolist() == [2, 4, 0, 2]
+    assert block["k"].tolist() == [5] * 4 and block["u"].tolist() == [200] * 4
+    assert block["big"].dtype == object  # (not a whole number within int64: made as numpy makes it, checked later)
+
+
+def _spec(tmp_path: Path, name: str, body: str) -> Path:
+    spec = (ROOT / "tests/data/sweeps/mul8_yielded.toml").read_text().replace(
+        'file = "../../../asm/mul8.s"', f'file = "{ROOT / "asm/mul8.s"}"')
+    folder = tmp_path / name  # (a module of its own each: none is cached under another's name)
+    folder.mkdir()
+    (folder / "yielded.py").write_text(f"import numpy as np\nfrom retro.routines.grid import Grid\ndef sweep():\n    {body}\n")
+    (folder / "spec.toml").write_text(spec)
+    return folder / "spec.toml"
+
+
+@pytest.mark.parametrize("body, says", [
+    # an axis's own column, passed on: its values in the block are checked (the block holding 256 is named)
+    ('return Grid({"b": 2, "a": [*range(250), 256, 3]}, lambda a, b: {"a": a, "b": b})',
+     "(Grid 1, cases 0..503): column a holds 256"),
+    ('return Grid({"b": 1, "a": [*range(70_000), 4]}, lambda a, b: {"a": a % 256, "b": np.where(a == 69_999, 300, b)})',
+     "(Grid 1, cases 65,536..70,000): column b holds 300"),  # a column make computed: every value
+    ('return Grid({"a": 256}, lambda a: {"a": a, "b": -1})', "column b holds -1"),  # a constant
+    ('return Grid({"a": 256}, lambda a: {"a": a, "b": 1.5})', "column b must hold whole numbers"),
+    ('return Grid({"a": 256}, lambda a: {"a": a, "b": 2 ** 70})', "column b must hold whole numbers"),
+    ('return Grid({"a": 300}, lambda a: {"a": np.where(a == 299, -5, a % 256), "b": a % 256})', "column a holds -5"),
+    ('return Grid({"a": 3, "b": 3}, lambda a, b: {"a": a, "b": b[:2]})', "column b has 2 cases"),
+])
+def test_every_value_a_grid_makes_is_checked_with_a_one_line_error(tmp_path, body, says):
+    spec = _spec(tmp_path, "bad", body)
+    with pytest.raises(InputError, match="cases.sweep") as caught:
+        list(case_sets.stream(case_sets.plan(load_spec(spec), exhaustive=True, seed=1), GRID_BLOCK))
+    assert says in str(caught.value) and "\n" not in str(caught.value), str(caught.value)
+
+
+def test_a_grid_sweep_s_blocks_are_its_combinations_through_the_check_s_stream(tmp_path):
+    """The blocks a check makes of a grid (cut at GRID_BLOCK, passed on whole) hold each combination once,
+    in order, from any case on."""
+    spec = _spec(tmp_path, "good", 'return Grid({"a": [5, 200, 9], "b": 256, "c": 131}, '
+                                   'lambda a, b, c: {"a": (a + c) % 256, "b": b})')
+    parts = [p for p in case_sets.plan(load_spec(spec), exhaustive=True, seed=1) if p.name == "sweep"]
+    axes = {"a": [5, 200, 9], "b": 256, "c": 131}
+    for first, size in ((0, GRID_BLOCK), (65_535, 4_096), (70_001, GRID_BLOCK)):
+        blocks = list(case_sets.stream(parts, size, first))
+        made = [np.concatenate(c).tolist() for c in zip(*blocks)]
+        expected = _expected(axes, first, parts[0].count)
+        assert made[0] == [(a + c) % 256 for a, c in zip(expected["a"], expected["c"])] and made[1] == expected["b"]
