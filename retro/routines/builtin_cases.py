@@ -1,8 +1,9 @@
 """Case generators of the seven built-in routines (asm/*.toml name them as `boundary`, `sweep` and
 `random_generator`), and the adapters their specs need.
 
-Cases are tuples in each spec's input order (the reference's argument order), or column blocks (dicts
-of numpy arrays by input name) where there are many; the sweeps are grids (retro.routines.grid: counted,
+Cases are tuples in each spec's input order (the reference's argument order) where there are few (the
+boundaries), column blocks (dicts of numpy arrays by the specs' input names) where there are many (the
+random generators: no Python object per value); the sweeps are grids (retro.routines.grid: counted,
 entered at any case by the worker whose range it is):
 - boundary: touching, one apart, overlapping by one, 0, 255/256, maximum sizes, screen edges;
 - sweep (with --exhaustive): mul8 every product; tile every 9-bit X by every Y; pixel every (dx, dy)
@@ -54,6 +55,12 @@ def _bytes(rng: np.random.Generator, n: int, columns: int) -> np.ndarray:
     return rng.integers(0, BYTE, size=(n, columns))
 
 
+def _block(names: tuple[str, ...], columns) -> dict[str, np.ndarray]:
+    """A column block by input name (each column its own contiguous int64 array): what a generator returns
+    instead of tuples, the same cases without a Python object per value."""
+    return {name: np.ascontiguousarray(column, dtype=np.int64) for name, column in zip(names, columns, strict=True)}
+
+
 # ---- aabb8 -----------------------------------------------------------------------------------
 
 def aabb8_boundary() -> list[tuple]:
@@ -69,7 +76,10 @@ def aabb8_boundary() -> list[tuple]:
     return out
 
 
-def aabb8_random(rng: np.random.Generator, n: int) -> list[tuple]:
+AABB8_INPUTS = ("ax", "ay", "aw", "ah", "bx", "by", "bw", "bh")  # asm/aabb8.toml's inputs, in order
+
+
+def aabb8_random(rng: np.random.Generator, n: int) -> dict[str, np.ndarray]:
     cases = _bytes(rng, n, 8)
     near = rng.random(n) < 0.5  # half the cases: b placed near a, so overlaps are common
     cases[near, 4] = (cases[near, 0] + rng.integers(-40, 40, size=near.sum())) % BYTE
@@ -77,7 +87,7 @@ def aabb8_random(rng: np.random.Generator, n: int) -> list[tuple]:
     small = rng.random(n) < 0.5
     cases[small, 2:4] = rng.integers(0, 48, size=(small.sum(), 2))
     cases[small, 6:8] = rng.integers(0, 48, size=(small.sum(), 2))
-    return [tuple(int(v) for v in row) for row in cases]
+    return _block(AABB8_INPUTS, cases.T)
 
 
 AABB8_OVERLAPPING = {"x": (10, 5, 8, 5), "y_a_first": (10, 5, 12, 5), "y_b_first": (12, 5, 10, 5)}
@@ -127,18 +137,17 @@ def aabb_sprite_boundary() -> list[tuple]:
     return out
 
 
-def aabb_sprite_random(rng: np.random.Generator, n: int) -> list[tuple]:
+AABB_SPRITE_INPUTS = ("x1", "x1h", "y1", "ox1", "oy1", "w1", "h1", "x2", "x2h", "y2", "ox2", "oy2", "w2", "h2")
+
+
+def aabb_sprite_random(rng: np.random.Generator, n: int) -> dict[str, np.ndarray]:
     x1 = rng.integers(0, X_POSITIONS, size=n)
     x2 = np.where(rng.random(n) < 0.6, (x1 + rng.integers(-48, 48, size=n)) % X_POSITIONS, rng.integers(0, X_POSITIONS, size=n))
     y1 = rng.integers(0, BYTE, size=n)
     y2 = np.where(rng.random(n) < 0.6, (y1 + rng.integers(-42, 42, size=n)) % BYTE, rng.integers(0, BYTE, size=n))
     small = rng.random(n) < 0.7
-    boxes = np.where(small[:, None], rng.integers(0, 48, size=(n, 8)), rng.integers(0, BYTE, size=(n, 8)))
-    out = []
-    for i in range(n):
-        b = [int(v) for v in boxes[i]]
-        out.append(_sprite_case(int(x1[i]), int(y1[i]), tuple(b[:4]), int(x2[i]), int(y2[i]), tuple(b[4:])))
-    return out
+    boxes = np.where(small[:, None], rng.integers(0, 48, size=(n, 8)), rng.integers(0, BYTE, size=(n, 8))).T
+    return _block(AABB_SPRITE_INPUTS, (x1 & 0xFF, x1 >> 8, y1, *boxes[:4], x2 & 0xFF, x2 >> 8, y2, *boxes[4:]))
 
 
 def aabb_sprite_sweep() -> Grid:
@@ -168,16 +177,28 @@ def circle_boundary() -> list[tuple]:
     return out
 
 
-def circle_random(rng: np.random.Generator, n: int) -> list[tuple]:
+CIRCLE_INPUTS = ("x1", "y1", "r1", "x2", "y2", "r2")
+
+
+def circle_random(rng: np.random.Generator, n: int) -> dict[str, np.ndarray]:
     cases = _bytes(rng, n, 6)
-    tight = rng.random(n) < 0.5  # half: radius sum at the distance, where the answer flips
-    for i in np.flatnonzero(tight):
-        x1, y1, _, x2, y2, _ = (int(v) for v in cases[i])
-        radius_sum = math.isqrt((x1 - x2) ** 2 + (y1 - y2) ** 2) + int(rng.integers(0, 2))
-        if radius_sum <= 255:
-            cases[i, 2] = radius_sum // 2
-            cases[i, 5] = radius_sum - radius_sum // 2
-    return [tuple(int(v) for v in row) for row in cases]
+    tight = np.flatnonzero(rng.random(n) < 0.5)  # half: radius sum at the distance, where the answer flips
+    x1, y1, _, x2, y2, _ = cases[tight].T
+    # (one draw of 0 or 1 per tight case, in case order: numpy's integers gives the same values drawn one
+    # at a time or all at once)
+    radius_sum = _isqrt((x1 - x2) ** 2 + (y1 - y2) ** 2) + rng.integers(0, 2, size=len(tight))
+    fits = radius_sum <= 255
+    cases[tight[fits], 2] = radius_sum[fits] // 2
+    cases[tight[fits], 5] = radius_sum[fits] - radius_sum[fits] // 2
+    return _block(CIRCLE_INPUTS, cases.T)
+
+
+def _isqrt(values: np.ndarray) -> np.ndarray:
+    """math.isqrt of each (whole numbers below 2^52): the float root's floor, corrected by one either way."""
+    root = np.floor(np.sqrt(values.astype(np.float64))).astype(np.int64)
+    root -= root * root > values
+    root += (root + 1) * (root + 1) <= values
+    return root
 
 
 def _apart(delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -210,8 +231,8 @@ def mul8_boundary() -> list[tuple]:
     return list(product(values, repeat=2))
 
 
-def mul8_random(rng: np.random.Generator, n: int) -> list[tuple]:
-    return [tuple(int(v) for v in row) for row in _bytes(rng, n, 2)]
+def mul8_random(rng: np.random.Generator, n: int) -> dict[str, np.ndarray]:
+    return _block(("a", "b"), _bytes(rng, n, 2).T)
 
 
 def mul8_sweep() -> Grid:
@@ -227,10 +248,10 @@ def tile_boundary() -> list[tuple]:
     return [(x & 0xFF, x >> 8, y) for x in _EDGE_X for y in _EDGE_Y]
 
 
-def tile_random(rng: np.random.Generator, n: int) -> list[tuple]:
+def tile_random(rng: np.random.Generator, n: int) -> dict[str, np.ndarray]:
     x = rng.integers(0, X_POSITIONS, size=n)
     y = rng.integers(0, BYTE, size=n)
-    return [(int(a) & 0xFF, int(a) >> 8, int(b)) for a, b in zip(x, y)]
+    return _block(("x", "xh", "y"), (x & 0xFF, x >> 8, y))
 
 
 def tile_sweep() -> Grid:
@@ -247,13 +268,13 @@ def tile_box_boundary() -> list[tuple]:
     return out
 
 
-def tile_box_random(rng: np.random.Generator, n: int) -> list[tuple]:
+def tile_box_random(rng: np.random.Generator, n: int) -> dict[str, np.ndarray]:
     x = rng.integers(0, X_POSITIONS, size=n)
     y = rng.integers(0, BYTE, size=n)
     small = rng.random(n) < 0.8
     w = np.where(small, rng.integers(0, 33, size=n), rng.integers(0, BYTE, size=n))
     h = np.where(small, rng.integers(0, 33, size=n), rng.integers(0, BYTE, size=n))
-    return [(int(a) & 0xFF, int(a) >> 8, int(b), int(c), int(d)) for a, b, c, d in zip(x, y, w, h)]
+    return _block(("x", "xh", "y", "w", "h"), (x & 0xFF, x >> 8, y, w, h))
 
 
 def tile_box_sweep() -> list[Grid]:
@@ -414,7 +435,7 @@ def _near(rng: np.random.Generator, start: np.ndarray, size: np.ndarray, limit: 
     return np.where(rng.random(len(start)) < 0.5, near, rng.integers(0, limit, size=len(start)))
 
 
-def aabb_edges_random(rng: np.random.Generator, n: int) -> list[tuple]:
+def aabb_edges_random(rng: np.random.Generator, n: int) -> dict[str, np.ndarray]:
     ax, aw = _boxes(rng, n, 256)
     ay, ah = _boxes(rng, n, 256)
     bw = np.where(rng.random(n) < 0.5, rng.integers(1, 48, size=n), rng.integers(1, 256, size=n))
@@ -422,10 +443,10 @@ def aabb_edges_random(rng: np.random.Generator, n: int) -> list[tuple]:
     bx = np.minimum(_near(rng, ax, aw, 256), 255 - bw)
     by = np.minimum(_near(rng, ay, ah, 256), 255 - bh)
     columns = (ax, ay, ax + aw - 1, ay + ah - 1, bx, bx + bw, by, by + bh)
-    return [tuple(int(v) for v in row) for row in zip(*columns)]
+    return _block(("a_left", "a_top", "a_right1", "a_bottom1", "b_left", "b_right", "b_top", "b_bottom"), columns)
 
 
-def sprite_edges_random(rng: np.random.Generator, n: int) -> list[tuple]:
+def sprite_edges_random(rng: np.random.Generator, n: int) -> dict[str, np.ndarray]:
     a_left, a_width = _boxes(rng, n, X_POSITIONS + 48)
     b_left = _near(rng, a_left, a_width, X_POSITIONS + 48)
     b_width = np.where(rng.random(n) < 0.5, rng.integers(1, 48, size=n), rng.integers(1, 256, size=n))
@@ -435,4 +456,5 @@ def sprite_edges_random(rng: np.random.Generator, n: int) -> list[tuple]:
     a_right, b_right = a_left + a_width, b_left + b_width
     columns = (a_left & 0xFF, a_top, a_top + a_height - 1, a_left >> 8, a_right & 0xFF, a_right >> 8,
                b_left & 0xFF, b_left >> 8, b_right & 0xFF, b_right >> 8, b_top, b_top + b_height)
-    return [tuple(int(v) for v in row) for row in zip(*columns)]
+    return _block(("a_left", "a_top", "a_bottom1", "a_left_hi", "a_right", "a_right_hi", "b_left", "b_left_hi", "b_right",
+                   "b_right_hi", "b_top", "b_bottom"), columns)

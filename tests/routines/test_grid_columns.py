@@ -134,3 +134,48 @@ def test_a_grid_sweep_s_blocks_are_its_combinations_through_the_check_s_stream(t
         made = [np.concatenate(c).tolist() for c in zip(*blocks)]
         expected = _expected(axes, first, parts[0].count)
         assert made[0] == [(a + c) % 256 for a, c in zip(expected["a"], expected["c"])] and made[1] == expected["b"]
+
+
+# ---- the built-in random generators: column blocks, the cases the per-case form made ---------------------
+
+def _circle_random_per_case(rng: np.random.Generator, n: int) -> list[tuple]:
+    """circle_random as it was written, one case at a time (the plain rule)."""
+    import math
+    cases = rng.integers(0, 256, size=(n, 6))
+    tight = rng.random(n) < 0.5
+    for i in np.flatnonzero(tight):
+        x1, y1, _, x2, y2, _ = (int(v) for v in cases[i])
+        radius_sum = math.isqrt((x1 - x2) ** 2 + (y1 - y2) ** 2) + int(rng.integers(0, 2))
+        if radius_sum <= 255:
+            cases[i, 2] = radius_sum // 2
+            cases[i, 5] = radius_sum - radius_sum // 2
+    return [tuple(int(v) for v in row) for row in cases]
+
+
+def _aabb_sprite_random_per_case(rng: np.random.Generator, n: int) -> list[tuple]:
+    x1 = rng.integers(0, 512, size=n)
+    x2 = np.where(rng.random(n) < 0.6, (x1 + rng.integers(-48, 48, size=n)) % 512, rng.integers(0, 512, size=n))
+    y1 = rng.integers(0, 256, size=n)
+    y2 = np.where(rng.random(n) < 0.6, (y1 + rng.integers(-42, 42, size=n)) % 256, rng.integers(0, 256, size=n))
+    small = rng.random(n) < 0.7
+    boxes = np.where(small[:, None], rng.integers(0, 48, size=(n, 8)), rng.integers(0, 256, size=(n, 8)))
+    return [(int(x1[i]) & 0xFF, int(x1[i]) >> 8, int(y1[i]), *map(int, boxes[i, :4]), int(x2[i]) & 0xFF, int(x2[i]) >> 8,
+             int(y2[i]), *map(int, boxes[i, 4:])) for i in range(n)]
+
+
+@pytest.mark.parametrize("name, per_case", [("circle", _circle_random_per_case), ("aabb_sprite", _aabb_sprite_random_per_case)])
+def test_a_built_in_random_generator_s_columns_are_the_cases_drawn_one_at_a_time(name, per_case):
+    from retro.routines import builtin_cases
+    generator = getattr(builtin_cases, f"{name}_random")
+    names = load_spec(ROOT / f"asm/{name}.toml").input_names
+    for seed, n in ((0, 1), (1, 7), (2, 4_000), (3, 65_536)):
+        made = generator(np.random.default_rng(seed), n)
+        assert tuple(made) == names and all(c.dtype == np.int64 and c.flags.c_contiguous for c in made.values())
+        assert list(zip(*(c.tolist() for c in made.values()))) == per_case(np.random.default_rng(seed), n), (seed, n)
+
+
+def test_the_whole_square_root_of_every_sum_of_two_squared_byte_differences():
+    import math
+    from retro.routines.builtin_cases import _isqrt
+    values = np.concatenate([np.arange(2 * 255 ** 2 + 2), np.arange(1, 3000) ** 2 - 1, [2 ** 50 - 1, 2 ** 50]])
+    assert _isqrt(values).tolist() == [math.isqrt(int(v)) for v in values]
