@@ -289,6 +289,8 @@ MUTANTS = [
            "fits = radius_sum <= 255", "fits = radius_sum < 255", GRID_TESTS),
     Mutant("circle-random-draws-out-of-case-order", "retro/routines/builtin_cases.py",
            "rng.integers(0, 2, size=len(tight))", "rng.integers(0, 2, size=len(tight))[::-1]", GRID_TESTS),
+    Mutant("stream-grid-cut-from-the-part-s-start", "retro/routines/cases.py",
+           "yield from part.aligned(skip, -done % size, size)", "yield from part.aligned(skip, 0, size)", GRID_TESTS),
     Mutant("column-fits-without-negatives", "retro/routines/cases.py",
            "column.view(np.uint64).max() < limit", "column.max() < limit", GRID_TESTS),
     Mutant("stop-leaves-the-cluster-open", "retro/workers.py",

@@ -64,6 +64,9 @@ class Part:
     # cases before it (None: they are made and dropped; `stream`)
     from_start: bool = False  # its seek runs the part's function from its start (the cases before are counted,
     # not checked nor converted): reached at a cost that grows with the index
+    aligned: Callable[[int, int, int], Iterator[Columns]] | None = None  # aligned(start, phase, size): as
+    # seek(start), its blocks cut where (case - phase) % size == 0, so that a stream's blocks are made whole,
+    # not joined from pieces (None: its own cuts)
 
     @property
     def cases(self) -> Iterator[tuple]:
@@ -162,7 +165,7 @@ def stream(parts: list[Part], size: int, first: int = 0,
     is passed over by its count, one it starts in is entered by its `seek` when it has one (a spec's sweep
     function's runs from its start, counting the cases before `first`); else its cases before `first`
     are made and dropped. `counted(i, n)`: told the count of part i, one that did not say it, once made."""
-    return rechunked(_cases_from(parts, first, counted), size)
+    return rechunked(_cases_from(parts, first, counted, size), size)
 
 
 def reachable(parts: list[Part], first: int) -> bool:
@@ -177,7 +180,10 @@ def reachable(parts: list[Part], first: int) -> bool:
     return True
 
 
-def _cases_from(parts: list[Part], first: int, counted: Callable[[int, int], None] | None) -> Iterator[Columns]:
+def _cases_from(parts: list[Part], first: int, counted: Callable[[int, int], None] | None,
+                size: int | None = None) -> Iterator[Columns]:
+    """The parts' blocks from case `first`; a part that can cuts its blocks at the multiples of `size`
+    counted over all the parts (where a stream from any such multiple cuts its own)."""
     done = 0  # cases of the parts before this one
     for index, part in enumerate(parts):
         before = done
@@ -185,7 +191,10 @@ def _cases_from(parts: list[Part], first: int, counted: Callable[[int, int], Non
             done += part.count
             continue
         skip = max(0, first - done)
-        if skip and part.seek is not None:
+        if part.aligned is not None and size is not None:
+            yield from part.aligned(skip, -done % size, size)
+            done += part.count
+        elif skip and part.seek is not None:
             if part.from_start:  # (its seek returns how many cases the part made in all)
                 done += yield from part.seek(skip)
             else:
@@ -546,7 +555,8 @@ def _sweep_part(routine: Routine, seed: int) -> Part:
                     seek=lambda start: _lazy_sweep(routine, fresh(), start), from_start=True)
     count = sum(grid.count for grid in grids)
     return Part("sweep", count, count, lambda: _grid_blocks(routine, grids),
-                seek=lambda start: _grid_blocks(routine, grids, start))
+                seek=lambda start: _grid_blocks(routine, grids, start),
+                aligned=lambda start, phase, size: _grid_blocks(routine, grids, start, (phase, size)))
 
 
 def _grids(routine: Routine, made) -> list[Grid] | None:
@@ -562,19 +572,25 @@ def _grids(routine: Routine, made) -> list[Grid] | None:
     return None
 
 
-def _grid_blocks(routine: Routine, grids: list[Grid], start: int = 0) -> Iterator[Columns]:
+def _grid_blocks(routine: Routine, grids: list[Grid], start: int = 0,
+                 cuts: tuple[int, int] | None = None) -> Iterator[Columns]:
     """The grids' cases from case `start` on (counted over all of them), as checked column blocks: the
-    combinations before it are never made."""
+    combinations before it are never made. Blocks are cut at each grid's multiples of GRID_BLOCK, or with
+    `cuts` (phase, size) where (case - phase) % size == 0, the cases counted over all the grids (and at
+    each grid's end)."""
     where = f"{routine.spec_path}: cases.sweep"
+    before = 0  # the cases of the grids before this one
     for number, grid in enumerate(grids, 1):
+        offset, before = before, before + grid.count
         if start >= grid.count:
             start -= grid.count
             continue
         make = None if grid.make is None else guarded(grid.make, f"{where} (Grid {number}'s make)", faults_only=False)
+        phase, size = (0, GRID_BLOCK) if cuts is None else ((cuts[0] - offset) % cuts[1], cuts[1])
         lo = start
         start = 0
         while lo < grid.count:
-            hi = min(grid.count, (lo // GRID_BLOCK + 1) * GRID_BLOCK)
+            hi = min(grid.count, lo + size - (lo - phase) % size)
             try:
                 block, known = grid.made_block(lo, hi, make)
             except ValueError as exc:

@@ -108,7 +108,8 @@ def _spec(tmp_path: Path, name: str, body: str) -> Path:
     ('return Grid({"b": 2, "a": [*range(250), 256, 3]}, lambda a, b: {"a": a, "b": b})',
      "(Grid 1, cases 0..503): column a holds 256"),
     ('return Grid({"b": 1, "a": [*range(70_000), 4]}, lambda a, b: {"a": a % 256, "b": np.where(a == 69_999, 300, b)})',
-     "(Grid 1, cases 65,536..70,000): column b holds 300"),  # a column make computed: every value
+     "(Grid 1, cases 65,472..70,000): column b holds 300"),  # a column make computed: every value (the block
+    # named as the check cuts it: where its stream's blocks end, after the spec's 64 boundary cases)
     ('return Grid({"a": 256}, lambda a: {"a": a, "b": -1})', "column b holds -1"),  # a constant
     ('return Grid({"a": 256}, lambda a: {"a": a, "b": 1.5})', "column b must hold whole numbers"),
     ('return Grid({"a": 256}, lambda a: {"a": a, "b": 2 ** 70})', "column b must hold whole numbers"),
@@ -122,9 +123,9 @@ def test_every_value_a_grid_makes_is_checked_with_a_one_line_error(tmp_path, bod
     assert says in str(caught.value) and "\n" not in str(caught.value), str(caught.value)
 
 
-def test_a_grid_sweep_s_blocks_are_its_combinations_through_the_check_s_stream(tmp_path):
-    """The blocks a check makes of a grid (cut at GRID_BLOCK, passed on whole) hold each combination once,
-    in order, from any case on."""
+def test_a_grid_sweep_s_blocks_are_its_combinations_through_the_check_s_stream(tmp_path, monkeypatch):
+    """The blocks a check makes of a grid hold each combination once, in order, from any case on; the grid
+    makes them where the stream cuts its blocks (counted over every part), so that they pass on whole."""
     spec = _spec(tmp_path, "good", 'return Grid({"a": [5, 200, 9], "b": 256, "c": 131}, '
                                    'lambda a, b, c: {"a": (a + c) % 256, "b": b})')
     parts = [p for p in case_sets.plan(load_spec(spec), exhaustive=True, seed=1) if p.name == "sweep"]
@@ -134,6 +135,16 @@ def test_a_grid_sweep_s_blocks_are_its_combinations_through_the_check_s_stream(t
         made = [np.concatenate(c).tolist() for c in zip(*blocks)]
         expected = _expected(axes, first, parts[0].count)
         assert made[0] == [(a + c) % 256 for a, c in zip(expected["a"], expected["c"])] and made[1] == expected["b"]
+    every = case_sets.plan(load_spec(spec), exhaustive=True, seed=1)
+    before = sum(p.count for p in every[:[p.name for p in every].index("sweep")])
+    made = []
+    real = Grid._axis_columns
+    monkeypatch.setattr(Grid, "_axis_columns", lambda grid, lo, hi: made.append((lo, hi)) or real(grid, lo, hi))
+    for first in (0, 4_096 * 20):
+        made.clear()
+        blocks = list(case_sets.stream(every, 4_096, first))
+        assert made[0][0] == max(0, first - before) and all((before + lo) % 4_096 == 0 for lo, _ in made[1:]), made[:3]
+        assert all(hi - lo == 4_096 for lo, hi in made[1:-1])
 
 
 # ---- the built-in random generators: column blocks, the cases the per-case form made ---------------------
