@@ -150,11 +150,22 @@ def aabb_sprite_random(rng: np.random.Generator, n: int) -> dict[str, np.ndarray
     return _block(AABB_SPRITE_INPUTS, (x1 & 0xFF, x1 >> 8, y1, *boxes[:4], x2 & 0xFF, x2 >> 8, y2, *boxes[4:]))
 
 
+def _nine_bit(low: str, high: str) -> dict[str, np.ndarray]:
+    """A grid axis of every 9-bit X position as its two inputs (low byte, high bit)."""
+    x = np.arange(X_POSITIONS)
+    return {low: x & 0xFF, high: x >> 8}
+
+
+def _held(**inputs: int) -> dict[str, list[int]]:
+    """A grid axis of one value: inputs held constant (by name)."""
+    return {name: [value] for name, value in inputs.items()}
+
+
 def aabb_sprite_sweep() -> Grid:
     """Every pair of 9-bit X positions with two fixed hitboxes (the 255/256 boundary included)."""
-    return Grid({"x1": X_POSITIONS, "x2": X_POSITIONS},
-                lambda x1, x2: dict(x1=x1 & 0xFF, x1h=x1 >> 8, y1=100, ox1=4, oy1=3, w1=16, h1=15, x2=x2 & 0xFF,
-                                    x2h=x2 >> 8, y2=104, ox2=0, oy2=0, w2=SPRITE_WIDTH, h2=SPRITE_HEIGHT))
+    return Grid({"x1": _nine_bit("x1", "x1h"), "x2": _nine_bit("x2", "x2h"),
+                 "held": _held(y1=100, ox1=4, oy1=3, w1=16, h1=15, y2=104, ox2=0, oy2=0, w2=SPRITE_WIDTH,
+                               h2=SPRITE_HEIGHT)})
 
 
 # ---- circle ------------------------------------------------------------------------------------
@@ -210,18 +221,20 @@ SIGNED_BYTE_DELTAS = range(-(BYTE - 1), BYTE)  # a difference of two bytes
 CIRCLE_RADIUS_DELTAS = np.array([(0, 0), (200, 100), (-255, -255), (3, 4)])  # (dx, dy) of circle's (r1, r2) sweep
 
 
+def _deltas(first: str, second: str, deltas=SIGNED_BYTE_DELTAS) -> dict[str, np.ndarray]:
+    """A grid axis of differences (first - second) as the two bytes (`_apart`)."""
+    return dict(zip((first, second), _apart(np.asarray(deltas))))
+
+
 def circle_sweep() -> list[Grid]:
     """Every (dx, dy) of both signs (-255..255 each) at every radius sum 0..255, split r1 = sum // 2;
-    then every (r1, r2) pair (each 0..255) at a few deltas (the radius domain and its edge)."""
-    def by_sum(dx, dy, radius_sum):
-        (x1, x2), (y1, y2) = _apart(dx), _apart(dy)
-        return dict(x1=x1, y1=y1, r1=radius_sum // 2, x2=x2, y2=y2, r2=radius_sum - radius_sum // 2)
-
-    def by_radii(delta, r1, r2):
-        (x1, x2), (y1, y2) = _apart(CIRCLE_RADIUS_DELTAS[delta, 0]), _apart(CIRCLE_RADIUS_DELTAS[delta, 1])
-        return dict(x1=x1, y1=y1, r1=r1, x2=x2, y2=y2, r2=r2)
-    return [Grid({"dx": SIGNED_BYTE_DELTAS, "dy": SIGNED_BYTE_DELTAS, "radius_sum": BYTE}, by_sum),
-            Grid({"delta": len(CIRCLE_RADIUS_DELTAS), "r1": BYTE, "r2": BYTE}, by_radii)]
+    then every (r1, r2) pair (each 0..255) at a few deltas (the radius domain and its edge). (Axes of
+    inputs that go together: no make, the columns kept from block to block.)"""
+    radius_sum = np.arange(BYTE)
+    by_radii = {**_deltas("x1", "x2", CIRCLE_RADIUS_DELTAS[:, 0]), **_deltas("y1", "y2", CIRCLE_RADIUS_DELTAS[:, 1])}
+    return [Grid({"dx": _deltas("x1", "x2"), "dy": _deltas("y1", "y2"),
+                  "radius_sum": {"r1": radius_sum // 2, "r2": radius_sum - radius_sum // 2}}),
+            Grid({"delta": by_radii, "r1": BYTE, "r2": BYTE})]
 
 
 # ---- mul8 ----------------------------------------------------------------------------------------
@@ -256,7 +269,7 @@ def tile_random(rng: np.random.Generator, n: int) -> dict[str, np.ndarray]:
 
 def tile_sweep() -> Grid:
     """Every 9-bit X by every Y."""
-    return Grid({"x": X_POSITIONS, "y": BYTE}, lambda x, y: {"x": x & 0xFF, "xh": x >> 8, "y": y})
+    return Grid({"x": _nine_bit("x", "xh"), "y": BYTE})
 
 
 def tile_box_boundary() -> list[tuple]:
@@ -279,8 +292,7 @@ def tile_box_random(rng: np.random.Generator, n: int) -> dict[str, np.ndarray]:
 
 def tile_box_sweep() -> list[Grid]:
     """Every 9-bit X and every Y for a sprite-sized box; every width at a few heights and back."""
-    return [Grid({"x": X_POSITIONS, "y": BYTE},
-                 lambda x, y: dict(x=x & 0xFF, xh=x >> 8, y=y, w=SPRITE_WIDTH, h=SPRITE_HEIGHT)),
+    return [Grid({"x": _nine_bit("x", "xh"), "y": BYTE, "box": _held(w=SPRITE_WIDTH, h=SPRITE_HEIGHT)}),
             Grid({"other": (0, 1, 8, 21, 255), "height_varies": 2, "size": BYTE},
                  lambda other, height_varies, size: dict(x=20, xh=0, y=45, w=np.where(height_varies, other, size),
                                                          h=np.where(height_varies, size, other)))]
@@ -401,10 +413,7 @@ def pixel_sweep(seed: int = 0) -> Grid:
 
 def circle_r_sweep() -> Grid:
     """Every (dx, dy) of both signs (-255..255 each) at every radius sum 0..255."""
-    def apart(dx, dy, radius_sum):
-        (x1, x2), (y1, y2) = _apart(dx), _apart(dy)
-        return dict(x1=x1, y1=y1, radius_sum=radius_sum, x2=x2, y2=y2)
-    return Grid({"dx": SIGNED_BYTE_DELTAS, "dy": SIGNED_BYTE_DELTAS, "radius_sum": BYTE}, apart)
+    return Grid({"dx": _deltas("x1", "x2"), "dy": _deltas("y1", "y2"), "radius_sum": BYTE})
 
 
 def circle_r_boundary() -> list[tuple]:

@@ -5,10 +5,18 @@ says how many cases it makes (the product of its axes' lengths) and makes any ra
 ones before it (mixed-radix counting, the last axis varying fastest), so a check's tasks are a range
 of case indices and each worker makes only its own (docs/dask.md). `make` turns the axes' columns into
 a column block of the routine's inputs (constants allowed: they are broadcast); without it the axes are
-the inputs themselves.
+the inputs themselves. An axis may also be several inputs whose values go together (a dict of equal-length
+value lists by input name: one value of the axis is one row); a one-value axis is a constant.
 
     def sweep():
         return Grid({"x": 512, "y": 256}, lambda x, y: {"x": x & 0xFF, "xh": x >> 8, "y": y})
+
+    def sweep():  # the same cases, made without a make: its columns are kept from block to block
+        x = np.arange(512)
+        return Grid({"x": {"x": x & 0xFF, "xh": x >> 8}, "y": 256})
+
+`make` is called per block of combinations (its columns read-only: they may be shared between blocks),
+and must make each case from that case's own values alone: where the blocks are cut is not fixed.
 
 Only numpy here: the specs' own modules import it.
 """
@@ -24,30 +32,37 @@ GRID_BLOCK = 1 << 16  # combinations made at once (one call of `make`)
 
 
 class Grid:
-    """Every combination of `axes` (name -> a count n for 0..n-1, or the values themselves, in order), the
-    last axis varying fastest; `make(**columns)` gives the column block of the routine's inputs by name
-    (numpy arrays, one element or row per combination, or single numbers), or None: the axes are the inputs."""
+    """Every combination of `axes` (name -> a count n for 0..n-1, the values themselves in order, or a dict
+    of equal-length value lists by column name: columns whose values go together), the last axis varying
+    fastest; `make(**columns)` gives the column block of the routine's inputs by name (numpy arrays, one
+    element or row per combination, or single numbers), or None: the axes' columns are the inputs."""
 
-    def __init__(self, axes: Mapping[str, int | Sequence[int]], make: Callable[..., Mapping] | None = None) -> None:
+    def __init__(self, axes: Mapping[str, int | Sequence[int] | Mapping[str, Sequence[int]]],
+                 make: Callable[..., Mapping] | None = None) -> None:
         if not isinstance(axes, Mapping) or not axes:
             raise ValueError("Grid: axes must be a non-empty dict of name -> count or values")
         if make is not None and not callable(make):
             raise ValueError(f"Grid: make must be a function, got {type(make).__name__}")
         self.names = tuple(axes)
-        self.values = tuple(_axis(name, axis) for name, axis in axes.items())
+        self.axis_columns = tuple(_axis(name, axis) for name, axis in axes.items())  # per axis: (column, values)
+        self.lengths = tuple(len(columns[0][1]) for columns in self.axis_columns)
+        names = [name for columns in self.axis_columns for name, _ in columns]
+        twice = next((name for name in names if names.count(name) > 1), None)
+        if twice is not None:
+            raise ValueError(f"Grid: column {twice} is on two axes")
         self.make = make
-        self.count = int(np.prod([len(v) for v in self.values], dtype=object))
-        self._kept: dict[tuple[int, int, int], _Column] = {}  # periodic columns by (axis, phase, length)
+        self.count = int(np.prod(self.lengths, dtype=object))
+        self._kept: dict[tuple[int, int, int, int], _Column] = {}  # periodic columns by (axis, column, phase, length)
         self._kept_bytes = 0
         self._writes_inputs = False  # make writes into its columns: it gets copies
 
     def __repr__(self) -> str:
-        return f"Grid({', '.join(f'{n}: {len(v)}' for n, v in zip(self.names, self.values))})"
+        return f"Grid({', '.join(f'{n}: {length}' for n, length in zip(self.names, self.lengths))})"
 
     def columns(self, lo: int, hi: int) -> dict[str, np.ndarray]:
         """The axes' columns of combinations lo..hi-1, by axis name (read-only views: a column may be shared
         with other blocks)."""
-        return {name: _read_only(axis.array) for name, axis in zip(self.names, self._axis_columns(lo, hi))}
+        return {name: _read_only(column.array) for name, column in self._axis_columns(lo, hi)}
 
     def block(self, lo: int, hi: int, make: Callable[..., Mapping] | None = None) -> dict[str, np.ndarray]:
         """The column block of combinations lo..hi-1: `make` (default: the grid's own, which a caller may
@@ -63,12 +78,11 @@ class Grid:
         made_columns = self._axis_columns(lo, hi)
         make = make or self.make
         if make is None:
-            return ({name: axis.array for name, axis in zip(self.names, made_columns)},
-                    {name: axis.extremes for name, axis in zip(self.names, made_columns)})
+            return ({name: axis.array for name, axis in made_columns}, {name: axis.extremes for name, axis in made_columns})
         given = {}  # id of the array make got -> (that array, the column it stands for)
         if not self._writes_inputs:
             arguments = {}
-            for name, axis in zip(self.names, made_columns):
+            for name, axis in made_columns:
                 view = _read_only(axis.array)
                 arguments[name] = view
                 given[id(view)] = (view, axis)
@@ -80,7 +94,7 @@ class Grid:
                 self._writes_inputs = True
         if self._writes_inputs:
             given = {}
-            made = make(**{name: axis.array.copy() for name, axis in zip(self.names, made_columns)})
+            made = make(**{name: axis.array.copy() for name, axis in made_columns})
         if not isinstance(made, Mapping):
             raise ValueError(f"Grid: make must return a dict of columns by input name, got {type(made).__name__}")
         n = hi - lo
@@ -108,46 +122,42 @@ class Grid:
             yield self.block(lo, hi)
             lo = hi
 
-    def _axis_columns(self, lo: int, hi: int) -> list[_Column]:
-        """Each axis's column of combinations lo..hi-1. Axis k's digit of combination i is (i // s) % r,
-        s the product of the later axes' lengths (its stride), r its own length: over a range of i, runs
-        of s equal digits, the digits counting up modulo r; the column repeats every r * s combinations.
-        A column whose period fits in the block is made from one period (and kept: the next block with
-        the same phase reuses it), a longer one from its runs."""
+    def _axis_columns(self, lo: int, hi: int) -> list[tuple[str, _Column]]:
+        """Each axis's columns of combinations lo..hi-1, by name, in axis order. Axis k's digit of combination
+        i is (i // s) % r, s the product of the later axes' lengths (its stride), r its own length: over a
+        range of i, runs of s equal digits, the digits counting up modulo r; the column repeats every r * s
+        combinations. A column whose period fits in the block is made from one period (and kept: the next
+        block with the same phase reuses it), a longer one from its runs."""
         n = hi - lo
         if not 0 <= lo <= hi <= self.count:
             raise ValueError(f"Grid: combinations {lo}..{hi - 1} are not within 0..{self.count - 1}")
         if not n:
-            return [_Column(np.zeros(0, dtype=np.int64), (0, 0)) for _ in self.values]
+            return [(name, _Column(np.zeros(0, dtype=np.int64), (0, 0))) for columns in self.axis_columns
+                    for name, _ in columns]
         made = []
         stride = 1
-        for index in reversed(range(len(self.values))):
-            values = self.values[index]
-            radix = len(values)
+        for index in reversed(range(len(self.axis_columns))):
+            radix = self.lengths[index]
             period = radix * stride
             if period <= n:
-                made.append(self._periodic(index, stride, lo % period, n))
+                made.append([(name, self._periodic(index, k, stride, lo % period, n))
+                             for k, (name, _) in enumerate(self.axis_columns[index])])
             else:
                 first, last = lo // stride, (hi - 1) // stride  # the runs' numbers (Python ints: no overflow)
                 digits = (first % radix + np.arange(last - first + 1, dtype=np.int64)) % radix
-                held = values[digits]
-                if len(held) == 1:
-                    made.append(_Column(_constant_column(int(held[0]), n), (int(held[0]),) * 2))
-                else:
-                    runs = np.full(len(held), stride, dtype=np.int64)
-                    runs[0] -= lo - first * stride
-                    runs[-1] -= (last + 1) * stride - hi
-                    made.append(_Column(np.repeat(held, runs) if stride > 1 else held,
-                                        (int(held.min()), int(held.max()))))
+                runs = np.full(len(digits), stride, dtype=np.int64)
+                runs[0] -= lo - first * stride
+                runs[-1] -= (last + 1) * stride - hi
+                made.append([(name, _runs(values[digits], runs, n)) for name, values in self.axis_columns[index]])
             stride = period
-        return made[::-1]
+        return [column for columns in made[::-1] for column in columns]
 
-    def _periodic(self, index: int, stride: int, phase: int, n: int) -> _Column:
-        """Axis `index`'s column of n combinations from `phase` into its period (one period fits in n)."""
-        key = (index, phase, n)
-        column = self._kept.get(key)
-        if column is None:
-            values = self.values[index]
+    def _periodic(self, index: int, column: int, stride: int, phase: int, n: int) -> _Column:
+        """Axis `index`'s `column` over n combinations from `phase` into its period (one period fits in n)."""
+        key = (index, column, phase, n)
+        kept = self._kept.get(key)
+        if kept is None:
+            values = self.axis_columns[index][column][1]
             period = np.repeat(values, stride) if stride > 1 else values
             array = np.empty(n, dtype=np.int64)
             head = min(n, len(period) - phase)
@@ -158,12 +168,19 @@ class Grid:
                 more = min(filled, n - filled)
                 array[filled:filled + more] = array[:more]
                 filled += more
-            column = _Column(array, (int(values.min()), int(values.max())) if len(values) else (0, 0))
-            self._kept[key] = column
+            kept = _Column(array, (int(values.min()), int(values.max())) if len(values) else (0, 0))
+            self._kept[key] = kept
             self._kept_bytes += array.nbytes
             while self._kept_bytes > KEPT_BYTES and len(self._kept) > 1:
                 self._kept_bytes -= self._kept.pop(next(iter(self._kept))).array.nbytes
-        return column
+        return kept
+
+
+def _runs(held: np.ndarray, runs: np.ndarray, n: int) -> _Column:
+    """The column of `held`'s values, each repeated its run's length (n in all)."""
+    if len(held) == 1:
+        return _Column(_constant_column(int(held[0]), n), (int(held[0]),) * 2)
+    return _Column(np.repeat(held, runs) if len(held) < n else held, (int(held.min()), int(held.max())))
 
 
 @dataclass(frozen=True)
@@ -205,7 +222,20 @@ def _read_only(array: np.ndarray) -> np.ndarray:
     return view
 
 
-def _axis(name: str, axis: int | Sequence[int]) -> np.ndarray:
+def _axis(name: str, axis) -> tuple[tuple[str, np.ndarray], ...]:
+    """An axis's columns: (name, values as int64) for each."""
+    if isinstance(axis, Mapping):
+        if not axis:
+            raise ValueError(f"Grid: axis {name} has no columns")
+        columns = tuple((column, _values(column, values)) for column, values in axis.items())
+        if len({len(values) for _, values in columns}) > 1:
+            raise ValueError(f"Grid: axis {name}'s columns have different lengths "
+                             f"({', '.join(f'{c}: {len(v)}' for c, v in columns)})")
+        return columns
+    return ((name, _values(name, axis)),)
+
+
+def _values(name: str, axis: int | Sequence[int]) -> np.ndarray:
     if not isinstance(name, str) or not name.isidentifier():
         raise ValueError(f"Grid: axis name {name!r} is not an identifier (make takes the axes as keywords)")
     if isinstance(axis, (int, np.integer)) and not isinstance(axis, bool):

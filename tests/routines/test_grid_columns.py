@@ -27,16 +27,24 @@ def _digits(lengths: list[int], index: int) -> list[int]:
 
 
 def _expected(axes: dict, lo: int, hi: int) -> dict[str, list[int]]:
-    values = [list(range(a)) if isinstance(a, int) else list(a) for a in axes.values()]
-    rows = [[v[d] for v, d in zip(values, _digits([len(v) for v in values], i))] for i in range(lo, hi)]
-    return {name: [row[k] for row in rows] for k, name in enumerate(axes)}
+    """Each column's values over combinations lo..hi-1 (a dict axis: several columns, one digit)."""
+    columns = [dict(a) if isinstance(a, dict) else {name: list(range(a)) if isinstance(a, int) else list(a)}
+               for name, a in axes.items()]
+    lengths = [len(next(iter(c.values()))) for c in columns]
+    expected = {name: [] for c in columns for name in c}
+    for i in range(lo, hi):
+        for c, digit in zip(columns, _digits(lengths, i)):
+            for name, values in c.items():
+                expected[name].append(values[digit])
+    return expected
 
 
 GRIDS = [{"a": 3, "b": 5, "c": 7},  # no power of two: every run and period ends at an odd place
          {"x": [9, 4, 250, 4], "y": 2, "z": [100, 3, 77]},  # listed values (out of order, one repeated)
          {"ax": [0, 17], "bx": 256, "aw": 256, "bw": 256},  # aabb8's shape: runs longer than a block
          {"p": 1, "q": 70_001},  # an axis longer than a block, varying fastest
-         {"u": 13, "v": 1, "w": 4_099}]  # a one-value axis between
+         {"u": 13, "v": 1, "w": 4_099},  # a one-value axis between
+         {"d": {"x1": [0, 0, 5, 9], "x2": [3, 1, 0, 0]}, "r": 256, "k": {"r1": [7], "r2": [8]}}]  # columns together
 
 
 @pytest.mark.parametrize("axes", GRIDS)
@@ -51,7 +59,7 @@ def test_a_grid_s_columns_are_the_mixed_radix_digits_of_any_range(axes):
             made = grid.columns(lo, hi)
             for at in (lo, (lo + hi) // 2, hi - 1_000):
                 expected = _expected(axes, at, at + 1_000)
-                assert {n: made[n][at - lo:at - lo + 1_000].tolist() for n in axes} == expected, (axes, lo, hi, at)
+                assert {n: made[n][at - lo:at - lo + 1_000].tolist() for n in expected} == expected, (axes, lo, hi, at)
         else:
             assert {n: c.tolist() for n, c in grid.columns(lo, hi).items()} == _expected(axes, lo, hi), (axes, lo, hi)
 
@@ -91,6 +99,10 @@ def test_a_block_s_columns_are_each_axis_s_values_and_constants_of_every_kind():
     assert block["x"].tolist() == [7, 7, 3, 3] and block["y"].tolist() == [2, 4, 0, 2]
     assert block["k"].tolist() == [5] * 4 and block["u"].tolist() == [200] * 4
     assert block["big"].dtype == object  # (not a whole number within int64: made as numpy makes it, checked later)
+    for axes, says in (({"a": {"x": [1, 2], "y": [3]}}, "different lengths"), ({"a": {}}, "no columns"),
+                       ({"a": {"x": [1]}, "x": 2}, "column x is on two axes"), ({"a": {"x y": [1]}}, "identifier")):
+        with pytest.raises(ValueError, match=says):
+            Grid(axes)
 
 
 def _spec(tmp_path: Path, name: str, body: str) -> Path:
