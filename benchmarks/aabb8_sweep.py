@@ -68,6 +68,8 @@ def sliced_spec(folder: Path, starts: int) -> Path:
 
 FLOOR_BLOCKS = 32
 FLOOR_ROUNDS = 3
+MAKING_BLOCKS = 256  # blocks made per round for the making stage: its rounds are short, and CPU time is
+# sampled at the kernel's ticks here (a round of a few ms can read 0): all its rounds are timed together
 
 
 def _best(stage, blocks: list) -> float:
@@ -88,7 +90,7 @@ def floor() -> None:
 
     from retro.analysis.check.engines import runner_for
     from retro.analysis.check.reference import reference_answers
-    from retro.analysis.check.run import array_block, held_entry_tally
+    from retro.analysis.check.run import Sweep, array_block, held_entry_tally
     from retro.routines.batch_runs import RETURN_TRAP, _lane_bytes, push_return_trap, return_s
     from retro.routines import cases as case_sets
     from retro.routines.cases import in_domain
@@ -96,8 +98,12 @@ def floor() -> None:
     spec = str(SPEC)
     runner = runner_for(spec, 0, None)
     compiled, plan = runner.compiled(), runner.plan
-    parts = [part for part in case_sets.plan(runner.routine, exhaustive=True, seed=0) if part.name == "sweep"]
-    sweep = case_sets.batches(parts, 1 << 16)  # the sweep's blocks as the check makes them
+    parts = case_sets.plan(runner.routine, exhaustive=True, seed=0)
+    size = Sweep(spec, 0, True, None, 0, "compiled").block
+    before = sum(part.count for part in parts[:[part.name for part in parts].index("sweep")])
+    # the sweep's blocks as the check makes them: a worker's stream from its task's first case (a multiple
+    # of the block), counted over every part (after the boundary cases)
+    sweep = case_sets.stream(parts, size, -(-before // size) * size)
     blocks = list(islice(sweep, FLOOR_BLOCKS))
     start = dict(plan.base_registers)
     base = np.asarray([start["a"], start["x"], start["y"], plan.base_flags], dtype=np.int64)
@@ -111,13 +117,16 @@ def floor() -> None:
         compiled.run(image, tuple(block), base, sp, runner.limit, RETURN_TRAP, return_s(runner.fixed_entry_s), out_addr,
                      lane_addr, lane_bytes)
 
-    def making(_block) -> None:
-        next(sweep)
+    def making() -> float:
+        began, made = time.process_time(), 0
+        for _ in range(FLOOR_ROUNDS * MAKING_BLOCKS):
+            made += len(next(sweep)[0])
+        return (time.process_time() - began) / made * 1e9
     held: list = []
 
     def check(block) -> None:
         held.append(array_block(spec, 0, block, len(held) * len(block[0]), 64, "compiled", None)[1])
-    stages = {"making the columns": _best(making, blocks),
+    stages = {"making the columns": making(),
               "the compiled function": _best(function, blocks),
               "run_compiled (function and outputs)": _best(runner.run_compiled, blocks),
               "the domain (in_domain)": _best(lambda b: in_domain(runner.routine, b), blocks),
