@@ -47,6 +47,7 @@ DRAW_BUDGET = 256  # candidates drawn in the box per random case wanted, at most
 DRAW_FLOOR, DRAW_CEILING = 1 << 22, 1 << 25  # ... but at least 4 Mi and at most 32 Mi of them
 DRAW_BATCH = 1 << 16  # candidates drawn (and tested against the domain) at once
 EAGER_INSIDE = 1 << 20  # up to this many random cases inside the domain are drawn when the plan is made
+GRID_VALUES = 1 << 20  # an exhaustive product is made as a grid when each swept input has at most this many values
 
 
 Columns = list  # one numpy array per input, in input order: (n,) int64, or (n, size) for a table
@@ -298,17 +299,29 @@ def _product(routine: Routine, seed: int, sample: int | None, valid: np.ndarray 
     radices = [ports[i].count for i in swept]
     total = int(np.prod(radices, dtype=object))
 
-    def columns_of(indices: np.ndarray, rng: np.random.Generator) -> Columns:
+    def digit_columns(indices: np.ndarray) -> list:
         columns: list = [None] * len(ports)
         rest = indices.copy()
         for i, radix in zip(reversed(swept), reversed(radices)):  # the last swept input varies fastest
             digit = rest % np.uint64(radix)
             rest //= np.uint64(radix)
             columns[i] = _digit_values(ports[i], digit)
-        for i, port in enumerate(ports):
-            if columns[i] is None:
-                columns[i] = _random_column(port, rng, len(indices))
         return columns
+
+    def drawn(columns: list, rng: np.random.Generator, n: int) -> Columns:
+        """The inputs not swept drawn into `columns`: per CHUNK of cases, input by input (the draws'
+        order since blocks were made a CHUNK at a time)."""
+        if len(swept) == len(ports):
+            return columns
+        out = [column if column is not None else
+               np.empty((n, len(port.places)) if port.table else n, dtype=np.int64)
+               for column, port in zip(columns, ports)]
+        for at in range(0, n, CHUNK):
+            m = min(CHUNK, n - at)
+            for i, port in enumerate(ports):
+                if columns[i] is None:
+                    out[i][at:at + m] = _random_column(port, rng, m)
+        return out
 
     if sample is not None:
         rng = np.random.default_rng(seed + EXHAUSTIVE_RNG_OFFSET)
@@ -317,14 +330,24 @@ def _product(routine: Routine, seed: int, sample: int | None, valid: np.ndarray 
         else:
             picked = np.sort(rng.choice(total, size=sample, replace=False).astype(np.uint64))
         for i in range(0, sample, CHUNK):
-            yield columns_of(picked[i:i + CHUNK], rng)
+            indices = picked[i:i + CHUNK]
+            yield drawn(digit_columns(indices), rng, len(indices))
         return
+    # every combination in order: the swept inputs' columns from a grid of their values (runs and periods,
+    # not a division per case), unless a table is swept or an input has very many values
+    grid = None if any(ports[i].table or ports[i].count > GRID_VALUES for i in swept) else Grid(
+        {f"input{i}": _digit_values(ports[i], np.arange(ports[i].count, dtype=np.uint64)) for i in swept})
 
     def block_of(block: int, lo: int, hi: int) -> Iterator[Columns]:
         rng = _block_rng(seed + EXHAUSTIVE_RNG_OFFSET, block)
-        for at in range(lo, hi, CHUNK):
-            positions = np.arange(at, min(at + CHUNK, hi), dtype=np.uint64)
-            yield columns_of(positions if valid is None else valid[positions.astype(np.int64)], rng)
+        if valid is None and grid is not None:
+            columns: list = [None] * len(ports)
+            for i, (_, column) in zip(swept, grid._axis_columns(lo, hi)):
+                columns[i] = column.array
+        else:
+            positions = np.arange(lo, hi, dtype=np.uint64)
+            columns = digit_columns(positions if valid is None else valid[positions.astype(np.int64)])
+        yield drawn(columns, rng, hi - lo)
     yield from _by_block(total if valid is None else len(valid), start, block_of)
 
 

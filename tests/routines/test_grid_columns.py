@@ -202,3 +202,37 @@ def test_the_whole_square_root_of_every_sum_of_two_squared_byte_differences():
     from retro.routines.builtin_cases import _isqrt
     values = np.concatenate([np.arange(2 * 255 ** 2 + 2), np.arange(1, 3000) ** 2 - 1, [2 ** 50 - 1, 2 ** 50]])
     assert _isqrt(values).tolist() == [math.isqrt(int(v)) for v in values]
+
+
+# ---- the exhaustive product: every combination of the swept inputs, in order ------------------------------
+
+def _product_spec(tmp_path: Path) -> Path:
+    """circle_r with its exhaustive inputs given odd values: a list out of order and a range not from 0."""
+    text = (ROOT / "asm/circle_r.toml").read_text().replace('file = "circle_r.s"', f'file = "{ROOT / "asm/circle_r.s"}"')
+    text = text.replace('exhaustive = ["x1", "radius_sum"]',
+                        'exhaustive = { x1 = [9, 3, 200, 4, 77], y2 = "5..11", radius_sum = "1..255" }')
+    spec = tmp_path / "product.toml"
+    spec.write_text(text)
+    return spec
+
+
+def test_an_exhaustive_product_is_every_combination_in_order_and_its_draws_per_chunk(tmp_path):
+    from itertools import product
+    routine = load_spec(_product_spec(tmp_path))
+    part = next(p for p in case_sets.plan(routine, exhaustive=True, seed=5, random=0) if p.name == "exhaustive")
+    ports = routine.part_inputs("exhaustive")
+    swept = [i for i, port in enumerate(ports) if port.name in routine.exhaustive]
+    values = [list(ports[i].values.listed) if ports[i].values.listed else list(range(ports[i].values.lo, ports[i].values.hi + 1))
+              for i in swept]
+    combinations = list(product(*values))  # the plain rule: the last swept input varies fastest
+    assert part.count == len(combinations) == 5 * 7 * 255
+    made = [np.concatenate(c) for c in zip(*case_sets.rechunked(part.blocks(), 4_096))]
+    assert list(zip(*(made[i].tolist() for i in swept))) == combinations
+    rng = np.random.default_rng(5 + case_sets.EXHAUSTIVE_RNG_OFFSET)  # one block: the part's own generator
+    drawn = {i: [] for i in range(len(ports)) if i not in swept}
+    for at in range(0, part.count, case_sets.CHUNK):  # per CHUNK, input by input
+        for i in drawn:
+            drawn[i].append(case_sets._random_column(ports[i], rng, min(case_sets.CHUNK, part.count - at)))
+    assert all(made[i].tolist() == np.concatenate(d).tolist() for i, d in drawn.items())
+    for start in (1, 4_001, part.count - 3):
+        assert [np.concatenate(c).tolist() for c in zip(*part.seek(start))] == [c[start:].tolist() for c in made]
