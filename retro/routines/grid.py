@@ -23,6 +23,7 @@ Only numpy here: the specs' own modules import it.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
@@ -169,10 +170,12 @@ class Grid:
                 array[filled:filled + more] = array[:more]
                 filled += more
             kept = _Column(array, (int(values.min()), int(values.max())) if len(values) else (0, 0))
-            self._kept[key] = kept
-            self._kept_bytes += array.nbytes
-            while self._kept_bytes > KEPT_BYTES and len(self._kept) > 1:
-                self._kept_bytes -= self._kept.pop(next(iter(self._kept))).array.nbytes
+            with _keeping:
+                if key not in self._kept:
+                    self._kept[key] = kept
+                    self._kept_bytes += array.nbytes
+                while self._kept_bytes > KEPT_BYTES and len(self._kept) > 1:
+                    self._kept_bytes -= self._kept.pop(next(iter(self._kept))).array.nbytes
         return kept
 
 
@@ -192,6 +195,7 @@ class _Column:
 KEPT_BYTES = 16 << 20  # a grid's periodic columns kept for the blocks after (several axes, a few phases each)
 CONSTANTS_KEPT = 16  # constant columns kept (a make's constants, an axis held for a block: the same in the next ones)
 _constants: dict[tuple[int, int], np.ndarray] = {}
+_keeping = threading.Lock()  # the kept columns' dicts (a worker may make blocks on several threads)
 
 
 def _constant(value, n: int) -> np.ndarray | None:
@@ -206,12 +210,16 @@ def _constant(value, n: int) -> np.ndarray | None:
 
 def _constant_column(value: int, n: int) -> np.ndarray:
     key = (value, n)
-    column = _constants.pop(key, None)  # (put back last: the most recently used go last)
-    if column is None:
-        column = np.full(n, value, dtype=np.int64)
+    with _keeping:
+        column = _constants.pop(key, None)  # (put back last: the most recently used go last)
+        if column is not None:
+            _constants[key] = column
+            return column
+    column = np.full(n, value, dtype=np.int64)
+    with _keeping:
         while len(_constants) >= CONSTANTS_KEPT:
             _constants.pop(next(iter(_constants)))
-    _constants[key] = column
+        _constants[key] = column
     return column
 
 

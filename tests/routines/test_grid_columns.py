@@ -236,3 +236,19 @@ def test_an_exhaustive_product_is_every_combination_in_order_and_its_draws_per_c
     assert all(made[i].tolist() == np.concatenate(d).tolist() for i, d in drawn.items())
     for start in (1, 4_001, part.count - 3):
         assert [np.concatenate(c).tolist() for c in zip(*part.seek(start))] == [c[start:].tolist() for c in made]
+
+
+def test_a_check_never_writes_into_a_grid_s_shared_columns():
+    """A grid's columns are shared between blocks (kept periods, constants): the engines, the reference, the
+    domain and the tally only read them."""
+    from retro.analysis.check.run import array_block
+
+    spec = str(ROOT / "asm/tile_box.toml")
+    parts = [p for p in case_sets.plan(load_spec(spec), exhaustive=True, seed=0) if p.name == "sweep"]
+    blocks = list(case_sets.stream(parts, 4_096))[:3]
+    before = [[c.copy() for c in block] for block in blocks]
+    for first, block in zip((0, 4_096, 8_192), blocks):
+        array_block(spec, 0, block, first, 1, "batch", None)
+    assert all(np.array_equal(a, b) for block, kept in zip(blocks, before) for a, b in zip(block, kept))
+    again = list(case_sets.stream(parts, 4_096))[:3]
+    assert all(np.array_equal(a, b) for block, kept in zip(again, before) for a, b in zip(block, kept))
