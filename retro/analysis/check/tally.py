@@ -322,11 +322,12 @@ def _entry_figures(out: Tally, calls: _Calls, entry: EntryBlock) -> None:
     _entry_counts(out, baseline, entry.runs, lambda k: calls.case(int(positions[k])))
 
 
-def entry_tally(variants: dict, baselines: list[EntryBaseline], seed: int) -> Tally:
+def entry_tally(variants: dict, baselines: list[EntryBaseline], seed: int, engine: str = "batch") -> Tally:
     """The entry-state figures of blocks whose rerun cases were held (`entry_baseline`), run together
-    on the batched core: the figures each block's own `count_block(..., entry=...)` would give."""
+    on `engine` (entry_runs.run_baselines): the figures each block's own `count_block(..., entry=...)`
+    would give."""
     out = Tally()
-    for baseline, runs in zip(baselines, run_baselines(variants, baselines, seed)):
+    for baseline, runs in zip(baselines, run_baselines(variants, baselines, seed, engine)):
         one = Tally()
         _entry_counts(one, baseline, runs, baseline.case)
         out.merge(one)
