@@ -15,8 +15,9 @@ them for the check: from a task's first case in the sweep part, counted over eve
 blocks a round, the rounds timed together), the compiled function alone
 (`CompiledRoutine.run`), `run_compiled` around it (the outputs made from its rows), the domain
 (`in_domain`), the reference on the arrays (`reference_answers`), and a whole block through the check
-(`array_block`: run, reference, domain and tally; the entry-state reruns apart, `held_entry_tally` on
-the block's 1-in-64 cases). The sum of the stages a check cannot skip (making, the function, the
+(`array_block`: run, reference, domain and tally, the outside-domain examples kept from the first block
+only, as a sweep task does; the entry-state reruns apart, `held_entry_tally` on the blocks' 1-in-64
+cases, on the batched core and on the compiled engine, where a sweep on it runs them). The sum of the stages a check cannot skip (making, the function, the
 reference) against the 3-minute goal's budget: 3 x 2^32 calls in 360 CPU seconds on 2 cores, 27.9 ns
 a call.
 
@@ -98,6 +99,7 @@ def floor() -> None:
     from retro.analysis.check.engines import runner_for
     from retro.analysis.check.reference import reference_answers
     from retro.analysis.check.run import Sweep, array_block, held_entry_tally
+    from retro.analysis.check.tally import EXAMPLES_KEPT
     from retro.routines.batch_runs import RETURN_TRAP, _lane_bytes, push_return_trap, return_s
     from retro.routines import cases as case_sets
     from retro.routines.cases import in_domain
@@ -131,8 +133,9 @@ def floor() -> None:
         return (time.process_time() - began) / made * 1e9
     held: list = []
 
-    def check(block) -> None:
-        held.append(array_block(spec, 0, block, len(held) * len(block[0]), 64, "compiled", None)[1])
+    def check(block) -> None:  # as a sweep task does: the outside examples kept from its first block only
+        held.append(array_block(spec, 0, block, len(held) * len(block[0]), 64, "compiled", None,
+                                0 if held else EXAMPLES_KEPT)[1])
     stages = {"making the columns": making(),
               "the compiled function": _best(function, blocks),
               "run_compiled (function and outputs)": _best(runner.run_compiled, blocks),
@@ -140,9 +143,12 @@ def floor() -> None:
               "the reference (reference_answers)": _best(
                   lambda b: reference_answers(runner.routine, b, None, runner.memory_values), blocks),
               "a block through the check (array_block)": _best(check, blocks)}
-    began = time.process_time()
-    held_entry_tally(spec, 0, None, held[:FLOOR_BLOCKS])
-    stages["entry-state reruns (1 in 64, 2 variants)"] = (time.process_time() - began) / (FLOOR_BLOCKS * len(blocks[0][0])) * 1e9
+    held_entry_tally(spec, 0, None, held[:1], "compiled")  # (the entry-state function loaded: not a call's cost)
+    for engine in ("batch", "compiled"):
+        began = time.process_time()
+        held_entry_tally(spec, 0, None, held[:FLOOR_BLOCKS], engine)
+        stages[f"entry-state reruns on {engine} (1 in 64, 2 variants)"] = (
+            (time.process_time() - began) / (FLOOR_BLOCKS * len(blocks[0][0])) * 1e9)
     for name, ns in stages.items():
         print(f"  {name:<44} {ns:6.1f} ns a call")
     least = stages["making the columns"] + stages["the compiled function"] + stages["the reference (reference_answers)"]

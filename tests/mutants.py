@@ -60,6 +60,7 @@ WORKER_TESTS = ("tests/test_workers.py",)
 STREAM_TESTS = ("tests/routines/test_case_stream.py",)
 GRID_TESTS = ("tests/routines/test_grid_columns.py", "tests/routines/test_case_stream.py")
 FLOW_TESTS = ("tests/cpu/test_flow_values.py", "tests/routines/test_static_smc.py")
+TALLY_TESTS = ("tests/routines/test_tally_blocks.py",)
 COMMAND_TESTS = ("tests/test_commands.py", "tests/test_cli_foundation.py", "tests/routines/test_routines_cli.py")
 
 MUTANTS = [
@@ -182,7 +183,7 @@ MUTANTS = [
     Mutant("static-budget-not-checked", "retro/analysis/check/verdicts.py",
            "if static is not None and static.worst > routine.budget:", "if False:", CHECK_TESTS),
     Mutant("outside-domain-counted-as-inside", "retro/analysis/check/tally.py",
-           "        inside &= ~broken\n", "        pass\n", CHECK_TESTS),
+           "        inside &= held\n", "        pass\n", CHECK_TESTS),
     Mutant("result-mismatch-not-counted", "retro/analysis/check/tally.py",
            "out.result_mismatches = len(wrong_inside)", "out.result_mismatches = 0", CHECK_TESTS),
     Mutant("run-error-not-stopping", "retro/analysis/check/engines.py",
@@ -195,6 +196,17 @@ MUTANTS = [
            + ("tests/routines/test_scene_batch.py",)),
     Mutant("outside-examples-never-kept", "retro/analysis/check/tally.py",
            "    if outside_wanted > 0 and out.outside_wrong:", "    if False:", ("tests/test_check_golden.py",)),
+    Mutant("tally-first-extreme-taken-outside-the-domain", "retro/analysis/check/tally.py",
+           "    if calls.everywhere or calls.inside[first]:", "    if True:", TALLY_TESTS),
+    Mutant("tally-block-inside-judged-by-its-first-case", "retro/analysis/check/tally.py",
+           "everywhere=bool(inside.all())", "everywhere=bool(inside[:1].all())", TALLY_TESTS),
+    Mutant("tally-block-right-judged-by-its-first-case", "retro/analysis/check/tally.py",
+           "all_equal=bool(equal.all())", "all_equal=bool(equal[:1].all())", TALLY_TESTS),
+    Mutant("tally-wrong-outside-counted-as-mismatch", "retro/analysis/check/tally.py",
+           "np.flatnonzero(~calls.equal if calls.everywhere else calls.inside & ~calls.equal)",
+           "np.flatnonzero(~calls.equal)", TALLY_TESTS),
+    Mutant("tally-cycles-sum-counts-the-cases-outside", "retro/analysis/check/tally.py",
+           "int(cycles.sum() - cycles[~calls.inside].sum())", "int(cycles.sum())", TALLY_TESTS),
     # ---- routine specs and static analysis -------------------------------------------------------
     Mutant("jsr-callee-cost-dropped", "retro/cpu/flow.py",
            "return _Effect((cycles + callee.best, cycles + callee.worst), after=_returned(callee.exit))",
@@ -243,11 +255,17 @@ MUTANTS = [
            "found += self.agreement.engine_mismatches + self.agreement.cycle_mismatches", "found += 0",
            BATCH_TESTS),
     Mutant("held-entry-reruns-dropped", "retro/analysis/check/run.py",
-           "        totals.merge(held_entry_tally(sweep.spec, sweep.seed, sweep.start, held))", "        pass",
+           "        totals.merge(held_entry_tally(sweep.spec, sweep.seed, sweep.start, held, sweep.rerun_engine))",
+           "        pass",
            ("tests/routines/test_entry_state.py",)),
     Mutant("held-entry-reruns-given-the-first-blocks-runs", "retro/analysis/check/entry_runs.py",
            "                part = slice(end - size, end)", "                part = slice(0, size)",
            ("tests/routines/test_entry_state.py",)),
+    Mutant("compiled-reruns-without-the-varied-flags", "retro/routines/batch_runs.py",
+           "[bits & bit for bit in bit_list]", "[bits & 0 for bit in bit_list]",
+           ("tests/routines/test_entry_state.py",)),
+    Mutant("compiled-reruns-not-cross-checked", "retro/analysis/check/entry_runs.py",
+           "    if differ.any():", "    if False:", ("tests/routines/test_entry_state.py",)),
     Mutant("agreement-run-skipped", "retro/analysis/check/run.py",
            "agreement.merge(agreement_chunk(spec, seed, chunk, engine, start))", "pass", BATCH_TESTS),
     # ---- the parallel work (retro/workers.py) and a task's cases (retro/routines/cases.py) ------------

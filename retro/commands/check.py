@@ -200,6 +200,8 @@ def check_record(check: RoutineCheck) -> dict:
 
 def fallback_counts(t) -> dict[str, int]:
     """The compiled engine's calls that ran on the batched core, by reason (the reason's text)."""
+    if not t.fallbacks:  # (no import of the compiled engine, numba's 0.2 s, for a check that had none)
+        return {}
     from retro.cpu.compiled import FALLBACK_REASON
 
     return {FALLBACK_REASON.get(code, str(code)): count for code, count in sorted(t.fallbacks.items())}

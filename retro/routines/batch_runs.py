@@ -144,14 +144,16 @@ def _fact_watches(runner: RoutineRunner) -> dict:
             for pc, fact in runner.watched_facts.items()}
 
 
-def compiled_routine(runner: RoutineRunner):
+def compiled_routine(runner: RoutineRunner, free: tuple = ()):
     """The routine compiled (`retro.cpu.compiled`), made on first use and again when the code bytes
-    changed (set_memory); Untranslatable when the compiled engine does not take it."""
+    changed (set_memory); Untranslatable when the compiled engine does not take it. `free`: an
+    entry-state run's free registers ("a", "x", "y") and P bits, each set from a column after the
+    inputs' (`run_compiled(..., entry=...)`: another function, compiled once)."""
     from retro.cpu.compiled import SET_FLAG, SET_REGISTERS, compile_routine
     from retro.cpu.mpu import FLAG_D
 
     image = bytes(runner.call_image)
-    held = runner._compiled
+    held = runner._compiled if not free else runner._compiled_free.get(free)
     if held is not None and (held[2] == image or all(image[a] == b for a, b in held[1])):
         return held[0]
     plan = runner.plan
@@ -161,12 +163,19 @@ def compiled_routine(runner: RoutineRunner):
     places = tuple((index, shift, address) for index, address, shift in plan.bytes)  # read from the columns per call
     sets = tuple([(index, shift, SET_REGISTERS.index(register)) for index, register, shift in plan.registers]
                  + [(index, bit, SET_FLAG) for index, bit in plan.flags])
+    inputs = len(runner.routine.inputs)
+    sets += tuple((inputs + k, 0, SET_REGISTERS.index(place)) if isinstance(place, str) else (inputs + k, place, SET_FLAG)
+                  for k, place in enumerate(free))
     routine = compile_routine(bytes(trapped), runner.entry, runner.routine.cpu, RETURN_TRAP, inputs_at,
-                              len(runner.routine.inputs), places, sets,
+                              inputs + len(free), places, sets,
                               lanes=tuple(a for _, addresses in plan.tables for a in addresses),
                               outputs=tuple(int(a) for a in plan.output_addresses),
                               decimal_entry=bool(plan.base_flags & FLAG_D))
-    runner._compiled = (routine, [(a, image[a]) for a in sorted(routine.translation.code_bytes)], image)
+    held = (routine, [(a, image[a]) for a in sorted(routine.translation.code_bytes)], image)
+    if free:
+        runner._compiled_free[free] = held
+    else:
+        runner._compiled = held
     return routine
 
 
@@ -183,16 +192,28 @@ def _lane_bytes(plan, columns: list, n: int) -> tuple[np.ndarray, np.ndarray]:
     return lane_addr, lane_bytes
 
 
-def run_compiled(runner: RoutineRunner, columns: list) -> BatchOutcome:
+def run_compiled(runner: RoutineRunner, columns: list,
+                 entry: tuple[dict, np.ndarray, int] | None = None) -> BatchOutcome:
     """Every case of a column block on the compiled engine; calls it leaves (`fallbacks`, by
-    reason) run on the batched core."""
-    compiled = runner.compiled()
+    reason) run on the batched core. `entry` as for run_batch: the free registers and P bits of an
+    entry-state run, per lane (read from columns of their own, over a base with them cleared)."""
     n = len(columns[0])
     plan = runner.plan
-    lane_addr, lane_bytes = _lane_bytes(plan, columns, n)
-    flat = tuple(np.ascontiguousarray(c if c.ndim == 1 else c[:, 0], dtype=np.int64) for c in columns)
     start = dict(plan.base_registers)
-    base = np.asarray([start["a"], start["x"], start["y"], plan.base_flags], dtype=np.int64)
+    p = plan.base_flags
+    free: tuple = ()
+    extra: list = []
+    if entry is not None:
+        registers, bits, mask = entry
+        bit_list = [1 << k for k in range(8) if mask >> k & 1]
+        free = (*sorted(registers), *bit_list)
+        extra = [registers[name] for name in sorted(registers)] + [bits & bit for bit in bit_list]
+        start.update(dict.fromkeys(registers, 0))
+        p &= ~mask
+    compiled = compiled_routine(runner, free)
+    lane_addr, lane_bytes = _lane_bytes(plan, columns, n)
+    flat = tuple(np.ascontiguousarray(c if c.ndim == 1 else c[:, 0], dtype=np.int64) for c in [*columns, *extra])
+    base = np.asarray([start["a"], start["x"], start["y"], p], dtype=np.int64)
     image = bytearray(runner.call_image)
     s = runner.fixed_entry_s
     stack_pointer = push_return_trap(image, s)
@@ -208,14 +229,14 @@ def run_compiled(runner: RoutineRunner, columns: list) -> BatchOutcome:
     if not n or not status.max():  # the common case: every call returned (one pass, no scan for the others)
         return BatchOutcome(outputs, cycles, np.zeros(n, dtype=np.int8))
     error = np.where(status == LaneError.BUDGET, LaneError.BUDGET, 0).astype(np.int8)
-    _rerun_fallbacks(runner, columns, status, outputs, cycles, error)
+    _rerun_fallbacks(runner, columns, status, outputs, cycles, error, entry)
     return BatchOutcome(outputs, cycles, error)
 
 
 def _rerun_fallbacks(runner: RoutineRunner, columns: list, status: np.ndarray, outputs: list, cycles: np.ndarray,
-                     error: np.ndarray) -> None:
+                     error: np.ndarray, entry: tuple | None = None) -> None:
     """The calls the compiled engine left (counted by reason in `runner.fallbacks`) run again on the
-    batched core, their results written over the compiled block's."""
+    batched core (with their entry state), their results written over the compiled block's."""
     from retro.cpu.compiled import FALLBACK
 
     if not len(status) or status.max() < FALLBACK:  # the common case: no scan for the calls left
@@ -225,7 +246,9 @@ def _rerun_fallbacks(runner: RoutineRunner, columns: list, status: np.ndarray, o
         return
     for code, count in zip(*np.unique(status[left], return_counts=True)):
         runner.fallbacks[int(code)] = runner.fallbacks.get(int(code), 0) + int(count)
-    batch = runner.run_batch([c[left] for c in columns])
+    if entry is not None:
+        entry = ({name: values[left] for name, values in entry[0].items()}, entry[1][left], entry[2])
+    batch = runner.run_batch([c[left] for c in columns], entry=entry)
     for output, redone in zip(outputs, batch.outputs):
         output[left] = redone
     cycles[left] = batch.cycles

@@ -161,6 +161,7 @@ class RoutineRunner:
         self.written_kept = _written_kept(routine)
         self.fallbacks: dict[int, int] = {}  # compiled engine: calls it left to the batched core, by status
         self._compiled = None  # compiled engine: (the routine, its code bytes, its image): batch_runs.compiled_routine
+        self._compiled_free: dict = {}  # ... an entry-state run's, by its free registers and P bits
         self._machine_s = not self.plan.s_varies and routine.entry_s == ENTRY_S  # S from the machine's stack top
 
     @property
@@ -300,9 +301,10 @@ class RoutineRunner:
         """The routine compiled (retro.routines.batch_runs.compiled_routine)."""
         return batch_runs.compiled_routine(self)
 
-    def run_compiled(self, columns: list) -> BatchOutcome:
-        """Run every case of a column block on the compiled engine (the calls it leaves on the batched core)."""
-        return batch_runs.run_compiled(self, columns)
+    def run_compiled(self, columns: list, entry: tuple[dict, np.ndarray, int] | None = None) -> BatchOutcome:
+        """Run every case of a column block on the compiled engine (the calls it leaves on the batched core);
+        `entry` as for run_batch."""
+        return batch_runs.run_compiled(self, columns, entry)
 
     def outputs(self, a: int, x: int, y: int, p: int, located: dict | None = None) -> tuple:
         read = self.machine.memory.__getitem__

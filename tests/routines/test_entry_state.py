@@ -146,3 +146,63 @@ def test_which_cases_run_again():
     import numpy as np
 
     assert np.concatenate(pieces)[np.concatenate(pieces) < 100].tolist() == whole.tolist() == list(range(0, 100, 7))
+
+
+# ---- the reruns on the compiled engine (entry_runs.rerun_engine) ------------------------------------
+
+def _needs_numba():
+    from retro.cpu.compiled import numba_problem
+
+    if numba_problem() is not None:
+        pytest.skip(numba_problem())
+
+
+@pytest.mark.parametrize("name", ["overlap8", "add_bcd", "index_x", "scratch", "room"])
+def test_compiled_reruns_give_the_batched_cores_verdict(capsys, monkeypatch, name):
+    """With every rerun on the compiled engine (its per-lane registers, flags, memory and S of each
+    variant), the entry-state figures are the batched core's, the first changed case of each variant
+    and what it depends on included."""
+    _needs_numba()
+    from retro.analysis.check import entry_runs
+
+    batched = _check(capsys, ENTRY / f"{name}.toml", "--exhaustive", "--engine", "batch")[1]
+    monkeypatch.setattr(entry_runs, "ENTRY_COMPILED_RERUNS", 0)  # every check's reruns on the compiled engine
+    monkeypatch.setattr(entry_runs, "CROSS_CHECKED", 0)  # none on the batched core: the compiled engine's alone
+    compiled = _check(capsys, ENTRY / f"{name}.toml", "--exhaustive", "--engine", "compiled")[1]
+    assert compiled["engine"] == "compiled"
+    assert compiled["entry_dependence"] == batched["entry_dependence"] and batched["entry_dependence"]["changed"]
+    assert compiled["mismatches"] == batched["mismatches"]
+
+
+def test_compiled_reruns_are_cross_checked_on_the_batched_core(capsys, monkeypatch):
+    """A compiled engine that counts one cycle too many when the entry state is varied is caught by the
+    reruns' sample on the batched core: the check fails naming the case and both engines' answers."""
+    _needs_numba()
+    from retro.analysis.check import entry_runs
+    from retro.routines import batch_runs
+
+    run_compiled = batch_runs.run_compiled
+
+    def one_cycle_more_when_varied(runner, columns, entry=None):
+        outcome = run_compiled(runner, columns, entry)
+        if entry is not None:
+            outcome.cycles[-1] += 1
+        return outcome
+
+    monkeypatch.setattr(batch_runs, "run_compiled", one_cycle_more_when_varied)
+    monkeypatch.setattr(entry_runs, "ENTRY_COMPILED_RERUNS", 0)
+    monkeypatch.setattr(entry_runs, "CROSS_CHECKED", 1 << 20)  # every rerun compared: the changed one is last
+    code = main(["check", str(ENTRY / "overlap8_stated.toml"), "--jobs", "1", "--engine", "compiled"])
+    assert code == 1
+    err = capsys.readouterr().err
+    assert "the engines disagree on case" in err and "run with the entry state varied" in err
+
+
+def test_which_engine_reruns():
+    from retro.analysis.check.entry_runs import ENTRY_COMPILED_RERUNS, rerun_engine
+
+    assert rerun_engine("batch", 10**9, True, 64) == "batch"  # the check's own engine first
+    assert rerun_engine("compiled", 10**9, False, 0) == "batch"  # no reruns
+    assert rerun_engine("compiled", 0, True, 64) == "compiled"  # a sweep: many
+    assert rerun_engine("compiled", ENTRY_COMPILED_RERUNS // 2, False, 1) == "compiled"  # two variants each
+    assert rerun_engine("compiled", ENTRY_COMPILED_RERUNS // 2 - 1, False, 1) == "batch"

@@ -163,12 +163,12 @@ def array_engine(engine: str, calls: int | None) -> tuple[str, str]:
     """Which array engine runs a check that `batched` sent to one, and why: ("compiled" or "batch",
     the reason the report gives). "auto" takes the compiled engine from AUTO_COMPILED_CASES planned
     calls (or a sweep) when numba can be imported; its routine may still be refused (`compiled_or_why`)."""
-    from retro.cpu.compiled import numba_problem
-
     if engine == "batch":
         return "batch", "--engine batch"
     if engine == "auto" and calls is not None and calls < AUTO_COMPILED_CASES:
         return "batch", f"auto: {calls:,} planned calls (the compiled engine from {AUTO_COMPILED_CASES:,})"
+    from retro.cpu.compiled import numba_problem  # (numba's import, 0.2 s: only when the compiled engine may run)
+
     problem = numba_problem()
     if problem is not None:
         _say_once(f"the compiled engine is off: {problem}; the batched core runs instead")

@@ -17,6 +17,7 @@ import numpy as np
 
 from retro.cpu.batch import LaneError
 from retro.errors import RunError
+from retro.routines.batch_runs import BatchOutcome
 from retro.routines.cases import case_of, in_domain
 from retro.routines.entry import VARIANTS, advice, memory_advice, stack_advice, variant_stack, variant_values
 from retro.routines.places import FLAGS
@@ -69,6 +70,19 @@ def entry_every(planned: int, exhaustive: bool, everything: int, sweep: bool = F
     cases are not counted beforehand, at most one in SWEEP_EVERY."""
     every = 1 if planned <= ENTRY_SAMPLE or (exhaustive and planned <= everything) else -(-planned // ENTRY_SAMPLE)
     return max(every, SWEEP_EVERY) if sweep else every
+
+
+ENTRY_COMPILED_RERUNS = 1_000_000  # reruns (all variants) from which a check on the compiled engine runs them
+# there: loading its entry-state function (numba's cache, ~0.1-0.5 CPU s) costs about what the batched core
+# takes for this many (250-670 ns a call: EntryBaseline)
+
+
+def rerun_engine(engine: str, planned: int, sweep: bool, every: int) -> str:
+    """The engine of a check's entry-state reruns on an array engine: the compiled engine when the
+    check runs on it and they are many (a sweep's, or ENTRY_COMPILED_RERUNS), else the batched core."""
+    if engine != "compiled" or not every:
+        return "batch"
+    return "compiled" if sweep or planned // every * len(VARIANTS) >= ENTRY_COMPILED_RERUNS else "batch"
 
 
 def rerun_positions(first: int, n: int, every: int) -> np.ndarray:
@@ -130,9 +144,10 @@ def entry_baseline(routine, outputs: list, cycles: np.ndarray, returned: int, co
 
 
 def run_baselines(variants: dict[str, RoutineRunner], baselines: list[EntryBaseline],
-                  seed: int) -> list[dict[str, VariantRun]]:
-    """Every baseline's cases in every variant, all blocks' in one batched-core run per variant; per
-    baseline, its variants' runs (as a run of its block's cases alone would give them)."""
+                  seed: int, engine: str = "batch") -> list[dict[str, VariantRun]]:
+    """Every baseline's cases in every variant, all blocks' in one run per variant on `engine` ("batch",
+    or "compiled": then its first CROSS_CHECKED cases on the batched core too, `_rerun`); per baseline,
+    its variants' runs (as a run of its block's cases alone would give them)."""
     sizes = [len(b.positions) for b in baselines]
     out: list[dict[str, VariantRun]] = [{} for _ in baselines]
     if not sum(sizes):
@@ -143,12 +158,47 @@ def run_baselines(variants: dict[str, RoutineRunner], baselines: list[EntryBasel
     for variant, runner in variants.items():
         state = runner.entry_state
         registers, bits = variant_values(state, variant, seed, indexes)
-        outcome = runner.run_batch(columns, entry=(registers, bits, state.free_mask))
+        outcome = _rerun(runner, variant, columns, (registers, bits, state.free_mask), engine, indexes)
         for k, (end, size) in enumerate(zip(ends.tolist(), sizes)):
             if size:
                 part = slice(end - size, end)
                 out[k][variant] = _variant_run(outcome.outputs, outcome.cycles, outcome.error, part)
     return out
+
+
+CROSS_CHECKED = 256  # of each compiled rerun, the cases also run on the batched core and compared (the engines
+# stay cross-checked on varied entry states: a sweep task's first block's reruns, ~1 in 250 of a sweep's)
+
+
+def _rerun(runner: RoutineRunner, variant: str, columns: list, entry: tuple, engine: str,
+           indexes: np.ndarray) -> BatchOutcome:
+    """The cases in one variant's entry state on `engine`; on the compiled engine the first CROSS_CHECKED
+    run on the batched core too, whose outputs, cycles and stops must be the same (a RunError if not)."""
+    if engine != "compiled":
+        return runner.run_batch(columns, entry=entry)
+    outcome = runner.run_compiled(columns, entry)
+    k = min(len(indexes), CROSS_CHECKED)
+    if not k:
+        return outcome
+    registers, bits, mask = entry
+    sample = runner.run_batch([c[:k] for c in columns], entry=({n: v[:k] for n, v in registers.items()}, bits[:k], mask))
+    stopped, also = outcome.error[:k] != 0, sample.error != 0
+    differ = stopped != also
+    for compiled, batched in zip(outcome.outputs, sample.outputs):
+        unequal = compiled[:k] != batched
+        differ |= (unequal.any(axis=1) if unequal.ndim == 2 else unequal) & ~stopped
+    differ |= (outcome.cycles[:k] != sample.cycles) & ~stopped
+    if differ.any():
+        i = int(np.flatnonzero(differ)[0])
+        raise RunError(f"the engines disagree on case {int(indexes[i])} run with the entry state varied ({variant}): "
+                       f"compiled engine {_shown(outcome, i)}, batched core {_shown(sample, i)}")
+    return outcome
+
+
+def _shown(outcome: BatchOutcome, i: int) -> str:
+    if outcome.error[i]:
+        return f"stopped ({LaneError(int(outcome.error[i])).name})"
+    return f"outputs {[o[i].tolist() for o in outcome.outputs]} in {int(outcome.cycles[i])} cycles"
 
 
 def _variant_run(outputs: list, cycles: np.ndarray, error: np.ndarray, part: slice) -> VariantRun:
@@ -258,6 +308,6 @@ def _memory_dependence(outcome, reference, baseline_image: bytes, varied_image: 
     return int(candidates[0])
 
 
-__all__ = ["ENTRY_SAMPLE", "VARIANTS", "EntryBaseline", "EntryBlock", "EntryFinding", "VariantRun", "changed_calls",
+__all__ = ["ENTRY_COMPILED_RERUNS", "ENTRY_SAMPLE", "VARIANTS", "EntryBaseline", "EntryBlock", "EntryFinding", "VariantRun", "changed_calls",
            "entry_baseline", "entry_block_on_machine", "entry_every", "name_dependence",
-           "rerun_positions", "run_baselines"]
+           "rerun_engine", "rerun_positions", "run_baselines"]

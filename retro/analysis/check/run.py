@@ -33,6 +33,7 @@ from retro.analysis.check.entry_runs import (
     entry_block_on_machine,
     entry_every,
     name_dependence,
+    rerun_engine,
 )
 from retro.analysis.check.results import PartRun, RoutineCheck
 from retro.analysis.check.search import DEFAULT_SEARCH, SearchResult, search
@@ -94,9 +95,11 @@ def array_block(spec: str, seed: int, columns: list, first: int, every: int, eng
     return tally, entry_baseline(runner.routine, block.outputs, block.cycles, block.returned, columns, first, every)
 
 
-def held_entry_tally(spec: str, seed: int, start: SceneStart | None, held: list[EntryBaseline]) -> Tally:
-    """The held rerun cases of blocks run with the entry state varied on the batched core, all at once."""
-    return _named(spec, seed, start, entry_tally(_variants(spec, seed, start), held, seed))
+def held_entry_tally(spec: str, seed: int, start: SceneStart | None, held: list[EntryBaseline],
+                     engine: str = "batch") -> Tally:
+    """The held rerun cases of blocks run with the entry state varied on `engine` (the batched core, or
+    the compiled engine: entry_runs.rerun_engine), all at once."""
+    return _named(spec, seed, start, entry_tally(_variants(spec, seed, start), held, seed, engine))
 
 
 def _variants(spec: str, seed: int, start: SceneStart | None) -> dict[str, RoutineRunner]:
@@ -148,6 +151,7 @@ class Sweep:
     engine: str  # "scalar" (Machine), "batch" or "compiled"
     every: int = 0  # every how many cases one is rerun with the entry state varied (0: none)
     start: SceneStart | None = None
+    rerun_engine: str = "batch"  # the array engine the entry-state reruns run on (entry_runs.rerun_engine)
 
     def parts(self) -> list[case_sets.Part]:
         """The plan's parts, made once per process (the check's own process registers the ones it made),
@@ -205,7 +209,7 @@ def sweep_task(sweep: Sweep, first: int, count: int) -> Tally:
         if totals.run_errors:
             break
     if held:
-        totals.merge(held_entry_tally(sweep.spec, sweep.seed, sweep.start, held))
+        totals.merge(held_entry_tally(sweep.spec, sweep.seed, sweep.start, held, sweep.rerun_engine))
     _CURSORS.clear()
     _CURSORS[sweep] = (position, blocks)
     return totals
@@ -485,7 +489,8 @@ def check_routine(spec: str | Routine, *, exhaustive: bool = False, seed: int | 
     agreement = _agreement(plan.spec, plan.seed, plan.parts, choice.used, start) if choice.on_batch else None
     every = entry_every(known, exhaustive, bounded_product, unknown) if entry_state and plan.parts else 0
     if plan.parts:
-        sweep = Sweep(plan.spec, plan.seed, exhaustive, plan.random, bounded_product, choice.used, every, start)
+        sweep = Sweep(plan.spec, plan.seed, exhaustive, plan.random, bounded_product, choice.used, every, start,
+                      rerun_engine(choice.used, known, unknown, every))
         _run_sweep(sweep, plan, workers, totals, report)
     searched = _search(plan, runner, choice.on_batch, totals, search_budget)
     _run_found(plan, searched, choice.on_batch, agreement, start, totals, report)

@@ -114,12 +114,14 @@ class _Calls:
     block: CallBlock
     columns: list
     cases: list[tuple] | None
-    broken_by: list[np.ndarray]
+    holds: list[np.ndarray]  # per condition of the domain, the calls whose case meets it
     inside: np.ndarray
     expected: list[np.ndarray]
     answerable: np.ndarray
     equal: np.ndarray
     row_keys: Sequence[str] | None = None  # the calls are a spec's rows (these their keys): no reference
+    everywhere: bool = True  # every call's case lies inside the domain
+    all_equal: bool = True  # every call gave the reference's answer (or has none to compare: rows)
 
     def case(self, i: int) -> tuple:
         return self.cases[i] if self.cases is not None else case_sets.case_of(self.columns, i)
@@ -182,17 +184,25 @@ def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[t
 def _reference_figures(out: Tally, calls: _Calls, outside_wanted: int = EXAMPLES_KEPT) -> np.ndarray:
     """The returned calls against the reference and the domain: result mismatches inside it, the
     cases outside it (per condition they break, and those the routine gets wrong) with examples;
-    the positions of the wrong calls inside the domain."""
+    the positions of the wrong calls inside the domain. A block whose cases all lie inside, or whose
+    answers are all right, skips the passes whose counts it knows to be 0."""
     routine = calls.routine
-    outside, wrong = ~calls.inside, ~calls.equal
-    wrong_inside = np.flatnonzero(calls.inside & wrong)
-    wrong_outside = outside & wrong & calls.answerable
+    n = calls.block.returned
+    if calls.all_equal:
+        wrong_inside = np.zeros(0, dtype=np.int64)
+    else:
+        wrong_inside = np.flatnonzero(~calls.equal if calls.everywhere else calls.inside & ~calls.equal)
     out.result_mismatches = len(wrong_inside)
-    out.outside = int(np.count_nonzero(outside))
-    out.outside_wrong = int(np.count_nonzero(wrong_outside))
-    for condition, broken in zip(routine.domain, calls.broken_by):
-        out.constraint_cases[condition.text] = int(np.count_nonzero(broken))
-        out.constraint_wrong[condition.text] = int(np.count_nonzero(broken & wrong_outside)) if out.outside_wrong else 0
+    wrong_outside = None
+    if not calls.everywhere:
+        out.outside = n - int(np.count_nonzero(calls.inside))
+        if not calls.all_equal:
+            wrong_outside = ~calls.inside & ~calls.equal & calls.answerable
+            out.outside_wrong = int(np.count_nonzero(wrong_outside))
+    for condition, held in zip(routine.domain, calls.holds):
+        out.constraint_cases[condition.text] = 0 if calls.everywhere else n - int(np.count_nonzero(held))
+        out.constraint_wrong[condition.text] = (int(np.count_nonzero(wrong_outside & ~held)) if out.outside_wrong
+                                                else 0)
     if outside_wanted > 0 and out.outside_wrong:
         _outside_examples(out, calls, wrong_outside, outside_wanted)
     return wrong_inside
@@ -200,6 +210,8 @@ def _reference_figures(out: Tally, calls: _Calls, outside_wanted: int = EXAMPLES
 
 def _calls(routine: Routine, block: CallBlock, columns: list, cases: list[tuple] | None, memory: dict,
            row_keys: Sequence[str] | None = None) -> _Calls:
+    """The block's returned calls with their domain and answers, in as few passes over the block as it
+    allows (most blocks: every case inside, every answer right)."""
     n = block.returned
     columns = [c[:n] for c in columns]
     if cases is not None:
@@ -209,42 +221,61 @@ def _calls(routine: Routine, block: CallBlock, columns: list, cases: list[tuple]
         return _Calls(routine, block, columns, cases, [], ~nothing, [], nothing, ~nothing, row_keys)
     if cases is None and (not routine.reference_arrays or any(c.test_columns is None for c in routine.domain)):
         cases = case_sets.columns_to_cases(columns)
-    broken_by = [~condition.over(columns, cases) for condition in routine.domain]
+    holds = [condition.over(columns, cases) for condition in routine.domain]
     inside = np.ones(n, dtype=bool)
-    for broken in broken_by:
-        inside &= ~broken
+    for held in holds:
+        inside &= held
     if n:
         expected, answerable = reference_answers(routine, columns, cases, memory, inside,
                                                  None if block.mock_calls is None else block.mock_calls[:n])
     else:
         expected, answerable = [np.zeros((0, *o.shape[1:]), dtype=np.int64) for o in block.outputs], inside
-    equal = np.ones(n, dtype=bool)
+    equal = None
     for got, wanted in zip(block.outputs, expected):
         same = got[:n] == wanted
-        equal &= same.all(axis=1) if same.ndim == 2 else same
-    return _Calls(routine, block, columns, cases, broken_by, inside, expected, answerable, equal)
+        same = same.all(axis=1) if same.ndim == 2 else same
+        equal = same if equal is None else equal & same
+    if equal is None:
+        equal = np.ones(n, dtype=bool)
+    return _Calls(routine, block, columns, cases, holds, inside, expected, answerable, equal,
+                  everywhere=bool(inside.all()), all_equal=bool(equal.all()))
 
 
 def _cycle_figures(out: Tally, calls: _Calls, cpu: np.ndarray, stalled: bool) -> None:
     """Fastest and slowest calls inside the domain (the first on a tie), the sum, CPU-only extremes."""
     block, n = calls.block, calls.block.returned
-    everywhere = bool(calls.inside.all())  # (most blocks: no gather then)
-    positions = np.arange(n) if everywhere else np.flatnonzero(calls.inside)
-    if not len(positions):
+    cycles = block.cycles[:n]
+    if calls.everywhere:  # (most blocks: no gather, no mask)
+        count = n
+    else:
+        count = int(np.count_nonzero(calls.inside))
+    if not count:
         return
-    cycles = block.cycles[:n] if everywhere else block.cycles[:n][positions]
-    low, high = int(np.argmin(cycles)), int(np.argmax(cycles))
-    out.cycles_min, out.min_case = int(cycles[low]), calls.case(int(positions[low]))
-    out.cycles_max, out.max_case = int(cycles[high]), calls.case(int(positions[high]))
-    out.cycles_sum = int(cycles.sum())
-    out.cycles_count = len(cycles)
+    low, high = _first_extreme(cycles, calls, np.argmin, _NEVER_LOW), _first_extreme(cycles, calls, np.argmax, -1)
+    out.cycles_min, out.min_case = int(cycles[low]), calls.case(low)
+    out.cycles_max, out.max_case = int(cycles[high]), calls.case(high)
+    out.cycles_sum = int(cycles.sum()) if calls.everywhere else int(cycles.sum() - cycles[~calls.inside].sum())
+    out.cycles_count = count
     if not stalled:  # (no scene): the CPU's cycles are the cycles
         out.cpu_min, out.cpu_max, out.stolen_max = out.cycles_min, out.cycles_max, 0
         return
-    stolen = block.stolen[:n] if everywhere else block.stolen[:n][positions]
-    inside_cpu = cpu if everywhere else cpu[positions]
+    positions = np.arange(n) if calls.everywhere else np.flatnonzero(calls.inside)
+    inside_cpu = cpu[:n][positions]
     out.cpu_min, out.cpu_max = int(inside_cpu.min()), int(inside_cpu.max())
-    out.stolen_max = int(stolen.max())
+    out.stolen_max = int(block.stolen[:n][positions].max())
+
+
+_NEVER_LOW = np.iinfo(np.int64).max  # no call runs this many cycles: what a case outside the domain counts as
+
+
+def _first_extreme(cycles: np.ndarray, calls: _Calls, arg, never: int) -> int:
+    """The position of the first call inside the domain with the fewest (np.argmin) or most (np.argmax)
+    cycles: the block's own first extreme when that call lies inside (then no call before it ties),
+    else the extreme with the calls outside counted as `never`."""
+    first = int(arg(cycles))
+    if calls.everywhere or calls.inside[first]:
+        return first
+    return int(arg(np.where(calls.inside, cycles, never)))
 
 
 def _examples(out: Tally, calls: _Calls, wrong_inside: np.ndarray, cycle_wrong: np.ndarray, cpu: np.ndarray,
@@ -275,7 +306,7 @@ def _examples(out: Tally, calls: _Calls, wrong_inside: np.ndarray, cycle_wrong: 
 def _outside_examples(out: Tally, calls: _Calls, wrong_outside: np.ndarray, wanted: int) -> None:
     routine = calls.routine
     for i in np.flatnonzero(wrong_outside)[:min(wanted, EXAMPLES_KEPT)].tolist():
-        broken = [c.text for c, b in zip(routine.domain, calls.broken_by) if b[i]]
+        broken = [c.text for c, held in zip(routine.domain, calls.holds) if not held[i]]
         out.outside_examples.append(
             f"{calls.described(i)}: returned {describe_outputs(routine, calls.block.row(i))}, "
             f"reference {describe_outputs(routine, calls.expected_row(i))} (outside: {', '.join(broken)})")
@@ -291,11 +322,12 @@ def _entry_figures(out: Tally, calls: _Calls, entry: EntryBlock) -> None:
     _entry_counts(out, baseline, entry.runs, lambda k: calls.case(int(positions[k])))
 
 
-def entry_tally(variants: dict, baselines: list[EntryBaseline], seed: int) -> Tally:
+def entry_tally(variants: dict, baselines: list[EntryBaseline], seed: int, engine: str = "batch") -> Tally:
     """The entry-state figures of blocks whose rerun cases were held (`entry_baseline`), run together
-    on the batched core: the figures each block's own `count_block(..., entry=...)` would give."""
+    on `engine` (entry_runs.run_baselines): the figures each block's own `count_block(..., entry=...)`
+    would give."""
     out = Tally()
-    for baseline, runs in zip(baselines, run_baselines(variants, baselines, seed)):
+    for baseline, runs in zip(baselines, run_baselines(variants, baselines, seed, engine)):
         one = Tally()
         _entry_counts(one, baseline, runs, baseline.case)
         out.merge(one)
