@@ -436,3 +436,24 @@ def sprite_edges_random(rng: np.random.Generator, n: int) -> list[tuple]:
     columns = (a_left & 0xFF, a_top, a_top + a_height - 1, a_left >> 8, a_right & 0xFF, a_right >> 8,
                b_left & 0xFF, b_left >> 8, b_right & 0xFF, b_right >> 8, b_top, b_top + b_height)
     return [tuple(int(v) for v in row) for row in zip(*columns)]
+
+
+# ---- mul16 ---------------------------------------------------------------------------------------
+
+WORD = 1 << 16
+_WORD_EDGES = (0, 1, 2, 0x7F, 0x80, 0xFF, 0x100, 0x5555, 0x7FFF, 0x8000, 0xAAAA, 0xFFFE, 0xFFFF)
+# the byte and sign edges, alternating bits, and b = 0 / $FFFF (no add, 16 adds: the cycle extremes;
+# with a = $FFFF every add carries out of the high byte)
+
+
+def mul16_boundary() -> list[tuple]:
+    return list(product(_WORD_EDGES, repeat=2))
+
+
+def mul16_random(rng: np.random.Generator, n: int) -> list[tuple]:
+    return [tuple(int(v) for v in row) for row in rng.integers(0, WORD, size=(n, 2))]
+
+
+def mul16_sweep() -> Grid:
+    """Every (a, b): 2^32 calls, b varying fastest (a grid: a worker makes only its range)."""
+    return Grid({"a": WORD, "b": WORD})
