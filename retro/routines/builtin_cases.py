@@ -1,11 +1,11 @@
-"""Case generators of the seven built-in routines (asm/*.toml name them as `boundary`, `sweep` and
+"""Case generators of the built-in routines (asm/*.toml name them as `boundary`, `sweep` and
 `random_generator`), and the adapters their specs need.
 
 Cases are tuples in each spec's input order (the reference's argument order), or column blocks (dicts
 of numpy arrays by input name) where there are many; the sweeps are grids (retro.routines.grid: counted,
 entered at any case by the worker whose range it is):
 - boundary: touching, one apart, overlapping by one, 0, 255/256, maximum sizes, screen edges;
-- sweep (with --exhaustive): mul8 every product; tile every 9-bit X by every Y; pixel every (dx, dy)
+- sweep (with --exhaustive): mul8 and mul16 every product; tile every 9-bit X by every Y; pixel every (dx, dy)
   for three mask pairs; circle and circle_r every (dx, dy) of both signs at every radius sum;
   exhaustive slices across each domain boundary for the others;
 - random: distributions that put half the cases near the answer's edge.
