@@ -219,6 +219,12 @@ MUTANTS = [
     Mutant("high-byte-of-output-dropped", "retro/routines/outputs.py",
            "value = value | widen(byte) << (8 * shift)", "value = value | (widen(byte) if shift == 0 else widen(0))",
            ("tests/routines",)),
+    # ---- mul16 (asm/mul16.s, its sweep) -------------------------------------------------------------
+    Mutant("mul16-add-without-clc", "asm/mul16.s", "        clc\n        lda p2\n", "        lda p2\n",
+           ("tests/routines/test_routines_exhaustive.py",)),
+    Mutant("mul16-sweep-misses-the-last-a", "retro/routines/builtin_cases.py",
+           'return Grid({"a": WORD, "b": WORD})', 'return Grid({"a": WORD - 1, "b": WORD})',
+           ("tests/routines/test_routines_exhaustive.py",)),
     # ---- the batched core and its checks --------------------------------------------------------
     Mutant("batch-branch-page-costs-nothing", "retro/cpu/batch_handlers.py",
            "extra_taken + crossed * BRANCH_PAGE_CYCLES, pc, cycles)", "extra_taken, pc, cycles)",
