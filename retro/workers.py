@@ -181,12 +181,14 @@ def _preload(module: str) -> None:
     with dask.config.set(EMBEDDED_CONFIG):
         context = get_mp_context()  # distributed sets its own list first (itself, numpy, ...)
     if isinstance(context, type(multiprocessing.get_context("forkserver"))):
-        context.set_forkserver_preload(["distributed", module, *(m for m in PRELOAD_IF_IMPORTED if m in sys.modules)])
+        extra = [name for used, names in PRELOAD_IF_IMPORTED.items() if used in sys.modules for name in names]
+        context.set_forkserver_preload(["distributed", module, *extra])
 
 
 _preloaded = False
-PRELOAD_IF_IMPORTED = ("numba",)  # imported by the server too when this process uses it (the compiled engine):
-# about 0.25 CPU-second per worker otherwise
+PRELOAD_IF_IMPORTED = {"numba": ("numba", "retro.cpu.numba_ready")}  # imported by the server too when this process
+# uses the first (the compiled engine): numba itself (about 0.25 CPU-second per worker otherwise) and its CPU target
+# made ready (retro/cpu/numba_ready.py: about 0.4 CPU-second more per worker, when it loads its first routine)
 
 
 @contextmanager
