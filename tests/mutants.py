@@ -283,7 +283,8 @@ MUTANTS = [
            "            cluster.close(timeout=STOP_CLOSE_SECONDS)\n", "            pass\n",
            ("tests/test_workers.py::test_ctrl_c_cancels_the_sweep_and_leaves_no_worker",)),
     Mutant("numba-not-ready-in-the-forkserver", "retro/workers.py",
-           'PRELOAD_IF_IMPORTED = {"numba": ("numba", "retro.cpu.numba_ready")}', 'PRELOAD_IF_IMPORTED = {"numba": ("numba",)}',
+           'PRELOAD_IF_IMPORTED = {"numba.np.arraymath": ("numba", "retro.cpu.numba_ready")}',
+           'PRELOAD_IF_IMPORTED = {"numba.np.arraymath": ("numba",)}',
            WORKER_TESTS),
     # ---- the CPU's timeline on a C64: sprite DMA, Bad Lines, BA (retro/chips/vic) ------------------
     Mutant("sprite-dma-retriggers-while-on", "retro/chips/vic/model.py",

@@ -210,7 +210,6 @@ def test_a_scheduler_that_does_not_answer_is_one_line(monkeypatch):
 COMPILED_ON_WORKERS = """
 import json, sys
 import multiprocessing.forkserver as forkserver
-import numba  # noqa: F401 (this process uses the compiled engine before its cluster starts)
 from retro.analysis.check import run
 from retro.commands.check import as_json
 
@@ -221,9 +220,9 @@ forkserver.set_forkserver_preload = lambda names: asked.extend(names) or real(na
 def records(checks):
     return json.dumps([{k: v for k, v in r.items() if k != "compile_seconds"} for r in as_json(checks)], sort_keys=True)
 
-one = records(run.run_checks(["mul8"], exhaustive=True, jobs=1, engine="compiled", search_budget=0))
-run.PARALLEL_CALLS = dict.fromkeys(run.PARALLEL_CALLS, 0)
+run.PARALLEL_CALLS = dict.fromkeys(run.PARALLEL_CALLS, 0)  # (the agreement loads the compiled code here first)
 two = records(run.run_checks(["mul8"], exhaustive=True, jobs=2, engine="compiled", search_budget=0))
+one = records(run.run_checks(["mul8"], exhaustive=True, jobs=1, engine="compiled", search_budget=0))
 print(json.dumps({"same": one == two, "engine": json.loads(two)[0]["engine"], "preloaded": asked}))
 """
 
@@ -242,6 +241,15 @@ def test_compiled_workers_fork_from_a_server_with_numba_ready_and_give_the_same_
     said = json.loads(done.stdout.splitlines()[-1])
     assert said["same"] and said["engine"] == "compiled"
     assert {"numba", "retro.cpu.numba_ready", "retro.analysis.check.run"} <= set(said["preloaded"])
+
+
+def test_the_server_makes_numba_ready_only_after_this_process_loaded_compiled_code(monkeypatch):
+    """Any check imports numba (to ask whether it can be used); only a process that loaded compiled code
+    (numba's array implementations imported) has its workers' server import numba and make it ready."""
+    monkeypatch.delitem(sys.modules, "numba.np.arraymath", raising=False)
+    assert workers.server_preload("tasks") == ["distributed", "tasks"]
+    monkeypatch.setitem(sys.modules, "numba.np.arraymath", sys)
+    assert workers.server_preload("tasks") == ["distributed", "tasks", "numba", "retro.cpu.numba_ready"]
 
 
 def test_numba_ready_installs_the_target_a_first_compiled_load_would():

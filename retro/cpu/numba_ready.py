@@ -1,5 +1,5 @@
 """Imported for its effect, by the server process the embedded Dask workers are forked from
-(retro.workers, when the command uses numba): numba's CPU target made ready once there (its
+(retro.workers, when the command has loaded compiled code): numba's CPU target made ready once there (its
 implementation registries imported and installed, its runtime started), so each worker forked from
 it inherits that instead of doing it again when it loads its first compiled routine.
 
