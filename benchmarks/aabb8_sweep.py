@@ -35,14 +35,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-from peak_memory import process_rss, process_tree  # benchmarks/: the script's own folder
+from peak_memory import sampled_run  # benchmarks/: the script's own folder
 
 ROOT = Path(__file__).resolve().parent.parent
 SPEC = ROOT / "asm" / "aabb8.toml"
@@ -50,17 +48,6 @@ FULL_CALLS = 3 << 32
 SAMPLE_SECONDS = 0.5
 GOAL_SECONDS = 180  # the issue's: under 3 minutes on 2 cores
 GOAL_RSS = 1 << 30  # per worker
-TICKS = os.sysconf("SC_CLK_TCK")
-
-
-def _cpu(pid: int) -> float | None:
-    """CPU seconds (user + system) of one process so far (None: gone)."""
-    try:
-        with open(f"/proc/{pid}/stat", "rb") as f:
-            fields = f.read().rsplit(b")", 1)[1].split()
-        return (int(fields[11]) + int(fields[12])) / TICKS
-    except (OSError, IndexError, ValueError):
-        return None
 
 
 def sliced_spec(folder: Path, starts: int) -> Path:
@@ -168,31 +155,16 @@ def main(argv: list[str]) -> None:
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory() as folder:
         spec = sliced_spec(Path(folder), args.starts)
-        began = time.monotonic()
-        process = subprocess.Popen([sys.executable, "-m", "retro", "check", str(spec), "--exhaustive", "--engine",
-                                    args.engine, "--jobs", str(args.jobs), "--no-search", "--json"],
-                                   stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
-                                   env={**os.environ, "PYTHONPATH": str(ROOT)})
-        peak, spent = 0, {}
-        while process.poll() is None:
-            for pid in process_tree(process.pid):
-                peak = max(peak, process_rss(pid))
-                seconds = _cpu(pid)
-                if seconds is not None:
-                    spent[pid] = seconds
-            time.sleep(SAMPLE_SECONDS)
-        out = process.stdout.read()
-        wall = time.monotonic() - began
-    # each process's CPU as last sampled (a worker is stopped, not waited for, so the rusage of
-    # children misses it): at most SAMPLE_SECONDS of a process's last moments are left out
-    cpu = sum(spent.values())
+        run = sampled_run([sys.executable, "-m", "retro", "check", str(spec), "--exhaustive", "--engine", args.engine,
+                           "--jobs", str(args.jobs), "--no-search", "--json"], SAMPLE_SECONDS)
+    out, cpu, wall, peak = run.stdout, run.cpu, run.wall, run.peak
     record = json.loads(out)[0] if out.strip() else {}
     calls = record.get("cases", 0)
     swept = 3 * args.starts << 24
     rate = calls / cpu if cpu else 0.0
     full_cpu = FULL_CALLS / rate if rate else float("inf")
     print(f"aabb8 slice: box A's position from {args.starts} of 256 values: {swept:,} sweep calls "
-          f"(2^{swept.bit_length() - 1}), {calls:,} calls in all, exit {process.returncode}, "
+          f"(2^{swept.bit_length() - 1}), {calls:,} calls in all, exit {run.returncode}, "
           f"mismatches {record.get('mismatches', '?')}")
     print(f"  --engine {args.engine} --jobs {args.jobs}: {wall:.1f} s wall, {cpu:.1f} CPU s, "
           f"{rate / 1e6:.1f} M calls per CPU-second; largest process RSS {peak / 2**20:.0f} MiB "

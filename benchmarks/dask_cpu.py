@@ -3,11 +3,14 @@
 that must not pay for Dask (`retro demo`, `retro check mul8`).
 
     python benchmarks/dask_cpu.py [ROUTINE ...] [--engine batch] [--repeat N] [--skip-small] [--before DIR]
+                                  [--sweep K]
 
 Each check runs in a fresh process (imports apart), in one process and on the workers, N times each
 (default 3, alternating): the medians are printed (a shared machine's load moves one run by 10-20%).
 
-Default: hit_slot, mul8 and tile with --exhaustive on the batched core. The CPU of the worker processes and
+Default: hit_slot, mul8 and tile with --exhaustive on the batched core. `--sweep K` adds a sweep-sized run:
+mul16's sweep with a from its first K values (K x 65,536 calls, benchmarks/mul16_sweep.py) on the compiled
+engine (K = 0: none). The CPU of the worker processes and
 of the server they are forked from is read from /proc (psutil) at the cluster's start and before it
 closes, the parent's (with the scheduler and the nannies, threads of it) from this process; the JSON of
 both runs must be identical (else the script fails).
@@ -21,6 +24,7 @@ import os
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from contextlib import contextmanager
 from pathlib import Path
@@ -132,6 +136,7 @@ def main() -> int:
     parser.add_argument("--repeat", type=int, default=3, metavar="N", help="runs of each, medians shown")
     parser.add_argument("--skip-small", action="store_true")
     parser.add_argument("--before", metavar="DIR", help="a checkout of earlier code, timed beside this one")
+    parser.add_argument("--sweep", type=int, default=0, metavar="K", help="mul16's sweep for a < K on the compiled engine")
     parser.add_argument("--measure", choices=["one", "two"], help=argparse.SUPPRESS)  # (the fresh process's part)
     args = parser.parse_args()
     if args.measure:
@@ -145,33 +150,40 @@ def main() -> int:
     roots = [("before", Path(args.before).resolve())] if args.before else []
     roots.append(("now", ROOT))
     if not args.skip_small:
-        import tempfile
-
         with tempfile.TemporaryDirectory() as out:
             for argv in (["demo", "--out", out], ["check", "mul8", "--quiet"]):
                 shown = " ".join(argv[:2])
                 for label, root in roots:
                     wall, cpu, dask = start_seconds(root, argv)
                     print(f"retro {shown:<12} {label:<7} {wall:6.2f} s wall {cpu:6.2f} CPU-s  Dask imported: {dask}")
-    print(f"{'check --exhaustive':<24} {'code':<7} {'1 process':>10} {'2 workers':>10} {'(start)':>9} {'ratio':>7} "
+    print(f"{'check --exhaustive':<28} {'code':<7} {'1 process':>10} {'2 workers':>10} {'(start)':>9} {'ratio':>7} "
           f"{'beyond start':>13}")
-    for name in args.routines:
-        label = Path(name).name if name.endswith(".toml") else name
+    checks = [(name, args.engine, Path(name).name if name.endswith(".toml") else name) for name in args.routines]
+    with tempfile.TemporaryDirectory() as folder:
+        if args.sweep:
+            from mul16_sweep import sliced_spec  # benchmarks/: the script's own folder
+
+            checks.append((str(sliced_spec(Path(folder), args.sweep)), "compiled", f"mul16 a < {args.sweep}"))
+        return _table(checks, roots, args.repeat)
+
+
+def _table(checks: list[tuple[str, str, str]], roots: list[tuple[str, Path]], repeat: int) -> int:
+    """One row per (check, code): the medians of `repeat` runs in one process and on two workers."""
+    for name, engine, label in checks:
         for code, root in roots:
             runs: dict[str, list[dict]] = {"one": [], "two": []}
-            for _ in range(args.repeat):
+            for _ in range(repeat):
                 for how in runs:
-                    runs[how].append(measured(root, how, name, args.engine))
+                    runs[how].append(measured(root, how, name, engine))
             if any(run["records"] != runs["one"][0]["records"] for run in runs["one"] + runs["two"]):
                 print(f"{name}: the two-worker JSON differs from one process's ({code})", file=sys.stderr)
                 return 1
             alone = {"cpu": statistics.median(run["cpu"] for run in runs["one"])}
             two = {key: statistics.median(run[key] for run in runs["two"]) for key in ("cpu", "start")}
             beyond = statistics.median(run["cpu"] - run["start"] for run in runs["two"])
-            print(f"{label + ' (' + args.engine + ')':<24} {code:<7} {alone['cpu']:9.2f}s {two['cpu']:9.2f}s "
-                  f"{two['start']:8.2f}s {two['cpu'] / alone['cpu']:6.2f}x {beyond / alone['cpu']:12.2f}x")
+            print(f"{label + ' (' + engine + ')':<28} {code:<7} {alone['cpu']:9.2f}s {two['cpu']:9.2f}s "
+                  f"{two['start']:8.2f}s {two['cpu'] / alone['cpu']:6.2f}x {beyond / alone['cpu']:12.2f}x", flush=True)
     return 0
-
 
 if __name__ == "__main__":
     raise SystemExit(main())

@@ -18,6 +18,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -117,6 +118,52 @@ def process_rss(pid: int) -> int:
 def tree_rss(root: int) -> int:
     """Resident bytes of a process and all its descendants."""
     return sum(process_rss(pid) for pid in process_tree(root))
+
+
+TICKS = os.sysconf("SC_CLK_TCK")
+
+
+def process_cpu(pid: int) -> float | None:
+    """CPU seconds (user + system) of one process so far (None: gone)."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as f:
+            fields = f.read().rsplit(b")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / TICKS
+    except (OSError, IndexError, ValueError):
+        return None
+
+
+@dataclass(frozen=True)
+class SampledRun:
+    """A command run to its end, its process tree sampled from /proc while it ran."""
+
+    returncode: int
+    stdout: str
+    wall: float  # seconds
+    cpu: float  # CPU seconds of every process of the tree, each as last sampled (a worker that is stopped,
+    # not waited for, is missed by the rusage of children; at most `every` of a process's last moments are lost)
+    peak: int  # the largest RSS of any one process of the tree (bytes)
+    peak_tree: int  # the largest RSS of the whole tree at once (bytes)
+
+
+def sampled_run(command: list[str], every: float = 0.5) -> SampledRun:
+    """Run `command` (stderr dropped) sampling its process tree's CPU and RSS every `every` seconds."""
+    began = time.monotonic()
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+                               env={**os.environ, "PYTHONPATH": str(ROOT)})
+    peak = peak_tree = 0
+    spent: dict[int, float] = {}
+    while process.poll() is None:
+        tree = [(pid, process_rss(pid)) for pid in process_tree(process.pid)]
+        peak = max([peak] + [rss for _, rss in tree])
+        peak_tree = max(peak_tree, sum(rss for _, rss in tree))
+        for pid, _ in tree:
+            seconds = process_cpu(pid)
+            if seconds is not None:
+                spent[pid] = seconds
+        time.sleep(every)
+    out = process.stdout.read()
+    return SampledRun(process.returncode, out, time.monotonic() - began, sum(spent.values()), peak, peak_tree)
 
 
 def measure(arguments: list[str], seconds: float) -> tuple[int, float, str]:

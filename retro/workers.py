@@ -181,12 +181,22 @@ def _preload(module: str) -> None:
     with dask.config.set(EMBEDDED_CONFIG):
         context = get_mp_context()  # distributed sets its own list first (itself, numpy, ...)
     if isinstance(context, type(multiprocessing.get_context("forkserver"))):
-        context.set_forkserver_preload(["distributed", module, *(m for m in PRELOAD_IF_IMPORTED if m in sys.modules)])
+        context.set_forkserver_preload(server_preload(module))
+
+
+def server_preload(module: str) -> list[str]:
+    """The modules the workers' server imports: Dask's, the tasks' `module`, and what PRELOAD_IF_IMPORTED
+    adds for what this process has imported."""
+    extra = [name for used, names in PRELOAD_IF_IMPORTED.items() if used in sys.modules for name in names]
+    return ["distributed", module, *extra]
 
 
 _preloaded = False
-PRELOAD_IF_IMPORTED = ("numba",)  # imported by the server too when this process uses it (the compiled engine):
-# about 0.25 CPU-second per worker otherwise
+PRELOAD_IF_IMPORTED = {"numba.np.arraymath": ("numba", "retro.cpu.numba_ready")}  # imported by the server too when
+# this process has imported the first: numba's array implementations come in when numba's CPU target is made ready
+# to load compiled code (the compiled engine in use here; any check imports numba itself, to ask whether it can be
+# used). Then the server imports numba (about 0.25 CPU-second per worker otherwise) and makes its target ready
+# (retro/cpu/numba_ready.py: about 0.4 CPU-second more per worker, when it loads its first routine)
 
 
 @contextmanager

@@ -232,6 +232,12 @@ MUTANTS = [
     Mutant("high-byte-of-output-dropped", "retro/routines/outputs.py",
            "value = value | widen(byte) << (8 * shift)", "value = value | (widen(byte) if shift == 0 else widen(0))",
            ("tests/routines",)),
+    # ---- mul16 (asm/mul16.s, its sweep) -------------------------------------------------------------
+    Mutant("mul16-add-without-clc", "asm/mul16.s", "        clc\n        lda p2\n", "        lda p2\n",
+           ("tests/routines/test_routines_exhaustive.py",)),
+    Mutant("mul16-sweep-misses-the-last-a", "retro/routines/builtin_cases.py",
+           'return Grid({"a": WORD, "b": WORD})', 'return Grid({"a": WORD - 1, "b": WORD})',
+           ("tests/routines/test_routines_exhaustive.py",)),
     # ---- the batched core and its checks --------------------------------------------------------
     Mutant("batch-branch-page-costs-nothing", "retro/cpu/batch_handlers.py",
            "extra_taken + crossed * BRANCH_PAGE_CYCLES, pc, cycles)", "extra_taken, pc, cycles)",
@@ -321,6 +327,10 @@ MUTANTS = [
     Mutant("stop-leaves-the-cluster-open", "retro/workers.py",
            "            cluster.close(timeout=STOP_CLOSE_SECONDS)\n", "            pass\n",
            ("tests/test_workers.py::test_ctrl_c_cancels_the_sweep_and_leaves_no_worker",)),
+    Mutant("numba-not-ready-in-the-forkserver", "retro/workers.py",
+           'PRELOAD_IF_IMPORTED = {"numba.np.arraymath": ("numba", "retro.cpu.numba_ready")}',
+           'PRELOAD_IF_IMPORTED = {"numba.np.arraymath": ("numba",)}',
+           WORKER_TESTS),
     # ---- the CPU's timeline on a C64: sprite DMA, Bad Lines, BA (retro/chips/vic) ------------------
     Mutant("sprite-dma-retriggers-while-on", "retro/chips/vic/model.py",
            "if (line % video.lines) & Y_COMPARE_MASK == y and line >= free_from:",

@@ -207,6 +207,63 @@ def test_a_scheduler_that_does_not_answer_is_one_line(monkeypatch):
         check(["mul8"], search=0, scheduler="tcp://127.0.0.1:9")
 
 
+COMPILED_ON_WORKERS = """
+import json, sys
+import multiprocessing.forkserver as forkserver
+from retro.analysis.check import run
+from retro.commands.check import as_json
+
+asked = []
+real = forkserver.set_forkserver_preload
+forkserver.set_forkserver_preload = lambda names: asked.extend(names) or real(names)
+
+def records(checks):
+    return json.dumps([{k: v for k, v in r.items() if k != "compile_seconds"} for r in as_json(checks)], sort_keys=True)
+
+run.PARALLEL_CALLS = dict.fromkeys(run.PARALLEL_CALLS, 0)  # (the agreement loads the compiled code here first)
+two = records(run.run_checks(["mul8"], exhaustive=True, jobs=2, engine="compiled", search_budget=0))
+one = records(run.run_checks(["mul8"], exhaustive=True, jobs=1, engine="compiled", search_budget=0))
+print(json.dumps({"same": one == two, "engine": json.loads(two)[0]["engine"], "preloaded": asked}))
+"""
+
+
+def test_compiled_workers_fork_from_a_server_with_numba_ready_and_give_the_same_json():
+    """With the compiled engine in use, the server the workers are forked from imports numba and makes its
+    CPU target ready (retro/cpu/numba_ready.py) once for all of them; a sweep on two such workers gives
+    the JSON of one process."""
+    from retro.cpu.compiled import numba_problem
+
+    if numba_problem() is not None:
+        pytest.skip(numba_problem())
+    done = subprocess.run([sys.executable, "-c", COMPILED_ON_WORKERS], capture_output=True, text=True, env=ENV,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    said = json.loads(done.stdout.splitlines()[-1])
+    assert said["same"] and said["engine"] == "compiled"
+    assert {"numba", "retro.cpu.numba_ready", "retro.analysis.check.run"} <= set(said["preloaded"])
+
+
+def test_the_server_makes_numba_ready_only_after_this_process_loaded_compiled_code(monkeypatch):
+    """Any check imports numba (to ask whether it can be used); only a process that loaded compiled code
+    (numba's array implementations imported) has its workers' server import numba and make it ready."""
+    monkeypatch.delitem(sys.modules, "numba.np.arraymath", raising=False)
+    assert workers.server_preload("tasks") == ["distributed", "tasks"]
+    monkeypatch.setitem(sys.modules, "numba.np.arraymath", sys)
+    assert workers.server_preload("tasks") == ["distributed", "tasks", "numba", "retro.cpu.numba_ready"]
+
+
+def test_numba_ready_installs_the_target_a_first_compiled_load_would():
+    """Imported, it loads numba's implementation registries (what a worker's first compiled load did)."""
+    from retro.cpu.compiled import numba_problem
+
+    if numba_problem() is not None:
+        pytest.skip(numba_problem())
+    probe = ("import sys, numba\nbefore = 'numba.np.arraymath' in sys.modules\nfrom retro.cpu import numba_ready\n"
+             "print(before, numba_ready.READY, 'numba.np.arraymath' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, env=ENV, timeout=120)
+    assert done.stdout.split() == ["False", "True", "True"], done.stderr[-2000:]
+
+
 SMALL = """
 import sys
 from retro.entry import main

@@ -1,4 +1,4 @@
-"""Case generators of the seven built-in routines (asm/*.toml name them as `boundary`, `sweep` and
+"""Case generators of the built-in routines (asm/*.toml name them as `boundary`, `sweep` and
 `random_generator`), and the adapters their specs need.
 
 Cases are tuples in each spec's input order (the reference's argument order) where there are few (the
@@ -6,7 +6,7 @@ boundaries), column blocks (dicts of numpy arrays by the specs' input names) whe
 random generators: no Python object per value); the sweeps are grids (retro.routines.grid: counted,
 entered at any case by the worker whose range it is):
 - boundary: touching, one apart, overlapping by one, 0, 255/256, maximum sizes, screen edges;
-- sweep (with --exhaustive): mul8 every product; tile every 9-bit X by every Y; pixel every (dx, dy)
+- sweep (with --exhaustive): mul8 and mul16 every product; tile every 9-bit X by every Y; pixel every (dx, dy)
   for three mask pairs; circle and circle_r every (dx, dy) of both signs at every radius sum;
   exhaustive slices across each domain boundary for the others;
 - random: distributions that put half the cases near the answer's edge.
@@ -467,3 +467,24 @@ def sprite_edges_random(rng: np.random.Generator, n: int) -> dict[str, np.ndarra
                b_left & 0xFF, b_left >> 8, b_right & 0xFF, b_right >> 8, b_top, b_top + b_height)
     return _block(("a_left", "a_top", "a_bottom1", "a_left_hi", "a_right", "a_right_hi", "b_left", "b_left_hi", "b_right",
                    "b_right_hi", "b_top", "b_bottom"), columns)
+
+
+# ---- mul16 ---------------------------------------------------------------------------------------
+
+WORD = 1 << 16
+_WORD_EDGES = (0, 1, 2, 0x7F, 0x80, 0xFF, 0x100, 0x5555, 0x7FFF, 0x8000, 0xAAAA, 0xFFFE, 0xFFFF)
+# the byte and sign edges, alternating bits, and b = 0 / $FFFF (no add, 16 adds: the cycle extremes;
+# with a = $FFFF every add carries out of the high byte)
+
+
+def mul16_boundary() -> list[tuple]:
+    return list(product(_WORD_EDGES, repeat=2))
+
+
+def mul16_random(rng: np.random.Generator, n: int) -> dict[str, np.ndarray]:
+    return _block(("a", "b"), rng.integers(0, WORD, size=(n, 2)).T)
+
+
+def mul16_sweep() -> Grid:
+    """Every (a, b): 2^32 calls, b varying fastest (a grid: a worker makes only its range)."""
+    return Grid({"a": WORD, "b": WORD})

@@ -62,6 +62,11 @@ def mul8(a, b):
     return _result(np.asarray(a, dtype=np.int64) * np.asarray(b, dtype=np.int64))
 
 
+def mul16(a, b):
+    """The 32-bit product of two 16-bit words."""
+    return _result(np.asarray(a, dtype=np.int64) * np.asarray(b, dtype=np.int64))
+
+
 def cell_under(x, xh, y):
     """(column, row, on_screen) of the text-screen cell under sprite-coordinate pixel (x + 256 xh, y)."""
     px = np.asarray(x, dtype=np.int64) + HIGH_BIT_WEIGHT * np.asarray(xh, dtype=np.int64) - SPRITE_X_AT_COLUMN_0

@@ -3,7 +3,7 @@
 `load_spec(path)` validates the file into a `Routine`: the program (file, symbols, entry, CPU,
 init), its inputs and outputs (where each value lives: register, flag or memory), the memory it reads
 besides its inputs, the reference function, the cases (exhaustive, random, boundary lists, sweeps,
-the `where` domain) and the cycle budget and loop bounds. The seven built-in routines are spec files
+the `where` domain) and the cycle budget and loop bounds. The built-in routines are spec files
 in asm/ read by this same code.
 
 Locations are resolved against the program's symbols when the spec is loaded, so an unknown label

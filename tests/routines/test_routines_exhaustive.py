@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 
+import numpy as np
 import pytest
 
 from retro.analysis.check import run_checks, static_bounds
@@ -72,3 +73,48 @@ def test_aabb8_sweep_is_every_input_of_each_axis_and_agrees_with_the_reference()
     wrong, seen = sweep_slice_mismatches(get("aabb8"), starts, step)
     assert not wrong, wrong
     assert seen == 3 * len(starts) * 256 * (1 << 16) // step
+
+
+MUL16_ROWS = (0, 1, 0x00FF, 0x0100, 0x5555, 0x8000, 0xAAAA, 0xFFFF)  # values of a whose every b is run here
+
+
+@pytest.mark.exhaustive
+def test_mul16_sweep_is_every_product_and_costs_what_its_header_says():
+    """The sweep is every (a, b) once, b fastest (a grid of 2^32, entered at any row of a); rows of it run
+    on the compiled engine (the batched core without numba) give a * b in $14-$17 in 437 + 17 x (one bits
+    of b) cycles, the cost asm/mul16.s states. The whole 2^32 runs with RETRO_EXHAUSTIVE=1 through
+    test_check_of_each_routine_finds_no_mismatch (`retro check mul16 --exhaustive`); here 8 rows of
+    65,536."""
+    from retro.cpu.compiled import numba_problem
+    from retro.routines.builtin_cases import mul16_sweep
+    from retro.routines.runner import RoutineRunner
+
+    grid = mul16_sweep()
+    assert grid.count == 1 << 32 and grid.names == ("a", "b")
+    runner = RoutineRunner(get("mul16"))
+    run = runner.run_batch if numba_problem() else runner.run_compiled
+    b = np.arange(1 << 16, dtype=np.int64)
+    ones = np.array([bin(v).count("1") for v in range(1 << 16)])
+    for a in MUL16_ROWS:
+        block = grid.block(a << 16, (a + 1) << 16)
+        assert (block["a"] == a).all() and np.array_equal(block["b"], b)
+        outcome = run([block["a"], block["b"]])
+        assert not outcome.error.any()
+        assert np.array_equal(outcome.outputs[0], a * b), a
+        assert np.array_equal(outcome.cycles, 437 + 17 * ones), a
+
+
+def test_mul16_exhaustive_plans_the_whole_space_and_auto_takes_the_compiled_engine():
+    """Planned, never made: boundary, the 2^32 sweep, 100,000 random; "auto" sends that many calls to the
+    compiled engine (numba importable) and a check without --exhaustive to neither (a few thousand)."""
+    from retro.analysis.check.engines import AUTO_BATCH_CASES, array_engine
+    from retro.cpu.compiled import numba_problem
+    from retro.routines import cases as case_sets
+
+    routine = get("mul16")
+    parts = case_sets.plan(routine, exhaustive=True)
+    assert [(p.name, p.count) for p in parts] == [("boundary", 13 * 13), ("sweep", 1 << 32), ("random", 100_000)]
+    calls = sum(p.count for p in parts)
+    assert array_engine("auto", calls) == (("batch", numba_problem()) if numba_problem() else
+                                           ("compiled", f"auto: {calls:,} planned calls"))
+    assert sum(p.count for p in case_sets.plan(routine, exhaustive=False)) < AUTO_BATCH_CASES

@@ -48,6 +48,12 @@ def test_mul8(runners, a, b):
 
 
 @PROPERTY_SETTINGS
+@given(st.integers(0, 0xFFFF), st.integers(0, 0xFFFF))
+def test_mul16(runners, a, b):
+    _agree(runners["mul16"], (a, b))
+
+
+@PROPERTY_SETTINGS
 @given(st.integers(0, 511), byte)
 def test_tile(runners, x, y):
     _agree(runners["tile"], (x & 0xFF, x >> 8, y))

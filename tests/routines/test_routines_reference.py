@@ -45,6 +45,13 @@ def test_mul8_products():
     assert reference.mul8(np.arange(3), 7).tolist() == [0, 7, 14]
 
 
+def test_mul16_products_need_32_bits():
+    assert reference.mul16(0xFFFF, 0xFFFF) == 0xFFFE0001
+    assert reference.mul16(0x100, 0x100) == 0x10000
+    assert reference.mul16(0, 0xFFFF) == 0
+    assert reference.mul16(np.array([0x8000, 3]), np.array([2, 0x5555])).tolist() == [0x10000, 0xFFFF]
+
+
 def test_screen_cells_and_edges():
     assert cell_of(24, 50) == (0, 0)
     assert cell_of(23, 50) is None and cell_of(24, 49) is None
