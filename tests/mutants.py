@@ -275,7 +275,7 @@ MUTANTS = [
     Mutant("grid-first-axis-fastest", "retro/routines/grid.py",
            "for index in reversed(range(len(self.axis_columns))):", "for index in range(len(self.axis_columns)):", GRID_TESTS),
     Mutant("grid-first-run-cut-at-the-end", "retro/routines/grid.py",
-           "runs[0] -= lo - first * stride", "runs[-1] -= lo - first * stride", GRID_TESTS),
+           "runs[0] = min((first + 1) * stride, hi) - lo", "runs[0] = min(stride, n)", GRID_TESTS),
     Mutant("grid-period-from-its-start", "retro/routines/grid.py",
            "self._periodic(index, k, stride, lo % period, n)", "self._periodic(index, k, stride, 0, n)",
            GRID_TESTS),
