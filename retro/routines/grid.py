@@ -46,7 +46,7 @@ class Grid:
             raise ValueError(f"Grid: make must be a function, got {type(make).__name__}")
         self.names = tuple(axes)
         self.axis_columns = tuple(_axis(name, axis) for name, axis in axes.items())  # per axis: (column, values)
-        self.lengths = tuple(len(columns[0][1]) for columns in self.axis_columns)
+        self.lengths = tuple(_length(columns[0][1]) for columns in self.axis_columns)
         names = [name for columns in self.axis_columns for name, _ in columns]
         twice = next((name for name in names if names.count(name) > 1), None)
         if twice is not None:
@@ -146,10 +146,10 @@ class Grid:
             else:
                 first, last = lo // stride, (hi - 1) // stride  # the runs' numbers (Python ints: no overflow)
                 digits = (first % radix + np.arange(last - first + 1, dtype=np.int64)) % radix
-                runs = np.full(len(digits), stride, dtype=np.int64)
-                runs[0] -= lo - first * stride
-                runs[-1] -= (last + 1) * stride - hi
-                made.append([(name, _runs(values[digits], runs, n)) for name, values in self.axis_columns[index]])
+                runs = np.full(len(digits), min(stride, n), dtype=np.int64)  # (a middle run: stride < n)
+                runs[0] = min((first + 1) * stride, hi) - lo
+                runs[-1] = hi - max(last * stride, lo)
+                made.append([(name, _runs(_at(values, digits), runs, n)) for name, values in self.axis_columns[index]])
             stride = period
         return [column for columns in made[::-1] for column in columns]
 
@@ -158,7 +158,7 @@ class Grid:
         key = (index, column, phase, n)
         kept = self._kept.get(key)
         if kept is None:
-            values = self.axis_columns[index][column][1]
+            values = _at(self.axis_columns[index][column][1], np.arange(self.lengths[index], dtype=np.int64))
             period = np.repeat(values, stride) if stride > 1 else values
             array = np.empty(n, dtype=np.int64)
             head = min(n, len(period) - phase)
@@ -236,20 +236,23 @@ def _axis(name: str, axis) -> tuple[tuple[str, np.ndarray], ...]:
         if not axis:
             raise ValueError(f"Grid: axis {name} has no columns")
         columns = tuple((column, _values(column, values)) for column, values in axis.items())
-        if len({len(values) for _, values in columns}) > 1:
+        if len({_length(values) for _, values in columns}) > 1:
             raise ValueError(f"Grid: axis {name}'s columns have different lengths "
-                             f"({', '.join(f'{c}: {len(v)}' for c, v in columns)})")
+                             f"({', '.join(f'{c}: {_length(v)}' for c, v in columns)})")
         return columns
     return ((name, _values(name, axis)),)
 
 
-def _values(name: str, axis: int | Sequence[int]) -> np.ndarray:
+def _values(name: str, axis: int | Sequence[int]) -> np.ndarray | int:
+    """An axis column's values as int64, or its count n when they are 0..n-1 (never made: a count may be huge)."""
     if not isinstance(name, str) or not name.isidentifier():
         raise ValueError(f"Grid: axis name {name!r} is not an identifier (make takes the axes as keywords)")
     if isinstance(axis, (int, np.integer)) and not isinstance(axis, bool):
         if axis < 0:
             raise ValueError(f"Grid: axis {name} has a negative count {axis}")
-        return np.arange(int(axis), dtype=np.int64)
+        if axis > COUNT_LIMIT:
+            raise ValueError(f"Grid: axis {name} has {int(axis):,} values, more than a case's int64 column holds")
+        return int(axis)
     try:
         values = np.asarray(list(axis) if not isinstance(axis, np.ndarray) else axis)
     except TypeError:
@@ -258,3 +261,15 @@ def _values(name: str, axis: int | Sequence[int]) -> np.ndarray:
     if values.ndim != 1 or (values.size and (values.dtype == bool or not np.issubdtype(values.dtype, np.integer))):
         raise ValueError(f"Grid: axis {name} must be a count or a sequence of whole numbers")
     return values.astype(np.int64)
+
+
+COUNT_LIMIT = 1 << 62  # an axis counted 0..n-1: its digits stay within int64
+
+
+def _length(values: np.ndarray | int) -> int:
+    return values if isinstance(values, int) else len(values)
+
+
+def _at(values: np.ndarray | int, digits: np.ndarray) -> np.ndarray:
+    """An axis column's values at `digits` (a counted axis's values are its digits)."""
+    return digits if isinstance(values, int) else values[digits]

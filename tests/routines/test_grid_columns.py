@@ -64,6 +64,20 @@ def test_a_grid_s_columns_are_the_mixed_radix_digits_of_any_range(axes):
             assert {n: c.tolist() for n, c in grid.columns(lo, hi).items()} == _expected(axes, lo, hi), (axes, lo, hi)
 
 
+def test_a_grid_of_huge_counts_makes_any_range_without_its_axes_values():
+    """Counted axes are never made whole (an axis of 2^40 values costs nothing); the digits are right past
+    2^64 combinations."""
+    lengths = [3, 1 << 40, 1 << 30]
+    grid = Grid(dict(zip("abc", lengths)))
+    assert grid.count == 3 << 70
+    for lo in (0, (1 << 30) - 2, (1 << 70) + 5, grid.count - 7):
+        hi = min(grid.count, lo + 9)
+        made = grid.columns(lo, hi)
+        assert [list(row) for row in zip(*(made[n].tolist() for n in "abc"))] == [_digits(lengths, i) for i in range(lo, hi)]
+    with pytest.raises(ValueError, match="more than a case's int64 column holds"):
+        Grid({"a": 1 << 63})
+
+
 def test_a_grid_s_blocks_are_the_same_made_again_and_in_any_order():
     """The columns a grid keeps for the next blocks (a period, a constant) are the same as made anew."""
     axes = {"a": 3, "b": [5, 6], "c": 1_000}
