@@ -134,13 +134,14 @@ class EntryBaseline:
 
 
 def entry_baseline(routine, outputs: list, cycles: np.ndarray, returned: int, columns: list, first: int,
-                   every: int) -> EntryBaseline:
+                   every: int, inside: np.ndarray | None = None) -> EntryBaseline:
     """The rerun cases among a block's first `returned` calls (its cases `columns`, its first case's
-    index `first`) with what the check's run gave for them."""
+    index `first`) with what the check's run gave for them; `inside`: which of the block's calls lie
+    inside the domain, when the tally has it (else worked out for the rerun cases)."""
     positions = rerun_positions(first, returned, every)
     subset = [c[positions] for c in columns]
     return EntryBaseline(first, positions, subset, [o[positions] for o in outputs], cycles[positions],
-                         in_domain(routine, subset))
+                         in_domain(routine, subset) if inside is None else inside[positions])
 
 
 def run_baselines(variants: dict[str, RoutineRunner], baselines: list[EntryBaseline],
