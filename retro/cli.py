@@ -9,37 +9,16 @@ or check that fails); argparse usage errors exit 2.
 from __future__ import annotations
 
 import argparse
-import importlib
 import sys
-from collections.abc import Iterator, Mapping
 
 from retro import __version__, interrupts
+from retro.commands import advise, asm, chart, check, cycles, demo, nes, optimize, parry, profile, run, stability, vic
 from retro.errors import RetroError
 
-
-class _Commands(Mapping):
-    """Command name -> its module in retro.commands, imported when first asked for: `retro check` loads
-    check's module and what it needs, not every command's (about 0.08 s of each run's start)."""
-
-    NAMES = ("demo", "asm", "run", "vic", "nes", "check", "cycles", "chart", "stability", "advise", "parry",
-             "profile", "optimize")  # in the order `retro --help` lists them
-
-    def __getitem__(self, name: str):
-        if name not in self.NAMES:
-            raise KeyError(name)
-        return importlib.import_module(f"retro.commands.{name}")
-
-    def __contains__(self, name: object) -> bool:
-        return name in self.NAMES
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self.NAMES)
-
-    def __len__(self) -> int:
-        return len(self.NAMES)
-
-
-COMMANDS = _Commands()
+# In the order `retro --help` lists them.
+COMMANDS = {"demo": demo, "asm": asm, "run": run, "vic": vic, "nes": nes, "check": check, "cycles": cycles,
+            "chart": chart, "stability": stability, "advise": advise, "parry": parry, "profile": profile,
+            "optimize": optimize}
 
 
 def one_line(text: str) -> str:
@@ -58,18 +37,12 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
-def build_parser(only: str | None = None) -> argparse.ArgumentParser:
-    """The parser of every command, or with `only`, of that command whole and the others' names (what
-    parsing a line that starts with `only` needs: no other command's module is imported)."""
+def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="retro", description="Collision detection on retro hardware (C64, NES).")
     parser.add_argument("--version", action="version", version=f"retro {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for name in COMMANDS:
-        if only is not None and name != only:
-            sub.add_parser(name)
-            continue
-        command = COMMANDS[name]
+    for name, command in COMMANDS.items():
         p = sub.add_parser(name, help=command.HELP, **getattr(command, "PARSER", {}))
         command.add_options(p)
         p.set_defaults(func=command.main)
@@ -77,8 +50,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    line = sys.argv[1:] if argv is None else argv
-    parser = build_parser(line[0] if line and line[0] in COMMANDS else None)
+    parser = build_parser()
     args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)

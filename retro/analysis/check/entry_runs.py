@@ -72,17 +72,19 @@ def entry_every(planned: int, exhaustive: bool, everything: int, sweep: bool = F
     return max(every, SWEEP_EVERY) if sweep else every
 
 
-ENTRY_COMPILED_RERUNS = 1_000_000  # reruns (all variants) from which a check on the compiled engine runs them
-# there: loading its entry-state function (numba's cache, ~0.1-0.5 CPU s) costs about what the batched core
-# takes for this many (250-670 ns a call: EntryBaseline)
+ENTRY_COMPILED_RERUNS = 1_000_000  # planned reruns (all variants) from which a check on the compiled engine runs
+# them there: loading its entry-state function costs 0.57 CPU s (numba's cache), about what the batched core
+# takes for this many (250-670 ns a call: EntryBaseline). Not a sweep's (its count unknown): measured on
+# aabb8's 1/256 slice (50 M calls, 790,000 reruns), the whole check took 2.5 CPU s more with them compiled
+# (8.2-8.8 s against 5.6-6.0) although the reruns alone cost 2.2 ns a call of the sweep against 4.3
 
 
 def rerun_engine(engine: str, planned: int, sweep: bool, every: int) -> str:
     """The engine of a check's entry-state reruns on an array engine: the compiled engine when the
-    check runs on it and they are many (a sweep's, or ENTRY_COMPILED_RERUNS), else the batched core."""
-    if engine != "compiled" or not every:
+    check runs on it and plans ENTRY_COMPILED_RERUNS of them or more, else the batched core."""
+    if engine != "compiled" or not every or sweep:
         return "batch"
-    return "compiled" if sweep or planned // every * len(VARIANTS) >= ENTRY_COMPILED_RERUNS else "batch"
+    return "compiled" if planned // every * len(VARIANTS) >= ENTRY_COMPILED_RERUNS else "batch"
 
 
 def rerun_positions(first: int, n: int, every: int) -> np.ndarray:
@@ -134,13 +136,14 @@ class EntryBaseline:
 
 
 def entry_baseline(routine, outputs: list, cycles: np.ndarray, returned: int, columns: list, first: int,
-                   every: int) -> EntryBaseline:
+                   every: int, inside: np.ndarray | None = None) -> EntryBaseline:
     """The rerun cases among a block's first `returned` calls (its cases `columns`, its first case's
-    index `first`) with what the check's run gave for them."""
+    index `first`) with what the check's run gave for them; `inside`: which of the block's calls lie
+    inside the domain, when the tally has it (else worked out for the rerun cases)."""
     positions = rerun_positions(first, returned, every)
     subset = [c[positions] for c in columns]
     return EntryBaseline(first, positions, subset, [o[positions] for o in outputs], cycles[positions],
-                         in_domain(routine, subset))
+                         in_domain(routine, subset) if inside is None else inside[positions])
 
 
 def run_baselines(variants: dict[str, RoutineRunner], baselines: list[EntryBaseline],
@@ -167,7 +170,7 @@ def run_baselines(variants: dict[str, RoutineRunner], baselines: list[EntryBasel
 
 
 CROSS_CHECKED = 256  # of each compiled rerun, the cases also run on the batched core and compared (the engines
-# stay cross-checked on varied entry states: a sweep task's first block's reruns, ~1 in 250 of a sweep's)
+# stay cross-checked on varied entry states: the first 256 of each task's reruns)
 
 
 def _rerun(runner: RoutineRunner, variant: str, columns: list, entry: tuple, engine: str,

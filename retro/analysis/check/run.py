@@ -37,7 +37,7 @@ from retro.analysis.check.entry_runs import (
 )
 from retro.analysis.check.results import PartRun, RoutineCheck
 from retro.analysis.check.search import DEFAULT_SEARCH, SearchResult, search
-from retro.analysis.check.tally import EXAMPLES_KEPT, Tally, count_block, entry_tally
+from retro.analysis.check.tally import EXAMPLES_KEPT, Tally, count_array_block, count_block, entry_tally
 from retro.analysis.check.verdicts import bounds_violations, budget_violations, static_bounds
 from retro.analysis.row_check import RowsCheck, check_rows, merged_agreement, rows_only_static
 from retro.errors import InputError, RunError
@@ -89,10 +89,11 @@ def array_block(spec: str, seed: int, columns: list, first: int, every: int, eng
     `outside_wanted` as for count_block."""
     runner = runner_for(spec, seed, start)
     block = run_on_batched_core(runner, columns, engine=engine)
-    tally = count_block(runner.routine, block, columns, None, runner.memory_values, outside_wanted=outside_wanted)
+    tally, inside = count_array_block(runner.routine, block, columns, runner.memory_values, outside_wanted)
     if not every:
         return tally, None
-    return tally, entry_baseline(runner.routine, block.outputs, block.cycles, block.returned, columns, first, every)
+    return tally, entry_baseline(runner.routine, block.outputs, block.cycles, block.returned, columns, first, every,
+                                 inside)
 
 
 def held_entry_tally(spec: str, seed: int, start: SceneStart | None, held: list[EntryBaseline],

@@ -148,6 +148,20 @@ def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[t
     only, never to the reference or the domain; every example and failure names the row.
     `outside_wanted`: how many examples of cases outside the domain the caller can still keep (a sweep
     task whose earlier blocks gave EXAMPLES_KEPT passes 0: the merge would drop these)."""
+    return _count(routine, block, columns, cases, memory, against, entry, row_keys, outside_wanted)[0]
+
+
+def count_array_block(routine: Routine, block: CallBlock, columns: list, memory: dict,
+                      outside_wanted: int = EXAMPLES_KEPT) -> tuple[Tally, np.ndarray]:
+    """count_block of an array engine's block, and which of its returned calls lie inside the domain
+    (what the entry-state reruns of its cases compare: entry_runs.entry_baseline)."""
+    tally, calls = _count(routine, block, columns, None, memory, outside_wanted=outside_wanted)
+    return tally, calls.inside
+
+
+def _count(routine: Routine, block: CallBlock, columns: list, cases: list[tuple] | None, memory: dict,
+           against: CallBlock | None = None, entry: EntryBlock | None = None,
+           row_keys: Sequence[str] | None = None, outside_wanted: int = EXAMPLES_KEPT) -> tuple[Tally, _Calls]:
     calls = _calls(routine, block, columns, cases, memory, row_keys)
     out = Tally()
     n = block.returned
@@ -178,7 +192,7 @@ def count_block(routine: Routine, block: CallBlock, columns: list, cases: list[t
     if block.stop is not None:  # the call that did not return ends the block, as it ends the check
         case = cases[n] if cases is not None else case_sets.case_of(columns, n)
         _stop(out, calls, case, engine_wrong.get(n))
-    return out
+    return out, calls
 
 
 def _reference_figures(out: Tally, calls: _Calls, outside_wanted: int = EXAMPLES_KEPT) -> np.ndarray:
