@@ -84,6 +84,8 @@ def circle_sweep() -> None:
 
 
 BIG_SWEEPS = ("circle", "circle_r")  # 67 million calls each: hours on Machine
+PROOF_SWEEPS = ("aabb8", "mul16")  # 3 x 2^32 and 2^32 calls: hours on the batched core, days on Machine; measured on
+# the compiled engine by benchmarks/aabb8_sweep.py and benchmarks/mul16_sweep.py
 
 
 def _wall(args: list[str]) -> tuple[float, str]:
@@ -95,10 +97,11 @@ def _wall(args: list[str]) -> tuple[float, str]:
 
 def check_walls() -> None:
     """retro check --exhaustive on both engines, side by side, for every routine but the two 67-million
-    call sweeps; those on the batched core, and on Machine extrapolated from its measured rate."""
+    call sweeps and the full proofs (PROOF_SWEEPS); the first on the batched core, and on Machine
+    extrapolated from its measured rate."""
     from retro.routines.registry import builtin_names
 
-    rest = [n for n in builtin_names() if n not in BIG_SWEEPS]
+    rest = [n for n in builtin_names() if n not in BIG_SWEEPS + PROOF_SWEEPS]
     batch_s, batch_what = _wall(["--exhaustive", "--engine", "batch", *rest])
     scalar_s, scalar_what = _wall(["--exhaustive", "--engine", "scalar", *rest])
     print(f"retro check --exhaustive ({len(rest)} routines): batch {batch_s:.1f} s ({batch_what}), "

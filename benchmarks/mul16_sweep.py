@@ -64,9 +64,10 @@ def main(argv: list[str]) -> None:
     calls = record.get("cases", 0)
     swept = FULL_CALLS if args.full else args.first_a * WORD
     rate = calls / run.cpu if run.cpu else 0.0
+    said = "" if args.full else (f", mismatches {record.get('mismatches', '?')}, engine {record.get('engine', '?')} "
+                                 f"({record.get('engine_reason', '')})")  # (the full run's report says them above)
     print(f"mul16 {'full sweep' if args.full else f'slice: a from {args.first_a} of 65,536 values'}: {swept:,} sweep "
-          f"calls, {calls:,} calls in all, exit {run.returncode}, mismatches {record.get('mismatches', '?')}, "
-          f"engine {record.get('engine', '?')} ({record.get('engine_reason', '')})")
+          f"calls, {calls:,} calls in all, exit {run.returncode}{said}")
     print(f"  --engine {args.engine} --jobs {args.jobs}: {run.wall:.1f} s wall, {run.cpu:.1f} CPU s, "
           f"{rate / 1e6:.2f} M calls per CPU-second; largest process RSS {run.peak / 2**20:.0f} MiB "
           f"(goal: under {GOAL_RSS >> 20} MiB per worker), whole tree {run.peak_tree / 2**20:.0f} MiB; "
