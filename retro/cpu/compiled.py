@@ -29,6 +29,7 @@ import shutil
 import sys
 import tempfile
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -189,13 +190,34 @@ def _clear(entry: Path) -> None:
             path.unlink()
 
 
+BLAS_PROBE = "scipy.linalg.cython_blas"
+
+
+@contextmanager
+def _no_blas_probe():
+    """numba's CPU target, on its first use in a process, asks whether a BLAS is there by importing
+    scipy.linalg (0.4 s of the 0.55 s a cached routine took to load in a fresh process, measured);
+    the generated code calls no BLAS, so while it loads that import fails at once (numba's
+    np.correlate and np.convolve then keep their own loop; np.dot still finds scipy when typed later)."""
+    if BLAS_PROBE in sys.modules or "numba.np.arraymath" in sys.modules:  # imported already, or probed
+        yield
+        return
+    sys.modules[BLAS_PROBE] = None  # the import system's "not there": ImportError, parents untouched
+    try:
+        yield
+    finally:
+        if sys.modules.get(BLAS_PROBE, 0) is None:
+            del sys.modules[BLAS_PROBE]
+
+
 def _load(entry: Path, key: str, name: str):
     module_name = f"retro_compiled_{key[:24]}"
     spec = importlib.util.spec_from_file_location(module_name, entry / MODULE_FILE)
     module = importlib.util.module_from_spec(spec)
     sys.modules[module_name] = module  # numba finds the module by name when it loads the cached code
     try:
-        spec.loader.exec_module(module)
+        with _no_blas_probe():
+            spec.loader.exec_module(module)
     except BaseException:
         del sys.modules[module_name]
         raise

@@ -39,7 +39,7 @@ from retro.cpu.timing import (
     branch_target,
 )
 
-TRANSLATOR_VERSION = 6  # part of every cache key: a change of the generated code's meaning bumps it
+TRANSLATOR_VERSION = 7  # part of every cache key: a change of the generated code's meaning bumps it
 # A call's status (the compiled function's per-call result): 0 returned, else why it stopped.
 RETURNED = 0
 BUDGET = 4  # the cycle budget was spent (retro.cpu.batch.LaneError.BUDGET)
@@ -155,6 +155,7 @@ class _Emitter:
         self.lines: list[str] = []
         self.fixed_writes: set[int] = set()
         self.computed_writes = False  # a write to a computed address (or a push) was emitted
+        self.pc = 0  # the instruction being emitted
         self.indent = ""
         self.inlined: set[int] = set()
         self.chained: set[int] = set()  # blocks some code reaches through the dispatch
@@ -363,7 +364,18 @@ def _jump_to(e: _Emitter, target: str, blocks: dict[int, int]) -> None:
     e.put("if blk < 0:")
     e.put(f"    status = {FALLBACK_JUMP}")
     e.put("    break")
+    _loop_check(e)
     e.put("continue")
+
+
+def _loop_check(e: _Emitter) -> None:
+    """Before control goes back through the dispatch to a block not after the jump (a loop, a return,
+    a computed jump): the call stops when the budget is spent or a write went into the code. Forward
+    jumps go unchecked: their blocks start at ever higher addresses, so code without a backward jump
+    ends by itself, and its cycles and writes are looked at once, when it does."""
+    e.put("if cycles >= budget or bad:")
+    e.put(f"    status = {FALLBACK_WRITE} if bad else {BUDGET}")
+    e.put("    break")
 
 
 def _go(e: _Emitter, address: int, blocks: dict[int, int], return_pc: int) -> None:
@@ -375,6 +387,8 @@ def _go(e: _Emitter, address: int, blocks: dict[int, int], return_pc: int) -> No
         e.emit_block(address)  # follows, no trip through the dispatch
         return
     e.chained.add(address)
+    if address <= e.pc:
+        _loop_check(e)
     e.put(f"blk = {blocks[address]}")
     e.put("continue")
 
@@ -388,6 +402,7 @@ def _branch(e: _Emitter, condition: str, pc: int, length: int, offset: int, bloc
     e.put(f"cycles += {extra}")
     _go(e, target, blocks, return_pc)
     e.indent = e.indent[:-4]
+    e.pc = pc  # (the taken side's inlined code moved it on)
     _go(e, following, blocks, return_pc)
 
 
@@ -720,6 +735,7 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
         while True:
             op = instructions[pc]
             e.put(f"# ${pc:04X} {op.mnemonic if op is not None else 'not translated'}")
+            e.pc = pc
             if _instruction(e, pc, op, blocks, return_pc):
                 break
             pc = (pc + MODE_LENGTH[op.mode]) & WORD
@@ -797,10 +813,9 @@ def {name}(mem, image, log, code_map, addr_block, cols, lane_addr, lane_bytes, b
         ea = np.int64(0)
         w = np.int64(0)
         pg = np.int64(0)
-        while True:
-            if cycles >= budget or bad:
-                status = ({fallback_write} if bad == 1 else {fallback_decimal}) if bad else {budget_status}
-                break
+        if cycles >= budget or bad:
+            status = {fallback_decimal} if bad else {budget_status}
+        while status == 0:
 {body}
         if status == 0 and bad:
             status = {fallback_write}
