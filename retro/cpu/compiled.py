@@ -29,13 +29,14 @@ import shutil
 import sys
 import tempfile
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from retro.cpu import compiled_ops, translate
-from retro.cpu.translate import FALLBACK, SET_A, SET_FLAG, SET_P, SET_REGISTERS, SET_X, SET_Y, Translation, Untranslatable
+from retro.cpu.translate import FALLBACK, REGISTERS_OUT, RESULT_ROWS, SET_A, SET_FLAG, SET_P, SET_REGISTERS, SET_X, SET_Y, Translation, Untranslatable
 
 CACHE_ENV = "RETRO_CACHE"
 MODULE_FILE = "routine.py"
@@ -49,7 +50,6 @@ FALLBACK_REASON = {translate.FALLBACK_STOP: "an instruction the compiled engine 
                    translate.FALLBACK_WRITE: "a write into the routine's own code",
                    translate.FALLBACK_DECIMAL: "decimal mode on entry to code translated for binary mode only "
                                                "(no SED or PLP in it)"}
-OUT_ROWS = ("a", "x", "y", "p", "cycles", "status")  # the rows of the function's `out` array
 
 
 def signature(columns: int) -> str:
@@ -100,8 +100,9 @@ class CompiledRoutine:
             lane_bytes: np.ndarray | None = None) -> dict:
         """Every call of the block (one per element of each column, `columns` the int64 arrays the
         routine was compiled to place: `compile_routine`) over `base` (A, X, Y, P), and `lane_bytes`
-        one row per address of `lane_addr`. Its results as arrays by OUT_ROWS name, the bytes at
-        `out_addr` one row per address."""
+        one row per address of `lane_addr`. Its results as arrays by name (those the routine was
+        compiled to write, `compile_routine`'s `results`, then RESULT_ROWS: cycles and status), the
+        bytes at `out_addr` one row per address ("bytes")."""
         n = len(columns[0]) if columns else lane_bytes.shape[1]
         wide, mem, log = self.memory_for(image)
         columns = tuple(columns) or (np.zeros(n, dtype=np.int64),)
@@ -111,7 +112,8 @@ class CompiledRoutine:
         if ((made_for.lanes is not None and tuple(lane_addr.tolist()) != made_for.lanes)
                 or (made_for.outputs is not None and tuple(out_addr.tolist()) != made_for.outputs)):
             raise ValueError("the lane or output addresses differ from those the routine was compiled for")
-        out = np.empty((len(OUT_ROWS), n), dtype=np.int64)
+        names = [name for name, _ in made_for.results] + list(RESULT_ROWS)
+        out = np.empty((len(names), n), dtype=np.int64)
         out_bytes = np.empty((len(out_addr), n), dtype=np.uint8)
         try:
             self.function(mem, wide, log, self.code_map, self.addr_block, columns, lane_addr, lane_bytes, base, sp,
@@ -120,7 +122,7 @@ class CompiledRoutine:
             placed = list(self.translation.placed)
             mem[placed] = wide[placed]
             mem[lane_addr] = wide[lane_addr]
-        results = dict(zip(OUT_ROWS, out))
+        results = dict(zip(names, out))
         results["bytes"] = out_bytes
         return results
 
@@ -188,13 +190,34 @@ def _clear(entry: Path) -> None:
             path.unlink()
 
 
+BLAS_PROBE = "scipy.linalg.cython_blas"
+
+
+@contextmanager
+def _no_blas_probe():
+    """numba's CPU target, on its first use in a process, asks whether a BLAS is there by importing
+    scipy.linalg (0.4 s of the 0.55 s a cached routine took to load in a fresh process, measured);
+    the generated code calls no BLAS, so while it loads that import fails at once (numba's
+    np.correlate and np.convolve then keep their own loop; np.dot still finds scipy when typed later)."""
+    if BLAS_PROBE in sys.modules or "numba.np.arraymath" in sys.modules:  # imported already, or probed
+        yield
+        return
+    sys.modules[BLAS_PROBE] = None  # the import system's "not there": ImportError, parents untouched
+    try:
+        yield
+    finally:
+        if sys.modules.get(BLAS_PROBE, 0) is None:
+            del sys.modules[BLAS_PROBE]
+
+
 def _load(entry: Path, key: str, name: str):
     module_name = f"retro_compiled_{key[:24]}"
     spec = importlib.util.spec_from_file_location(module_name, entry / MODULE_FILE)
     module = importlib.util.module_from_spec(spec)
     sys.modules[module_name] = module  # numba finds the module by name when it loads the cached code
     try:
-        spec.loader.exec_module(module)
+        with _no_blas_probe():
+            spec.loader.exec_module(module)
     except BaseException:
         del sys.modules[module_name]
         raise
@@ -236,19 +259,22 @@ def _function(translation: Translation, columns: int) -> tuple[object, float, bo
 
 def compile_routine(image: bytes, entry: int, cpu: str, return_pc: int, inputs_at=(), columns: int = 0,
                     places: tuple = (), sets: tuple = (), lanes: tuple[int, ...] | None = None,
-                    outputs: tuple[int, ...] | None = None, decimal_entry: bool = False) -> CompiledRoutine:
+                    outputs: tuple[int, ...] | None = None, decimal_entry: bool = False,
+                    results: tuple[tuple[str, str], ...] = REGISTERS_OUT) -> CompiledRoutine:
     """The routine at entry in this memory image, compiled (or loaded from the cache) for calls whose
     inputs come in `columns` case columns placed by `places` and `sets` rows (retro.cpu.translate's
     `_placing`; `CompiledRoutine.run`), and, when given, the `lane_addr` and `out_addr` every run
     passes (`lanes`, `outputs`: one line each in the code instead of a loop), and whether calls may
-    start with D set (`decimal_entry`: ADC and SBC then keep decimal mode); Untranslatable when the
+    start with D set (`decimal_entry`: ADC and SBC then keep decimal mode), and what its runs give
+    per call (`results`: (name, expression) pairs, retro.cpu.translate's `_out_lines`; A, X, Y and
+    P unless told); Untranslatable when the
     compiled engine does not take it (the message says why)."""
     problem = numba_problem()
     if problem is not None:
         raise Untranslatable(problem)
     translation = translate.translate(image.__getitem__, entry, cpu, return_pc, inputs_at, places, sets,
                                       None if lanes is None else tuple(lanes),
-                                      None if outputs is None else tuple(outputs), decimal_entry)
+                                      None if outputs is None else tuple(outputs), decimal_entry, tuple(results))
     function, seconds, from_cache = _function(translation, columns)
     code_map = np.zeros(MEMORY, dtype=np.uint8)
     code_map[list(translation.code_bytes)] = 1
@@ -258,6 +284,6 @@ def compile_routine(image: bytes, entry: int, cpu: str, return_pc: int, inputs_a
     return CompiledRoutine(translation, function, seconds, from_cache, code_map, addr_block)
 
 
-__all__ = ["CompiledRoutine", "FALLBACK", "FALLBACK_REASON", "OUT_ROWS", "SET_A", "SET_FLAG", "SET_P", "SET_REGISTERS", "SET_X", "SET_Y",
+__all__ = ["CompiledRoutine", "FALLBACK", "FALLBACK_REASON", "RESULT_ROWS", "SET_A", "SET_FLAG", "SET_P", "SET_REGISTERS", "SET_X", "SET_Y",
            "Untranslatable", "cache_root", "compile_routine",
            "numba_problem"]

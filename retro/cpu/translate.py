@@ -39,7 +39,7 @@ from retro.cpu.timing import (
     branch_target,
 )
 
-TRANSLATOR_VERSION = 5  # part of every cache key: a change of the generated code's meaning bumps it
+TRANSLATOR_VERSION = 7  # part of every cache key: a change of the generated code's meaning bumps it
 # A call's status (the compiled function's per-call result): 0 returned, else why it stopped.
 RETURNED = 0
 BUDGET = 4  # the cycle budget was spent (retro.cpu.batch.LaneError.BUDGET)
@@ -54,6 +54,8 @@ BYTE = 0xFF
 STACK_PAGE = 0x100
 
 
+REGISTERS_OUT = tuple((name, name) for name in "axyp")  # `translate`'s `results`: the registers and P
+RESULT_ROWS = ("cycles", "status")  # the rows of the function's `out` array after the results
 SET_A, SET_X, SET_Y, SET_P, SET_FLAG = range(5)  # what a `sets` row of `translate` does with its column
 SET_REGISTERS = "axyp"
 
@@ -75,6 +77,7 @@ class Translation:
     placed: tuple[int, ...] = ()  # addresses the function puts the case columns' bytes at (`places`)
     lanes: tuple[int, ...] | None = None  # the `lane_addr` the function was made for (None: any, looped over)
     outputs: tuple[int, ...] | None = None  # the `out_addr` likewise
+    results: tuple[tuple[str, str], ...] = REGISTERS_OUT  # (name, expression) per `out` row before RESULT_ROWS
 
 
 def tables_for(cpu: str) -> dict[int, Op]:
@@ -151,6 +154,8 @@ class _Emitter:
         self.read = read
         self.lines: list[str] = []
         self.fixed_writes: set[int] = set()
+        self.computed_writes = False  # a write to a computed address (or a push) was emitted
+        self.pc = 0  # the instruction being emitted
         self.indent = ""
         self.inlined: set[int] = set()
         self.chained: set[int] = set()  # blocks some code reaches through the dispatch
@@ -169,6 +174,7 @@ class _Emitter:
 
     def write_at(self, address: str, value: str) -> None:
         """A write to a computed address: into the code -> the call falls back; logged for the restore."""
+        self.computed_writes = True
         self.put(f"t = {address}")
         self.put("bad |= code_map[t]")  # looked at when the block ends: the call then runs again elsewhere
         self.put("log[nlog & LOG_MASK] = t")
@@ -358,7 +364,18 @@ def _jump_to(e: _Emitter, target: str, blocks: dict[int, int]) -> None:
     e.put("if blk < 0:")
     e.put(f"    status = {FALLBACK_JUMP}")
     e.put("    break")
+    _loop_check(e)
     e.put("continue")
+
+
+def _loop_check(e: _Emitter) -> None:
+    """Before control goes back through the dispatch to a block not after the jump (a loop, a return,
+    a computed jump): the call stops when the budget is spent or a write went into the code. Forward
+    jumps go unchecked: their blocks start at ever higher addresses, so code without a backward jump
+    ends by itself, and its cycles and writes are looked at once, when it does."""
+    e.put("if cycles >= budget or bad:")
+    e.put(f"    status = {FALLBACK_WRITE} if bad else {BUDGET}")
+    e.put("    break")
 
 
 def _go(e: _Emitter, address: int, blocks: dict[int, int], return_pc: int) -> None:
@@ -370,6 +387,8 @@ def _go(e: _Emitter, address: int, blocks: dict[int, int], return_pc: int) -> No
         e.emit_block(address)  # follows, no trip through the dispatch
         return
     e.chained.add(address)
+    if address <= e.pc:
+        _loop_check(e)
     e.put(f"blk = {blocks[address]}")
     e.put("continue")
 
@@ -383,6 +402,7 @@ def _branch(e: _Emitter, condition: str, pc: int, length: int, offset: int, bloc
     e.put(f"cycles += {extra}")
     _go(e, target, blocks, return_pc)
     e.indent = e.indent[:-4]
+    e.pc = pc  # (the taken side's inlined code moved it on)
     _go(e, following, blocks, return_pc)
 
 
@@ -448,6 +468,9 @@ def _emit_jsr(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: i
 
 
 def _emit_rts(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
+    e.put("if direct:  # the caller's own return address, unchanged on the stack: the call has returned")
+    e.put(f"    cycles += {op.cycles}")
+    e.put("    break")
     e.pull("t")
     e.pull("u")
     e.put(f"cycles += {op.cycles}")
@@ -643,6 +666,30 @@ def _placing(places: tuple, sets: tuple) -> str:
     return "\n".join(" " * 8 + line for line in lines)
 
 
+STACK_MNEMONICS = {"PHA", "PHP", "PHX", "PHY", "PLA", "PLP", "PLX", "PLY", "JSR", "TXS", "BRK", "RTI"}
+
+
+def returns_directly(instructions: Iterable[Op | None], computed_writes: bool, fixed_writes: Iterable[int],
+                     placed: Iterable[int], lanes: tuple[int, ...] | None) -> bool:
+    """Whether every RTS the code runs is the call's own return: no instruction moves S but RTS, and
+    nothing writes page 1 (no push, no store to a computed address, no fixed store or placed input
+    there): S at an RTS is S at entry and the return address is the image's, read once per run (the
+    generated `direct`) instead of from memory on every call."""
+    page = range(STACK_PAGE, 2 * STACK_PAGE)
+    return (lanes is not None and not computed_writes
+            and not any(op is not None and op.mnemonic in STACK_MNEMONICS for op in instructions)
+            and not any(address in page for address in (*fixed_writes, *placed, *lanes)))
+
+
+def _out_lines(results: tuple[tuple[str, str], ...]) -> str:
+    """The lines that write a call's results into `out`: one row per (name, expression) of `results`
+    (an expression of a, x, y, p: P as pushed, and mem[address]), then cycles and status."""
+    lines = [f"p = (nv & 128) | (fv << 6) | 32 | (fd << 3) | (fi << 2) | {_Z_BIT} | fc"]
+    lines += [f"out[{k}, lane] = {expression}" for k, (_, expression) in enumerate(results)]
+    lines += [f"out[{len(results)}, lane] = cycles", f"out[{len(results) + 1}, lane] = status"]
+    return "\n".join(" " * 8 + line for line in lines)
+
+
 def _lane_lines(lanes: tuple[int, ...] | None, outputs: tuple[int, ...] | None) -> tuple[str, str]:
     """The lines that put the per-lane bytes in place and copy the output bytes out: one line per
     address when the addresses are known (an empty loop costs more than aabb8's whole call), else loops."""
@@ -660,12 +707,13 @@ def _lane_lines(lanes: tuple[int, ...] | None, outputs: tuple[int, ...] | None) 
 def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
               inputs_at: Iterable[int] = (), places: tuple = (), sets: tuple = (),
               lanes: tuple[int, ...] | None = None, outputs: tuple[int, ...] | None = None,
-              decimal_entry: bool = False) -> Translation:
+              decimal_entry: bool = False, results: tuple[tuple[str, str], ...] = REGISTERS_OUT) -> Translation:
     """The routine at entry (its bytes as `read` gives them: the memory every call starts from) as
     the source of one function (see the module docstring; `places` and `sets`: where the case
     columns go, `_placing`; `lanes` and `outputs`: the `lane_addr` and `out_addr` every run will
     pass, when known, `_lane_lines`; `decimal_entry`: calls may start with D set, so ADC and SBC
-    keep their decimal mode); Untranslatable when it certainly modifies its own code."""
+    keep their decimal mode; `results`: what the function writes per call, `_out_lines`);
+    Untranslatable when it certainly modifies its own code."""
     starts, instructions = find_blocks(read, entry, cpu, return_pc)
     code_bytes = frozenset((pc + k) & WORD for pc, op in instructions.items()
                            for k in range(MODE_LENGTH[op.mode] if op is not None else 1))
@@ -687,6 +735,7 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
         while True:
             op = instructions[pc]
             e.put(f"# ${pc:04X} {op.mnemonic if op is not None else 'not translated'}")
+            e.pc = pc
             if _instruction(e, pc, op, blocks, return_pc):
                 break
             pc = (pc + MODE_LENGTH[op.mode]) & WORD
@@ -713,10 +762,12 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
     source = _FUNCTION.format(name=name, entry_block=blocks[entry], body="\n".join(e.lines), budget_status=BUDGET,
                               bad="fd * 2" if e.binary and e.adds else "0", fallback_decimal=FALLBACK_DECIMAL,
                               lane_placing=placing_lanes, out_copying=copying,
-                              fallback_write=FALLBACK_WRITE, z_bit=_Z_BIT, restore=restore,
-                              placing=_placing(places, sets))
+                              fallback_write=FALLBACK_WRITE, restore=restore, placing=_placing(places, sets),
+                              out_rows=_out_lines(results),
+                              direct=returns_directly(instructions.values(), e.computed_writes, e.fixed_writes,
+                                                      (address for _, _, address in places), lanes))
     return Translation(source, name, blocks, code_bytes, tuple(sorted(e.fixed_writes)), len(instructions),
-                       tuple(address for _, _, address in places), lanes, outputs)
+                       tuple(address for _, _, address in places), lanes, outputs, tuple(results))
 
 
 # The function around the blocks: one call per lane, inputs placed from the case columns (`cols`, a
@@ -729,12 +780,19 @@ LOG_MASK = 65535
 
 def {name}(mem, image, log, code_map, addr_block, cols, lane_addr, lane_bytes, base, start_sp, budget, return_pc,
            return_sp, out_addr, out, out_bytes):
+    a0 = base[0]  # read once: in the loop the compiler cannot tell that `out` does not overwrite them
+    x0 = base[1]
+    y0 = base[2]
+    p0 = base[3]
+    low = image[256 + ((start_sp + 1) & 255)]  # the return address every call finds on the stack
+    high = image[256 + ((start_sp + 2) & 255)]
+    direct = {direct} and ((high << 8 | low) + 1) & 65535 == return_pc and (start_sp + 2) & 255 == return_sp
     for lane in range(out.shape[1]):
 {lane_placing}
-        a = base[0]
-        x = base[1]
-        y = base[2]
-        p = base[3]
+        a = a0
+        x = x0
+        y = y0
+        p = p0
 {placing}
         p = (p | 32) & 239
         nv = p & 128
@@ -755,21 +813,15 @@ def {name}(mem, image, log, code_map, addr_block, cols, lane_addr, lane_bytes, b
         ea = np.int64(0)
         w = np.int64(0)
         pg = np.int64(0)
-        while True:
-            if cycles >= budget or bad:
-                status = ({fallback_write} if bad == 1 else {fallback_decimal}) if bad else {budget_status}
-                break
+        if cycles >= budget or bad:
+            status = {fallback_decimal} if bad else {budget_status}
+        while status == 0:
 {body}
         if status == 0 and bad:
             status = {fallback_write}
         if status == 0 and cycles > budget:
             status = {budget_status}
-        out[0, lane] = a
-        out[1, lane] = x
-        out[2, lane] = y
-        out[3, lane] = (nv & 128) | (fv << 6) | 32 | (fd << 3) | (fi << 2) | {z_bit} | fc
-        out[4, lane] = cycles
-        out[5, lane] = status
+{out_rows}
 {out_copying}
         if nlog > LOG_MASK + 1:  # more writes than the log holds: the whole memory
             mem[:] = image

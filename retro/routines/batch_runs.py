@@ -24,6 +24,7 @@ from retro.cpu.mpu import FLAG_B, FLAG_U
 from retro.cpu.variants import VARIANTS
 from retro.routines.input_plan import column_byte
 from retro.routines.outputs import port_values
+from retro.routines.world import WORLD_PLACES
 from retro.routines.world_lanes import BatchWorld
 
 if TYPE_CHECKING:
@@ -170,13 +171,55 @@ def compiled_routine(runner: RoutineRunner, free: tuple = ()):
                               inputs + len(free), places, sets,
                               lanes=tuple(a for _, addresses in plan.tables for a in addresses),
                               outputs=tuple(int(a) for a in plan.output_addresses),
-                              decimal_entry=bool(plan.base_flags & FLAG_D))
+                              decimal_entry=bool(plan.base_flags & FLAG_D), results=_results(runner.routine.outputs))
     held = (routine, [(a, image[a]) for a in sorted(routine.translation.code_bytes)], image)
     if free:
         runner._compiled_free[free] = held
     else:
         runner._compiled = held
     return routine
+
+
+class _Code:
+    """An expression of the compiled function's variables: `port_values` run on these (instead of
+    arrays) writes what the function computes per call for an output, so how an output is read from
+    the registers, P and memory has one home (retro.routines.outputs) on every engine."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+
+    def _with(self, symbol: str, other) -> _Code:
+        return _Code(f"({self.text} {symbol} {other.text if isinstance(other, _Code) else int(other)})")
+
+    def __and__(self, other) -> _Code:
+        return self._with("&", other)
+
+    def __or__(self, other) -> _Code:
+        return self._with("|", other)
+
+    def __lshift__(self, other) -> _Code:
+        return self._with("<<", other)
+
+    def __ne__(self, other) -> _Code:  # type: ignore[override]
+        return self._with("!=", other)
+
+
+def _in_function(port) -> bool:
+    """Whether the compiled function computes this output itself (a number from registers, P or fixed
+    memory bytes; not a table, an output placed by the case or a world's)."""
+    return not port.table and port.via is None and port.places[0].kind not in WORLD_PLACES
+
+
+def _results(ports) -> tuple[tuple[str, str], ...]:
+    """What the compiled function writes per call: each output it computes itself (`_in_function`),
+    then the registers the others read."""
+    computed = [port for port in ports if _in_function(port)]
+    expressions = port_values(computed, {name: _Code(name) for name in "axy"}, _Code("p"),
+                              lambda address: _Code(f"mem[{int(address)}]"),
+                              widen=lambda value: _Code(f"np.int64({value.text if isinstance(value, _Code) else int(value)})"),
+                              table=None)
+    return (tuple((f"out{k}", code.text) for k, code in enumerate(expressions))
+            + tuple((name, name) for name in "axyp" if any(not _in_function(port) for port in ports)))
 
 
 def _lane_bytes(plan, columns: list, n: int) -> tuple[np.ndarray, np.ndarray]:
@@ -220,10 +263,7 @@ def run_compiled(runner: RoutineRunner, columns: list,
     out_addr = np.asarray(plan.output_addresses, dtype=np.int64)
     done = compiled.run(bytes(image), flat, base, stack_pointer, runner.limit, RETURN_TRAP, return_s(s), out_addr,
                         lane_addr, lane_bytes)
-    column_of = {int(address): k for k, address in enumerate(out_addr)}
-    out_bytes = done["bytes"]
-    outputs = port_values(runner.routine.outputs, {"a": done["a"], "x": done["x"], "y": done["y"]}, done["p"],
-                          lambda address: out_bytes[column_of[address]].astype(np.int64), widen=_widen, table=_table)
+    outputs = _outputs(runner.routine.outputs, done, out_addr)
     status = done["status"]
     cycles = done["cycles"]
     if not n or not status.max():  # the common case: every call returned (one pass, no scan for the others)
@@ -231,6 +271,20 @@ def run_compiled(runner: RoutineRunner, columns: list,
     error = np.where(status == LaneError.BUDGET, LaneError.BUDGET, 0).astype(np.int8)
     _rerun_fallbacks(runner, columns, status, outputs, cycles, error, entry)
     return BatchOutcome(outputs, cycles, error)
+
+
+def _outputs(ports, done: dict, out_addr: np.ndarray) -> list:
+    """Per output, its values: computed by the compiled function (`_results`), else read from the
+    registers and output bytes it wrote."""
+    others = [port for port in ports if not _in_function(port)]
+    if others:
+        column_of = {int(address): k for k, address in enumerate(out_addr)}
+        out_bytes = done["bytes"]
+        read = iter(port_values(others, {name: done[name] for name in "axy"}, done["p"],
+                                lambda address: out_bytes[column_of[address]].astype(np.int64),
+                                widen=_widen, table=_table))
+    computed = iter(done[f"out{k}"] for k in range(len(ports) - len(others)))
+    return [next(computed) if _in_function(port) else next(read) for port in ports]
 
 
 def _rerun_fallbacks(runner: RoutineRunner, columns: list, status: np.ndarray, outputs: list, cycles: np.ndarray,

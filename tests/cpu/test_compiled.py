@@ -217,6 +217,53 @@ def test_random_routines_agree_on_all_three_engines(cpu, seed, compiled_cache):
     assert sum(r is not None for r in machine) > LANES // 2
 
 
+def _run_known(code: bytes, registers) -> dict:
+    """The code compiled as the runner compiles it (no lane bytes, no output bytes: both known, empty),
+    A, X, Y and P from the columns; its run's rows."""
+    image = image_with(code)
+    sp = push_return_trap(image)
+    sets = ((0, 0, SET_A), (1, 0, SET_X), (2, 0, SET_Y), (3, 0, SET_P))
+    routine = compile_routine(bytes(image), CODE, "6510", RETURN_TRAP, columns=4, sets=sets, lanes=(), outputs=())
+    columns = tuple(np.ascontiguousarray(registers[:, k], dtype=np.int64) for k in range(4))
+    return routine.run(bytes(image), columns, np.zeros(4, dtype=np.int64), sp, BUDGET, RETURN_TRAP, CALL_STACK_TOP,
+                       np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, len(registers)), dtype=np.uint8))
+
+
+def test_a_leaf_routine_returns_directly_and_agrees_with_the_batched_core(compiled_cache):
+    """CMP #$40; BCC +2; ADC #$22; TAX; RTS compiled for known lanes: no JSR, push, pull or store to a
+    computed address, so its RTS is the call's return (`direct`: no stack read); every call agrees
+    with the batched core."""
+    code = bytes([0xC9, 0x40, 0x90, 0x02, 0x69, 0x22, 0xAA, 0x60])
+    image = image_with(code)
+    push_return_trap(image)
+    assert "direct = True and" in translate(image.__getitem__, CODE, "6510", RETURN_TRAP, lanes=()).source
+    registers, memory = random_states(3, LANES)
+    done = _run_known(code, registers)
+    compiled = [(int(done["a"][i]), int(done["x"][i]), int(done["y"][i]), int(done["p"][i]) & 0xCF,
+                 int(done["cycles"][i])) for i in range(LANES)]
+    assert done["status"].tolist() == [0] * LANES
+    assert compiled == [r[:5] for r in on_batch("6510", code, registers, memory)]
+
+
+def _stack_top() -> int:
+    return push_return_trap(image_with(b""))
+
+
+@pytest.mark.parametrize("code,why", [
+    (bytes([0x68, 0x68, 0x60]), "PLA; PLA; RTS: the RTS takes what lies above the return address"),
+    (bytes([0xBA, 0xA9, 0x50, 0x9D, 0x01, 0x01, 0x60]), "TSX; LDA #$50; STA $0101,X; RTS: a computed store "
+                                                          "rewrites the return address"),
+    (bytes([0xA9, 0x50, 0x8D, 0x01 + _stack_top(), 0x01, 0x60]), "LDA #$50; STA $01xx; RTS: a fixed store "
+                                                                 "rewrites the return address"),
+])
+def test_a_return_address_moved_or_rewritten_is_not_taken_for_the_callers(code, why, compiled_cache):
+    """The caller's return is taken without reading the stack only where nothing can move S or write
+    page 1: here the RTS goes to $xx51 or above the trap, where no block starts, and the call is left
+    to the batched core (not returned with the registers as they are)."""
+    done = _run_known(code, np.array([[0, 0, 0, 0x20]] * 4))
+    assert done["status"].tolist() == [FALLBACK + 2] * 4, why
+
+
 @pytest.mark.parametrize("cpu", ["6510", "65c02"])
 def test_code_that_cannot_set_d_runs_binary_and_leaves_a_call_entered_with_d_set(cpu, compiled_cache):
     """No SED, no PLP, no column sets P: ADC and SBC are translated for binary mode only (inline), the
@@ -342,6 +389,14 @@ def test_the_cache_loads_the_second_time_and_rebuilds_a_corrupt_or_foreign_entry
 def test_a_runaway_call_stops_at_the_budget(compiled_cache):
     code = bytes([0xE8, 0x4C, 0xA0, 0xC0])  # INX; JMP $C0A0
     compiled, left = on_compiled("6510", code, np.array([[0, 0, 0, 0x20]]), np.zeros((1, len(PLACED)), dtype=np.int64))
+    assert compiled == [None] and left == 0
+
+
+def test_a_jump_to_itself_stops_at_the_budget(compiled_cache):
+    """JMP $C0A0 at $C0A0: a jump to the same address goes through the budget's check (a forward jump
+    alone skips it)."""
+    compiled, left = on_compiled("6510", bytes([0x4C, 0xA0, 0xC0]), np.array([[0, 0, 0, 0x20]]),
+                                 np.zeros((1, len(PLACED)), dtype=np.int64))
     assert compiled == [None] and left == 0
 
 
