@@ -46,7 +46,7 @@ LANES = 65_536
 SCALAR_CASES = 2_000
 MIN_SECONDS = 0.5
 ROUTINES = ["aabb8", "mul8", "circle", "tile", "tile_box", "pixel", "aabb_sprite", "aabb_edges", "circle_r",
-            "sprite_edges"]
+            "sprite_edges", "mul16"]
 GOAL = 8  # the issue: at least 8x the batched core on aabb8, mul8, circle and tile
 SWEEP_BLOCKS = 4
 
