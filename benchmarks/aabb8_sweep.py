@@ -40,7 +40,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from peak_memory import sampled_run  # benchmarks/: the script's own folder
+from peak_memory import sampled_run, spec_with_sweep  # benchmarks/: the script's own folder
 
 ROOT = Path(__file__).resolve().parent.parent
 SPEC = ROOT / "asm" / "aabb8.toml"
@@ -51,14 +51,9 @@ GOAL_RSS = 1 << 30  # per worker
 
 
 def sliced_spec(folder: Path, starts: int) -> Path:
-    text = SPEC.read_text()
-    text = text.replace('file = "aabb8.s"', f'file = "{(SPEC.parent / "aabb8.s").as_posix()}"')
-    text = text.replace('sweep = "retro.routines.builtin_cases:aabb8_sweep"', 'sweep = "slice.py:sweep"')
-    (folder / "slice.py").write_text("from retro.routines.builtin_cases import aabb8_sweep\n\n\n"
-                                     f"def sweep():\n    return aabb8_sweep(range({starts}))\n")
-    spec = folder / "aabb8_slice.toml"
-    spec.write_text(text)
-    return spec
+    """aabb8's spec with box A's position from the first `starts` of 256 values."""
+    return spec_with_sweep(SPEC, folder, "from retro.routines.builtin_cases import aabb8_sweep\n\n\n"
+                                         f"def sweep():\n    return aabb8_sweep(range({starts}))\n")
 
 
 FLOOR_BLOCKS = 32

@@ -23,7 +23,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from peak_memory import sampled_run  # benchmarks/: the script's own folder
+from peak_memory import sampled_run, spec_with_sweep  # benchmarks/: the script's own folder
 
 ROOT = Path(__file__).resolve().parent.parent
 SPEC = ROOT / "asm" / "mul16.toml"
@@ -34,13 +34,8 @@ GOAL_RSS = 1 << 30  # per worker
 
 def sliced_spec(folder: Path, first_a: int) -> Path:
     """A copy of mul16's spec whose sweep takes a from 0..first_a-1 (every b for each)."""
-    text = SPEC.read_text().replace('file = "mul16.s"', f'file = "{(SPEC.parent / "mul16.s").as_posix()}"')
-    text = text.replace('sweep = "retro.routines.builtin_cases:mul16_sweep"', 'sweep = "slice.py:sweep"')
-    (folder / "slice.py").write_text("from retro.routines.grid import Grid\n\n\n"
-                                     f"def sweep():\n    return Grid({{'a': {first_a}, 'b': {WORD}}})\n")
-    spec = folder / "mul16_slice.toml"
-    spec.write_text(text)
-    return spec
+    return spec_with_sweep(SPEC, folder, "from retro.routines.grid import Grid\n\n\n"
+                                         f"def sweep():\n    return Grid({{'a': {first_a}, 'b': {WORD}}})\n")
 
 
 def main(argv: list[str]) -> None:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -164,6 +165,20 @@ def sampled_run(command: list[str], every: float = 0.5) -> SampledRun:
         time.sleep(every)
     out = process.stdout.read()
     return SampledRun(process.returncode, out, time.monotonic() - began, sum(spent.values()), peak, peak_tree)
+
+
+def spec_with_sweep(spec: Path, folder: Path, sweep_module: str) -> Path:
+    """A copy of a built-in spec in `folder` whose sweep is `sweep()` of `sweep_module` (Python source,
+    written beside it as slice.py), its program read from the spec's own folder: a bounded slice of a
+    proof for the sweep benchmarks."""
+    text = spec.read_text()
+    program = re.search(r'^file = "([^"]+)"', text, re.MULTILINE).group(1)
+    text = text.replace(f'file = "{program}"', f'file = "{(spec.parent / program).as_posix()}"')
+    text = re.sub(r'^sweep = "[^"]+"', 'sweep = "slice.py:sweep"', text, count=1, flags=re.MULTILINE)
+    (folder / "slice.py").write_text(sweep_module)
+    copy = folder / f"{spec.stem}_slice.toml"
+    copy.write_text(text)
+    return copy
 
 
 def measure(arguments: list[str], seconds: float) -> tuple[int, float, str]:
