@@ -194,7 +194,7 @@ BLAS_PROBE = "scipy.linalg.cython_blas"
 
 
 @contextmanager
-def _no_blas_probe():
+def without_blas_probe():
     """numba's CPU target, on its first use in a process, asks whether a BLAS is there by importing
     scipy.linalg (0.4 s of the 0.55 s a cached routine took to load in a fresh process, measured);
     the generated code calls no BLAS, so while it loads that import fails at once (numba's
@@ -216,7 +216,7 @@ def _load(entry: Path, key: str, name: str):
     module = importlib.util.module_from_spec(spec)
     sys.modules[module_name] = module  # numba finds the module by name when it loads the cached code
     try:
-        with _no_blas_probe():
+        with without_blas_probe():
             spec.loader.exec_module(module)
     except BaseException:
         del sys.modules[module_name]

@@ -18,7 +18,10 @@ def make_ready() -> bool:
     try:
         from numba.core.registry import cpu_target
 
-        cpu_target.target_context.refresh()
+        from retro.cpu.compiled import without_blas_probe
+
+        with without_blas_probe():  # as a worker's own first load would (retro.cpu.compiled)
+            cpu_target.target_context.refresh()
     except Exception:  # numba missing, or a version without this path: the worker loads as before
         return False
     return True
