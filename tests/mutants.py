@@ -78,8 +78,7 @@ MUTANTS = [
     Mutant("line0-raster-delay-zero", "retro/chips/vic/constants.py",
            "RASTER_IRQ_LINE0_DELAY = 1", "RASTER_IRQ_LINE0_DELAY = 0", VIC_TESTS),
     Mutant("register-write-same-cycle", "retro/chips/vic/device.py",
-           "self._advance(t + 1)  # what is drawn up to and including this cycle used the old value",
-           "self._advance(t)", VIC_TESTS),
+           "self._advance(t if register in _SWITCH_PIXEL else t + 1)", "self._advance(t)", VIC_TESTS),
     Mutant("collision-latch-delay", "retro/chips/vic/constants.py",
            "COLLISION_LATCH_DELAY = 4", "COLLISION_LATCH_DELAY = 3", VIC_TESTS),
     Mutant("d019-ack-ignored", "retro/chips/vic/device.py",
@@ -109,7 +108,7 @@ MUTANTS = [
            "bus_registers = self._sampled_registers(self.bad_lines_allowed, self.sprite_enable)",
            "bus_registers = self._sampled_registers(written_den, self.sprite_enable)", VIC_TESTS),
     Mutant("display-follows-bad-lines-only", "retro/chips/vic/device.py",
-           "self._sampled_registers(self.bad_lines_allowed and self.display_opened,",
+           "self._sampled_registers(self.display_opened,",
            "self._sampled_registers(self.bad_lines_allowed,", VIC_TESTS),
     # ---- a sprite X write within a line (tests/vic/test_sprite_x_write.py) ------------------------------
     Mutant("sprite-x-write-moves-a-started-row", "retro/chips/vic/device.py",
