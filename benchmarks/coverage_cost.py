@@ -16,29 +16,29 @@ import time
 from contextlib import contextmanager
 
 from retro.analysis.check import run as check_run
-from retro.analysis.check.engines import run_on_batched_core, runner_for
-from retro.analysis.check.tally import count_block
 from retro.routines.registry import builtin_names, spec_path
 
 GOAL = 1.15
 
 
-def _batch_chunk_without_coverage(spec: str, seed: int, columns: list):
-    runner = runner_for(spec, seed, None)
-    return count_block(runner.routine, run_on_batched_core(runner, columns, coverage=False), columns, None,
-                       runner.memory_values)
+def _without_coverage(run_on_batched_core):
+    def run(runner, columns, confirm_stop=True, coverage=True, engine="batch"):
+        return run_on_batched_core(runner, columns, confirm_stop, False, engine)
+    return run
 
 
 @contextmanager
 def coverage_left_out():
-    saved = check_run.batch_chunk, check_run.completed, check_run.worst_path
-    check_run.batch_chunk = _batch_chunk_without_coverage
+    """The check's blocks (run.array_block through `run_on_batched_core`) run without collecting
+    coverage, and its last step (completed, worst_path) does nothing."""
+    saved = check_run.run_on_batched_core, check_run.completed, check_run.worst_path
+    check_run.run_on_batched_core = _without_coverage(saved[0])
     check_run.completed = lambda coverage, runner: coverage
     check_run.worst_path = lambda runner, case: ()
     try:
         yield
     finally:
-        check_run.batch_chunk, check_run.completed, check_run.worst_path = saved
+        check_run.run_on_batched_core, check_run.completed, check_run.worst_path = saved
 
 
 def seconds(name: str, random: int | None) -> tuple[float, int]:
