@@ -712,6 +712,13 @@ MUTANTS = [
            'return self._with("<<", other)', 'return self._with("|", other)', ("tests/routines/test_compiled_check.py",)),
     Mutant("compiled-rts-without-plus-one", "retro/cpu/translate.py",
            'e.put("t = ((u << 8 | t) + 1) & 65535")', 'e.put("t = (u << 8 | t) & 65535")', COMPILED_VECTOR_TESTS),
+    # ---- each Machine call starts from the code as loaded; stated facts stay off the compiled engine --------
+    Mutant("machine-call-keeps-patched-code", "retro/routines/runner.py",
+           "        self._restore_code()\n        if self.start is not None:",
+           "        if self.start is not None:", ("tests/routines/test_static_smc.py",)),
+    Mutant("compiled-takes-stated-facts", "retro/analysis/check/engines.py",
+           "    if runner.watched_facts:  # Machine", "    if False:  # Machine",
+           ("tests/routines/test_compiled_check.py",)),
 ]
 
 

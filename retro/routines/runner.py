@@ -12,8 +12,10 @@ read back by retro.routines.outputs, and `size` counts bytes with retro.routines
 
 Memory on the scalar path persists between calls: every input is written before each call, and so
 are the output places in memory (restored to their value after `init`, so an output a routine writes
-only on some paths reads the same on both engines); the `[memory]` blocks once after loading (then
-`init` runs). A routine must not depend on anything else it wrote in an earlier call.
+only on some paths reads the same on both engines), and so is the routine's own code as it stood after
+`init` (self-modifying code: each call starts from the same instructions, as each lane does); the
+`[memory]` blocks once after loading (then `init` runs). A routine must not depend on anything else
+it wrote in an earlier call.
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ from retro.routines.entry import EntryState, variant_memory, variant_stack
 from retro.routines.input_plan import InputPlan, case_byte
 from retro.routines.outputs import port_values
 from retro.routines.sandbox import bytes_of
-from retro.routines.size import Size, data_address, program_size
+from retro.routines.size import Size, data_address, program_size, routine_code
 from retro.routines.spec import Routine, call_with
 from retro.routines.world_machine import MachineWorld, chip_overlaps
 from retro.scenes.vic import VicScene
@@ -111,6 +113,17 @@ def _pointer_pcs(routine: Routine) -> frozenset[int]:
     return frozenset(program.origin + i for i, b in enumerate(program.code) if b in indirect_y)
 
 
+def _code_span(routine: Routine, image: bytes) -> tuple[int, int]:
+    """[start, end) of the instructions reachable from the entry and init (what a store into the
+    routine's own code patches); (0, 0) when none is decoded."""
+    program = routine.program
+    entries = [routine.entry_address] + ([routine.init_address] if routine.init is not None else [])
+    code = routine_code(image.__getitem__, entries, (program.origin, program.end), routine.cpu, routine.world)
+    if not code:
+        return 0, 0
+    return min(code), max(pc + length for pc, length in code.items())
+
+
 def _written_kept(routine: Routine) -> dict[str, int]:
     """Per hardware entry, how many of the values written the outputs show."""
     kept: dict[str, int] = {}
@@ -154,6 +167,8 @@ class RoutineRunner:
         if routine.init is not None:
             self.machine.call_fast(routine.init_address, budget=self.limit)
         self.call_image = bytearray(self.machine.memory)  # what every call starts from (the batch's image)
+        self._code_span = _code_span(routine, self.call_image)
+        self._code_as_called = self._code_bytes_of(self.call_image)
         self.pointer_pcs = _pointer_pcs(routine)
         self.plan = InputPlan.of(routine, self.call_image, seed)
         self._dirty: list[int] = []  # addresses the last call's ports placed by the case took (restored)
@@ -188,6 +203,19 @@ class RoutineRunner:
         """Start the following calls from this memory image (entry-state runs, naming a dependence)."""
         self.machine.memory[:] = list(image)
         self.call_image = bytearray(image)
+        self._code_as_called = self._code_bytes_of(self.call_image)
+
+    def _code_bytes_of(self, image) -> list[int]:
+        start, end = self._code_span
+        return list(image[start:end])
+
+    def _restore_code(self) -> None:
+        """Put back the code a previous call patched (self-modifying code): each call starts from the
+        code as every lane of the array engines does, whatever case ran before it."""
+        start, end = self._code_span
+        memory = self.machine.memory
+        if memory[start:end] != self._code_as_called:
+            memory[start:end] = self._code_as_called
 
     def run(self, case: Sequence, record: list | None = None, entry: tuple[dict, int, int] | None = None
             ) -> tuple[tuple, int]:
@@ -195,6 +223,7 @@ class RoutineRunner:
         world, `record` leaves out the traps (mocks, exits) and `last_extra_cycles` says what the timing
         model must add for them and for an interrupt entry; `last_calls` holds the recorded mocks' calls."""
         writes, registers, p = self.inputs_for_call(case, entry)
+        self._restore_code()
         if self.start is not None:
             self.restart_beam()
             stolen = self.machine.mpu.stolen

@@ -52,9 +52,8 @@ def test_a_page_stored_into_an_operand_keeps_its_low_byte(capsys, engine):
 
 
 def test_the_bounds_come_from_the_code_as_loaded_not_from_memory_a_case_left():
-    # smc_some patches its operand on one path only (which the check's contract does not allow: a
-    # call must not depend on an earlier one; Machine's memory persists); after a carry-set call the
-    # runner's memory holds $FF there, but the carry-clear path still starts from the byte as loaded
+    # smc_some patches its operand on one path only; after a carry-set call the runner's memory holds
+    # $FF there (Machine's memory persists), but the carry-clear path still starts from the byte as loaded
     # ($00 + X = 1: no crossing, 13 cycles); the other path 19 (header of smc_some.s)
     from retro.analysis.check.verdicts import static_bounds
     from retro.routines.registry import get
@@ -66,3 +65,14 @@ def test_the_bounds_come_from_the_code_as_loaded_not_from_memory_a_case_left():
     assert runner.machine.memory[runner.entry + 8] == 0xFF  # the patched operand, left in memory
     bounds = static_bounds(routine, runner)
     assert (bounds.best, bounds.worst) == (13, 19)
+
+
+def test_every_call_on_machine_starts_from_the_code_as_loaded():
+    # smc_some's carry-set path leaves $FF in its read's operand; the next call (carry clear) must not
+    # see it (LDA $C2FF,X would cross a page: 14 cycles): each call starts from the code as every lane
+    # of the array engines does, whatever case ran before it (13 cycles: the header of smc_some.s)
+    from retro.routines.registry import get
+    from retro.routines.runner import RoutineRunner
+
+    runner = RoutineRunner(get(str(SMC / "smc_some.toml")))
+    assert [runner.run(case) for case in [(1, 1), (0, 1), (1, 1), (0, 1)]] == [((0,), 19), ((0,), 13)] * 2

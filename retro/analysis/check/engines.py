@@ -199,6 +199,8 @@ def compiled_or_why(runner: RoutineRunner) -> str | None:
         return "a scene: the VIC-II's stalls are modelled on Machine and the batched core only"
     if runner.plan.vias is not None or runner.plan.s_varies:
         return "inputs placed by the case (on the stack, in a table slot or behind a pointer), which it does not place"
+    if runner.watched_facts:  # Machine and the batched core stop a call that contradicts one
+        return "the spec states facts ([facts]), which it does not hold against the calls"
     try:
         runner.compiled()
     except Untranslatable as exc:
