@@ -206,3 +206,36 @@ def test_which_engine_reruns():
     assert rerun_engine("compiled", 0, True, 64) == "batch"  # a sweep: its count unknown (measured: no gain)
     assert rerun_engine("compiled", ENTRY_COMPILED_RERUNS // 2, False, 1) == "compiled"  # two variants each
     assert rerun_engine("compiled", ENTRY_COMPILED_RERUNS // 2 - 1, False, 1) == "batch"
+
+
+@pytest.mark.parametrize("engine", ["batch", "compiled"])
+def test_blocks_rerun_together_keep_their_own_places(engine):
+    """Several blocks' held reruns run and counted together (entry_runs.run_baselines, tally.entry_tally)
+    give the figures of the blocks counted one by one: each case keeps its own index in the check (its
+    block's first plus its place), which names the first changed case and seeds its random state."""
+    if engine == "compiled":
+        _needs_numba()
+    from dataclasses import replace
+
+    import numpy as np
+
+    from retro.analysis.check.engines import run_on_batched_core, runner_for
+    from retro.analysis.check.entry_runs import entry_baseline
+    from retro.analysis.check.run import _variants
+    from retro.analysis.check.tally import Tally, entry_tally
+
+    spec = str(ENTRY / "index_x.toml")
+    runner = runner_for(spec, 0)
+    columns = [np.arange(16, dtype=np.int64)]
+    block = run_on_batched_core(runner, columns)
+    held = [entry_baseline(runner.routine, block.outputs, block.cycles, block.returned, columns, first, 1)
+            for first in (0, 5_000, 9_000)]
+    held[0] = replace(held[0], compared=np.zeros(16, dtype=bool))  # (outside the domain: its changes not counted)
+    variants = _variants(spec, 0, None)
+    together = entry_tally(variants, held, 0, engine)
+    alone = Tally()
+    for baseline in held:
+        alone.merge(entry_tally(variants, [baseline], 0, engine))
+    assert together.entry_cases == alone.entry_cases == 32 and together.entry_changed == alone.entry_changed == 32
+    assert {v: f.index for v, f in together.entry_first.items()} == {"ones": 5_000, "random": 5_000}
+    assert together.entry_first == alone.entry_first
