@@ -273,6 +273,12 @@ MUTANTS = [
            ("tests/routines/test_entry_state.py",)),
     Mutant("compiled-reruns-not-cross-checked", "retro/analysis/check/entry_runs.py",
            "    if differ.any():", "    if False:", ("tests/routines/test_entry_state.py",)),
+    Mutant("compiled-reruns-cross-checked-per-task-not-per-block", "retro/analysis/check/entry_runs.py",
+           "CROSS_CHECKED * max(1, len(baselines) // CROSS_CHECKED_BLOCKS)", "CROSS_CHECKED",
+           ("tests/routines/test_entry_state.py",)),
+    Mutant("long-sweep-tasks-not-larger", "retro/analysis/check/run.py",
+           "long = LONG_SWEEP_FACTOR if planned >= LONG_SWEEP_CALLS else 1", "long = 1",
+           ("tests/routines/test_entry_state.py",)),
     Mutant("agreement-run-skipped", "retro/analysis/check/run.py",
            "agreement.merge(agreement_chunk(spec, seed, chunk, engine, start))", "pass", BATCH_TESTS),
     # ---- the parallel work (retro/workers.py) and a task's cases (retro/routines/cases.py) ------------

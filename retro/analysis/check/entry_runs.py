@@ -164,9 +164,10 @@ def joined_baselines(baselines: list[EntryBaseline]) -> EntryBaseline:
 def run_baselines(variants: dict[str, RoutineRunner], baselines: list[EntryBaseline],
                   seed: int, engine: str = "batch") -> tuple[EntryBaseline, dict[str, VariantRun]]:
     """Every baseline's cases in every variant, all blocks' in one run per variant on `engine` ("batch",
-    or "compiled": then its first CROSS_CHECKED cases on the batched core too, `_rerun`): the baselines
-    joined into one (`joined_baselines`) and per variant its run over them, as runs of each block's cases
-    alone would give them (a stopped call's message kept for the first of its block)."""
+    or "compiled": then its first CROSS_CHECKED cases, more for many blocks, on the batched core too,
+    `_rerun`): the baselines joined into one (`joined_baselines`) and per variant its run over them, as
+    runs of each block's cases alone would give them (a stopped call's message kept for the first of its
+    block)."""
     joined = joined_baselines(baselines)
     sizes = [len(b.positions) for b in baselines]
     runs: dict[str, VariantRun] = {}
@@ -175,23 +176,26 @@ def run_baselines(variants: dict[str, RoutineRunner], baselines: list[EntryBasel
     for variant, runner in variants.items():
         state = runner.entry_state
         registers, bits = variant_values(state, variant, seed, joined.positions)
-        outcome = _rerun(runner, variant, joined.columns, (registers, bits, state.free_mask), engine, joined.positions)
+        outcome = _rerun(runner, variant, joined.columns, (registers, bits, state.free_mask), engine, joined.positions,
+                         CROSS_CHECKED * max(1, len(baselines) // CROSS_CHECKED_BLOCKS))
         runs[variant] = _variant_run(outcome.outputs, outcome.cycles, outcome.error, sizes)
     return joined, runs
 
 
 CROSS_CHECKED = 256  # of each compiled rerun, the cases also run on the batched core and compared (the engines
-# stay cross-checked on varied entry states: the first 256 of each task's reruns)
+# stay cross-checked on varied entry states: the first 256 of each task's reruns) ...
+CROSS_CHECKED_BLOCKS = 32  # ... and 256 more for each further 32 blocks a task holds (as many as tasks of 32 blocks
+# check, whatever the task's size: run.LONG_SWEEP_FACTOR)
 
 
 def _rerun(runner: RoutineRunner, variant: str, columns: list, entry: tuple, engine: str,
-           indexes: np.ndarray) -> BatchOutcome:
-    """The cases in one variant's entry state on `engine`; on the compiled engine the first CROSS_CHECKED
+           indexes: np.ndarray, cross_checked: int) -> BatchOutcome:
+    """The cases in one variant's entry state on `engine`; on the compiled engine the first `cross_checked`
     run on the batched core too, whose outputs, cycles and stops must be the same (a RunError if not)."""
     if engine != "compiled":
         return runner.run_batch(columns, entry=entry)
     outcome = runner.run_compiled(columns, entry)
-    k = min(len(indexes), CROSS_CHECKED)
+    k = min(len(indexes), cross_checked)
     if not k:
         return outcome
     registers, bits, mask = entry
