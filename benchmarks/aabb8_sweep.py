@@ -9,7 +9,7 @@ and the full sweep's time extrapolated from the slice's rate (the boundary and r
 start-up are in the slice's time: the extrapolation is on the safe side).
 
 With `--floor`: what one call of the sweep costs at least on the compiled engine, stage by stage, in
-this process on FLOOR_BLOCKS of the sweep's 65,536-case blocks (CPU ns a call, the best of FLOOR_ROUNDS
+this process (with the C heap's settings of the embedded workers: `as_a_worker`) on FLOOR_BLOCKS of the sweep's 65,536-case blocks (CPU ns a call, the best of FLOOR_ROUNDS
 rounds): making the block's int64 columns (the blocks of `retro.routines.cases.stream` as a worker makes
 them for the check: from a task's first case in the sweep part, counted over every part; MAKING_BLOCKS
 blocks a round, the rounds timed together), the compiled function alone
@@ -139,8 +139,25 @@ def floor() -> None:
           f"CPU s, {least * FULL_CALLS / 1e9 / 2 / 60:.1f} min on 2 cores (goal: {budget:.1f} ns a call)")
 
 
+def as_a_worker(argv: list[str]) -> None:
+    """Run this script again with the C heap's thresholds the embedded workers start with (retro.workers:
+    MALLOC_MMAP_THRESHOLD_, MALLOC_TRIM_THRESHOLD_, read by glibc as a process starts), unless it has them:
+    with glibc's defaults a block's freed arrays are handed back and faulted in again, block after block
+    (measured here: about 1,070 page faults a block, a block through the check 57 CPU ns a call against 19)."""
+    import os
+
+    from retro.workers import EMBEDDED_CONFIG
+
+    wanted = {k: str(v) for k, v in EMBEDDED_CONFIG["distributed.nanny.pre-spawn-environ"].items()
+              if k.startswith("MALLOC_")}
+    if all(os.environ.get(k) == v for k, v in wanted.items()):
+        return
+    os.execve(sys.executable, [sys.executable, __file__, *argv], {**os.environ, **wanted})
+
+
 def main(argv: list[str]) -> None:
     if "--floor" in argv:
+        as_a_worker(argv)
         floor()
         return
     parser = argparse.ArgumentParser()

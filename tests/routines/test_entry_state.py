@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from retro.cli import main
-from retro.errors import InputError
+from retro.errors import InputError, RunError
 from retro.routines.registry import get
 from retro.routines.runner import RoutineRunner
 
@@ -206,3 +206,81 @@ def test_which_engine_reruns():
     assert rerun_engine("compiled", 0, True, 64) == "batch"  # a sweep: its count unknown (measured: no gain)
     assert rerun_engine("compiled", ENTRY_COMPILED_RERUNS // 2, False, 1) == "compiled"  # two variants each
     assert rerun_engine("compiled", ENTRY_COMPILED_RERUNS // 2 - 1, False, 1) == "batch"
+
+
+@pytest.mark.parametrize("engine", ["batch", "compiled"])
+def test_blocks_rerun_together_keep_their_own_places(engine):
+    """Several blocks' held reruns run and counted together (entry_runs.run_baselines, tally.entry_tally)
+    give the figures of the blocks counted one by one: each case keeps its own index in the check (its
+    block's first plus its place), which names the first changed case and seeds its random state."""
+    if engine == "compiled":
+        _needs_numba()
+    from dataclasses import replace
+
+    import numpy as np
+
+    from retro.analysis.check.engines import run_on_batched_core, runner_for
+    from retro.analysis.check.entry_runs import entry_baseline
+    from retro.analysis.check.run import _variants
+    from retro.analysis.check.tally import Tally, entry_tally
+
+    spec = str(ENTRY / "index_x.toml")
+    runner = runner_for(spec, 0)
+    columns = [np.arange(16, dtype=np.int64)]
+    block = run_on_batched_core(runner, columns)
+    held = [entry_baseline(runner.routine, block.outputs, block.cycles, block.returned, columns, first, 1)
+            for first in (0, 5_000, 9_000)]
+    held[0] = replace(held[0], compared=np.zeros(16, dtype=bool))  # (outside the domain: its changes not counted)
+    variants = _variants(spec, 0, None)
+    together = entry_tally(variants, held, 0, engine)
+    alone = Tally()
+    for baseline in held:
+        alone.merge(entry_tally(variants, [baseline], 0, engine))
+    assert together.entry_cases == alone.entry_cases == 32 and together.entry_changed == alone.entry_changed == 32
+    assert {v: f.index for v, f in together.entry_first.items()} == {"ones": 5_000, "random": 5_000}
+    assert together.entry_first == alone.entry_first
+
+
+def test_a_long_sweeps_larger_tasks_cross_check_as_many_reruns():
+    """Tasks of a long sweep on the compiled engine are LONG_SWEEP_FACTOR times larger; their reruns are
+    cross-checked on the batched core as much as the smaller tasks' were: CROSS_CHECKED for each
+    CROSS_CHECKED_BLOCKS blocks held, so a compiled engine wrong on a later rerun is still caught."""
+    _needs_numba()
+    import numpy as np
+
+    from retro.analysis.check import entry_runs
+    from retro.analysis.check.engines import run_on_batched_core, runner_for
+    from retro.analysis.check.entry_runs import CROSS_CHECKED, CROSS_CHECKED_BLOCKS, entry_baseline
+    from retro.analysis.check.run import (COMPILED_TASK_FACTOR, LONG_SWEEP_CALLS, LONG_SWEEP_FACTOR, TASK_BLOCKS,
+                                          Sweep, _variants)
+    from retro.analysis.check.tally import entry_tally
+    from retro.routines import batch_runs
+
+    spec = str(ENTRY / "index_x.toml")
+    sweep = Sweep(spec, 0, True, None, 0, "compiled")
+    assert sweep.task_cases(LONG_SWEEP_CALLS - 1) == TASK_BLOCKS * COMPILED_TASK_FACTOR * sweep.block
+    assert sweep.task_cases(LONG_SWEEP_CALLS) == LONG_SWEEP_FACTOR * sweep.task_cases(LONG_SWEEP_CALLS - 1)
+    assert Sweep(spec, 0, True, None, 0, "batch").task_cases(LONG_SWEEP_CALLS) == TASK_BLOCKS * sweep.block
+
+    runner = runner_for(spec, 0)
+    columns = [np.arange(16, dtype=np.int64)]
+    block = run_on_batched_core(runner, columns)
+    held = [entry_baseline(runner.routine, block.outputs, block.cycles, block.returned, columns, 16 * k, 1)
+            for k in range(2 * CROSS_CHECKED_BLOCKS)]  # 1,024 reruns a variant: 512 cross-checked
+    wrong = CROSS_CHECKED + 40  # past the first CROSS_CHECKED
+    run_compiled = batch_runs.run_compiled
+
+    def one_cycle_more_on_a_later_rerun(runner, columns, entry=None):
+        outcome = run_compiled(runner, columns, entry)
+        if entry is not None and len(outcome.cycles) > wrong:
+            outcome.cycles[wrong] += 1
+        return outcome
+
+    variants = _variants(spec, 0, None)
+    entry_tally(variants, held, 0, "compiled")  # right: no error
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(batch_runs, "run_compiled", one_cycle_more_on_a_later_rerun)
+        with pytest.raises(RunError, match=f"the engines disagree on case {wrong} run with the entry state varied"):
+            entry_tally(variants, held, 0, "compiled")
+        patch.setattr(entry_runs, "CROSS_CHECKED_BLOCKS", 1 << 20)  # (one task's worth, whatever its size)
+        entry_tally(variants, held, 0, "compiled")  # not caught

@@ -141,46 +141,61 @@ def entry_baseline(routine, outputs: list, cycles: np.ndarray, returned: int, co
     index `first`) with what the check's run gave for them; `inside`: which of the block's calls lie
     inside the domain, when the tally has it (else worked out for the rerun cases)."""
     positions = rerun_positions(first, returned, every)
-    subset = [c[positions] for c in columns]
-    return EntryBaseline(first, positions, subset, [o[positions] for o in outputs], cycles[positions],
-                         in_domain(routine, subset) if inside is None else inside[positions])
+    picked = slice(int(positions[0]) if len(positions) else returned, returned, every)  # the same cases as
+    # `positions`, copied by stride rather than gathered (and copied: the block's arrays are not held)
+    subset = [c[picked].copy() for c in columns]
+    return EntryBaseline(first, positions, subset, [o[picked].copy() for o in outputs], cycles[picked].copy(),
+                         in_domain(routine, subset) if inside is None else inside[picked].copy())
+
+
+def joined_baselines(baselines: list[EntryBaseline]) -> EntryBaseline:
+    """Blocks' baselines as one, their cases in the blocks' order: its `first` 0, its positions the cases'
+    indexes in the check."""
+    if len(baselines) == 1:
+        one = baselines[0]
+        return EntryBaseline(0, one.positions + one.first, one.columns, one.outputs, one.cycles, one.compared)
+    return EntryBaseline(0, np.concatenate([b.positions + b.first for b in baselines]),
+                         [np.concatenate(parts) for parts in zip(*(b.columns for b in baselines))],
+                         [np.concatenate(parts) for parts in zip(*(b.outputs for b in baselines))],
+                         np.concatenate([b.cycles for b in baselines]),
+                         np.concatenate([b.compared for b in baselines]))
 
 
 def run_baselines(variants: dict[str, RoutineRunner], baselines: list[EntryBaseline],
-                  seed: int, engine: str = "batch") -> list[dict[str, VariantRun]]:
+                  seed: int, engine: str = "batch") -> tuple[EntryBaseline, dict[str, VariantRun]]:
     """Every baseline's cases in every variant, all blocks' in one run per variant on `engine` ("batch",
-    or "compiled": then its first CROSS_CHECKED cases on the batched core too, `_rerun`); per baseline,
-    its variants' runs (as a run of its block's cases alone would give them)."""
+    or "compiled": then its first CROSS_CHECKED cases, more for many blocks, on the batched core too,
+    `_rerun`): the baselines joined into one (`joined_baselines`) and per variant its run over them, as
+    runs of each block's cases alone would give them (a stopped call's message kept for the first of its
+    block)."""
+    joined = joined_baselines(baselines)
     sizes = [len(b.positions) for b in baselines]
-    out: list[dict[str, VariantRun]] = [{} for _ in baselines]
-    if not sum(sizes):
-        return out
-    columns = [np.concatenate(parts) for parts in zip(*(b.columns for b in baselines))]
-    indexes = np.concatenate([b.positions + b.first for b in baselines])
-    ends = np.cumsum(sizes)
+    runs: dict[str, VariantRun] = {}
+    if not len(joined.positions):
+        return joined, runs
     for variant, runner in variants.items():
         state = runner.entry_state
-        registers, bits = variant_values(state, variant, seed, indexes)
-        outcome = _rerun(runner, variant, columns, (registers, bits, state.free_mask), engine, indexes)
-        for k, (end, size) in enumerate(zip(ends.tolist(), sizes)):
-            if size:
-                part = slice(end - size, end)
-                out[k][variant] = _variant_run(outcome.outputs, outcome.cycles, outcome.error, part)
-    return out
+        registers, bits = variant_values(state, variant, seed, joined.positions)
+        outcome = _rerun(runner, variant, joined.columns, (registers, bits, state.free_mask), engine, joined.positions,
+                         CROSS_CHECKED * max(1, len(baselines) // CROSS_CHECKED_BLOCKS))
+        runs[variant] = _variant_run(outcome.outputs, outcome.cycles, outcome.error, sizes)
+    return joined, runs
 
 
 CROSS_CHECKED = 256  # of each compiled rerun, the cases also run on the batched core and compared (the engines
-# stay cross-checked on varied entry states: the first 256 of each task's reruns)
+# stay cross-checked on varied entry states: the first 256 of each task's reruns) ...
+CROSS_CHECKED_BLOCKS = 32  # ... and 256 more for each further 32 blocks a task holds (as many as tasks of 32 blocks
+# check, whatever the task's size: run.LONG_SWEEP_FACTOR)
 
 
 def _rerun(runner: RoutineRunner, variant: str, columns: list, entry: tuple, engine: str,
-           indexes: np.ndarray) -> BatchOutcome:
-    """The cases in one variant's entry state on `engine`; on the compiled engine the first CROSS_CHECKED
+           indexes: np.ndarray, cross_checked: int) -> BatchOutcome:
+    """The cases in one variant's entry state on `engine`; on the compiled engine the first `cross_checked`
     run on the batched core too, whose outputs, cycles and stops must be the same (a RunError if not)."""
     if engine != "compiled":
         return runner.run_batch(columns, entry=entry)
     outcome = runner.run_compiled(columns, entry)
-    k = min(len(indexes), CROSS_CHECKED)
+    k = min(len(indexes), cross_checked)
     if not k:
         return outcome
     registers, bits, mask = entry
@@ -204,11 +219,20 @@ def _shown(outcome: BatchOutcome, i: int) -> str:
     return f"outputs {[o[i].tolist() for o in outcome.outputs]} in {int(outcome.cycles[i])} cycles"
 
 
-def _variant_run(outputs: list, cycles: np.ndarray, error: np.ndarray, part: slice) -> VariantRun:
-    stopped = error[part] != 0
-    messages = {int(k): f"the batched core stopped the call ({LaneError(int(error[part][k])).name})"
-                for k in np.flatnonzero(stopped)[:1]}
-    return VariantRun([o[part] for o in outputs], cycles[part], stopped, messages)
+def _variant_run(outputs: list, cycles: np.ndarray, error: np.ndarray, sizes: list[int]) -> VariantRun:
+    """A variant's run of blocks' rerun cases (`sizes` of them each, in order), the message of the first
+    stopped call of each block kept."""
+    stopped = error != 0
+    messages = {}
+    if stopped.any():
+        end = 0
+        for size in sizes:
+            first = np.flatnonzero(stopped[end:end + size])[:1]
+            if len(first):
+                k = end + int(first[0])
+                messages[k] = f"the batched core stopped the call ({LaneError(int(error[k])).name})"
+            end += size
+    return VariantRun(outputs, cycles, stopped, messages)
 
 
 def _columns(runner: RoutineRunner, answers: list) -> list[np.ndarray]:
@@ -312,5 +336,5 @@ def _memory_dependence(outcome, reference, baseline_image: bytes, varied_image: 
 
 
 __all__ = ["ENTRY_COMPILED_RERUNS", "ENTRY_SAMPLE", "VARIANTS", "EntryBaseline", "EntryBlock", "EntryFinding", "VariantRun", "changed_calls",
-           "entry_baseline", "entry_block_on_machine", "entry_every", "name_dependence",
+           "entry_baseline", "entry_block_on_machine", "entry_every", "joined_baselines", "name_dependence",
            "rerun_engine", "rerun_positions", "run_baselines"]

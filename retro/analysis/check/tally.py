@@ -338,17 +338,18 @@ def _entry_figures(out: Tally, calls: _Calls, entry: EntryBlock) -> None:
 
 def entry_tally(variants: dict, baselines: list[EntryBaseline], seed: int, engine: str = "batch") -> Tally:
     """The entry-state figures of blocks whose rerun cases were held (`entry_baseline`), run together
-    on `engine` (entry_runs.run_baselines): the figures each block's own `count_block(..., entry=...)`
-    would give."""
+    on `engine` (entry_runs.run_baselines) and counted together: the figures each block's own
+    `count_block(..., entry=...)` would give, merged."""
     out = Tally()
-    for baseline, runs in zip(baselines, run_baselines(variants, baselines, seed, engine)):
-        one = Tally()
-        _entry_counts(one, baseline, runs, baseline.case)
-        out.merge(one)
+    if baselines:
+        joined, runs = run_baselines(variants, baselines, seed, engine)
+        _entry_counts(out, joined, runs, joined.case)
     return out
 
 
 def _entry_counts(out: Tally, baseline: EntryBaseline, runs: dict, case_at) -> None:
+    """The rerun cases compared, those changed in any variant, and per variant its changed case with the
+    lowest index in the check (Tally.merge's rule)."""
     compared = baseline.compared
     out.entry_cases = int(compared.sum())
     any_changed = np.zeros(len(compared), dtype=bool)
@@ -356,8 +357,9 @@ def _entry_counts(out: Tally, baseline: EntryBaseline, runs: dict, case_at) -> N
         run = run.head(len(compared))
         changed = changed_calls(baseline.outputs, baseline.cycles, compared, run)
         any_changed |= changed
-        if changed.any():
-            k = int(np.flatnonzero(changed)[0])
+        at = np.flatnonzero(changed)
+        if len(at):
+            k = int(at[np.argmin(baseline.positions[at])])
             varied = ((None, run.messages.get(k, "the call did not return")) if run.stopped[k]
                       else (row_of(run.outputs, k), int(run.cycles[k])))
             out.entry_first[variant] = EntryFinding(variant, baseline.first + int(baseline.positions[k]), case_at(k),
