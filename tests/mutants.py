@@ -279,7 +279,17 @@ MUTANTS = [
            "long = LONG_SWEEP_FACTOR if planned >= LONG_SWEEP_CALLS else 1", "long = 1",
            ("tests/routines/test_entry_state.py",)),
     Mutant("agreement-run-skipped", "retro/analysis/check/run.py",
-           "agreement.merge(agreement_chunk(spec, seed, chunk, engine, start))", "pass", BATCH_TESTS),
+           "agreement.merge(agreement_chunk(spec, seed, columns, engine, start))", "pass", BATCH_TESTS),
+    # the timing model the recording loop sums as it runs (retro.cpu.mpu.run_recorded): the engine agreement's
+    Mutant("recorded-model-skips-penalties", "retro/cpu/mpu.py",
+           "modelled += bases[op] if rule is None else bases[op] + rule(read, pc, self.x, self.y, self.p, None)",
+           "modelled += bases[op]", BATCH_TESTS + ("tests/cpu/test_machine.py",)),
+    Mutant("recorded-model-without-the-pointer", "retro/cpu/mpu.py",
+           "rule(read, pc, self.x, self.y, self.p, None)", "rule(read, pc, self.x, self.y, self.p, 0)",
+           BATCH_TESTS + ("tests/cpu/test_machine.py",)),
+    Mutant("recorded-model-swaps-x-and-y", "retro/cpu/mpu.py",
+           "rule(read, pc, self.x, self.y, self.p, None)", "rule(read, pc, self.y, self.x, self.p, None)",
+           BATCH_TESTS + ("tests/cpu/test_machine.py",)),
     # ---- the parallel work (retro/workers.py) and a task's cases (retro/routines/cases.py) ------------
     Mutant("results-merged-in-finishing-order", "retro/workers.py",
            "if report(pending.popleft().result()):", "if report(pending.pop().result()):", WORKER_TESTS),

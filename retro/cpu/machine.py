@@ -25,6 +25,7 @@ from retro.cpu.mpu import (
     OPCODE_BRK,
     CpuHalt,
 )
+from retro.cpu.timing import model_cycles, step_model
 from retro.cpu.traps import TRAP_OPCODE
 from retro.cpu.variants import VARIANTS
 from retro.errors import InputError, RunError
@@ -129,6 +130,7 @@ class Machine:
         self.symbols: dict[str, int] = {}
         self.ambiguous: dict[str, tuple[str, ...]] = {}
         self.trap_names: dict[int, str] = {}  # a trap's address (retro.cpu.traps) -> what listings call it
+        self.step_model = step_model(variant)  # the timing model, as the recording loop reads it
 
     @property
     def entry_s(self) -> int:
@@ -262,25 +264,37 @@ class Machine:
     def call_fast(self, address: int, writes=(), *, a: int = 0, x: int = 0, y: int = 0, p: int = DEFAULT_FLAGS,
                   budget: int = DEFAULT_BUDGET, record: list | None = None,
                   pointer_pcs: frozenset[int] = frozenset(), enter: str = "jsr",
-                  s: int | None = None) -> tuple[int, int, int, int, int]:
+                  s: int | None = None, timed: bool = False) -> tuple[int, int, int, int, int]:
         """`call` for sweeps of many thousands of calls: the same run without its conveniences.
 
         `address` is the entry as a number, `writes` are raw (address, byte) pairs stored into RAM,
         register values are trusted. Returns (cycles, a, x, y, p) with p as `call` reports it.
         With `record` (a list), each executed instruction appends (pc, x, y, p, pointer, a) as they were
         before it ran; pointer is the zero-page word its operand names when its PC is in
-        `pointer_pcs` (for (indirect),Y instructions), else 0. Failures are RunErrors as in `call`.
+        `pointer_pcs` (for (indirect),Y instructions), else 0. `timed`: the independent timing model
+        (retro.cpu.timing) also counts the executed path, into `last_modelled`. Failures are RunErrors
+        as in `call`.
         """
         memory = self.bus.memory
         for target, value in writes:
             memory[target] = value
         s = self.entry_s if s is None else s
         start = self._enter(address, a, x, y, p, enter, s)
-        observer = None if record is None else _Recorder(record, pointer_pcs)
-        count = self._execute(RETURN_TRAP, return_s(s), start + budget, observer)
-        cycles = self._returned(start, budget, count, return_s(s))
+        stop_s = return_s(s)
+        if (record is not None or timed) and self.mpu.lines is None:  # the loop that records and times itself
+            count = self._execute(RETURN_TRAP, stop_s, start + budget, recorded=(record, pointer_pcs))
+            self.last_modelled = self.mpu.modelled if timed else None
+        else:
+            if timed and record is None:
+                record = []
+            observer = None if record is None else _Recorder(record, pointer_pcs)
+            count = self._execute(RETURN_TRAP, stop_s, start + budget, observer)
+            self.last_modelled = model_cycles(memory.__getitem__, record, self.variant) if timed else None
+        cycles = self._returned(start, budget, count, stop_s)
         mpu = self.mpu
         return cycles, mpu.a, mpu.x, mpu.y, _status(mpu.p)
+
+    last_modelled: int | None = None  # the timing model's cycles of the last `call_fast(timed=True)`
 
     def run(self, entry: str | int, *, until: str | int | None = None, cycles: int = DEFAULT_BUDGET) -> int:
         """Run from entry for a number of cycles, or until the PC reaches `until` (error if it never does).
@@ -302,11 +316,15 @@ class Machine:
         stop = NO_ADDRESS if until is None else until
         return self._execute(stop, ANY_STACK, self.mpu.processorCycles + cycles, observer)
 
-    def _execute(self, stop_pc: int, stop_sp: int, limit: int, observer=None) -> int:
-        """Run to stop_pc (and stop_sp) or the limit (the MPU's one run loop); a CpuHalt becomes a
-        RunError saying where."""
+    def _execute(self, stop_pc: int, stop_sp: int, limit: int, observer=None,
+                 recorded: tuple[list | None, frozenset[int]] | None = None) -> int:
+        """Run to stop_pc (and stop_sp) or the limit (the MPU's run loop; `recorded`: (record,
+        pointer_pcs) for its recording loop, `run_recorded`, no chip on the control lines); a CpuHalt
+        becomes a RunError saying where."""
         mpu = self.mpu
         try:
+            if recorded is not None:
+                return mpu.run_recorded(stop_pc, stop_sp, limit, *recorded, self.step_model)
             return mpu.run(stop_pc, stop_sp, limit, observer)
         except CpuHalt as halt:
             raise RunError(f"{self._called_nowhere(halt) or halt}; last instructions: "

@@ -96,6 +96,8 @@ INTERRUPT_WRITES = (3, 4, 5)  # the interrupt sequence pushes PCH, PCL, P like B
 RECENT_SIZE = 16  # a power of two: run_until keeps the addresses of this many recent instructions
 RECENT_MASK = RECENT_SIZE - 1
 _KEEP_ALL_BUT_NVZC = 0xFF & ~(FLAG_N | FLAG_V | FLAG_Z | FLAG_C)
+_KEEP_ALL_BUT_NZC = 0xFF & ~(FLAG_N | FLAG_Z | FLAG_C)
+_KEEP_ALL_BUT_NZ = 0xFF & ~(FLAG_N | FLAG_Z)
 # From the opcode table (retro.cpu.opcodes): JAM locks the NMOS CPU until reset; the unstable opcodes'
 # results depend on the chip revision, temperature or bus state ("unstable" in No More Secrets).
 JAM_OPCODES = frozenset(opcodes_of(JAM))
@@ -151,6 +153,7 @@ class MPU6510(_Py65MPU):
         self.ba_high_until = -1  # BA is known high up to (not including) this cycle
         self.halted_at = -1  # the start of the instruction a DMA (`stall`) halted the CPU after ...
         self.halted = 0  # ... and for how many cycles
+        self.modelled = 0  # the timing model's cycles of the last run_recorded
         super().__init__(memory=memory, pc=pc)
         self.name = type(self).__name__[3:]
         # instructions that write have a fixed cycle count: their write cycles are known in advance
@@ -203,6 +206,58 @@ class MPU6510(_Py65MPU):
                 self.processorCycles += cycletime[op] + self.excycles
         finally:
             self.executed = count
+
+    def run_recorded(self, stop_pc: int, stop_sp: int, limit: int, record: list | None,
+                     pointer_pcs: frozenset[int], model) -> int:
+        """`run_until` that also tells the executed path, for Machine's sweeps of many calls: before each
+        instruction, (pc, x, y, P, pointer, a) is appended to `record` (unless None), pointer being the
+        zero-page word its operand names when its PC is in `pointer_pcs` (else 0); and the independent
+        timing model's count of the path (`model`, a retro.cpu.timing.StepModel: its cycles from the
+        opcode, operand bytes, pointer and registers before the instruction, never from this core's cycle
+        bookkeeping) is summed into `modelled` as it goes. An opcode the model does not know counts 0:
+        the CPU halts on it (JAM, unstable). Without chips on the control lines only (no
+        stall, no interrupt): `run` with an observer is the general loop."""
+        memory = self.memory
+        read = memory.__getitem__
+        instruct = self.instruct
+        cycletime = self.cycletime
+        extracycles = self.extracycles
+        bases, rules = model.bases, model.rules
+        recent = self.recent
+        append = None if record is None else record.append
+        count = 0
+        modelled = 0
+        self.modelled = 0
+        try:
+            while True:
+                pc = self.pc
+                if pc == stop_pc and (stop_sp < 0 or self.sp == stop_sp):
+                    return count
+                if self.processorCycles >= limit:
+                    return count
+                recent[count & RECENT_MASK] = pc
+                count += 1
+                op = memory[pc]
+                # the model before the instruction runs, from its registers and memory as they are now
+                rule = rules[op]
+                modelled += bases[op] if rule is None else bases[op] + rule(read, pc, self.x, self.y, self.p, None)
+                if append is not None:
+                    if pc in pointer_pcs:
+                        zp = memory[(pc + 1) & ADDRESS_MASK]
+                        pointer = memory[zp] | memory[(zp + 1) & 0xFF] << 8
+                    else:
+                        pointer = 0
+                    append((pc, self.x, self.y, (self.p | FLAG_U) & ~FLAG_B, pointer, self.a))
+                self.current_op = op
+                self.pc = (pc + 1) & ADDRESS_MASK
+                self.excycles = 0
+                self.addcycles = extracycles[op]
+                instruct[op](self)
+                self.pc &= ADDRESS_MASK
+                self.processorCycles += cycletime[op] + self.excycles
+        finally:
+            self.executed = count
+            self.modelled = modelled
 
     def recent_addresses(self, count: int) -> list[int]:
         """The addresses of the last min(count, RECENT_SIZE) instructions, oldest first."""
@@ -424,6 +479,49 @@ class MPU6510(_Py65MPU):
         else:
             device.write(addr, old, self._access_cycle(2))
             device.write(addr, new, self._access_cycle(1))
+
+    # ---- py65's commonest operations, each in one frame (the same results: the CPU test vectors) ---
+
+    def FlagsNZ(self, value):
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+
+    def opLDA(self, x):
+        self.a = value = self.ByteAt(x())
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+
+    def opLDX(self, y):
+        self.x = value = self.ByteAt(y())
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+
+    def opLDY(self, x):
+        self.y = value = self.ByteAt(x())
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+
+    def opAND(self, x):
+        self.a = value = self.a & self.ByteAt(x())
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+
+    def opORA(self, x):
+        self.a = value = self.a | self.ByteAt(x())
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+
+    def opEOR(self, x):
+        self.a = value = self.a ^ self.ByteAt(x())
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+
+    def opCMPR(self, get_address, register_value):
+        diff = register_value - self.ByteAt(get_address())
+        self.p = (self.p & _KEEP_ALL_BUT_NZC) | (diff & FLAG_N) | (FLAG_Z if diff == 0 else 0) \
+            | (FLAG_C if diff >= 0 else 0)
+
+    def BranchRelAddr(self):
+        """A taken branch: one cycle more, and one more again when the target lies in another page
+        than the next instruction (PC is at the offset byte here)."""
+        offset = self.memory[self.pc]
+        after = self.pc + 1
+        target = after + (offset - 256 if offset & FLAG_N else offset)
+        self.excycles += 2 if (after ^ target) & 0xFF00 else 1
+        self.pc = target & ADDRESS_MASK
 
     # ---- py65 operations that write memory, rerouted through the bus ------------------------
 

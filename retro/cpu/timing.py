@@ -18,7 +18,9 @@ rotates abs,X have the page penalty (6 or 7 cycles). `timing_table(cpu)` gives a
 
 `model_cycles(trace)` sums these over an executed path, deriving every penalty from addresses
 (the operand bytes, the index registers before the instruction, the next PC), never from the
-emulator's own cycle bookkeeping.
+emulator's own cycle bookkeeping. `step_model(cpu)` is the same table and rules as a run loop reads
+them (per opcode a base count and a rule, a function, for what it adds): Machine's recording loop
+sums the model as it runs (`MPU6510.run_recorded`), with no trace to walk again.
 """
 
 from __future__ import annotations
@@ -220,6 +222,97 @@ def branch_taken(opcode: int, p: int) -> bool:
     return bool(p & flag) == bool(wanted)
 
 
+# ---- the rules as the run loop reads them: per opcode, its base cycles and what it adds ------------
+
+Rule = Callable[[Callable[[int], int], int, int, int, int, "int | None"], int]  # (read, pc, x, y, p, pointer) -> cycles
+
+
+def _pointer(read: Callable[[int], int], pc: int, pointer: int | None) -> int:
+    """The zero-page word the operand of the instruction at pc names, unless given (None: read now,
+    before the instruction runs)."""
+    if pointer is not None:
+        return pointer
+    zp = read((pc + 1) & 0xFFFF)
+    return read(zp) | read((zp + 1) & 0xFF) << 8
+
+
+def _branch_rule(is_taken: Callable[[int, int], bool], length: int) -> Rule:
+    """A branch: +1 when taken, +1 more when the target lies in another page than the next instruction;
+    `is_taken(p, read, pc, pointer)` decides (the offset is the instruction's last byte)."""
+    def extra(read, pc, x, y, p, pointer):
+        if not is_taken(p, read, pc, pointer):
+            return 0
+        target = branch_target(pc, read((pc + length - 1) & 0xFFFF), length)
+        return BRANCH_TAKEN_CYCLES + (BRANCH_PAGE_CYCLES if crosses_page((pc + length) & 0xFFFF, target) else 0)
+    return extra
+
+
+def _page_rule(mode: str) -> Rule:
+    """A read in an indexed mode: +1 when the indexed address lies in another page than its base."""
+    if mode == "iny":
+        def extra(read, pc, x, y, p, pointer):
+            base = _pointer(read, pc, pointer)
+            return PAGE_CROSS_CYCLES if crosses_page(base, base + y) else 0
+        return extra
+    use_x = mode == "abx"
+
+    def extra(read, pc, x, y, p, pointer):
+        base = read((pc + 1) & 0xFFFF) | read((pc + 2) & 0xFFFF) << 8
+        return PAGE_CROSS_CYCLES if crosses_page(base, base + (x if use_x else y)) else 0
+    return extra
+
+
+def _decimal_rule(rule: Rule | None) -> Rule:
+    """The 65C02's ADC and SBC: one cycle more with D set (besides a page penalty `rule`)."""
+    def extra(read, pc, x, y, p, pointer):
+        return (CMOS_DECIMAL_CYCLES if p & 0x08 else 0) + (rule(read, pc, x, y, p, pointer) if rule else 0)
+    return extra
+
+
+def _rule(opcode: int, op: OpTiming, cpu: str) -> Rule | None:
+    rule: Rule | None = None
+    if op.mnemonic == "BRA":
+        rule = _branch_rule(lambda p, read, pc, pointer: True, 2)
+    elif op.mode == "rel":
+        rule = _branch_rule(lambda p, read, pc, pointer: branch_taken(opcode, p), 2)
+    elif op.mode == "zpr":  # BBR/BBS: the zero-page byte they test is the pointer's low byte
+        bit, when_set = int(op.mnemonic[3]), op.mnemonic[2] == "S"
+        rule = _branch_rule(lambda p, read, pc, pointer: bool(_pointer(read, pc, pointer) >> bit & 1) == when_set, 3)
+    elif op.page_penalty:
+        rule = _page_rule(op.mode)
+    if cpu == WDC_65C02 and op.mnemonic in ("ADC", "SBC"):
+        rule = _decimal_rule(rule)
+    return rule
+
+
+@dataclass(frozen=True)
+class StepModel:
+    """A CPU's timing table as a run loop reads it, per opcode: `bases`, its base cycles (0 for an opcode
+    the table does not know: `known` says which it knows), and `rules`, None when it adds nothing to
+    them, else a function (read, pc, x, y, p, pointer) -> the cycles it adds, from the registers before
+    the instruction; `pointer` is the zero-page word an (indirect),Y operand (or the 65C02's BBR/BBS)
+    names as it was then, or None to read it from memory as it is now (before the instruction)."""
+
+    bases: tuple[int, ...]
+    rules: tuple[Rule | None, ...]
+    known: frozenset[int]
+
+
+def _step_model(cpu: str) -> StepModel:
+    table = timing_table(cpu)
+    return StepModel(tuple(table[op].cycles if op in table else 0 for op in range(256)),
+                     tuple(_rule(op, table[op], cpu) if op in table else None for op in range(256)),
+                     frozenset(table))
+
+
+STEP_MODELS = {cpu: _step_model(cpu) for cpu in ("6510", WDC_65C02)}
+
+
+def step_model(cpu: str = "6510") -> StepModel:
+    """The run loop's form of a CPU variant's timing table ("6510", "2a03": NMOS; "65c02": WDC)."""
+    return STEP_MODELS[WDC_65C02 if cpu == WDC_65C02 else "6510"]
+
+
 def instruction_cycles(read: Callable[[int], int], pc: int, x: int, y: int, p: int, pointer: int,
                        cpu: str = "6510") -> int:
     """Cycles of the instruction at pc, given the registers before it.
@@ -228,34 +321,26 @@ def instruction_cycles(read: Callable[[int], int], pc: int, x: int, y: int, p: i
     the 65C02's BBR/BBS its low byte is the zero-page byte they test.
     """
     opcode = read(pc)
-    op = timing_of(opcode, cpu)
-    cycles = op.cycles
-    mode = op.mode
-    if mode == "rel":
-        if op.mnemonic == "BRA" or branch_taken(opcode, p):
-            cycles += BRANCH_TAKEN_CYCLES
-            if crosses_page((pc + 2) & 0xFFFF, branch_target(pc, read((pc + 1) & 0xFFFF))):
-                cycles += BRANCH_PAGE_CYCLES
-    elif mode == "zpr":
-        bit_set = bool(pointer >> int(op.mnemonic[3]) & 1)
-        if bit_set == (op.mnemonic[2] == "S"):
-            cycles += BRANCH_TAKEN_CYCLES
-            if crosses_page((pc + 3) & 0xFFFF, branch_target(pc, read((pc + 2) & 0xFFFF), 3)):
-                cycles += BRANCH_PAGE_CYCLES
-    elif op.page_penalty:
-        if mode == "iny":
-            base, index = pointer, y
-        else:
-            base = read((pc + 1) & 0xFFFF) | read((pc + 2) & 0xFFFF) << 8
-            index = x if mode == "abx" else y
-        if crosses_page(base, base + index):
-            cycles += PAGE_CROSS_CYCLES
-    if cpu == WDC_65C02 and p & 0x08 and op.mnemonic in ("ADC", "SBC"):
-        cycles += CMOS_DECIMAL_CYCLES
-    return cycles
+    model = step_model(cpu)
+    if opcode not in model.known:
+        timing_of(opcode, cpu)  # (its TimingError)
+    rule = model.rules[opcode]
+    return model.bases[opcode] + (rule(read, pc, x, y, p, pointer) if rule is not None else 0)
 
 
 def model_cycles(read: Callable[[int], int], steps: Iterable[tuple[int, int, int, int, int]],
                  cpu: str = "6510") -> int:
     """Total cycles of an executed path; steps are (pc, x, y, p, pointer, ...) before each instruction."""
-    return sum(instruction_cycles(read, pc, x, y, p, pointer, cpu) for pc, x, y, p, pointer, *_ in steps)
+    model = step_model(cpu)
+    bases, rules, known = model.bases, model.rules, model.known
+    total = 0
+    for step in steps:
+        pc = step[0]
+        opcode = read(pc)
+        if opcode not in known:
+            timing_of(opcode, cpu)  # (its TimingError)
+        total += bases[opcode]
+        rule = rules[opcode]
+        if rule is not None:
+            total += rule(read, pc, step[1], step[2], step[3], step[4])
+    return total

@@ -77,6 +77,25 @@ class Part:
                 yield from columns_to_cases([column[start:start + CHUNK] for column in block])
 
 
+    def head(self, n: int) -> Columns | None:
+        """The part's first n cases (fewer when it has fewer) as one column block of int64 arrays, as
+        `cases_to_columns` makes them; None for a part without cases. Only the blocks that hold them
+        are made, and only those n cases are kept."""
+        pieces: list[Columns] = []
+        have = 0
+        for block in self.blocks():
+            take = min(n - have, len(block[0]))
+            if take:
+                pieces.append([column[:take] for column in block])
+                have += take
+            if have >= n:
+                break  # (before the next block is made)
+        if not have:
+            return None
+        return [np.concatenate([piece[k] for piece in pieces]).astype(np.int64, copy=False) if len(pieces) > 1
+                else np.asarray(pieces[0][k], dtype=np.int64) for k in range(len(pieces[0]))]
+
+
 def columns_to_cases(block: Columns) -> list[tuple]:
     return list(zip(*(c.tolist() if c.ndim == 1 else [tuple(row) for row in c.tolist()] for c in block)))
 

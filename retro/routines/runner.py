@@ -29,7 +29,7 @@ import numpy as np
 from retro.chips.vic.constants import IRQ_SOURCES, REG_IRQ_ENABLE
 from retro.cpu.machine import DEFAULT_BUDGET, ENTRY_S, CallResult
 from retro.cpu.mpu import FLAG_I
-from retro.cpu.timing import timing_table
+from retro.cpu.timing import model_cycles, timing_table
 from retro.errors import InputError, RunError
 from retro.fileio import read_text
 from retro.machines import build_machine
@@ -217,11 +217,13 @@ class RoutineRunner:
         if memory[start:end] != self._code_as_called:
             memory[start:end] = self._code_as_called
 
-    def run(self, case: Sequence, record: list | None = None, entry: tuple[dict, int, int] | None = None
-            ) -> tuple[tuple, int]:
+    def run(self, case: Sequence, record: list | None = None, entry: tuple[dict, int, int] | None = None,
+            timed: bool = False) -> tuple[tuple, int]:
         """(outputs in the spec's order, cycles) of one call; `entry` as in `inputs_for_call`. With a
         world, `record` leaves out the traps (mocks, exits) and `last_extra_cycles` says what the timing
-        model must add for them and for an interrupt entry; `last_calls` holds the recorded mocks' calls."""
+        model must add for them and for an interrupt entry; `last_calls` holds the recorded mocks' calls.
+        `timed`: the independent timing model (retro.cpu.timing) counts the call too, into
+        `last_modelled` (a world's traps and interrupt entry added)."""
         writes, registers, p = self.inputs_for_call(case, entry)
         self._restore_code()
         if self.start is not None:
@@ -231,8 +233,10 @@ class RoutineRunner:
         world = self.world
         if world is None:
             cycles, a, x, y, p = self.machine.call_fast(self.entry, writes, **registers, p=p, budget=self.limit,
-                                                        record=record, pointer_pcs=self.pointer_pcs)
+                                                        record=record, pointer_pcs=self.pointer_pcs, timed=timed)
         else:
+            if timed and record is None:
+                record = []  # the model times the path less the traps
             world.reset(self.machine.cycle)
             cycles, a, x, y, p = self.machine.call_fast(self.entry, writes, **registers, p=self._entry_p(p),
                                                         budget=self.limit, record=record, pointer_pcs=self.pointer_pcs,
@@ -245,9 +249,14 @@ class RoutineRunner:
                 record[:] = [step for step in record if step[0] not in traps]
             self.last_extra_cycles = world.trap_cycles + self.routine.world.entry_cycles
             self.last_calls = world.recorded_calls()
+        if timed:
+            self.last_modelled = self.last_extra_cycles + (
+                self.machine.last_modelled if world is None else
+                model_cycles(self.machine.memory.__getitem__, record, self.routine.cpu))
         return self.outputs(a, x, y, p, located), cycles
 
     last_extra_cycles = 0
+    last_modelled = 0
     last_calls: dict | None = None
 
     def _entry_p(self, p):

@@ -435,3 +435,49 @@ def test_run_reports_cycles_without_the_6_cycle_jsr(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "13 cycles, 3 instructions" in out  # PHP 3 + PLA 4 + RTS 6
     assert "the caller's JSR, 6 cycles, is not included" in out
+
+
+PENALTIES = {0xC0F0: [
+    0xA2, 0x01,        # C0F0 LDX #$01       2
+    0xBD, 0xFF, 0xC0,  # C0F2 LDA $C0FF,X    4 + 1 ($C100: another page)
+    0xA0, 0x02,        # C0F5 LDY #$02       2
+    0xB1, 0x10,        # C0F7 LDA ($10),Y    5 + 1 ($C0FF + 2)
+    0xEA, 0xEA, 0xEA, 0xEA, 0xEA, 0xEA,  # C0F9 NOP x6   12
+    0x88,              # C0FF DEY            2 x2
+    0xD0, 0xFD,        # C100 BNE $C0FF      3 + 1 (taken into another page), then 2
+    0x60,              # C102 RTS            6
+], 0x10: [0xFF, 0xC0]}
+PENALTIES_CYCLES = 2 + 5 + 2 + 6 + 12 + (2 + 4) + (2 + 2) + 6
+
+
+def test_a_timed_call_counts_the_timing_model_as_it_runs():
+    from retro.cpu.timing import model_cycles
+
+    machine = machine_with(PENALTIES)
+    record: list = []
+    cycles, *_ = machine.call_fast(0xC0F0, record=record, pointer_pcs=frozenset({0xC0F7}), timed=True)
+    assert cycles == machine.last_modelled == PENALTIES_CYCLES == 43
+    assert model_cycles(machine.memory.__getitem__, record) == 43
+    assert record[3][:5] == (0xC0F7, 1, 2, 0x24, 0xC0FF)  # (pc, x, y, P, the (zp),Y pointer) before it ran
+    record = []
+    machine.call_fast(0xC0F0, record=record, timed=True)  # the model reads the pointer as the call runs ...
+    assert machine.last_modelled == 43
+    assert model_cycles(machine.memory.__getitem__, record) == 42  # ... a record names it only in pointer_pcs
+    machine.call_fast(0xC0F0)
+    assert machine.last_modelled is None
+
+
+def test_the_timed_calls_model_is_its_own_table_not_the_cpus_count():
+    from retro.cpu.timing import StepModel
+
+    machine = machine_with(PENALTIES)
+    model = machine.step_model
+    machine.step_model = StepModel(tuple(b + (op == 0xEA) for op, b in enumerate(model.bases)), model.rules, model.known)
+    cycles, *_ = machine.call_fast(0xC0F0, timed=True)
+    assert (cycles, machine.last_modelled) == (43, 43 + 6)
+
+
+@pytest.mark.parametrize("variant, cycles", [("6510", 2 + 2 + 2 + 6), ("65c02", 2 + 3 + 2 + 6)])
+def test_the_timed_model_knows_the_65c02s_decimal_cycle(variant, cycles):
+    machine = machine_with({ORIGIN: [0xF8, 0x69, 0x00, 0xD8, 0x60]}, variant)  # SED, ADC #0, CLD, RTS
+    assert machine.call_fast(ORIGIN, timed=True)[0] == machine.last_modelled == cycles

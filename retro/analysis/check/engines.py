@@ -9,7 +9,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from retro.cpu.batch import LaneError
-from retro.cpu.timing import model_cycles
 from retro.analysis.check.coverage import count_steps, from_lanes
 from retro.analysis.check.results import describe_outputs
 from retro.analysis.coverage_model import CodeCoverage
@@ -216,14 +215,15 @@ def run_on_machine(runner: RoutineRunner, cases: list[tuple], coverage: bool = T
     calls = [] if runner.routine.world.recorded else None
     stop, message = None, ""
     covered = CodeCoverage() if coverage else None
+    keep_steps = coverage or bool(runner.watched_facts)  # else the timing model counts as the call runs
     for case in cases:
-        steps: list = []
+        steps: list | None = [] if keep_steps else None
         try:
-            answer, spent = runner.run(case, steps)
+            answer, spent = runner.run(case, steps, timed=not coverage)
         except RunError as exc:
             stop, message = "run", str(exc)
             break
-        broken = facts_broken(runner, steps)
+        broken = facts_broken(runner, steps) if steps is not None else ""
         if broken:
             stop, message = "run", broken
             break
@@ -231,8 +231,8 @@ def run_on_machine(runner: RoutineRunner, cases: list[tuple], coverage: bool = T
         cycles.append(spent)
         stolen.append(runner.last_stolen)
         # the timing model times the routine's instructions; a world's traps and interrupt entry are added
-        modelled.append((count_steps(covered, read, steps, runner.routine.cpu) if coverage else
-                         model_cycles(read, steps, runner.routine.cpu)) + runner.last_extra_cycles)
+        modelled.append(count_steps(covered, read, steps, runner.routine.cpu) + runner.last_extra_cycles
+                        if coverage else runner.last_modelled)
         if calls is not None:
             calls.append(runner.last_calls)
     return CallBlock(_output_arrays(runner.routine, answers), np.asarray(cycles, dtype=np.int64),
@@ -292,6 +292,24 @@ def run_on_batched_core(runner: RoutineRunner, columns: list, confirm_stop: bool
                 f"the engines disagree: the batched core stopped the call "
                 f"({LaneError(int(outcome.error[block.returned])).name}), Machine returned")
     return block
+
+
+def disagreements(routine: Routine, machine: CallBlock, batch: CallBlock) -> dict[int, str]:
+    """`disagreement` of each call of Machine's block that has one, by call, in call order; the calls
+    both engines returned with the same outputs and cycles (compared as arrays) are passed over."""
+    n, r = machine.calls, machine.returned
+    stopped = (batch.lane_errors[:r] != 0 if batch.lane_errors is not None
+               else np.arange(r) >= batch.returned)
+    same = ~stopped & (machine.cycles[:r] == batch.cycles[:r])
+    for ours, theirs in zip(machine.outputs, batch.outputs):
+        equal = ours[:r] == theirs[:r]
+        same &= equal.all(axis=1) if equal.ndim == 2 else equal
+    found = {}
+    for i in np.flatnonzero(~same).tolist() + list(range(r, n)):
+        message = disagreement(routine, machine, batch, i)
+        if message is not None:
+            found[i] = message
+    return found
 
 
 def disagreement(routine: Routine, machine: CallBlock, batch: CallBlock, i: int) -> str | None:

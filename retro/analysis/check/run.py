@@ -125,12 +125,12 @@ def _named(spec: str, seed: int, start: SceneStart | None, tally: Tally) -> Tall
     return tally
 
 
-def agreement_chunk(spec: str, seed: int, cases: list[tuple], engine: str = "batch",
+def agreement_chunk(spec: str, seed: int, columns: list, engine: str = "batch",
                     start: SceneStart | None = None) -> Tally:
-    """Cases on both engines: Machine's tally (timing model included), its block compared with the
-    array engine's call for call."""
+    """A column block's cases on both engines: Machine's tally (timing model included), its block
+    compared with the array engine's call for call."""
     runner = runner_for(spec, seed, start)
-    columns = case_sets.cases_to_columns(runner.routine, cases)
+    cases = case_sets.columns_to_cases(columns)
     against = run_on_batched_core(runner, columns, confirm_stop=False, coverage=False, engine=engine)
     return count_block(runner.routine, run_on_machine(runner, cases, coverage=False), columns, cases,
                        runner.memory_values, against)  # (the array engine counts these cases' coverage)
@@ -367,10 +367,9 @@ def _agreement(spec: str, seed: int, parts: list[case_sets.Part], engine: str,
     """Machine first: the reference engine's verdict on a prefix of every part, both engines compared."""
     agreement = Tally()
     for part in parts:
-        for chunk in case_sets.chunks(islice(part.cases, AGREEMENT_PER_PART)):
-            agreement.merge(agreement_chunk(spec, seed, chunk, engine, start))
-            if agreement.run_errors:
-                break
+        columns = part.head(AGREEMENT_PER_PART)
+        if columns is not None:
+            agreement.merge(agreement_chunk(spec, seed, columns, engine, start))
     return agreement
 
 

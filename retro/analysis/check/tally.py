@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from retro.analysis.check.engines import CallBlock, disagreement
+from retro.analysis.check.engines import CallBlock, disagreements
 from retro.analysis.check.entry_runs import EntryBaseline, EntryBlock, EntryFinding, changed_calls, run_baselines
 from retro.analysis.check.reference import reference_answers
 from retro.analysis.check.results import Failure, describe_case, describe_outputs
@@ -177,10 +177,7 @@ def _count(routine: Routine, block: CallBlock, columns: list, cases: list[tuple]
     engine_wrong: dict[int, str] = {}
     if against is not None:
         out.engine_cases = block.calls
-        for i in range(block.calls):
-            message = disagreement(routine, block, against, i)
-            if message is not None:
-                engine_wrong[i] = message
+        engine_wrong = disagreements(routine, block, against)
         out.engine_mismatches = len(engine_wrong)
     wrong_inside = np.zeros(0, dtype=np.int64)
     if row_keys is None:
