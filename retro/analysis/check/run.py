@@ -333,11 +333,14 @@ def _engine_choice(plan: _Plan, runner: RoutineRunner, engine: str, start: Scene
         reason = (runner.engine_reason if start is not None else
                   note or (f"{engine}: {plan.known:,} planned calls" if engine == "auto" else f"--engine {engine}"))
         return _Engine(False, "scalar", reason, note)
-    static = None
+    static = cycles = None
     if engine == "auto" and plan.calls is not None:  # by the planned calls' work (engines.planned_cycles)
-        static = (_static(plan, runner),)
-    used, reason = array_engine(engine, plan.calls, None if static is None else
-                                planned_cycles(runner, plan.parts, static[0]))
+        try:
+            static = (_static(plan, runner),)
+        except InputError:  # (the record raises it, after the checks that come before it)
+            pass
+        cycles = planned_cycles(runner, plan.parts, None if static is None else static[0])
+    used, reason = array_engine(engine, plan.calls, cycles)
     if start is not None:
         reason = runner.engine_reason
     if used != "compiled":
