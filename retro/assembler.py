@@ -267,13 +267,16 @@ def _store_program(key: str, program: Program, read: list[str]) -> None:
     entry = _entry_path(key)
     stored = {"key": key, "code": program.code.hex(), "origin": program.origin, "symbols": program.symbols,
               "listing": program.listing, "read": sums}
+    staged = None
     try:
         entry.parent.mkdir(parents=True, exist_ok=True)
         with tempfile.NamedTemporaryFile("w", encoding="utf-8", dir=entry.parent, suffix=".tmp", delete=False) as f:
+            staged = f.name
             json.dump(stored, f)
-        os.replace(f.name, entry)
+        os.replace(staged, entry)
     except OSError:
-        return
+        if staged is not None:
+            Path(staged).unlink(missing_ok=True)
 
 
 def _first_error(output: str, resolved: str, shown: str) -> str:
