@@ -8,7 +8,7 @@ edge: the branches go either way at random, the compiled engine's worst case); t
 and the compiled engine on the first SWEEP_BLOCKS blocks of the routine's `--exhaustive` cases (its
 exhaustive product, else its sweep: what a proof runs, the issue's measure); the ratios; and apart, the compiled engine's compile time (CPU seconds, into an empty cache)
 and its load time from the cache, and from how many calls the compile pays for itself against the
-batched core (what `--engine auto`'s AUTO_COMPILED_CASES is set from).
+batched core.
 
 With `--checks`: whole checks instead, `retro check NAME --exhaustive --no-search --jobs 1 --json` in a
 fresh process per routine and engine (start-up, compile or cache load, the engine agreement on Machine,
@@ -17,9 +17,18 @@ the process (getrusage of the child) on the batched core (`--engine batch`: toda
 compiled engine (its cache filled first: the compile is counted apart above), with the ratio per
 routine and for the whole set. aabb8's full sweep (3 x 2^32 calls) is too long to run twice here: its
 row is the same check with box A's position from the first AABB8_STARTS values only
-(benchmarks/aabb8_sweep.py's slice; 3 x 2^24 calls per value).
+(benchmarks/aabb8_sweep.py's slice; 3 x 2^24 calls per value). Then the issue's own measure: the whole
+set (every routine named but aabb8, whose work changed since the issue was filed) checked in ONE process,
+`retro check NAME... --exhaustive --no-search --jobs 1`, on `--engine batch` and on `--engine auto`, CPU
+seconds of the process and its children, best of SET_ROUNDS runs each, and the ratio (`--set`: that
+figure alone).
 
-    python benchmarks/compiled_speed.py [ROUTINE ...] [--checks]
+With `--auto`: the figures `--engine auto`'s rule between the batched core and the compiled engine is
+set from (retro.analysis.check.engines): CPU ns per 6502 cycle of each routine's calls on both engines,
+the compiled engine's start in a fresh process, the crossover they give against the rule's, and where
+each routine's --exhaustive check falls.
+
+    python benchmarks/compiled_speed.py [ROUTINE ...] [--checks | --set | --auto]
 """
 
 from __future__ import annotations
@@ -170,7 +179,99 @@ def whole_checks(names: list[str]) -> None:
                   f"{record.get('engine')}, {record.get('compiled_fallbacks') or 0}"
                   f"{'' if not differ else '  records differ: ' + ', '.join(differ)}")
     print(f"{'all':<24} {'':>15} {totals[0]:>10.1f} {totals[1]:>13.1f} {totals[0] / totals[1]:>6.1f}x  "
-          "(issue 24: at least 4x)")
+          "(one process per routine)")
+    one_process([n for n in names if n != "aabb8"])
+
+
+SET_ROUNDS = 2
+ISSUE_SET = [n for n in CHECK_ROUTINES if n != "aabb8"]  # issue 24's set: every built-in with an --exhaustive run
+ISSUE_FIGURES = {"64be42f (batched only)": 35.9}  # ... its CPU s where the issue was filed (quiet machine)
+
+
+def one_process(names: list[str]) -> None:
+    """The set in one process (issue 24's measure), `--engine batch` and `--engine auto`, best of SET_ROUNDS."""
+    if not names:
+        return
+    spent = {}
+    for engine in ("batch", "auto"):
+        rounds = []
+        for _ in range(SET_ROUNDS):
+            before = _child_cpu()
+            done = subprocess.run([sys.executable, "-m", "retro", "check", *names, "--exhaustive", "--no-search",
+                                   "--jobs", "1", "--engine", engine, "--json"], capture_output=True, text=True,
+                                  env={**os.environ, "PYTHONPATH": str(ROOT)})
+            rounds.append(_child_cpu() - before)
+            if done.returncode not in (0, 1) or not done.stdout.strip():
+                sys.exit(f"compiled_speed: retro check --engine {engine} failed: {done.stderr.strip()[-300:]}")
+        spent[engine] = min(rounds)
+    load = os.getloadavg()[0]
+    print(f"one process, {' '.join(names)} (--exhaustive --no-search --jobs 1), CPU s, best of {SET_ROUNDS}, "
+          f"load {load:.1f}: batch {spent['batch']:.1f}, auto {spent['auto']:.1f} "
+          f"({spent['batch'] / spent['auto']:.1f}x)"
+          + "".join(f"; {where}: {seconds:.1f} ({seconds / spent['auto']:.1f}x, issue 24: at least 4x)"
+                    for where, seconds in ISSUE_FIGURES.items() if names == ISSUE_SET))
+
+
+AUTO_ROUTINES = ["aabb8", "aabb_edges", "aabb_sprite", "circle", "circle_r", "mul8", "sprite_edges", "tile",
+                 "tile_box", "mul16"]
+START_SCRIPT = """
+import resource, sys, time
+import retro.cli
+from retro.routines.registry import get
+from retro.routines.runner import RoutineRunner
+routine = get(sys.argv[1])
+runner = RoutineRunner(routine, routine.seed)
+began = time.process_time()
+runner.compiled()
+print(time.process_time() - began)
+"""
+
+
+def _fresh_start(name: str) -> float:
+    """CPU seconds of a fresh process's first load of `name`'s compiled code from the cache (numba's import
+    and start included: what a check on the compiled engine pays before its first call)."""
+    done = subprocess.run([sys.executable, "-c", START_SCRIPT, name], capture_output=True, text=True, check=True,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    return float(done.stdout.split()[-1])
+
+
+def auto_rule(names: list[str]) -> None:
+    """The figures `--engine auto`'s rule is set from (retro.analysis.check.engines): per routine, CPU ns per
+    6502 cycle of its calls on the batched core and on the compiled engine (its --exhaustive cases' first
+    blocks and its random cases), the compiled engine's start in a fresh process, the crossover they give,
+    and the planned cycles of each routine's --exhaustive check against it."""
+    from retro.analysis.check import engines
+    from retro.analysis.check.run import _planned, _static
+    from retro.routines.registry import spec_path
+
+    print("CPU ns per 6502 cycle of the calls (mean cycles per call from the run); start: a fresh process's first "
+          "load from the cache, numba's import and start included (CPU s)")
+    print(f"{'routine':<13} {'cycles':>8} {'batch':>8} {'compiled':>9} {'saved':>7} {'start':>7} "
+          f"{'planned (M cycles)':>19}  auto")
+    batches, fasts, starts = [], [], []
+    for name in names:
+        routine = get(name)
+        runner = RoutineRunner(routine, routine.seed)
+        runner.compiled()  # (into the cache: the start below loads it)
+        blocks = sweep_blocks(routine, LANES) + [random_block(routine, LANES)]
+        cycles = sum(int(runner.run_batch(b).cycles.sum()) for b in blocks)
+        batch = 1e9 / per_cpu_second(_each(runner.run_batch, blocks), cycles)
+        fast = 1e9 / per_cpu_second(_each(runner.run_compiled, blocks), cycles)
+        start = _fresh_start(name)
+        batches.append(batch)
+        fasts.append(fast)
+        starts.append(start)
+        plan = _planned(str(spec_path(name)), True, None, None, case_sets.BOUNDED_PRODUCT)
+        planned = engines.planned_cycles(runner, plan.parts, _static(plan, runner))
+        calls = sum(len(b[0]) for b in blocks)
+        print(f"{name:<13} {cycles / calls:>8.1f} {batch:>8.2f} {fast:>9.2f} {batch - fast:>7.2f} {start:>7.2f} "
+              f"{'(a sweep)' if planned is None else f'{planned / 1e6:,.0f}':>19}  "
+              f"{engines.array_engine('auto', plan.calls, planned)[0]}")
+    batch, fast, start = (float(np.median(figures)) for figures in (batches, fasts, starts))
+    print(f"median: batch {batch:.2f} ns, compiled {fast:.2f} ns a cycle, {start:.2f} s to start: the compiled "
+          f"engine pays from {start / (batch - fast) * 1e3:,.0f} M cycles; the rule's constants "
+          f"(retro.analysis.check.engines): {engines.BATCH_NS_PER_CYCLE} and {engines.COMPILED_NS_PER_CYCLE} ns, "
+          f"{engines.COMPILED_START_SECONDS} s: AUTO_COMPILED_CYCLES {engines.AUTO_COMPILED_CYCLES / 1e6:,.0f} M")
 
 
 def main(argv: list[str]) -> None:
@@ -182,6 +283,12 @@ def main(argv: list[str]) -> None:
     names = [a for a in argv if not a.startswith("--")]
     if "--checks" in argv:
         whole_checks(names or CHECK_ROUTINES)
+        return
+    if "--set" in argv:  # the one-process figure alone
+        one_process([n for n in names or CHECK_ROUTINES if n != "aabb8"])
+        return
+    if "--auto" in argv:
+        auto_rule(names or AUTO_ROUTINES)
         return
     names = names or ROUTINES
     with tempfile.TemporaryDirectory() as cache:

@@ -154,3 +154,75 @@ def test_code_running_past_ffff_is_an_error_naming_the_source(tmp_path):
     # exactly up to $FFFF is fine
     source.write_text(".org $fff0\n.byte " + ", ".join(["1"] * 16) + "\n")
     assert assemble_file(source).end == 0x10000
+
+
+# ---- the disk cache of assembled programs ---------------------------------------------------------
+
+def _fresh_process(monkeypatch) -> list:
+    """Forget the in-process cache (as a new process would) and count the assembler processes started."""
+    from retro import assembler
+
+    assembler._assemble_cached.cache_clear()
+    started = []
+    real = subprocess.run
+    monkeypatch.setattr(assembler.subprocess, "run", lambda *a, **k: started.append(a) or real(*a, **k))
+    return started
+
+
+def _included_source(tmp_path: Path) -> Path:
+    (tmp_path / "values.s").write_text("values: .byte 7, 8\n")
+    source = tmp_path / "main.s"
+    source.write_text('.org $1000\nlda values\nrts\n.include "values.s"\n\n; retro-tables: sq_lo\n')
+    return source
+
+
+def test_a_program_assembled_once_is_read_from_the_disk_cache_in_a_later_process(tmp_path, monkeypatch):
+    from retro.fileio import recording_reads
+
+    monkeypatch.setenv("RETRO_CACHE", str(tmp_path / "cache"))
+    source = _included_source(tmp_path)
+    started = _fresh_process(monkeypatch)
+    first = assemble_file(source)
+    assert len(started) == 1 and len(list((tmp_path / "cache" / "assembled").glob("*.json"))) == 1
+    started = _fresh_process(monkeypatch)
+    with recording_reads() as reads:
+        again = assemble_file(source)
+    assert started == []  # no assembler process: the stored program
+    assert again == first and again.code[:4] == bytes([0xAD, 0x04, 0x10, 0x60])
+    assert again.symbols["values"] == 0x1004 and "sq_lo" in again.symbols
+    # the include is still an input of the command (no output may replace it), as when Ophis read it
+    assert any(shown == f"included file {tmp_path / 'values.s'}" for _, shown, _ in reads)
+
+
+def test_an_include_edited_since_is_assembled_again(tmp_path, monkeypatch):
+    monkeypatch.setenv("RETRO_CACHE", str(tmp_path / "cache"))
+    source = _included_source(tmp_path)
+    _fresh_process(monkeypatch)
+    assert assemble_file(source).code[4:6] == bytes([7, 8])
+    (tmp_path / "values.s").write_text("values: .byte 9, 10, 11\n")
+    started = _fresh_process(monkeypatch)
+    assert assemble_file(source).code[4:7] == bytes([9, 10, 11])
+    assert len(started) == 1
+    source.write_text(source.read_text().replace("lda values", "ldx values"))  # the source itself: a new entry
+    assert assemble_file(source).code[0] == 0xAE
+
+
+def test_a_damaged_or_foreign_cache_entry_is_assembled_again_and_replaced(tmp_path, monkeypatch):
+    monkeypatch.setenv("RETRO_CACHE", str(tmp_path / "cache"))
+    source = _included_source(tmp_path)
+    _fresh_process(monkeypatch)
+    first = assemble_file(source)
+    (entry,) = (tmp_path / "cache" / "assembled").glob("*.json")
+    stored = entry.read_text()
+    for damaged in ("{not json", "[]", stored.replace('"key": "', '"key": "0'), stored.replace('"origin": 4096', '"origin": "x"')):
+        entry.write_text(damaged)
+        started = _fresh_process(monkeypatch)
+        assert assemble_file(source) == first and len(started) == 1
+        assert entry.read_text() == stored
+
+
+def test_an_unwritable_cache_is_no_error(tmp_path, monkeypatch):
+    (tmp_path / "cache").write_text("a file where the cache folder would be")
+    monkeypatch.setenv("RETRO_CACHE", str(tmp_path / "cache"))
+    _fresh_process(monkeypatch)
+    assert assemble_file(_included_source(tmp_path)).code[:4] == bytes([0xAD, 0x04, 0x10, 0x60])

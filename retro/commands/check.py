@@ -32,7 +32,7 @@ from retro.routines.chip_access import FREE_REASON, NesStart
 from retro.workers import MAX_WORKERS, configured
 import argparse
 from retro.analysis.check import AGREEMENT_PER_PART, AUTO_BATCH_CASES
-from retro.analysis.check.engines import AUTO_COMPILED_CASES
+from retro.analysis.check.engines import AUTO_COMPILED_CYCLES
 from retro.commands import options
 from retro.progress import progress_printer
 from retro.routines.registry import builtin_names
@@ -607,7 +607,8 @@ def routine_options(p: argparse.ArgumentParser) -> None:
     options.scene_entry(p)
     options.engine(p, f"; scalar is the reference and the timing model checks every call, batch and compiled are "
                       f"checked against Machine on the first {AGREEMENT_PER_PART:,} cases of each part, auto takes "
-                      f"batch from {AUTO_BATCH_CASES:,} cases and compiled from {AUTO_COMPILED_CASES:,}")
+                      f"batch from {AUTO_BATCH_CASES:,} cases and compiled from {AUTO_COMPILED_CYCLES:,} cycles of planned "
+                      f"calls (their count times the geometric mean of the static best and worst cycles)")
     searching = p.add_mutually_exclusive_group()
     searching.add_argument("--search", metavar="N", help="candidate cases the coverage-guided search may run after "
                            f"the planned cases (default: the spec's [cases] search, else {DEFAULT_SEARCH:,}; the "

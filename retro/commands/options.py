@@ -73,7 +73,7 @@ def engine(p: argparse.ArgumentParser, detail: str = "") -> None:
     p.add_argument("--engine", choices=ENGINES, default="auto",
                    help="which engine runs the 6502 calls: scalar (Machine), batch (the numpy batched core), compiled "
                         "(native code through numba, docs/compiled.md; retro check only, the other commands run the "
-                        f"batched core for it) or auto (batch for many calls, compiled for millions; default){detail}")
+                        f"batched core for it) or auto (batch for many calls, compiled when their work pays for its start; default){detail}")
 
 
 def scale(p: argparse.ArgumentParser, what: str, top: int) -> None:

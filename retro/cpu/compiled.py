@@ -36,9 +36,9 @@ from pathlib import Path
 import numpy as np
 
 from retro.cpu import compiled_ops, translate
+from retro.paths import CACHE_ENV, cache_dir
 from retro.cpu.translate import FALLBACK, REGISTERS_OUT, RESULT_ROWS, SET_A, SET_FLAG, SET_P, SET_REGISTERS, SET_X, SET_Y, Translation, Untranslatable
 
-CACHE_ENV = "RETRO_CACHE"
 MODULE_FILE = "routine.py"
 MANIFEST_FILE = "manifest.json"
 LOCK_FILE = ".lock"
@@ -73,8 +73,7 @@ def numba_problem() -> str | None:
 
 
 def cache_root() -> Path:
-    base = os.environ.get(CACHE_ENV)
-    return (Path(base) if base else Path.home() / ".cache" / "retro") / "compiled"
+    return cache_dir("compiled")
 
 
 @dataclass

@@ -19,7 +19,7 @@ unknown result (their timing does not change).
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 ANY = (1 << 256) - 1  # a byte that may hold any value
 NONE = 0
@@ -124,6 +124,16 @@ class State:
     nz: str = ""  # the register ("a", "x", "y") whose value N and Z were last set from ("": none)
     _index: dict = field(default=None, compare=False, hash=False, repr=False)
 
+    def changed(self, **changes) -> State:
+        """This state with `changes`: dataclasses.replace without its per-call work (a static analysis
+        makes tens of thousands of states: tile_box's 21,750), field names still checked."""
+        if not changes.keys() <= _STATE_FIELDS:
+            raise TypeError(f"State has no field {sorted(changes.keys() - _STATE_FIELDS)[0]!r}")
+        new = object.__new__(State)
+        new.__dict__.update(self.__dict__)
+        new.__dict__.update(changes)
+        return new
+
     def read(self, memory: MemoryModel, address: int) -> int:
         address &= 0xFFFF
         if address >> 8 == STACK_PAGE >> 8:
@@ -144,14 +154,14 @@ class State:
         """The state after a store of `value` to one of `addresses` (None: an unknown address)."""
         if addresses is None:
             kept = tuple((a, v) for a, v in self.stored if memory.protected(a))
-            return replace(self, stored=kept, wild=True, _index=None)
+            return self.changed(stored=kept, wild=True, _index=None)
         index = dict(self._lookup())
         strong = len(addresses) == 1
         for address in addresses:
             if address >> 8 == STACK_PAGE >> 8:
                 continue
             index[address] = value if strong else value | self.read(memory, address)
-        return replace(self, stored=tuple(sorted(index.items())), _index=None)
+        return self.changed(stored=tuple(sorted(index.items())), _index=None)
 
     def join(self, other: "State", memory: MemoryModel) -> "State":
         if other is self:
@@ -170,15 +180,18 @@ class State:
                      stack, self.nz if self.nz == other.nz else "")
 
     def pushed(self, item: tuple) -> "State":
-        return replace(self, stack=None if self.stack is None else (*self.stack, item))
+        return self.changed(stack=None if self.stack is None else (*self.stack, item))
 
     def pulled(self) -> tuple[tuple | None, "State"]:
         if not self.stack:
-            return None, replace(self, stack=None)
-        return self.stack[-1], replace(self, stack=self.stack[:-1])
+            return None, self.changed(stack=None)
+        return self.stack[-1], self.changed(stack=self.stack[:-1])
 
     def flags(self) -> tuple[int, int, int, int, int]:
         return self.c, self.z, self.n, self.v, self.d
+
+
+_STATE_FIELDS = frozenset(State.__dataclass_fields__)
 
 
 def _join_item(p: tuple, q: tuple) -> tuple:
@@ -204,7 +217,7 @@ def narrowed(state: State, register: str, mask: int) -> State:
         else:
             value &= {SET: HIGH_HALF, CLEAR: LOW_HALF}.get(mask, ANY)
         changes[source] = value
-    return replace(state, **changes)
+    return state.changed(**changes)
 
 
 def is_empty(state: State) -> bool:

@@ -116,3 +116,33 @@ def test_stores_pay_no_page_crossing():
     # from $C0FE crosses, and neither bound may count it (a best case above the real one would fail)
     source = "entry: ldx #2\n sta obj,x\n rts\n .advance $c0fe\nobj: .byte 0, 0, 0\n"
     assert _bounds(source)[:2] == (2 + 5 + 6, 2 + 5 + 6)
+
+
+def test_a_compare_s_n_over_two_sets_is_every_pair_s_bit_7():
+    """difference_sign (the windows of the operand's set) against the pairs enumerated, on sets of every size,
+    the wrap-around ones (values near 0 and 255, the windows crossing the end of the byte) included."""
+    import random
+
+    from retro.cpu.value_steps import difference_sign
+    from retro.cpu.values import CLEAR, EITHER, SET, flag_of, members
+
+    rng = random.Random(24)
+    sets = [single(0), single(255), single(128) | single(127), span(0, 127), span(128, 255), span(120, 135), ANY]
+    sets += [sum(1 << v for v in rng.sample(range(256), k)) for k in (1, 2, 3, 5, 20, 60, 200) for _ in range(40)]
+    for register in sets:
+        for operand in rng.sample(sets, 30):
+            pairs = {bool((r - m) & 0x80) for r in members(register) for m in members(operand)}
+            assert difference_sign(register, operand) == flag_of(pairs), (register, operand)
+    assert difference_sign(single(5), single(5)) == CLEAR and difference_sign(single(4), single(5)) == SET
+    assert difference_sign(single(0), single(0) | single(1)) == EITHER
+
+
+def test_a_changed_state_is_the_replaced_one_and_names_are_checked():
+    from dataclasses import replace
+
+    state = State(a=single(3), stored=((0x10, single(1)),))
+    assert state.changed(a=ANY, c=1) == replace(state, a=ANY, c=1)
+    assert hash(state.changed(x=single(2))) == hash(replace(state, x=single(2)))
+    assert state.a == single(3)  # (a new state: the old one unchanged)
+    with pytest.raises(TypeError, match="no field 'q'"):
+        state.changed(q=1)

@@ -79,18 +79,54 @@ def test_without_numba_auto_runs_the_batched_core_and_says_so_once(monkeypatch, 
     monkeypatch.setattr(compiled, "numba_problem", lambda: "numba cannot be imported (ImportError: no numba)")
     monkeypatch.setattr(engines, "_SAID", set())
     assert engines.array_engine("auto", None) == ("batch", "numba cannot be imported (ImportError: no numba)")
-    assert engines.array_engine("auto", 10 ** 9)[0] == "batch"
+    assert engines.array_engine("auto", 10 ** 9, 10 ** 11)[0] == "batch"
     assert engines.array_engine("compiled", 5)[0] == "batch"
     assert capsys.readouterr().err.count("the compiled engine is off: numba cannot be imported") == 1
-    assert engines.array_engine("auto", 30_000) == ("batch", "auto: 30,000 planned calls (the compiled engine "
-                                                             "from 16,000,000)")
+    assert engines.array_engine("auto", 30_000, 900_000) == ("batch", "auto: 30,000 planned calls, about 1 M cycles "
+                                                                      "(the compiled engine from 127 M)")
 
 
 @needs_numba
-def test_auto_takes_the_compiled_engine_for_a_sweep_or_millions_of_calls():
+def test_auto_takes_the_compiled_engine_for_a_sweep_or_calls_whose_work_pays_for_its_start():
+    """The rule's crossover, measured (benchmarks/compiled_speed.py --auto: the batched core 3.9 ns a cycle, the
+    compiled engine 0.35, 0.45 CPU-s to start): 126,760,563 cycles; a call's cycles the geometric mean of the
+    static bounds. Both sides of it, and where the built-ins' --exhaustive checks fall."""
+    assert engines.AUTO_COMPILED_CYCLES == 126_760_563
+    assert engines.compiled_pays(126_760_563) and not engines.compiled_pays(126_760_562)
     assert engines.array_engine("auto", None) == ("compiled", "auto: a sweep")
-    assert engines.array_engine("auto", 20_000_000) == ("compiled", "auto: 20,000,000 planned calls")
+    assert engines.array_engine("auto", 1_000, 126_760_563) == ("compiled", "auto: 1,000 planned calls, about 127 M cycles")
+    assert engines.array_engine("auto", 20_000_000, 126_000_000)[0] == "batch"  # many calls, little work each
     assert engines.array_engine("batch", None) == ("batch", "--engine batch")
+    assert engines.expected_cycles(52, 26_800) == pytest.approx(1180.5, abs=0.1)
+    assert engines.expected_cycles(0, 40) == pytest.approx(6.32, abs=0.01)  # (a zero bound counts as one cycle)
+
+
+@needs_numba
+@pytest.mark.parametrize("name, engine", [("tile_box", "compiled"), ("tile", "batch"), ("aabb_sprite", "batch"),
+                                          ("circle", "compiled")])
+def test_auto_on_the_built_ins_exhaustive_checks(name, engine):
+    """tile_box's 234,472 long calls (a loop: static bounds 52 and 26,800 cycles, 277 M cycles planned) take the
+    compiled engine; tile's 231,192 short ones (15-44 cycles, 6 M) and aabb_sprite's (17 M) the batched core."""
+    from retro.analysis.check.run import _planned, _static
+    from retro.routines.registry import spec_path
+
+    plan = _planned(str(spec_path(name)), True, None, None, 1 << 20)
+    runner = engines.runner_for(plan.spec, plan.seed)
+    cycles = engines.planned_cycles(runner, plan.parts, _static(plan, runner))
+    assert engines.array_engine("auto", plan.calls, cycles)[0] == engine
+
+
+def test_without_static_bounds_auto_takes_a_call_s_cycles_from_machine(tmp_path):
+    """A spec that turns the static analysis off: the first AUTO_PROBE_CASES cases of each part run on Machine."""
+    from retro.analysis.check.run import _planned
+    from retro.routines.registry import spec_path
+
+    plan = _planned(str(spec_path("mul8")), True, None, None, 1 << 20)
+    runner = engines.runner_for(plan.spec, plan.seed)
+    measured = engines.planned_cycles(runner, plan.parts, None)
+    assert [p.count for p in plan.parts] == [64, 65_536, 100_000]
+    assert 44 * plan.calls <= measured <= 48 * plan.calls  # mul8 takes 44-48 cycles a call
+    assert measured != round(46 * plan.calls)  # (measured, not the bounds' mean)
 
 
 def test_when_numba_fails_to_import_auto_runs_the_batched_core_and_says_so_once():
@@ -103,7 +139,7 @@ def test_when_numba_fails_to_import_auto_runs_the_batched_core_and_says_so_once(
 
     script = ("import sys\nsys.modules['numba'] = None\n"
               "from retro.analysis.check import engines\n"
-              "print(engines.array_engine('auto', None))\nprint(engines.array_engine('auto', 10 ** 9))\n")
+              "print(engines.array_engine('auto', None))\nprint(engines.array_engine('auto', 10 ** 9, 10 ** 11))\n")
     root = str(Path(__file__).resolve().parents[2])
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
                           env={**os.environ, "PYTHONPATH": root})

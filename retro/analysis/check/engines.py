@@ -5,6 +5,7 @@ timing model on every call) or the batched core (retro.cpu.batch). The one rule 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import islice
 
 import numpy as np
 
@@ -25,10 +26,17 @@ ARRAY_ENGINES = ("batch", "compiled")  # engines that run a column block at once
 BATCH_LANES = 65_536  # cases the batched core runs at once (memory stays bounded: see LaneMemory)
 AUTO_BATCH_CASES = 20_000  # planned cases from which engine="auto" takes the batched core for a check
 # (it then also runs AGREEMENT_PER_PART cases of each part on Machine: below this it would not pay)
-AUTO_COMPILED_CASES = 16_000_000  # planned cases from which "auto" takes the compiled engine (numba importable):
-# a routine's first compile costs 0.7-4.9 s of CPU, won back against the batched core after 0.4-61 million
-# calls (benchmarks/compiled_speed.py, "pays from", load 16: 5-12 million for mul8, tile, circle and the
-# edges routines; aabb8's 61 million include numba's own start, the process's first compile)
+# "auto" between the batched core and the compiled engine: by the planned calls' work, their 6502 cycles (the
+# count times a call's expected cycles: the geometric mean of the static best and worst, `expected_cycles`), the
+# CPU the compiled engine saves on them against what it costs a process before its first call (each figure
+# measured by `python benchmarks/compiled_speed.py --auto`; docs/compiled.md "What auto picks"):
+BATCH_NS_PER_CYCLE = 3.9  # the batched core's CPU per cycle of the calls it runs (median; 1.7-6.6 ns by routine)
+COMPILED_NS_PER_CYCLE = 0.35  # the compiled engine's (median; 0.1-0.5 ns)
+COMPILED_START_SECONDS = 0.45  # numba's import, its CPU target's start and the load from the cache, per process
+AUTO_COMPILED_CYCLES = round(COMPILED_START_SECONDS / (BATCH_NS_PER_CYCLE - COMPILED_NS_PER_CYCLE) * 1e9)
+# (a routine's first compile, 0.6-5 s, is not counted: it is paid once per routine and content, its code kept in
+# the cache, and a check this big wins it back within a few runs)
+AUTO_PROBE_CASES = 32  # without static bounds: cases of each part run on Machine for a call's mean cycles
 AGREEMENT_PER_PART = 2_000  # cases of each part also run on Machine when the batched core runs the check
 TRACE_SHOWN = 400  # instructions of the first failing case's trace in the report
 
@@ -158,22 +166,59 @@ def batched(engine: str, calls: int | None, batchable: bool, threshold: int) -> 
     return batchable and (engine in ARRAY_ENGINES or (engine == "auto" and (calls is None or calls >= threshold)))
 
 
-def array_engine(engine: str, calls: int | None) -> tuple[str, str]:
+def compiled_pays(cycles: int) -> bool:
+    """The rule "auto" takes the compiled engine by for a check of known size: its `cycles` of planned calls
+    cost more on the batched core than on the compiled engine by at least what the compiled engine costs
+    a process before its first call."""
+    return cycles >= AUTO_COMPILED_CYCLES
+
+
+def expected_cycles(best: int, worst: int) -> float:
+    """A call's expected cycles from the static bounds: their geometric mean (a loop's worst case is far above
+    its typical call: tile_box's bounds 52 and 26,800 give 1,180 for a measured mean of 504)."""
+    return (max(best, 1) * max(worst, 1)) ** 0.5
+
+
+def planned_cycles(runner: RoutineRunner, parts: list, bounds) -> int | None:
+    """The planned calls' 6502 cycles, estimated: their count times `expected_cycles` of the static `bounds`,
+    or without them (None: the spec turns the analysis off) each part's count times the mean cycles of its
+    first AUTO_PROBE_CASES cases on Machine; None when a part's count is unknown (a sweep function's)."""
+    if any(part.count is None for part in parts):
+        return None
+    if bounds is not None:
+        return round(sum(part.count for part in parts) * expected_cycles(bounds.best, bounds.worst))
+    total = 0.0
+    for part in parts:
+        spent = []
+        for case in islice(part.cases, min(part.count, AUTO_PROBE_CASES)):
+            try:
+                spent.append(runner.run(case)[1])
+            except RunError:  # (the check finds it again and reports it)
+                break
+        total += part.count * (sum(spent) / len(spent) if spent else 0)
+    return round(total)
+
+
+def array_engine(engine: str, calls: int | None, cycles: int | None = None) -> tuple[str, str]:
     """Which array engine runs a check that `batched` sent to one, and why: ("compiled" or "batch",
-    the reason the report gives). "auto" takes the compiled engine from AUTO_COMPILED_CASES planned
-    calls (or a sweep) when numba can be imported; its routine may still be refused (`compiled_or_why`)."""
+    the reason the report gives). "auto" takes the compiled engine for a sweep, and for `calls` whose
+    `cycles` (planned_cycles) pay for it (compiled_pays), when numba can be imported; its routine may
+    still be refused (`compiled_or_why`)."""
     if engine == "batch":
         return "batch", "--engine batch"
-    if engine == "auto" and calls is not None and calls < AUTO_COMPILED_CASES:
-        return "batch", f"auto: {calls:,} planned calls (the compiled engine from {AUTO_COMPILED_CASES:,})"
+    why = "auto: a sweep"
+    if engine == "auto" and calls is not None:
+        cycles = cycles or 0
+        why = f"auto: {calls:,} planned calls, about {cycles / 1e6:,.0f} M cycles"
+        if not compiled_pays(cycles):
+            return "batch", f"{why} (the compiled engine from {AUTO_COMPILED_CYCLES / 1e6:,.0f} M)"
     from retro.cpu.compiled import numba_problem  # (numba's import, 0.2 s: only when the compiled engine may run)
 
     problem = numba_problem()
     if problem is not None:
         _say_once(f"the compiled engine is off: {problem}; the batched core runs instead")
         return "batch", problem
-    return "compiled", "--engine compiled" if engine == "compiled" else (
-        "auto: a sweep" if calls is None else f"auto: {calls:,} planned calls")
+    return "compiled", "--engine compiled" if engine == "compiled" else why
 
 
 _SAID: set[str] = set()

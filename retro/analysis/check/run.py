@@ -19,6 +19,7 @@ from retro.analysis.check.engines import (
     check_engine,
     compiled_or_why,
     failure_trace,
+    planned_cycles,
     routine_key,
     routine_of,
     run_on_batched_core,
@@ -309,6 +310,7 @@ class _Engine:
     reason: str
     note: str = ""  # why Machine ran calls an array engine was asked for or would have run
     compile_seconds: float | None = None
+    static: tuple | None = None  # (the static bounds,) when the choice needed them (the record uses them too)
 
 
 def _planned(spec: str | Routine, exhaustive: bool, seed: int | None, random_count: int | None,
@@ -338,15 +340,29 @@ def _engine_choice(plan: _Plan, runner: RoutineRunner, engine: str, start: Scene
         reason = (runner.engine_reason if start is not None else
                   note or (f"{engine}: {plan.known:,} planned calls" if engine == "auto" else f"--engine {engine}"))
         return _Engine(False, "scalar", reason, note)
-    used, reason = array_engine(engine, plan.calls)
+    static = cycles = None
+    if engine == "auto" and plan.calls is not None:  # by the planned calls' work (engines.planned_cycles)
+        try:
+            static = (_static(plan, runner),)
+        except InputError:  # (the record raises it, after the checks that come before it)
+            pass
+        cycles = planned_cycles(runner, plan.parts, None if static is None else static[0])
+    used, reason = array_engine(engine, plan.calls, cycles)
     if start is not None:
         reason = runner.engine_reason
     if used != "compiled":
-        return _Engine(True, used, reason, note)
+        return _Engine(True, used, reason, note, static=static)
     refused = compiled_or_why(runner)
     if refused is not None:
-        return _Engine(True, "batch", f"the compiled engine does not take it: {refused}", note)
-    return _Engine(True, used, reason, note, runner.compiled().compile_seconds)
+        return _Engine(True, "batch", f"the compiled engine does not take it: {refused}", note, static=static)
+    return _Engine(True, used, reason, note, runner.compiled().compile_seconds, static)
+
+
+def _static(plan: _Plan, runner: RoutineRunner):
+    """The routine's static bounds (verdicts.static_bounds), or for a spec of rows only, what is known of them."""
+    if plan.routine.reference is None:
+        return rows_only_static(plan.routine, runner)[0]
+    return static_bounds(plan.routine, runner)
 
 
 def _rows_first(plan: _Plan, start: SceneStart | None, choice: _Engine, totals: Tally,
@@ -444,7 +460,7 @@ def _assembled(plan: _Plan, runner: RoutineRunner, choice: _Engine, totals: Tall
     if routine.reference is None:  # rows only: unknown static bounds are said, not an error
         static, rows.static_note = rows_only_static(routine, runner)
     else:
-        static = static_bounds(routine, runner)
+        static = choice.static[0] if choice.static is not None else static_bounds(routine, runner)
     probe = chain((row.case for row in routine.rows), *(islice(p.cases, PROBE_CASES) for p in plan.parts))
     return RoutineCheck(routine, runner.size(runner.blocks_read(probe)), static, totals,
                         bounds_violations(routine, static, totals), budget_violations(routine, static, totals),
