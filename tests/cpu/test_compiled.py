@@ -667,3 +667,25 @@ def test_a_patched_jmp_goes_through_the_dispatch(compiled_cache):
     assert fell == ((x == 0xAD) & ~z).tolist() and left == sum(fell)
     assert [r[0] for r in compiled if r != "fallback"] == [3 if x[i] == 0xB0 and not z[i] else 2
                                                           for i in range(LANES) if not fell[i]]
+
+
+@pytest.mark.parametrize("cpu", ["6510", "65c02"])
+def test_a_patched_jmp_indirect_reads_its_pointer_where_the_patch_says(cpu, compiled_cache):
+    """BCS $C0A5; LDA #2; RTS; $C0A5: CLC; STX $C0AA (JMP's pointer low byte); JMP ($0300) (patched to
+    ($03xx)), carry set on entry. The pointer at $0310 is $C0A0 (the entry: carry now clear, A = 2; by
+    hand 3 + 2 + 4 + 5 + 2 + 2 + 6 = 24 cycles on the 6510, 25 on the 65C02, whose JMP (ind) takes 6);
+    at $03FF the NMOS takes the high byte from $0300 ($C0: the entry again), the 65C02 from $0400 ($00:
+    no block, left to the batched core); at $0320, $C0AA: inside an instruction, left."""
+    code = bytes([0xB0, 0x03, 0xA9, 0x02, 0x60, 0x18, 0x8E, 0xAA, 0xC0, 0x6C, 0x00, 0x03])
+    registers, memory = random_states(35, 30)
+    xs = np.array([0x10, 0xFF, 0x20])
+    registers[:, 1] = xs[np.arange(30) % len(xs)]
+    registers[:, 3] = 0x21
+    for address, byte in ((0x0310, 0xA0), (0x0311, 0xC0), (0x03FF, 0xA0), (0x0300, 0xC0), (0x0400, 0x00),
+                          (0x0320, 0xAA), (0x0321, 0xC0)):
+        memory[:, len(ZERO_PAGE) + address - DATA.start] = byte
+    compiled, left = _three_engines(cpu, code, registers, memory)
+    x = registers[:, 1]
+    fell = [r == "fallback" for r in compiled]
+    assert fell == ((x == 0x20) | ((x == 0xFF) & (cpu == "65c02"))).tolist() and left == sum(fell)
+    assert {(r[0], r[4]) for r in compiled if r != "fallback"} == {(2, 24 if cpu == "6510" else 25)}
