@@ -276,7 +276,7 @@ def compile_routine(image: bytes, entry: int, cpu: str, return_pc: int, inputs_a
                                       None if outputs is None else tuple(outputs), decimal_entry, tuple(results))
     function, seconds, from_cache = _function(translation, columns)
     code_map = np.zeros(MEMORY, dtype=np.uint8)
-    code_map[list(translation.code_bytes)] = 1
+    code_map[list(translation.code_bytes - translation.live_bytes)] = 1  # a write to a live operand is no fallback
     addr_block = np.full(MEMORY, translate.NO_BLOCK, dtype=np.int32)
     for address, number in translation.blocks.items():  # (a jump to an inlined block's number falls back:
         addr_block[address] = number  # the dispatch has no arm for it, translate's `else`)

@@ -17,9 +17,16 @@ the generated code calls for the rare paths (decimal arithmetic, ARR) are in `re
 
 What is not translated stops the call with FALLBACK, and the caller runs that call on the batched
 core: BRK, RTI, JAM and unstable opcodes, STP/WAI, a jump (RTS, JMP (ind)) to an address that starts
-no block, a write into the routine's own code bytes (self-modifying code). Code that certainly modifies
-itself (a store to a fixed address inside the code, an input placed in it) is refused as a whole
-(`Untranslatable`, with the reason the report gives).
+no block, a write into code bytes the translation fixed (self-modifying code beyond operands).
+
+Self-modifying code that patches only OPERANDS is translated (`live_operands`): an instruction one of
+whose operand bytes a store at a fixed address (STA abs, INC zp, ...) writes reads all its operand
+bytes from memory when it runs (its address, page crossing, immediate value or JMP target computed
+then), so a patch made earlier in the call is seen, as `Machine` sees it; a store to a computed
+address into those bytes is allowed too (logged and restored like any other). A fixed store into an
+opcode byte, or into an operand the translation decodes (a branch's offset, a JSR's target, a BBR/BBS
+operand), or an input placed in the code, is refused as a whole (`Untranslatable`, with the reason
+the report gives); a computed store into such bytes leaves the call to the batched core.
 """
 
 from __future__ import annotations
@@ -39,7 +46,7 @@ from retro.cpu.timing import (
     branch_target,
 )
 
-TRANSLATOR_VERSION = 7  # part of every cache key: a change of the generated code's meaning bumps it
+TRANSLATOR_VERSION = 8  # part of every cache key: a change of the generated code's meaning bumps it
 # A call's status (the compiled function's per-call result): 0 returned, else why it stopped.
 RETURNED = 0
 BUDGET = 4  # the cycle budget was spent (retro.cpu.batch.LaneError.BUDGET)
@@ -71,13 +78,14 @@ class Translation:
     source: str
     function_name: str
     blocks: dict[int, int]  # block start address -> block number
-    code_bytes: frozenset[int]  # every byte of a translated instruction (writes there fall back)
+    code_bytes: frozenset[int]  # every byte of a translated instruction (writes there fall back, but to live_bytes)
     fixed_writes: tuple[int, ...]  # addresses written at a fixed address (restored after every call)
     instructions: int
     placed: tuple[int, ...] = ()  # addresses the function puts the case columns' bytes at (`places`)
     lanes: tuple[int, ...] | None = None  # the `lane_addr` the function was made for (None: any, looped over)
     outputs: tuple[int, ...] | None = None  # the `out_addr` likewise
     results: tuple[tuple[str, str], ...] = REGISTERS_OUT  # (name, expression) per `out` row before RESULT_ROWS
+    live_bytes: frozenset[int] = frozenset()  # operand bytes read from memory at run time (`live_operands`)
 
 
 def tables_for(cpu: str) -> dict[int, Op]:
@@ -135,6 +143,49 @@ def find_blocks(read: Callable[[int], int], entry: int, cpu: str, return_pc: int
     return sorted(leaders), instructions
 
 
+# ---- operands patched by the code itself ---------------------------------------------------------------
+
+WRITERS = {"STA", "STX", "STY", "SAX", "STZ", "ASL", "LSR", "ROL", "ROR", "INC", "DEC", "SLO", "RLA", "SRE", "RRA",
+           "DCP", "ISC", "TSB", "TRB", *(f"{kind}MB{bit}" for kind in "RS" for bit in range(8))}
+DECODED = "a branch's offset, a JSR's target or a BBR/BBS operand, which the translation decodes"
+
+
+def _fixed_target(pc: int, op: Op | None, read: Callable[[int], int]) -> int | None:
+    """The address an instruction writes when it is a fixed one (zero page or absolute, as the image has it)."""
+    if op is None or op.mnemonic not in WRITERS or op.mode not in ("zpg", "abs"):
+        return None
+    return read((pc + 1) & WORD) | (read((pc + 2) & WORD) << 8 if op.mode == "abs" else 0)
+
+
+def _can_be_live(op: Op) -> bool:
+    """Whether an instruction can read its operand bytes at run time (exactly, as the batched core and
+    Machine do): not the control flow the blocks are cut by (branches, BBR/BBS, JSR: its push comes
+    between the reads of its target's bytes); JMP abs and JMP (ind) go through the dispatch then."""
+    return op.mode not in ("rel", "zpr") and op.mnemonic != "JSR"
+
+
+def live_operands(instructions: dict, read: Callable[[int], int]) -> set[int]:
+    """The instructions (their pc) whose operand bytes some store at a fixed address writes: they read
+    their operands from memory when they run. Untranslatable when a fixed store reaches an opcode byte or
+    an operand the translation decodes (`_can_be_live`). A store whose own operand is live has its image
+    target looked at all the same (conservative: an extra live instruction is exact, only slower)."""
+    holder = {(pc + k) & WORD: pc for pc, op in instructions.items() if op is not None
+              for k in range(1, MODE_LENGTH[op.mode])}
+    live: set[int] = set()
+    for pc, op in sorted(instructions.items()):
+        address = _fixed_target(pc, op, read)
+        if address is None or (address not in instructions and address not in holder):
+            continue
+        why = f"self-modifying code: the instruction at ${pc:04X} writes ${address:04X}, "
+        if address in instructions:
+            raise Untranslatable(why + "an opcode byte of the routine's code")
+        owner = holder[address]
+        if not _can_be_live(instructions[owner]):
+            raise Untranslatable(why + f"an operand byte of the instruction at ${owner:04X}: {DECODED}")
+        live.add(owner)
+    return live
+
+
 # ---- code generation ------------------------------------------------------------------------------------
 # State: a x y sp (ints), cycles; flags as fc fv fd fi (0/1) and N, Z lazily: N is bit 7 of `nv`, Z is
 # set when `zv` == 0 (most instructions set both from one value: one assignment each).
@@ -144,13 +195,15 @@ def _read(address: str) -> str:
 
 
 class _Emitter:
-    def __init__(self, cpu: str, code_bytes: frozenset[int], read: Callable[[int], int]) -> None:
+    def __init__(self, cpu: str, code_bytes: frozenset[int], read: Callable[[int], int],
+                 live: frozenset[int] = frozenset()) -> None:
         self.cpu = cpu
         self.decimal = cpu == "6510"  # NMOS decimal mode; the 2A03 has none; the 65C02's own below
         self.cmos = cpu == WDC_65C02
         self.binary = False  # D is 0 throughout (`decimal_free`): ADC and SBC inline, binary only
         self.adds = False  # an ADC or SBC was emitted: only then can D on entry make binary-only code wrong
-        self.code_bytes = code_bytes
+        self.code_bytes = code_bytes  # the bytes the translation fixed (not live operands)
+        self.live = live  # instructions that read their operand bytes at run time (`live_operands`)
         self.read = read
         self.lines: list[str] = []
         self.fixed_writes: set[int] = set()
@@ -166,7 +219,7 @@ class _Emitter:
 
     # memory
     def write_fixed(self, pc: int, address: int, value: str) -> None:
-        if address in self.code_bytes:
+        if address in self.code_bytes:  # (live_operands refused it first; kept so that no path misses it)
             raise Untranslatable(f"self-modifying code: the instruction at ${pc:04X} writes ${address:04X}, "
                                  f"a byte of the routine's code")
         self.fixed_writes.add(address)
@@ -190,11 +243,20 @@ class _Emitter:
         self.put(f"{into} = {_read(f'{STACK_PAGE} + sp')}")
 
     # operands: (address expression or int, page-crossing expression or None)
-    def address(self, pc: int, op: Op) -> tuple[str | int, str | None]:
+    def operand_bytes(self, pc: int, length: int) -> tuple[int | str, int | str]:
+        """(low byte, the word when `length` is 3): numbers folded into the code, or, for a live
+        instruction (`live_operands`), expressions of the bytes memory holds when it runs (the low
+        one in `w`); the page crossing is then computed from that run-time address."""
+        if pc in self.live:
+            self.put(f"w = {_read((pc + 1) & WORD)}")
+            return "w", (f"(w | ({_read((pc + 2) & WORD)} << 8))" if length == 3 else "w")
         lo = self.read((pc + 1) & WORD)
-        hi = self.read((pc + 2) & WORD)
-        word = lo | hi << 8
+        return lo, (lo | self.read((pc + 2) & WORD) << 8 if length == 3 else lo)
+
+    def address(self, pc: int, op: Op) -> tuple[str | int, str | None]:
         mode = op.mode
+        lo, word = self.operand_bytes(pc, MODE_LENGTH[mode])
+        following = (lo + 1) & BYTE if isinstance(lo, int) else f"({lo} + 1) & 255"
         if mode == "zpg":
             return lo, None
         if mode == "zpx":
@@ -202,6 +264,9 @@ class _Emitter:
         if mode == "zpy":
             return f"({lo} + y) & 255", None
         if mode == "abs":
+            if isinstance(word, str):
+                self.put(f"ea = {word}")
+                return "ea", None
             return word, None
         if mode in ("abx", "aby"):
             index = "x" if mode == "abx" else "y"
@@ -213,19 +278,23 @@ class _Emitter:
             self.put(f"ea = {_read('t')} | ({_read('(t + 1) & 255')} << 8)")
             return "ea", None
         if mode == "iny":
-            self.put(f"t = {_read(lo)} | ({_read((lo + 1) & BYTE)} << 8)")
+            self.put(f"t = {_read(lo)} | ({_read(following)} << 8)")
             self.put("ea = (t + y) & 65535")
             self.put("pg = ((t & 255) + y) >> 8")
             return "ea", "pg"
         if mode == "zpi":
-            self.put(f"ea = {_read(lo)} | ({_read((lo + 1) & BYTE)} << 8)")
+            self.put(f"ea = {_read(lo)} | ({_read(following)} << 8)")
             return "ea", None
         raise AssertionError(mode)  # pragma: no cover
+
+    def immediate(self, pc: int) -> str:
+        """An immediate operand: the number, or for a live instruction the byte memory holds then."""
+        return str(self.operand_bytes(pc, 2)[0])
 
     def operand(self, pc: int, op: Op) -> tuple[str, str | None]:
         """The value an instruction reads (an expression) and its page-crossing test."""
         if op.mode == "imm":
-            return str(self.read((pc + 1) & WORD)), None
+            return self.immediate(pc), None
         address, crossed = self.address(pc, op)
         self.put(f"v = {_read(address)}")
         return "v", crossed
@@ -443,17 +512,27 @@ def _emit_bit_branch(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], retur
 
 def _emit_jmp(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
     e.put(f"cycles += {op.cycles}")
-    pointer = e.read((pc + 1) & WORD) | e.read((pc + 2) & WORD) << 8
+    _, pointer = e.operand_bytes(pc, 3)
     if op.mode == "abs":
-        _go(e, pointer, blocks, return_pc)
+        if isinstance(pointer, int):
+            _go(e, pointer, blocks, return_pc)
+        else:  # a patched target: through the dispatch (a target no block starts at falls back)
+            e.put(f"t = {pointer}")
+            _jump_to(e, "t", blocks)
         return True
+    if isinstance(pointer, str):
+        e.put(f"w = {pointer}")
+        pointer = "w"
     if op.mode == "iax":
         e.put(f"t = ({pointer} + x) & 65535")
         e.put(f"t = {_read('t')} | ({_read('(t + 1) & 65535')} << 8)")
     elif e.cmos:
-        e.put(f"t = {_read(pointer)} | ({_read((pointer + 1) & WORD)} << 8)")
+        following = (pointer + 1) & WORD if isinstance(pointer, int) else f"({pointer} + 1) & 65535"
+        e.put(f"t = {_read(pointer)} | ({_read(following)} << 8)")
     else:  # NMOS: the high byte from the start of the pointer's page when the pointer ends one
-        e.put(f"t = {_read(pointer)} | ({_read((pointer & PAGE_MASK) | ((pointer + 1) & BYTE))} << 8)")
+        following = ((pointer & PAGE_MASK) | ((pointer + 1) & BYTE) if isinstance(pointer, int)
+                     else f"({pointer} & {PAGE_MASK}) | (({pointer} + 1) & 255)")
+        e.put(f"t = {_read(pointer)} | ({_read(following)} << 8)")
     _jump_to(e, "t", blocks)
     return True
 
@@ -497,7 +576,7 @@ def _emit_read(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: 
     if op.mode == "imp":  # the undocumented one-byte NOPs
         e.put(f"cycles += {op.cycles}")
     elif e.cmos and op.mnemonic == "BIT" and op.mode == "imm":  # 65C02 BIT #imm: Z only
-        e.put(f"zv = a & {e.read((pc + 1) & WORD)}")
+        e.put(f"zv = a & {e.immediate(pc)}")
         e.put(f"cycles += {op.cycles}")
     else:
         value, crossed = e.operand(pc, op)
@@ -630,12 +709,15 @@ def _exits(start: int, instructions: dict, leaders: set[int], return_pc: int, re
         pc = following
 
 
-def _inlined(starts: list[int], instructions: dict, entry: int, return_pc: int, read) -> set[int]:
+def _inlined(starts: list[int], instructions: dict, entry: int, return_pc: int, read,
+             live: frozenset[int] = frozenset()) -> set[int]:
     """Blocks whose code goes inside their one predecessor's: a block reached by one jump (or fall) from
-    a block before it, never by a return or as the entry. Forward only, so no loop is unrolled."""
+    a block before it, never by a return, a patched JMP (`live`: through the dispatch) or as the entry.
+    Forward only, so no loop is unrolled."""
     leaders = set(starts)
     into: dict[int, list[int]] = {start: [] for start in starts}
-    returned_to = set()
+    returned_to = {_successors(pc, instructions[pc], read)[0][0] for pc in live
+                   if instructions[pc].mnemonic == "JMP" and instructions[pc].mode == "abs"}
     for start in starts:
         goes, comes_back = _exits(start, instructions, leaders, return_pc, read)
         for target in goes:
@@ -721,11 +803,19 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
         if address in code_bytes:
             raise Untranslatable(f"self-modifying code: an input is placed at ${address:04X}, a byte of the "
                                  f"routine's code")
-    inlined = _inlined(starts, instructions, entry, return_pc, read)
+    live = frozenset(live_operands(instructions, read))
+    live_bytes = frozenset((pc + k) & WORD for pc in live for k in range(1, MODE_LENGTH[instructions[pc].mode]))
+
+    def fixed_read(address: int) -> int:  # the code generation never folds a byte that may be patched
+        if address in live_bytes:
+            raise AssertionError(f"${address:04X} is a live operand byte")  # pragma: no cover
+        return read(address)
+
+    inlined = _inlined(starts, instructions, entry, return_pc, read, live)
     dispatched = [start for start in starts if start not in inlined]
     blocks = {start: number for number, start in enumerate(dispatched + sorted(inlined))}
     leaders = set(starts)
-    e = _Emitter(cpu, code_bytes, read)
+    e = _Emitter(cpu, code_bytes - live_bytes, fixed_read, live)
     e.inlined = inlined
     e.binary = (e.decimal or e.cmos) and not decimal_entry and decimal_free(instructions.values(), sets)
 
@@ -767,7 +857,7 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
                               direct=returns_directly(instructions.values(), e.computed_writes, e.fixed_writes,
                                                       (address for _, _, address in places), lanes))
     return Translation(source, name, blocks, code_bytes, tuple(sorted(e.fixed_writes)), len(instructions),
-                       tuple(address for _, _, address in places), lanes, outputs, tuple(results))
+                       tuple(address for _, _, address in places), lanes, outputs, tuple(results), live_bytes)
 
 
 # The function around the blocks: one call per lane, inputs placed from the case columns (`cols`, a

@@ -355,9 +355,16 @@ def test_a_store_into_the_code_leaves_the_call_to_the_batched_core(compiled_cach
     assert left == 1 and compiled[1] == "fallback" and compiled[0][0] == 1
 
 
-def test_a_fixed_store_into_the_code_is_refused_with_its_reason():
-    image = image_with(bytes([0x8D, 0xA4, 0xC0, 0xA9, 0x00, 0x60]))  # STA $C0A4: LDA's operand
-    with pytest.raises(Untranslatable, match=r"self-modifying code: the instruction at \$C0A0 writes \$C0A4"):
+@pytest.mark.parametrize("code,written,why", [
+    (bytes([0x8D, 0xA3, 0xC0, 0xA9, 0x00, 0x60]), 0xC0A3, "an opcode byte"),  # STA $C0A3: LDA's opcode
+    (bytes([0xEE, 0xA4, 0xC0, 0x90, 0x00, 0x60]), 0xC0A4,  # INC $C0A4: BCC's offset
+     r"an operand byte of the instruction at \$C0A3: a branch's offset"),
+    (bytes([0x8D, 0xA4, 0xC0, 0x20, 0xA6, 0xC0, 0x60]), 0xC0A4,  # STA $C0A4: JSR's target
+     r"an operand byte of the instruction at \$C0A3: a branch's offset, a JSR's target"),
+])
+def test_a_fixed_store_into_an_opcode_or_a_decoded_operand_is_refused_with_its_reason(code, written, why):
+    image = image_with(code)
+    with pytest.raises(Untranslatable, match=rf"self-modifying code: the instruction at \$C0A0 writes \${written:04X}, {why}"):
         compile_routine(bytes(image), CODE, "6510", RETURN_TRAP)
 
 
@@ -427,3 +434,258 @@ def test_a_return_into_an_inlined_block_falls_back_instead_of_spinning(compiled_
     compiled, left = on_compiled("6510", code, registers, memory)
     assert left == 1 and compiled == ["fallback"]
     assert on_batch("6510", code, registers, memory)[0][0] == 7
+
+
+# ---- self-modifying code that patches operands ------------------------------------------------------------
+
+OPERAND_MODES = ("imm", "zpg", "zpx", "zpy", "abs", "abx", "aby", "inx", "iny", "zpi")
+PATCH_STORES = {"6510": [0x8D, 0x8E, 0x8C, 0x8F, 0xEE, 0xCE, 0x0E, 0x2E, 0x4E, 0x6E, 0xCF, 0xEF],  # STA..SAX, RMW, DCP, ISC
+                "2a03": [0x8D, 0x8E, 0x8C, 0xEE, 0xCE, 0x0E, 0x2E, 0x4E, 0x6E],
+                "65c02": [0x8D, 0x8E, 0x8C, 0xEE, 0xCE, 0x0E, 0x2E, 0x4E, 0x6E, 0x9C, 0x0C, 0x1C]}  # STZ, TSB, TRB
+
+
+def random_smc_program(cpu: str, seed: int, length: int = 34) -> bytes:
+    """Random instructions with operands, and stores at fixed addresses into their operand bytes (before
+    them, and after them inside counted loops, so a patch made on one pass is read on the next): STA of
+    A masked to $03-$04 into an absolute high byte (the data pages) or to $20-$3F into a zero-page
+    operand, any store or read-modify-write of any value into an immediate or a low byte (page
+    crossings either way); reads of the patched bytes (LDA abs of a code byte); now and then STA abs,X
+    into the code, X 2 or 3 from the data (landing on a patched operand when X is 3, on the byte before it else: an
+    opcode makes that call fall back); forward branches. Ends with RTS."""
+    rng = random.Random(seed)
+    table = tables_for(cpu)
+    pool = [op for op in _pool(cpu) if table[op].mode in OPERAND_MODES and not (cpu == "65c02" and table[op].kind == RESERVED)]
+    loop_pool = [op for op in pool if "Y" not in table[op].mnemonic and table[op].mode not in ("aby", "zpy", "iny")]
+    items: list = []  # ["op", bytes] / ["patch", store opcode] / ["peek"] / ["poke"] / ["branch", opcode, label] / ["label", n]
+    labels = 0
+    for _ in range(length):
+        roll = rng.random()
+        if roll < 0.3:
+            items.append(["patch", rng.choice(PATCH_STORES[cpu])])
+        elif roll < 0.36:
+            items.append(["peek"])
+        elif roll < 0.40:
+            labels += 1
+            items.append(["branch", rng.choice([0x90, 0xB0, 0xD0, 0xF0, 0x10, 0x30]), labels])
+            op = rng.choice(pool)
+            items.append(["op", bytes([op, *_operand(rng, table[op].mode)])])
+            items.append(["label", labels])
+        elif roll < 0.46:  # a counted loop whose body patches itself
+            labels += 1
+            items.append(["op", bytes([0xA0, rng.randrange(1, 4)])])
+            items.append(["label", labels])
+            for _ in range(rng.randrange(2, 5)):
+                if rng.random() < 0.5:
+                    items.append(["patch", rng.choice(PATCH_STORES[cpu])])
+                else:
+                    op = rng.choice(loop_pool)
+                    items.append(["op", bytes([op, *_operand(rng, table[op].mode)])])
+            items.append(["op", bytes([0x88])])
+            items.append(["branch", 0xD0, labels])
+        elif roll < 0.48:
+            items.append(["poke"])
+        else:
+            op = rng.choice(pool)
+            items.append(["op", bytes([op, *_operand(rng, table[op].mode)])])
+    items.append(["op", bytes([0x60])])
+    operands = [k for k, item in enumerate(items) if item[0] == "op" and len(item[1]) > 1]
+    target_of, mask_of = {}, {}  # per patch, peek and poke: (item, byte 1 or 2); per patch: (AND, ORA) or None
+    for k, item in enumerate(items):
+        if item[0] in ("patch", "peek"):
+            target = rng.choice(operands)
+            target_of[k] = (target, rng.randrange(1, len(items[target][1])))
+        if item[0] == "patch":
+            mode = table[items[target][1][0]].mode
+            high = mode in ("abs", "abx", "aby") and target_of[k][1] == 2
+            mask_of[k] = (0x01, 0x03) if high else (0x1F, 0x20) if mode not in ("imm", "abs", "abx", "aby") else None
+            if mask_of[k]:
+                item[1] = 0x8D  # STA of the masked A
+
+    patched = sorted({target_of[k] for k, item in enumerate(items) if item[0] == "patch"})
+    for k, item in enumerate(items):
+        if item[0] == "poke":  # onto a patched operand (a live instruction's), or the byte before it
+            target_of[k] = rng.choice(patched) if patched else (operands[0], 1)
+
+    def length_of(k: int, item) -> int:
+        if item[0] == "op":
+            return len(item[1])
+        if item[0] == "patch":
+            return 7 if mask_of[k] else 3
+        return {"peek": 3, "poke": 10, "branch": 2, "label": 0}[item[0]]
+
+    address, at, where = CODE, {}, {}
+    for k, item in enumerate(items):
+        at[k] = address
+        if item[0] == "label":
+            where[item[1]] = address
+        address += length_of(k, item)
+    code = bytearray()
+    for k, item in enumerate(items):
+        assert CODE + len(code) == at[k]
+        if item[0] == "op":
+            code += item[1]
+        elif item[0] == "branch":
+            offset = where[item[2]] - (CODE + len(code) + 2)
+            code += bytes([item[1], offset & 0xFF])
+        elif item[0] != "label":
+            target, byte = target_of[k]
+            written = at[target] + byte
+            if item[0] == "patch":
+                if mask_of[k]:
+                    code += bytes([0x29, mask_of[k][0], 0x09, mask_of[k][1]])  # AND #; ORA #
+                code += bytes([item[1], *written.to_bytes(2, "little")])
+            elif item[0] == "peek":
+                code += bytes([0xAD, *written.to_bytes(2, "little")])  # LDA abs: the operand byte as it is now
+            else:  # poke: X = 2 or 3 from the data (LDA $20; AND #1; ORA #2; TAX), STA base,X: on the chosen byte when X is 3
+                code += bytes([0xA5, 0x20, 0x29, 0x01, 0x09, 0x02, 0xAA, 0x9D, *(written - 3).to_bytes(2, "little")])
+    return bytes(code)
+
+
+@pytest.mark.parametrize("cpu,seed", [(cpu, seed) for cpu in ("6510", "2a03", "65c02") for seed in range(2)])
+def test_random_self_modifying_routines_agree_on_all_three_engines(cpu, seed, compiled_cache):
+    """Routines that patch their own operands (`random_smc_program`) are compiled, not refused; every call
+    agrees with the batched core and Machine (registers, flags, cycles with the page crossings of the
+    patched addresses, memory); only calls whose STA abs,X hit an opcode byte are left to the batched core."""
+    code = random_smc_program(cpu, 100 + seed * 3 + ("6510", "2a03", "65c02").index(cpu))
+    image = image_with(code)
+    push_return_trap(image)
+    assert translate(image.__getitem__, CODE, cpu, RETURN_TRAP).live_bytes  # some operands are read at run time
+    registers, memory = random_states(seed + 20, LANES)
+    compiled, left = on_compiled(cpu, code, registers, memory)
+    batch = on_batch(cpu, code, registers, memory)
+    machine = on_machine(cpu, code, registers, memory)
+    problems = _differences("compiled vs batch", compiled, batch) + _differences("batch vs Machine", batch, machine)
+    assert not problems, "\n".join(problems[:10])
+    assert left < LANES * 2 // 3  # (a poke with X = 2 onto a patched low byte hits the opcode: about half the calls)
+    assert sum(r is not None for r in compiled if r != "fallback") > LANES // 4
+
+
+def _three_engines(cpu: str, code: bytes, registers, memory, watched=WATCHED) -> tuple[list, int]:
+    """(the compiled engine's results, calls it left), after checking them against the batched core and
+    Machine call by call."""
+    compiled, left = on_compiled(cpu, code, registers, memory, watched)
+    batch = on_batch(cpu, code, registers, memory, watched)
+    problems = _differences("compiled vs batch", compiled, batch)
+    problems += _differences("batch vs Machine", batch, on_machine(cpu, code, registers, memory))
+    assert not problems, "\n".join(problems[:10])
+    return compiled, left
+
+
+def _data(memory, address: int) -> np.ndarray:
+    """Per call, the byte the calls start with at address (the data pages, zero beyond them)."""
+    if DATA.start <= address < DATA.stop:
+        return memory[:, len(ZERO_PAGE) + address - DATA.start]
+    return np.zeros(len(memory), dtype=np.int64)
+
+
+def test_a_patched_high_byte_reads_the_page_it_names_with_its_page_crossing(compiled_cache):
+    """CLC; ADC #$03; STA $C0A8 (the high byte of the next read); LDA $0380,Y; RTS, A 0 or 1: the read
+    is of page $03 or $04, crossing into the next when Y >= $80. By hand: 2 + 2 + 4 + 4 (+1) + 6 =
+    18-19 cycles, A the byte at $0380 + 256 A + Y."""
+    code = bytes([0x18, 0x69, 0x03, 0x8D, 0xA8, 0xC0, 0xB9, 0x80, 0x03, 0x60])
+    registers, memory = random_states(30, LANES)
+    registers[:, 0] &= 1
+    registers[:, 3] = 0x20
+    compiled, left = _three_engines("6510", code, registers, memory)
+    assert left == 0
+    a, y = registers[:, 0], registers[:, 2]
+    wanted = [int(_data(memory, 0x0380 + 256 * int(a[i]) + int(y[i]))[i]) for i in range(LANES)]
+    assert [r[0] for r in compiled] == wanted
+    assert [r[4] for r in compiled] == (18 + (y >= 0x80)).tolist()
+    assert {r[4] for r in compiled} == {18, 19}
+
+
+def test_a_patched_immediate_and_a_read_of_the_patched_byte(compiled_cache):
+    """STX $C0A7 (ADC's immediate); LDY $C0A7 (the patched byte, read back); ADC #$00; RTS. By hand:
+    Y = X, A = A + X + C, 4 + 4 + 2 + 6 = 16 cycles."""
+    code = bytes([0x8E, 0xA7, 0xC0, 0xAC, 0xA7, 0xC0, 0x69, 0x00, 0x60])
+    registers, memory = random_states(31, LANES)
+    registers[:, 3] = 0x20 | (registers[:, 3] & 1)
+    compiled, left = _three_engines("6510", code, registers, memory)
+    assert left == 0
+    a, x, c = registers[:, 0], registers[:, 1], registers[:, 3] & 1
+    assert [r[:3] for r in compiled] == list(zip(((a + x + c) & 255).tolist(), x.tolist(), x.tolist()))
+    assert [r[3] & 1 for r in compiled] == ((a + x + c) >> 8).tolist() and {r[4] for r in compiled} == {16}
+
+
+def test_a_patch_lasts_for_its_call_only(compiled_cache):
+    """BCC +5; LDA #$FF; STA $C0A8 (the low byte of the read); LDA $0300,X; RTS: the carry-set calls
+    patch the read to $03FF,X, and the carry-clear calls between and after them (and a second run of
+    the block) read $0300,X again: memory is the image at every call's start, as on the batched core.
+    By hand: clear 3 + 4 + 6 = 13 cycles; set 2 + 2 + 4 + 4 (+1 when X > 0) + 6 = 18-19."""
+    code = bytes([0x90, 0x05, 0xA9, 0xFF, 0x8D, 0xA8, 0xC0, 0xBD, 0x00, 0x03, 0x60])
+    registers, memory = random_states(32, LANES)
+    registers[:, 3] = 0x20 | (np.arange(LANES) % 2)  # carry clear, set, clear, ...
+    compiled, left = _three_engines("6510", code, registers, memory)
+    assert left == 0
+    x, c = registers[:, 1], registers[:, 3] & 1
+    wanted = [int(_data(memory, (0x03FF if c[i] else 0x0300) + int(x[i]))[i]) for i in range(LANES)]
+    assert [r[0] for r in compiled] == wanted
+    assert [r[4] for r in compiled] == np.where(c == 1, 18 + (x > 0), 13).tolist()
+    image = image_with(code)
+    sp = push_return_trap(image)
+    routine = compile_routine(bytes(image), CODE, "6510", RETURN_TRAP, columns=2, sets=((0, 0, SET_X), (1, 0, SET_P)))
+    columns = (np.ascontiguousarray(x, dtype=np.int64), np.ascontiguousarray(registers[:, 3], dtype=np.int64))
+    runs = [routine.run(bytes(image), columns, np.zeros(4, dtype=np.int64), sp, BUDGET, RETURN_TRAP, CALL_STACK_TOP,
+                        np.asarray([0xC0A8], dtype=np.int64), PLACED, np.ascontiguousarray(memory.T.astype(np.uint8)))
+            for _ in range(2)]
+    assert runs[0]["a"].tolist() == runs[1]["a"].tolist() == wanted
+    assert runs[1]["bytes"][0].tolist() == np.where(c == 1, 0xFF, 0x00).tolist()  # the patched byte as each call left it
+
+
+def test_an_indexed_store_may_land_on_a_patched_operand_but_not_on_an_opcode(compiled_cache):
+    """STY $C0A7 (a fixed patch: ADC's immediate is live); STA $C0A4,X; ADC #$00; RTS. The indexed
+    store lands on $C0A4 + X: X = 3, the live immediate (compiled: A = 2 A + C); X = 0, 1, 2, 4: the
+    STA's own operand, ADC's opcode, RTS (left to the batched core, which agrees); X = $10: past the
+    code (compiled: A = A + Y + C)."""
+    code = bytes([0x8C, 0xA7, 0xC0, 0x9D, 0xA4, 0xC0, 0x69, 0x00, 0x60])
+    registers, memory = random_states(33, LANES)
+    xs = np.array([3, 0, 1, 2, 4, 0x10])
+    registers[:, 1] = xs[np.arange(LANES) % len(xs)]
+    registers[:, 3] = 0x20 | (registers[:, 3] & 1)
+    compiled, left = _three_engines("6510", code, registers, memory)
+    a, x, y, c = registers[:, 0], registers[:, 1], registers[:, 2], registers[:, 3] & 1
+    fell = [r == "fallback" for r in compiled]
+    assert fell == np.isin(x, [0, 1, 2, 4]).tolist() and left == sum(fell)
+    ran = [i for i in range(LANES) if not fell[i]]
+    assert [compiled[i][0] for i in ran] == [int((a[i] + (a[i] if x[i] == 3 else y[i]) + c[i]) & 255) for i in ran]
+
+
+def test_a_patched_jmp_goes_through_the_dispatch(compiled_cache):
+    """STX $C0A8 (JMP's low byte); BEQ $C0AA; BCC $C0AA; JMP $C0B0 (patched); $C0AA: LDA #2; RTS; NOP x3;
+    $C0B0: LDA #3; RTS. With Z and C clear the JMP goes where X says: $B0 and $AA start blocks (both
+    dispatched: $C0AA has two ways in), compiled; $AD (a NOP inside a block) is left to the batched core."""
+    code = bytes([0x8E, 0xA8, 0xC0, 0xF0, 0x05, 0x90, 0x03, 0x4C, 0xB0, 0xC0, 0xA9, 0x02, 0x60,
+                  0xEA, 0xEA, 0xEA, 0xA9, 0x03, 0x60])
+    registers, memory = random_states(34, LANES)
+    xs = np.array([0xB0, 0xAA, 0xAD])
+    registers[:, 1] = xs[np.arange(LANES) % len(xs)]
+    registers[:, 3] = np.where(np.arange(LANES) % 7 == 0, 0x22, 0x21)  # Z set now and then: BEQ to $C0AA
+    compiled, left = _three_engines("6510", code, registers, memory)
+    x, z = registers[:, 1], registers[:, 3] == 0x22
+    fell = [r == "fallback" for r in compiled]
+    assert fell == ((x == 0xAD) & ~z).tolist() and left == sum(fell)
+    assert [r[0] for r in compiled if r != "fallback"] == [3 if x[i] == 0xB0 and not z[i] else 2
+                                                          for i in range(LANES) if not fell[i]]
+
+
+@pytest.mark.parametrize("cpu", ["6510", "65c02"])
+def test_a_patched_jmp_indirect_reads_its_pointer_where_the_patch_says(cpu, compiled_cache):
+    """BCS $C0A5; LDA #2; RTS; $C0A5: CLC; STX $C0AA (JMP's pointer low byte); JMP ($0300) (patched to
+    ($03xx)), carry set on entry. The pointer at $0310 is $C0A0 (the entry: carry now clear, A = 2; by
+    hand 3 + 2 + 4 + 5 + 2 + 2 + 6 = 24 cycles on the 6510, 25 on the 65C02, whose JMP (ind) takes 6);
+    at $03FF the NMOS takes the high byte from $0300 ($C0: the entry again), the 65C02 from $0400 ($00:
+    no block, left to the batched core); at $0320, $C0AA: inside an instruction, left."""
+    code = bytes([0xB0, 0x03, 0xA9, 0x02, 0x60, 0x18, 0x8E, 0xAA, 0xC0, 0x6C, 0x00, 0x03])
+    registers, memory = random_states(35, 30)
+    xs = np.array([0x10, 0xFF, 0x20])
+    registers[:, 1] = xs[np.arange(30) % len(xs)]
+    registers[:, 3] = 0x21
+    for address, byte in ((0x0310, 0xA0), (0x0311, 0xC0), (0x03FF, 0xA0), (0x0300, 0xC0), (0x0400, 0x00),
+                          (0x0320, 0xAA), (0x0321, 0xC0)):
+        memory[:, len(ZERO_PAGE) + address - DATA.start] = byte
+    compiled, left = _three_engines(cpu, code, registers, memory)
+    x = registers[:, 1]
+    fell = [r == "fallback" for r in compiled]
+    assert fell == ((x == 0x20) | ((x == 0xFF) & (cpu == "65c02"))).tolist() and left == sum(fell)
+    assert {(r[0], r[4]) for r in compiled if r != "fallback"} == {(2, 24 if cpu == "6510" else 25)}

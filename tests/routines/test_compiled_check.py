@@ -67,11 +67,47 @@ def test_every_spec_gives_the_same_record_on_all_three_engines(spec, capsys):
 
 
 @needs_numba
-def test_self_modifying_code_runs_on_the_batched_core_and_says_why(capsys):
-    code, (record,) = check_json(capsys, "pixel", "--engine", "compiled", "--random", "50")
+def test_self_modifying_code_that_patches_operands_runs_compiled(capsys):
+    """pixel patches the high bytes of two table reads: compiled, the same record as the batched core."""
+    common = ("--random", "300", "--no-search")
+    code_b, (batched,) = check_json(capsys, "pixel", "--engine", "batch", *common)
+    code_c, (compiled,) = check_json(capsys, "pixel", "--engine", "compiled", *common)
+    assert code_b == code_c == 0 and compiled["engine"] == "compiled" and not compiled["compiled_fallbacks"]
+    assert without_engine(batched) == without_engine(compiled)
+
+
+@needs_numba
+def test_auto_with_enough_cases_runs_pixel_compiled_with_the_batched_cores_record(capsys, monkeypatch):
+    """auto picks the compiled engine above its threshold (lowered here to the check's size, 20,000
+    cases: auto's threshold for an array engine): pixel's record is the batched core's."""
+    monkeypatch.setattr(engines, "AUTO_COMPILED_CASES", 20_000)
+    common = ("--random", "20000", "--no-search")
+    code_b, (batched,) = check_json(capsys, "pixel", "--engine", "batch", *common)
+    code_a, (auto,) = check_json(capsys, "pixel", "--engine", "auto", *common)
+    assert code_b == code_a == 0 and auto["engine"] == "compiled" and auto["engine_reason"].startswith("auto: ")
+    assert without_engine(batched) == without_engine(auto)
+
+
+@needs_numba
+def test_a_store_into_an_opcode_runs_on_the_batched_core_and_says_why(capsys, tmp_path):
+    (tmp_path / "smc_opcode.s").write_text(
+        "        .org $c000\n"
+        "smc_opcode:\n"
+        "        lda #$a9\n"
+        "        sta patch      ; the opcode of the next instruction (the same LDA #)\n"
+        "patch:  lda #0\n"
+        "        rts\n")
+    (tmp_path / "refs.py").write_text("def zero(x):\n    return 0\n")
+    (tmp_path / "smc_opcode.toml").write_text(
+        'summary = "a store into an opcode"\n[program]\nfile = "smc_opcode.s"\nentry = "smc_opcode"\n'
+        '[inputs]\nx = { at = "X", values = "0..3" }\n[outputs]\nbyte = "A"\n'
+        '[reference]\nfunction = "refs.py:zero"\n[cases]\nexhaustive = ["x"]\n[cycles]\nstatic = false\n')
+    spec = str(tmp_path / "smc_opcode.toml")
+    code, (record,) = check_json(capsys, spec, "--engine", "compiled")
     assert code == 0 and record["engine"] == "batch"
-    assert "self-modifying code" in record["engine_reason"]
-    main(["check", "pixel", "--engine", "compiled", "--random", "50", "--jobs", "1"])
+    assert record["engine_reason"] == ("the compiled engine does not take it: self-modifying code: the instruction "
+                                       "at $C002 writes $C005, an opcode byte of the routine's code")
+    main(["check", spec, "--engine", "compiled", "--jobs", "1"])
     assert "engine: batch (the compiled engine does not take it: self-modifying code" in capsys.readouterr().out
 
 
