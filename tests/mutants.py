@@ -56,6 +56,7 @@ STABILITY_TESTS = ("tests/study/test_stability_pinned.py", "tests/study/test_sta
 FIELD_TESTS = ("tests/test_fields.py",)
 COMPILED_TESTS = ("tests/cpu/test_compiled.py",)
 COMPILED_VECTOR_TESTS = ("tests/cpu/test_compiled_vectors.py",)  # needs RETRO_CPU_VECTORS
+IFCONV_TESTS = ("tests/cpu/test_compiled_ifconvert.py",)
 WORKER_TESTS = ("tests/test_workers.py",)
 STREAM_TESTS = ("tests/routines/test_case_stream.py",)
 GRID_TESTS = ("tests/routines/test_grid_columns.py", "tests/routines/test_case_stream.py")
@@ -592,7 +593,7 @@ MUTANTS = [
            'self.put(f"cycles += {base} + {crossed} * {PAGE_CROSS_CYCLES}")', 'self.put(f"cycles += {base}")',
            COMPILED_TESTS),
     Mutant("compiled-branch-page-cycle-dropped", "retro/cpu/translate.py",
-           "extra = BRANCH_TAKEN_CYCLES + (BRANCH_PAGE_CYCLES if", "extra = BRANCH_TAKEN_CYCLES + (0 if",
+           "return BRANCH_TAKEN_CYCLES + (BRANCH_PAGE_CYCLES if", "return BRANCH_TAKEN_CYCLES + (0 if",
            COMPILED_TESTS),
     Mutant("compiled-nmos-decimal-high-adjust-off-by-one", "retro/cpu/compiled_ops.py",
            "    if high >= 0xA0:", "    if high > 0xA0:", COMPILED_TESTS),
@@ -688,7 +689,7 @@ MUTANTS = [
            'lines.append(f"{SET_REGISTERS[what]} |= cols[{column}][lane] & 255")',
            COMPILED_TESTS + ("tests/routines/test_compiled_check.py",)),
     Mutant("compiled-taken-branch-cycle-dropped", "retro/cpu/translate.py",
-           "extra = BRANCH_TAKEN_CYCLES + (", "extra = 0 + (", COMPILED_VECTOR_TESTS),
+           "return BRANCH_TAKEN_CYCLES + (", "return 0 + (", COMPILED_VECTOR_TESTS),
     Mutant("compiled-6510-decimal-ignored", "retro/cpu/translate.py",
            'self.decimal = cpu == "6510"', 'self.decimal = False', COMPILED_VECTOR_TESTS),
     Mutant("compiled-2a03-decimal-applied", "retro/cpu/translate.py",
@@ -711,6 +712,28 @@ MUTANTS = [
            COMPILED_TESTS),
     Mutant("compiled-output-shift-lost", "retro/routines/batch_runs.py",
            'return self._with("<<", other)', 'return self._with("|", other)', ("tests/routines/test_compiled_check.py",)),
+    # ---- if-conversion (retro/cpu/ifconvert.py, translate.py's `_emit_converted`) ----------------------
+    Mutant("ifconv-store-made-on-both-ways", "retro/cpu/translate.py",
+           "        if self.guard is not None:  # a converted way's store", "        if False:  # a converted way's store",
+           IFCONV_TESTS),
+    Mutant("ifconv-nested-store-ignores-the-outer-way", "retro/cpu/translate.py",
+           'within = "" if e.guard is None else f"{e.guard} & "', 'within = ""', IFCONV_TESTS),
+    Mutant("ifconv-taken-way-starts-from-the-other-ways-state", "retro/cpu/translate.py",
+           '+ [f"{e.indent}{name} = s{k}_{name}" for name in fall_writes])', ")", IFCONV_TESTS),
+    Mutant("ifconv-selection-inverted", "retro/cpu/translate.py",
+           'e.put(f"{name} = choose({taken}, {name}, f{k}_{name})")',
+           'e.put(f"{name} = choose({taken}, f{k}_{name}, {name})")', IFCONV_TESTS),
+    Mutant("ifconv-select-picks-the-other", "retro/cpu/compiled_ops.py",
+           "return builder.select(flag, taken_value, other_value)", "return builder.select(flag, other_value, taken_value)",
+           IFCONV_TESTS),
+    Mutant("ifconv-taken-cycles-dropped", "retro/cpu/translate.py",
+           '    e.put(f"cycles += {_taken_cycles(region.pc, length, e.read((region.pc + length - 1) & WORD))}")\n',
+           "", IFCONV_TESTS),
+    Mutant("ifconv-computed-store-in-a-way", "retro/cpu/translate.py",
+           'if stores and op.mode not in ("zpg", "abs"):', "if False:", IFCONV_TESTS),
+    Mutant("ifconv-one-way-to-rts-is-enough", "retro/cpu/ifconvert.py",
+           "elif taken.end == RTS_JOIN and fall.end == RTS_JOIN:", "elif taken.end == RTS_JOIN or fall.end == RTS_JOIN:",
+           IFCONV_TESTS),
     Mutant("compiled-rts-without-plus-one", "retro/cpu/translate.py",
            'e.put("t = ((u << 8 | t) + 1) & 65535")', 'e.put("t = (u << 8 | t) & 65535")', COMPILED_VECTOR_TESTS),
 ]
