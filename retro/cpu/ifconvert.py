@@ -16,6 +16,10 @@ branches whose ways all end at an RTS converts whole). Every address a way passe
 than the one before, so the analysis ends and converts no loop. A region's cost (the instructions the
 converted code runs on every call, both ways and all nested ways) is held under MAX_COST: above it,
 running everything costs more than the jumps it saves.
+
+Two ways that do not meet but each end at a branch of their own to the same two addresses (tile's
+table tests) convert as a merged exit: both branches are evaluated, the way taken's decides, and the
+choice between the two addresses is a region of its own (`Region.then`), so the shared tails run once.
 """
 
 from __future__ import annotations
@@ -67,20 +71,27 @@ class Way:
 
 @dataclass(frozen=True)
 class Region:
-    """A converted branch at `pc`: its taken and its not-taken way to `join`."""
+    """A converted branch at `pc`: its taken and its not-taken way to `join`. Or, when `exits` names
+    them, ways that each end at a branch of their own (taken way's first) to the same two addresses:
+    both of those branches are evaluated, the one on the way taken decides, and `then` is the
+    converted choice between the two addresses (its pc: the taken way's branch; its taken way: from
+    that branch's target), which ends at `join` (tile: BCS to two table tests that both go to the
+    same two tails)."""
 
     pc: int
     taken: Way
     fall: Way
     join: int  # the address both ways reach, or RTS_JOIN: both end at an RTS (not run inside the ways)
+    exits: tuple[int, ...] = ()
+    then: "Region | None" = None
 
     @property
     def cost(self) -> int:
-        return 1 + self.taken.cost + self.fall.cost
+        return 1 + self.taken.cost + self.fall.cost + len(self.exits) + (self.then.cost if self.then else 0)
 
     @property
     def stores(self) -> bool:
-        return self.taken.stores or self.fall.stores
+        return self.taken.stores or self.fall.stores or (self.then is not None and self.then.stores)
 
 
 def plan(instructions: dict[int, Op | None], leaders: set[int], read: Callable[[int], int], return_pc: int,
@@ -88,7 +99,8 @@ def plan(instructions: dict[int, Op | None], leaders: set[int], read: Callable[[
     """Every conditional branch of the code that converts: {pc of the branch: Region}."""
     found: dict[int, Region | None] = {}
 
-    def walk(pc: int) -> Way:
+    def walk(pc: int, nested: bool = True) -> Way:
+        """The way from pc (`nested`: through the branches that convert, else to the first branch)."""
         items: list = []
         spent = 0
         passed = set()
@@ -101,7 +113,7 @@ def plan(instructions: dict[int, Op | None], leaders: set[int], read: Callable[[
                 return Way(tuple(items), RTS_JOIN)
             following = pc + MODE_LENGTH[op.mode]
             if op.mode in ("rel", "zpr") and op.mnemonic != "BRA":
-                region = region_at(pc)
+                region = region_at(pc) if nested else None
                 if region is None:
                     break
                 items.append((pc, region, region.cost, region.stores))
@@ -125,6 +137,36 @@ def plan(instructions: dict[int, Op | None], leaders: set[int], read: Callable[[
             pc = following
         return Way(tuple(items), pc)
 
+    def meeting(pc: int, taken: Way, fall: Way) -> Region | None:
+        """The region of two ways that meet (at an address, or each at an RTS), else None."""
+        common = [address for address in fall.boundaries() if address in set(taken.boundaries())]
+        if common and (common[0] in leaders or common[0] == return_pc):
+            join = common[0]  # the first address the way not taken reaches that the taken one reaches too
+            return Region(pc, taken.until(join), fall.until(join), join)
+        if taken.end == RTS_JOIN and fall.end == RTS_JOIN:
+            return Region(pc, taken, fall, RTS_JOIN)
+        return None
+
+    def targets(pc: int) -> tuple[int, int] | None:
+        """(target, following) of the conditional branch at pc, else None."""
+        op = instructions.get(pc)
+        if op is None or op.mode not in ("rel", "zpr") or op.mnemonic == "BRA":
+            return None
+        length = MODE_LENGTH[op.mode]
+        return branch_target(pc, read((pc + length - 1) & WORD), length), (pc + length) & WORD
+
+    def merged(pc: int, target: int, following: int) -> Region | None:
+        """Ways to two branches of their own to the same two addresses, and the choice between those."""
+        taken, fall = walk(target, nested=False), walk(following, nested=False)
+        first, second = targets(taken.end), targets(fall.end)
+        if first is None or second is None or taken.end == fall.end or set(first) != set(second) \
+                or first[0] == first[1]:
+            return None
+        then = meeting(taken.end, walk(first[0]), walk(first[1]))
+        if then is None:
+            return None
+        return Region(pc, taken, fall, then.join, (taken.end, fall.end), then)
+
     def region_at(pc: int) -> Region | None:
         if pc in found:
             return found[pc]
@@ -135,13 +177,9 @@ def plan(instructions: dict[int, Op | None], leaders: set[int], read: Callable[[
         following = pc + length
         region = None
         if following <= WORD:
-            taken, fall = walk(target), walk(following)
-            common = [address for address in fall.boundaries() if address in set(taken.boundaries())]
-            if common and (common[0] in leaders or common[0] == return_pc):
-                join = common[0]  # the first address the way not taken reaches that the taken one reaches too
-                region = Region(pc, taken.until(join), fall.until(join), join)
-            elif taken.end == RTS_JOIN and fall.end == RTS_JOIN:
-                region = Region(pc, taken, fall, RTS_JOIN)
+            region = meeting(pc, walk(target), walk(following))
+            if region is None or region.cost > MAX_COST:
+                region = merged(pc, target, following)
             if region is not None and region.cost > MAX_COST:
                 region = None
         found[pc] = region

@@ -478,7 +478,7 @@ CONVERTED_NOTE = "if-converted: both ways run, the taken one's state kept"  # (t
 CONVERTED_STATE = ("a", "x", "y", "nv", "zv", "fv", "fc", "fd", "fi", "cycles")
 TEMPORARIES = {"t", "u", "v", "ea", "w", "pg"}
 _ASSIGNED = re.compile(r"^\s*([a-z]\w*(?:\s*,\s*[a-z]\w*)*)\s*[-+|&^]?=(?!=)")
-_REGION_NAME = re.compile(r"^[csfg]\d+")  # the converted code's own variables: c7, s7_a, f7_a, g7t
+_REGION_NAME = re.compile(r"^[csfge]\d+")  # the converted code's own variables: c7, s7_a, f7_a, g7t, e7t
 
 
 def _assigned(lines: list[str]) -> set[str]:
@@ -534,12 +534,38 @@ def _emit_converted(e: _Emitter, region: ifconvert.Region) -> None:
     """The branch at region.pc without a jump (its base cycles counted already): the state after it is
     the taken way's or the other's, as the branch goes, at region.join."""
     k = e.converted
-    e.converted += 1
     op = e.instructions[region.pc]
     length = MODE_LENGTH[op.mode]
-    taken = f"c{k}"
     e.put(f"# ${region.pc:04X} {op.mnemonic} {CONVERTED_NOTE}")
-    e.put(f"{taken} = 1 if {_condition(e, region.pc, op)} else 0")
+    e.put(f"c{k} = 1 if {_condition(e, region.pc, op)} else 0")
+    _emit_ways(e, region, _taken_cycles(region.pc, length, e.read((region.pc + length - 1) & WORD)))
+    if region.then is not None:  # the ways' own branches, one chosen above (e{k}): their two addresses
+        e.put(f"# ${region.then.pc:04X} and ${region.exits[1]:04X}: the way taken's branch, {CONVERTED_NOTE}")
+        _emit_ways(e, region.then, 0, f"e{k}")
+
+
+def _exit_branch(e: _Emitter, pc: int, towards: int, into: str) -> None:
+    """A way's own last branch (a merged region's exit): its cycles, and `into` = 1 when it goes to `towards`."""
+    op = e.instructions[pc]
+    length = MODE_LENGTH[op.mode]
+    offset = e.read((pc + length - 1) & WORD)
+    e.put(f"# ${pc:04X} {op.mnemonic}")
+    e.put(f"cycles += {op.cycles}")
+    e.put(f"u = 1 if {_condition(e, pc, op)} else 0")
+    e.put(f"cycles += {_taken_cycles(pc, length, offset)} * u")
+    e.put(f"{into} = u" if branch_target(pc, offset, length) == towards else f"{into} = u ^ 1")
+
+
+def _emit_ways(e: _Emitter, region: ifconvert.Region, extra: int, taken: str | None = None) -> None:
+    """Both ways of a region, then the selection by `taken` (the branch's own test, c{k}, when None;
+    `extra`: what the taken way adds for the branch)."""
+    k = e.converted
+    e.converted += 1
+    taken = taken or f"c{k}"
+    towards = 0
+    if region.exits:  # where the taken way's own branch goes when taken: where e{k} = 1 leads
+        length = MODE_LENGTH[e.instructions[region.exits[0]].mode]
+        towards = branch_target(region.exits[0], e.read((region.exits[0] + length - 1) & WORD), length)
     guard_taken = guard_fall = None
     if region.stores:
         guard_taken, guard_fall = f"g{k}t", f"g{k}f"
@@ -548,16 +574,23 @@ def _emit_converted(e: _Emitter, region: ifconvert.Region) -> None:
         e.put(f"{guard_fall} = {within}({taken} ^ 1)")
     start = len(e.lines)
     _emit_way(e, region.fall, guard_fall)
+    if region.exits:
+        _exit_branch(e, region.exits[1], towards, f"e{k}f")
     fall_writes = [name for name in CONVERTED_STATE if name in _assigned(e.lines[start:])]
     e.lines[start:start] = [f"{e.indent}s{k}_{name} = {name}" for name in fall_writes]
     middle = len(e.lines)
-    e.put(f"cycles += {_taken_cycles(region.pc, length, e.read((region.pc + length - 1) & WORD))}")
+    if extra:
+        e.put(f"cycles += {extra}")
     _emit_way(e, region.taken, guard_taken)
+    if region.exits:
+        _exit_branch(e, region.exits[0], towards, f"e{k}t")
     changed = [name for name in CONVERTED_STATE if name in fall_writes or name in _assigned(e.lines[middle:])]
     e.lines[middle:middle] = ([f"{e.indent}f{k}_{name} = {name}" for name in changed]
                               + [f"{e.indent}{name} = s{k}_{name}" for name in fall_writes])
     for name in changed:
         e.put(f"{name} = choose({taken}, {name}, f{k}_{name})")
+    if region.exits:
+        e.put(f"e{k} = choose({taken}, e{k}t, e{k}f)")
 
 
 def _emit_jmp(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:

@@ -71,6 +71,25 @@ empty: lda #0
     rts
 """
 
+# tile's own shape: the two ways each end at a branch of their own to the same two tails, too long to
+# run twice each: the ways' branches are both evaluated, the one on the way taken chosen (a merged exit).
+MERGED = """
+.org $C0A0
+    lda $2A
+    beq empty
+    bcs right
+    ldy $2B
+    bmi empty
+good: lda ($30),y
+    tax
+    lda $0320,x
+    rts
+right: ldy $2D
+    bpl good
+empty: lda #0
+    rts
+"""
+
 # Branches into another page inside converted ways: +2 cycles when taken (+1, and +1 for the page).
 PAGES = """
 .org $C0A0
@@ -134,6 +153,7 @@ def _assembled(text: str, cpu: str, tmp_path) -> tuple[bytes, dict]:
 @pytest.mark.parametrize("name,text,cpu,branches", [
     ("shapes", SHAPES, "6510", 7),  # bmi s3, beq s3, bcc t1, bpl d1, bvs t2, bne far (RTS tree), beq z1
     ("backward", BACKWARD, "6510", 3),  # bcs right (both ways end at RTS), bmi empty, bpl good
+    ("merged", MERGED, "6510", 2),  # bcs right with its ways' bmi / bpl merged
     ("pages", PAGES, "6510", 2),
     ("cmos", CMOS, "65c02", 2),
     ("shapes-2a03", SHAPES, "2a03", 7),
@@ -180,3 +200,13 @@ def test_a_branch_with_one_way_to_rts_and_one_to_the_stack_keeps_its_jump(tmp_pa
                          "stack: pha\n    pla\n    eor #$55\n    rts\n").code
     assert _converted(code, "6510") == set()
     _agree("6510", code, 0)
+
+
+def test_ways_ending_at_two_branches_to_the_same_tails_merge_them(tmp_path):
+    """MERGED's BCS: each way ends at its own branch (BMI, BPL) to the same two tails; converting the
+    ways with the tails inside each costs more than MAX_COST, merging them costs less."""
+    code, symbols = _assembled(MERGED, "6510", tmp_path)
+    image = image_with(code)
+    push_return_trap(image)
+    source = translate(image.__getitem__, CODE, "6510", RETURN_TRAP, sets=((3, 0, 3),)).source
+    assert f"${symbols['right'] + 2:04X} and ${symbols['good'] - 2:04X}: the way taken's branch" in source
