@@ -19,6 +19,8 @@ from test_compiled import CODE, LANES, _differences, image_with, on_batch, on_co
 
 pytestmark = pytest.mark.skipif(numba_problem() is not None, reason=f"{numba_problem()}")
 
+# (Data are read at even zero-page addresses: the random states put $03 or $04 at the odd ones, the
+# high bytes of (zp) pointers, which would send a branch the same way on every call.)
 # A triangle over a triangle over a store (the inner store is made only when both ways are the ones
 # taken), triangles over fixed stores (zero page and absolute: made only on the way taken), a diamond
 # joined by a JMP, a triangle over a V test, and a tree whose ways end at RTS with a triangle inside.
@@ -26,32 +28,32 @@ SHAPES = """
 .org $C0A0
     lda $2E
     bmi s3
-    ldx $2F
+    ldx $3C
     beq s3
     sta $0312
 s3: lda $20
-    cmp $21
+    cmp $32
     bcc t1
     inc $22
     inx
-t1: lda $23
+t1: lda $34
     bpl d1
     eor #$FF
     sta $0310
     jmp j1
 d1: ora $24
-    ldy $25
+    ldy $36
 j1: bit $26
     bvs t2
     tay
-t2: cpy $27
+t2: cpy $38
     bne far
     lda $28
     beq z1
     adc #$10
 z1: rts
 far: sec
-    sbc $29
+    sbc $3A
     rts
 """
 
@@ -78,13 +80,13 @@ MERGED = """
     lda $2A
     beq empty
     bcs right
-    ldy $2B
+    ldy $2C
     bmi empty
 good: lda ($30),y
     tax
     lda $0320,x
     rts
-right: ldy $2D
+right: ldy $3E
     bpl good
 empty: lda #0
     rts
@@ -94,14 +96,14 @@ empty: lda #0
 PAGES = """
 .org $C0A0
     lda $20
-    ldx $21
+    ldx $32
     jmp near
 .advance $C0F8
 near: cmp $22
     bcs over
-    adc $23
+    adc $34
     sta $24
-over: cpx $25
+over: cpx $36
     beq done
     dex
     stx $0311
