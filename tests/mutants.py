@@ -56,6 +56,7 @@ STABILITY_TESTS = ("tests/study/test_stability_pinned.py", "tests/study/test_sta
 FIELD_TESTS = ("tests/test_fields.py",)
 COMPILED_TESTS = ("tests/cpu/test_compiled.py",)
 COMPILED_VECTOR_TESTS = ("tests/cpu/test_compiled_vectors.py",)  # needs RETRO_CPU_VECTORS
+IFCONV_TESTS = ("tests/cpu/test_compiled_ifconvert.py",)
 WORKER_TESTS = ("tests/test_workers.py",)
 STREAM_TESTS = ("tests/routines/test_case_stream.py",)
 GRID_TESTS = ("tests/routines/test_grid_columns.py", "tests/routines/test_case_stream.py")
@@ -628,7 +629,7 @@ MUTANTS = [
            'self.put(f"cycles += {base} + {crossed} * {PAGE_CROSS_CYCLES}")', 'self.put(f"cycles += {base}")',
            COMPILED_TESTS),
     Mutant("compiled-branch-page-cycle-dropped", "retro/cpu/translate.py",
-           "extra = BRANCH_TAKEN_CYCLES + (BRANCH_PAGE_CYCLES if", "extra = BRANCH_TAKEN_CYCLES + (0 if",
+           "return BRANCH_TAKEN_CYCLES + (BRANCH_PAGE_CYCLES if", "return BRANCH_TAKEN_CYCLES + (0 if",
            COMPILED_TESTS),
     Mutant("compiled-nmos-decimal-high-adjust-off-by-one", "retro/cpu/compiled_ops.py",
            "    if high >= 0xA0:", "    if high > 0xA0:", COMPILED_TESTS),
@@ -724,7 +725,7 @@ MUTANTS = [
            'lines.append(f"{SET_REGISTERS[what]} |= cols[{column}][lane] & 255")',
            COMPILED_TESTS + ("tests/routines/test_compiled_check.py",)),
     Mutant("compiled-taken-branch-cycle-dropped", "retro/cpu/translate.py",
-           "extra = BRANCH_TAKEN_CYCLES + (", "extra = 0 + (", COMPILED_VECTOR_TESTS),
+           "return BRANCH_TAKEN_CYCLES + (", "return 0 + (", COMPILED_VECTOR_TESTS),
     Mutant("compiled-6510-decimal-ignored", "retro/cpu/translate.py",
            'self.decimal = cpu == "6510"', 'self.decimal = False', COMPILED_VECTOR_TESTS),
     Mutant("compiled-2a03-decimal-applied", "retro/cpu/translate.py",
@@ -747,6 +748,35 @@ MUTANTS = [
            COMPILED_TESTS),
     Mutant("compiled-output-shift-lost", "retro/routines/batch_runs.py",
            'return self._with("<<", other)', 'return self._with("|", other)', ("tests/routines/test_compiled_check.py",)),
+    # ---- if-conversion (retro/cpu/ifconvert.py, translate.py's `_emit_converted`) ----------------------
+    Mutant("ifconv-store-made-on-both-ways", "retro/cpu/translate.py",
+           "        if self.guard is not None:  # a converted way's store", "        if False:  # a converted way's store",
+           IFCONV_TESTS),
+    Mutant("ifconv-nested-store-ignores-the-outer-way", "retro/cpu/translate.py",
+           'within = "" if e.guard is None else f"{e.guard} & "', 'within = ""', IFCONV_TESTS),
+    Mutant("ifconv-taken-way-starts-from-the-other-ways-state", "retro/cpu/translate.py",
+           '+ [f"{e.indent}{name} = s{k}_{name}" for name in fall_writes])', ")", IFCONV_TESTS),
+    Mutant("ifconv-selection-inverted", "retro/cpu/translate.py",
+           'e.put(f"{name} = choose({taken}, {name}, f{k}_{name})")',
+           'e.put(f"{name} = choose({taken}, f{k}_{name}, {name})")', IFCONV_TESTS),
+    Mutant("ifconv-select-picks-the-other", "retro/cpu/compiled_ops.py",
+           "return builder.select(flag, taken_value, other_value)", "return builder.select(flag, other_value, taken_value)",
+           IFCONV_TESTS),
+    Mutant("ifconv-taken-cycles-dropped", "retro/cpu/translate.py",
+           '    if extra:\n        e.put(f"cycles += {extra}")', "    if extra:\n        pass", IFCONV_TESTS),
+    Mutant("ifconv-computed-store-in-a-way", "retro/cpu/translate.py",
+           'if stores and op.mode not in ("zpg", "abs"):', "if False:", IFCONV_TESTS),
+    Mutant("ifconv-one-way-to-rts-is-enough", "retro/cpu/ifconvert.py",
+           "        if taken.end == RTS_JOIN and fall.end == RTS_JOIN:", "        if taken.end == RTS_JOIN or fall.end == RTS_JOIN:",
+           IFCONV_TESTS),
+    Mutant("ifconv-merged-exit-direction-inverted", "retro/cpu/translate.py",
+           'e.put(f"{into} = u" if branch_target(pc, offset, length) == towards else f"{into} = u ^ 1")',
+           'e.put(f"{into} = u ^ 1" if branch_target(pc, offset, length) == towards else f"{into} = u")', IFCONV_TESTS),
+    Mutant("ifconv-merged-exit-cycles-dropped", "retro/cpu/translate.py",
+           'e.put(f"cycles += {_taken_cycles(pc, length, offset)} * u")', "pass", IFCONV_TESTS),
+    Mutant("ifconv-merged-exit-of-the-other-way", "retro/cpu/translate.py",
+           'e.put(f"e{k} = choose({taken}, e{k}t, e{k}f)")', 'e.put(f"e{k} = choose({taken}, e{k}f, e{k}t)")',
+           IFCONV_TESTS),
     Mutant("compiled-rts-without-plus-one", "retro/cpu/translate.py",
            'e.put("t = ((u << 8 | t) + 1) & 65535")', 'e.put("t = (u << 8 | t) & 65535")', COMPILED_VECTOR_TESTS),
     # ---- each Machine call starts from the code as loaded; stated facts stay off the compiled engine --------
@@ -779,6 +809,9 @@ MUTANTS = [
     Mutant("compiled-smc-patched-absolute-address-ignored", "retro/cpu/translate.py",
            '                self.put(f"ea = {word}")\n                return "ea", None',
            '                self.put(f"ea = {word}")\n                return 0x0300, None', COMPILED_TESTS),
+    Mutant("compiled-live-store-converted", "retro/cpu/translate.py",
+           "    fixed = {pc: (None if pc in live else op) for pc, op in instructions.items()}",
+           "    fixed = instructions", ("tests/cpu/test_compiled_ifconvert.py",)),
 ]
 
 

@@ -15,13 +15,16 @@ N, V and Z; the 65C02's valid N and Z), and "NMOS 6510 Unintended Opcodes - No M
 from __future__ import annotations
 
 try:
-    from numba import njit
+    from llvmlite import ir as llvm_ir
+    from numba import njit, types
     from numba.core.compiler import CompilerBase, DefaultPassBuilder
+    from numba.extending import intrinsic
 except Exception:  # noqa: BLE001 - an unsupported Python or numpy fails at import in many ways
     def njit(*args, **kwargs):
         return lambda function: function
     CompilerBase = object
     DefaultPassBuilder = None
+    intrinsic = None
 
 
 class Pipeline(CompilerBase):
@@ -145,4 +148,32 @@ def sbc_cmos(a, value, carry, decimal):
     return sbc_decimal_cmos(a, value, carry) if decimal else adc_binary(a, value ^ 0xFF, carry)
 
 
-HELPERS = ("adc_binary", "adc_nmos", "sbc_nmos", "adc_cmos", "sbc_cmos", "arr", "Pipeline")  # what generated code uses
+if intrinsic is not None:
+    @intrinsic
+    def _select(typingctx, condition, taken, other):
+        """LLVM's `select` of two values each passed through an empty inline assembly block (no
+        instruction): with a value it can still see as a load, LLVM's code generator turns the select
+        back into a jump (to load only on the way that needs it), mispredicted half the time on
+        random data: the very cost the selection is there to remove."""
+        def codegen(context, builder, signature, args):
+            word = llvm_ir.IntType(64)
+            opaque = llvm_ir.FunctionType(word, [word])
+            taken_value, other_value = (builder.asm(opaque, "", "=r,0", [value], side_effect=False)
+                                        for value in args[1:])
+            flag = builder.icmp_signed("!=", args[0], llvm_ir.Constant(word, 0))
+            return builder.select(flag, taken_value, other_value)
+        return types.int64(types.int64, types.int64, types.int64), codegen
+else:
+    def _select(condition, taken, other):
+        return taken if condition else other
+
+
+@_jit
+def choose(condition, taken, other):
+    """`taken` when `condition` is not 0, else `other`, without a jump (a conditional move): the
+    compiled engine's if-converted branches (retro.cpu.translate) keep one way's state by it."""
+    return _select(condition, taken, other)
+
+
+HELPERS = ("adc_binary", "adc_nmos", "sbc_nmos", "adc_cmos", "sbc_cmos", "arr", "choose",
+           "Pipeline")  # what generated code uses

@@ -31,8 +31,11 @@ the report gives); a computed store into such bytes leaves the call to the batch
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+
+from retro.cpu import ifconvert
 
 from retro.cpu.mpu import FLAG_D
 from retro.cpu.opcodes import DOCUMENTED, MODE_LENGTH, OPCODE_TABLE, OPCODE_TABLE_65C02, RESERVED, STABLE, Op
@@ -46,7 +49,7 @@ from retro.cpu.timing import (
     branch_target,
 )
 
-TRANSLATOR_VERSION = 8  # part of every cache key: a change of the generated code's meaning bumps it
+TRANSLATOR_VERSION = 9  # part of every cache key: a change of the generated code's meaning bumps it
 # A call's status (the compiled function's per-call result): 0 returned, else why it stopped.
 RETURNED = 0
 BUDGET = 4  # the cycle budget was spent (retro.cpu.batch.LaneError.BUDGET)
@@ -213,6 +216,10 @@ class _Emitter:
         self.inlined: set[int] = set()
         self.chained: set[int] = set()  # blocks some code reaches through the dispatch
         self.emit_block: Callable[[int], None] = lambda start: None
+        self.instructions: dict[int, Op | None] = {}
+        self.regions: dict[int, ifconvert.Region] = {}  # branches run without a jump (`_emit_converted`)
+        self.converted = 0  # regions emitted so far: their variables' numbers
+        self.guard: str | None = None  # inside a converted way: the variable that is 1 when it is the way taken
 
     def put(self, line: str) -> None:
         self.lines.append(self.indent + line)
@@ -223,6 +230,8 @@ class _Emitter:
             raise Untranslatable(f"self-modifying code: the instruction at ${pc:04X} writes ${address:04X}, "
                                  f"a byte of the routine's code")
         self.fixed_writes.add(address)
+        if self.guard is not None:  # a converted way's store: made only on the way taken (`_emit_converted`)
+            value = f"choose({self.guard}, {value}, mem[{address}])"
         self.put(f"mem[{address}] = {value}")
 
     def write_at(self, address: str, value: str) -> None:
@@ -423,6 +432,7 @@ FLAG_SETTERS = {"CLC": ("fc", 0), "SEC": ("fc", 1), "CLI": ("fi", 0), "SEI": ("f
 TRANSFERS = {"TAX": ("x", "a"), "TAY": ("y", "a"), "TXA": ("a", "x"), "TYA": ("a", "y"), "TSX": ("x", "sp")}
 STEPS = {"INX": ("x", 1), "INY": ("y", 1), "DEX": ("x", -1), "DEY": ("y", -1)}
 SHIFTS_ABX_65C02 = {"ASL", "LSR", "ROL", "ROR"}
+TEST_BITS = {"TSB", "TRB", *(f"{kind}MB{bit}" for kind in "RS" for bit in range(8))}
 
 
 def _jump_to(e: _Emitter, target: str, blocks: dict[int, int]) -> None:
@@ -462,10 +472,17 @@ def _go(e: _Emitter, address: int, blocks: dict[int, int], return_pc: int) -> No
     e.put("continue")
 
 
+def _taken_cycles(pc: int, length: int, offset: int) -> int:
+    """What a taken branch adds: +1, and +1 more into another page than the next instruction's."""
+    following = (pc + length) & WORD
+    target = branch_target(pc, offset, length)
+    return BRANCH_TAKEN_CYCLES + (BRANCH_PAGE_CYCLES if (following & PAGE_MASK) != (target & PAGE_MASK) else 0)
+
+
 def _branch(e: _Emitter, condition: str, pc: int, length: int, offset: int, blocks, return_pc: int) -> None:
     following = (pc + length) & WORD
     target = branch_target(pc, offset, length)
-    extra = BRANCH_TAKEN_CYCLES + (BRANCH_PAGE_CYCLES if (following & PAGE_MASK) != (target & PAGE_MASK) else 0)
+    extra = _taken_cycles(pc, length, offset)
     e.put(f"if {condition}:")
     e.indent += "    "
     e.put(f"cycles += {extra}")
@@ -490,24 +507,159 @@ def _emit_stop(e: _Emitter, pc: int, op: Op | None, blocks: dict[int, int], retu
     return True
 
 
-def _emit_branch(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
-    e.put(f"cycles += {op.cycles}")
-    offset = e.read((pc + 1) & WORD)
+def _condition(e: _Emitter, pc: int, op: Op) -> str:
+    """When the branch at pc is taken (BBRn / BBSn zp, offset: the 65C02's bit branches)."""
     if op.mnemonic == "BRA":
-        _branch(e, "True", pc, 2, offset, blocks, return_pc)
-    else:
-        flag, wanted = BRANCH_CONDITIONS[e.read(pc)]
-        _branch(e, BRANCH_TESTS[flag][0 if wanted else 1], pc, 2, offset, blocks, return_pc)
-    return True
+        return "True"
+    if op.mode == "zpr":
+        test = f"({_read(e.read((pc + 1) & WORD))} >> {int(op.mnemonic[3])}) & 1"
+        return f"{test} == {1 if op.mnemonic[2] == 'S' else 0}"
+    flag, wanted = BRANCH_CONDITIONS[e.read(pc)]
+    return BRANCH_TESTS[flag][0 if wanted else 1]
 
 
-def _emit_bit_branch(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
-    """BBRn / BBSn zp, offset (65C02)."""
-    name = op.mnemonic
+def _emit_branch(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
+    """A branch (BXX offset, BBRn / BBSn zp, offset): a jump, or both ways run when it converts."""
     e.put(f"cycles += {op.cycles}")
-    test = f"({_read(e.read((pc + 1) & WORD))} >> {int(name[3])}) & 1"
-    _branch(e, f"{test} == {1 if name[2] == 'S' else 0}", pc, 3, e.read((pc + 2) & WORD), blocks, return_pc)
+    region = e.regions.get(pc)
+    if region is not None:
+        _emit_converted(e, region)
+        if region.join == ifconvert.RTS_JOIN:
+            return _emit_rts(e, pc, tables_for(e.cpu)[RTS_OPCODE], blocks, return_pc)
+        e.pc = pc
+        _go(e, region.join, blocks, return_pc)
+        return True
+    length = MODE_LENGTH[op.mode]
+    _branch(e, _condition(e, pc, op), pc, length, e.read((pc + length - 1) & WORD), blocks, return_pc)
     return True
+
+
+# ---- if-conversion (retro.cpu.ifconvert finds the regions) -----------------------------------------------
+# Both ways of a converted branch run, one after the other: the way not taken first, then, from the state
+# saved before it, the way taken; then each variable either way changed takes the taken way's value or
+# the other's by selection (no jump: LLVM's select). Inside a way nothing is seen outside but its
+# variables and its stores, which are conditional on the way being the one taken (`_Emitter.guard`),
+# so the way run in vain leaves memory as it was. Temporaries (t, u, v, ea, w, pg) are dead between
+# instructions; S, the write log and `bad` no way changes (the classifier keeps their writers out).
+
+RTS_OPCODE = 0x60
+CONVERTED_NOTE = "if-converted: both ways run, the taken one's state kept"  # (the generated code's comment)
+CONVERTED_STATE = ("a", "x", "y", "nv", "zv", "fv", "fc", "fd", "fi", "cycles")
+TEMPORARIES = {"t", "u", "v", "ea", "w", "pg"}
+_ASSIGNED = re.compile(r"^\s*([a-z]\w*(?:\s*,\s*[a-z]\w*)*)\s*[-+|&^]?=(?!=)")
+_REGION_NAME = re.compile(r"^[csfge]\d+")  # the converted code's own variables: c7, s7_a, f7_a, g7t, e7t
+
+
+def _assigned(lines: list[str]) -> set[str]:
+    """The state variables these generated lines assign (an unknown name is a translator bug)."""
+    names = set()
+    for line in lines:
+        match = _ASSIGNED.match(line)
+        if match:
+            names.update(name.strip() for name in match.group(1).split(","))
+    unknown = names - set(CONVERTED_STATE) - TEMPORARIES - {n for n in names if _REGION_NAME.match(n)}
+    if unknown:  # pragma: no cover - a way holding an instruction the classifier should have kept out
+        raise AssertionError(f"a converted way assigns {sorted(unknown)}")
+    return names & set(CONVERTED_STATE)
+
+
+def _way_kind(e: _Emitter, pc: int, op: Op) -> tuple[int, bool] | None:
+    """ifconvert's classifier: (cost, stores) of an instruction a converted way may hold, else None
+    (control flow, the stack, a store to a computed address: logged, checked against the code)."""
+    name = op.mnemonic
+    if name in STOPS or name in STACK_MNEMONICS or name in ("JMP", "JSR", "RTS") or op.mode in ("rel", "zpr"):
+        return None
+    stores = (name in STORES or name in TEST_BITS
+              or (name in (*SHIFTS, *COMBINED) and op.mode != "acc")) and not (e.cmos and op.kind == RESERVED)
+    if stores and op.mode not in ("zpg", "abs"):
+        return None
+    helper = name in HELPER_MNEMONICS and (name == "ARR" or (not e.binary and (e.decimal or e.cmos)))
+    return (HELPER_COST if helper else 1), stores
+
+
+HELPER_MNEMONICS = {"ADC", "SBC", "USBC", "RRA", "ISC", "ARR"}  # a call of a compiled_ops helper unless binary
+HELPER_COST = 3
+
+
+def _emit_way(e: _Emitter, way: ifconvert.Way, guard: str | None) -> None:
+    outer, e.guard = e.guard, guard
+    for pc, region, _, _ in way.items:
+        op = e.instructions[pc]
+        e.pc = pc
+        e.put(f"# ${pc:04X} {op.mnemonic}")
+        if region is not None:
+            e.put(f"cycles += {op.cycles}")
+            _emit_converted(e, region)
+        elif op.mnemonic == "BRA":
+            e.put(f"cycles += {op.cycles + _taken_cycles(pc, 2, e.read((pc + 1) & WORD))}")
+        elif op.mnemonic == "JMP":
+            e.put(f"cycles += {op.cycles}")
+        else:
+            _instruction(e, pc, op, {}, -1)
+    e.guard = outer
+
+
+def _emit_converted(e: _Emitter, region: ifconvert.Region) -> None:
+    """The branch at region.pc without a jump (its base cycles counted already): the state after it is
+    the taken way's or the other's, as the branch goes, at region.join."""
+    k = e.converted
+    op = e.instructions[region.pc]
+    length = MODE_LENGTH[op.mode]
+    e.put(f"# ${region.pc:04X} {op.mnemonic} {CONVERTED_NOTE}")
+    e.put(f"c{k} = 1 if {_condition(e, region.pc, op)} else 0")
+    _emit_ways(e, region, _taken_cycles(region.pc, length, e.read((region.pc + length - 1) & WORD)))
+    if region.then is not None:  # the ways' own branches, one chosen above (e{k}): their two addresses
+        e.put(f"# ${region.then.pc:04X} and ${region.exits[1]:04X}: the way taken's branch, {CONVERTED_NOTE}")
+        _emit_ways(e, region.then, 0, f"e{k}")
+
+
+def _exit_branch(e: _Emitter, pc: int, towards: int, into: str) -> None:
+    """A way's own last branch (a merged region's exit): its cycles, and `into` = 1 when it goes to `towards`."""
+    op = e.instructions[pc]
+    length = MODE_LENGTH[op.mode]
+    offset = e.read((pc + length - 1) & WORD)
+    e.put(f"# ${pc:04X} {op.mnemonic}")
+    e.put(f"cycles += {op.cycles}")
+    e.put(f"u = 1 if {_condition(e, pc, op)} else 0")
+    e.put(f"cycles += {_taken_cycles(pc, length, offset)} * u")
+    e.put(f"{into} = u" if branch_target(pc, offset, length) == towards else f"{into} = u ^ 1")
+
+
+def _emit_ways(e: _Emitter, region: ifconvert.Region, extra: int, taken: str | None = None) -> None:
+    """Both ways of a region, then the selection by `taken` (the branch's own test, c{k}, when None;
+    `extra`: what the taken way adds for the branch)."""
+    k = e.converted
+    e.converted += 1
+    taken = taken or f"c{k}"
+    towards = 0
+    if region.exits:  # where the taken way's own branch goes when taken: where e{k} = 1 leads
+        length = MODE_LENGTH[e.instructions[region.exits[0]].mode]
+        towards = branch_target(region.exits[0], e.read((region.exits[0] + length - 1) & WORD), length)
+    guard_taken = guard_fall = None
+    if region.stores:
+        guard_taken, guard_fall = f"g{k}t", f"g{k}f"
+        within = "" if e.guard is None else f"{e.guard} & "
+        e.put(f"{guard_taken} = {within}{taken}")
+        e.put(f"{guard_fall} = {within}({taken} ^ 1)")
+    start = len(e.lines)
+    _emit_way(e, region.fall, guard_fall)
+    if region.exits:
+        _exit_branch(e, region.exits[1], towards, f"e{k}f")
+    fall_writes = [name for name in CONVERTED_STATE if name in _assigned(e.lines[start:])]
+    e.lines[start:start] = [f"{e.indent}s{k}_{name} = {name}" for name in fall_writes]
+    middle = len(e.lines)
+    if extra:
+        e.put(f"cycles += {extra}")
+    _emit_way(e, region.taken, guard_taken)
+    if region.exits:
+        _exit_branch(e, region.exits[0], towards, f"e{k}t")
+    changed = [name for name in CONVERTED_STATE if name in fall_writes or name in _assigned(e.lines[middle:])]
+    e.lines[middle:middle] = ([f"{e.indent}f{k}_{name} = {name}" for name in changed]
+                              + [f"{e.indent}{name} = s{k}_{name}" for name in fall_writes])
+    for name in changed:
+        e.put(f"{name} = choose({taken}, {name}, f{k}_{name})")
+    if region.exits:
+        e.put(f"e{k} = choose({taken}, e{k}t, e{k}f)")
 
 
 def _emit_jmp(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
@@ -665,12 +817,12 @@ def _mnemonics(mode: str) -> set[str]:
 HANDLERS: dict[str, Callable[..., bool]] = {
     **{name: _emit_stop for name in STOPS},
     **{name: _emit_branch for name in _mnemonics("rel")},
-    **{name: _emit_bit_branch for name in _mnemonics("zpr")},
+    **{name: _emit_branch for name in _mnemonics("zpr")},
     "JMP": _emit_jmp, "JSR": _emit_jsr, "RTS": _emit_rts,
     **{name: _emit_store for name in STORES},
     **{name: _emit_read for name in READS},
     **{name: _emit_modify for name in (*SHIFTS, *COMBINED)},
-    **{name: _emit_test_bits for name in ("TSB", "TRB", *(f"{kind}MB{bit}" for kind in "RS" for bit in range(8)))},
+    **{name: _emit_test_bits for name in TEST_BITS},
     **{name: _implied(_set_flag) for name in FLAG_SETTERS},
     **{name: _implied(_transfer) for name in TRANSFERS},
     **{name: _implied(_step) for name in STEPS},
@@ -695,11 +847,16 @@ def _instruction(e: _Emitter, pc: int, op: Op | None, blocks: dict[int, int], re
     return handler(e, pc, op, blocks, return_pc)
 
 
-def _exits(start: int, instructions: dict, leaders: set[int], return_pc: int, read) -> tuple[list[int], list[int]]:
-    """(blocks a block goes to by its code, blocks reached later by an RTS: the addresses after its JSRs)."""
+def _exits(start: int, instructions: dict, leaders: set[int], return_pc: int, read,
+           regions: dict | None = None) -> tuple[list[int], list[int]]:
+    """(blocks a block goes to by its code, blocks reached later by an RTS: the addresses after its JSRs);
+    a converted branch (`regions`) goes only to its join."""
     pc = start
     while True:
         op = instructions[pc]
+        if regions and pc in regions:
+            join = regions[pc].join
+            return ([join] if join not in (ifconvert.RTS_JOIN, return_pc) else []), []
         targets, falls = _successors(pc, op, read)
         if op is not None and op.mnemonic == "JSR":
             return [t for t in targets[:1] if t != return_pc], targets[1:]  # a JSR to the return address starts no block
@@ -710,21 +867,29 @@ def _exits(start: int, instructions: dict, leaders: set[int], return_pc: int, re
 
 
 def _inlined(starts: list[int], instructions: dict, entry: int, return_pc: int, read,
-             live: frozenset[int] = frozenset()) -> set[int]:
-    """Blocks whose code goes inside their one predecessor's: a block reached by one jump (or fall) from
-    a block before it, never by a return, a patched JMP (`live`: through the dispatch) or as the entry.
-    Forward only, so no loop is unrolled."""
+             live: frozenset[int] = frozenset(), regions: dict | None = None) -> tuple[set[int], set[int]]:
+    """(blocks whose code goes inside their one predecessor's: a block reached by one jump (or fall) from
+    a block before it, never by a return, a patched JMP (`live`: through the dispatch) or as the entry;
+    forward only, so no loop is unrolled, blocks control reaches from the entry: not those only inside
+    converted branches' ways, `regions`)."""
     leaders = set(starts)
     into: dict[int, list[int]] = {start: [] for start in starts}
     returned_to = {_successors(pc, instructions[pc], read)[0][0] for pc in live
                    if instructions[pc].mnemonic == "JMP" and instructions[pc].mode == "abs"}
-    for start in starts:
-        goes, comes_back = _exits(start, instructions, leaders, return_pc, read)
+    reached, pending = {entry}, [entry]
+    while pending:
+        start = pending.pop()
+        goes, comes_back = _exits(start, instructions, leaders, return_pc, read, regions)
         for target in goes:
             into[target].append(start)
         returned_to.update(comes_back)
-    return {start for start, sources in into.items()
-            if start != entry and start not in returned_to and len(sources) == 1 and sources[0] < start}
+        for target in (*goes, *comes_back):
+            if target in into and target not in reached:
+                reached.add(target)
+                pending.append(target)
+    inlined = {start for start, sources in into.items()
+               if start != entry and start not in returned_to and len(sources) == 1 and sources[0] < start}
+    return inlined, reached
 
 
 def decimal_free(instructions: Iterable[Op | None], sets: tuple) -> bool:
@@ -811,13 +976,17 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
             raise AssertionError(f"${address:04X} is a live operand byte")  # pragma: no cover
         return read(address)
 
-    inlined = _inlined(starts, instructions, entry, return_pc, read, live)
-    dispatched = [start for start in starts if start not in inlined]
-    blocks = {start: number for number, start in enumerate(dispatched + sorted(inlined))}
-    leaders = set(starts)
     e = _Emitter(cpu, code_bytes - live_bytes, fixed_read, live)
-    e.inlined = inlined
     e.binary = (e.decimal or e.cmos) and not decimal_entry and decimal_free(instructions.values(), sets)
+    e.instructions = instructions
+    # a converted way never holds a live instruction (its patched store or JMP target is not the image's)
+    fixed = {pc: (None if pc in live else op) for pc, op in instructions.items()}
+    e.regions = ifconvert.plan(fixed, set(starts), fixed_read, return_pc, lambda pc, op: _way_kind(e, pc, op))
+    inlined, reached = _inlined(starts, instructions, entry, return_pc, read, live, e.regions)
+    dispatched = [start for start in starts if start in reached and start not in inlined]
+    blocks = {start: number for number, start in enumerate(dispatched + [s for s in starts if s not in dispatched])}
+    leaders = set(starts)
+    e.inlined = inlined
 
     def emit_block(start: int) -> None:
         pc = start
