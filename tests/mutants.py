@@ -736,6 +736,8 @@ MUTANTS = [
     Mutant("compiled-smc-patched-absolute-address-ignored", "retro/cpu/translate.py",
            '                self.put(f"ea = {word}")\n                return "ea", None',
            '                self.put(f"ea = {word}")\n                return 0x0300, None', COMPILED_TESTS),
+    Mutant("compiled-many-known-lanes-one-line-each", "retro/cpu/translate.py",
+           "    if lanes is None or len(lanes) > LINES_LIMIT:", "    if lanes is None:", COMPILED_TESTS),
 ]
 
 
