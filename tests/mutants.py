@@ -812,6 +812,8 @@ MUTANTS = [
     Mutant("compiled-live-store-converted", "retro/cpu/translate.py",
            "    fixed = {pc: (None if pc in live else op) for pc, op in instructions.items()}",
            "    fixed = instructions", ("tests/cpu/test_compiled_ifconvert.py",)),
+    Mutant("compiled-many-known-lanes-one-line-each", "retro/cpu/translate.py",
+           "    if lanes is None or len(lanes) > LINES_LIMIT:", "    if lanes is None:", COMPILED_TESTS),
 ]
 
 

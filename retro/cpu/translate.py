@@ -937,14 +937,19 @@ def _out_lines(results: tuple[tuple[str, str], ...]) -> str:
     return "\n".join(" " * 8 + line for line in lines)
 
 
+LINES_LIMIT = 64  # known lane or output addresses from which they are looped over, not written one line each
+
+
 def _lane_lines(lanes: tuple[int, ...] | None, outputs: tuple[int, ...] | None) -> tuple[str, str]:
     """The lines that put the per-lane bytes in place and copy the output bytes out: one line per
-    address when the addresses are known (an empty loop costs more than aabb8's whole call), else loops."""
-    if lanes is None:
+    address when the addresses are known (an empty loop costs more than aabb8's whole call), else loops
+    over the `lane_addr` and `out_addr` a run passes (`run` holds them to the known ones); loops too
+    above LINES_LIMIT addresses: numba's and LLVM's passes took over 200 s on hundreds of such lines."""
+    if lanes is None or len(lanes) > LINES_LIMIT:
         placing = "        for k in range(lane_addr.shape[0]):\n            mem[lane_addr[k]] = lane_bytes[k, lane]"
     else:
         placing = "\n".join(f"        mem[{address}] = lane_bytes[{k}, lane]" for k, address in enumerate(lanes))
-    if outputs is None:
+    if outputs is None or len(outputs) > LINES_LIMIT:
         copying = "        for k in range(out_addr.shape[0]):\n            out_bytes[k, lane] = mem[out_addr[k]]"
     else:
         copying = "\n".join(f"        out_bytes[{k}, lane] = mem[{address}]" for k, address in enumerate(outputs))

@@ -689,3 +689,27 @@ def test_a_patched_jmp_indirect_reads_its_pointer_where_the_patch_says(cpu, comp
     fell = [r == "fallback" for r in compiled]
     assert fell == ((x == 0x20) | ((x == 0xFF) & (cpu == "65c02"))).tolist() and left == sum(fell)
     assert {(r[0], r[4]) for r in compiled if r != "fallback"} == {(2, 24 if cpu == "6510" else 25)}
+
+
+def test_many_known_lane_and_output_addresses_are_looped_over(compiled_cache):
+    """1,500 known lane addresses and 1,500 known output addresses: above LINES_LIMIT the function loops
+    over the arrays a run passes (numba took minutes over hundreds of lines, one per address), so the
+    source does not grow with them; LDA $2000+k; STA $3000 copies one lane byte to the first output."""
+    from retro.cpu.translate import LINES_LIMIT
+
+    lanes = tuple(range(0x2000, 0x2000 + 1500))
+    outputs = tuple(range(0x3000, 0x3000 + 1500))
+    code = bytes([0xAD, 0xDB, 0x25, 0x8D, 0x00, 0x30, 0x60])  # LDA $25DB (the last lane byte); STA $3000; RTS
+    image = image_with(code)
+    sp = push_return_trap(image)
+    sizes = {count: len(translate(image.__getitem__, CODE, "6510", RETURN_TRAP, lanes=lanes[:count],
+                                  outputs=outputs[:count]).source) for count in (LINES_LIMIT + 1, len(lanes))}
+    assert sizes[LINES_LIMIT + 1] == sizes[len(lanes)]
+    routine = compile_routine(bytes(image), CODE, "6510", RETURN_TRAP, lanes=lanes, outputs=outputs)
+    n = 50
+    lane_bytes = np.random.default_rng(8).integers(0, 256, size=(len(lanes), n)).astype(np.uint8)
+    done = routine.run(bytes(image), (), np.asarray([0, 0, 0, 0x20], dtype=np.int64), sp, BUDGET, RETURN_TRAP,
+                       CALL_STACK_TOP, np.asarray(outputs, dtype=np.int64), np.asarray(lanes, dtype=np.int64), lane_bytes)
+    assert done["status"].tolist() == [0] * n and done["a"].tolist() == lane_bytes[-1].tolist()
+    assert done["bytes"][0].tolist() == lane_bytes[-1].tolist() and not done["bytes"][1:].any()
+    assert done["cycles"].tolist() == [4 + 4 + 6] * n

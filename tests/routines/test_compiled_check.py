@@ -78,9 +78,9 @@ def test_self_modifying_code_that_patches_operands_runs_compiled(capsys):
 
 @needs_numba
 def test_auto_with_enough_cases_runs_pixel_compiled_with_the_batched_cores_record(capsys, monkeypatch):
-    """auto picks the compiled engine above its threshold (lowered here to the check's size, 20,000
+    """auto picks the compiled engine above its threshold (lowered here below the check's work; 20,000
     cases: auto's threshold for an array engine): pixel's record is the batched core's."""
-    monkeypatch.setattr(engines, "AUTO_COMPILED_CASES", 20_000)
+    monkeypatch.setattr(engines, "AUTO_COMPILED_CYCLES", 1)
     common = ("--random", "20000", "--no-search")
     code_b, (batched,) = check_json(capsys, "pixel", "--engine", "batch", *common)
     code_a, (auto,) = check_json(capsys, "pixel", "--engine", "auto", *common)
