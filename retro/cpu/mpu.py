@@ -168,7 +168,6 @@ class MPU6510(_Py65MPU):
         self.current_op = op
         self.pc = (pc + 1) & ADDRESS_MASK
         self.excycles = 0
-        self.addcycles = self.extracycles[op]
         self.instruct[op](self)
         self.pc &= ADDRESS_MASK
         self.processorCycles += self.cycletime[op] + self.excycles
@@ -184,7 +183,6 @@ class MPU6510(_Py65MPU):
         memory = self.memory
         instruct = self.instruct
         cycletime = self.cycletime
-        extracycles = self.extracycles
         recent = self.recent
         count = 0
         try:
@@ -200,7 +198,6 @@ class MPU6510(_Py65MPU):
                 self.current_op = op
                 self.pc = (pc + 1) & ADDRESS_MASK
                 self.excycles = 0
-                self.addcycles = extracycles[op]
                 instruct[op](self)
                 self.pc &= ADDRESS_MASK
                 self.processorCycles += cycletime[op] + self.excycles
@@ -221,7 +218,6 @@ class MPU6510(_Py65MPU):
         read = memory.__getitem__
         instruct = self.instruct
         cycletime = self.cycletime
-        extracycles = self.extracycles
         bases, rules = model.bases, model.rules
         recent = self.recent
         append = None if record is None else record.append
@@ -251,7 +247,6 @@ class MPU6510(_Py65MPU):
                 self.current_op = op
                 self.pc = (pc + 1) & ADDRESS_MASK
                 self.excycles = 0
-                self.addcycles = extracycles[op]
                 instruct[op](self)
                 self.pc &= ADDRESS_MASK
                 self.processorCycles += cycletime[op] + self.excycles
@@ -297,7 +292,6 @@ class MPU6510(_Py65MPU):
         i_before = self.p & FLAG_I
         self.pc = (pc + 1) & ADDRESS_MASK
         self.excycles = 0
-        self.addcycles = self.extracycles[op]
         self.settled = (0, 0)
         self.instruct[op](self)
         self.pc &= ADDRESS_MASK
@@ -416,8 +410,8 @@ class MPU6510(_Py65MPU):
 
     def _indexed(self, base: int, index: int) -> int:
         address = (base + index) & ADDRESS_MASK
-        if self.addcycles and (base ^ address) & 0xFF00:
-            self.excycles += 1  # the page-crossing penalty of reads
+        if (base ^ address) & 0xFF00 and self.extracycles[self.current_op]:
+            self.excycles += 1  # the page-crossing penalty of reads (stores and RMW have none)
         return address
 
     def AbsoluteXAddr(self):
