@@ -168,7 +168,6 @@ class MPU6510(_Py65MPU):
         self.current_op = op
         self.pc = (pc + 1) & ADDRESS_MASK
         self.excycles = 0
-        self.addcycles = self.extracycles[op]
         self.instruct[op](self)
         self.pc &= ADDRESS_MASK
         self.processorCycles += self.cycletime[op] + self.excycles
@@ -184,7 +183,6 @@ class MPU6510(_Py65MPU):
         memory = self.memory
         instruct = self.instruct
         cycletime = self.cycletime
-        extracycles = self.extracycles
         recent = self.recent
         count = 0
         try:
@@ -200,7 +198,6 @@ class MPU6510(_Py65MPU):
                 self.current_op = op
                 self.pc = (pc + 1) & ADDRESS_MASK
                 self.excycles = 0
-                self.addcycles = extracycles[op]
                 instruct[op](self)
                 self.pc &= ADDRESS_MASK
                 self.processorCycles += cycletime[op] + self.excycles
@@ -221,7 +218,6 @@ class MPU6510(_Py65MPU):
         read = memory.__getitem__
         instruct = self.instruct
         cycletime = self.cycletime
-        extracycles = self.extracycles
         bases, rules = model.bases, model.rules
         recent = self.recent
         append = None if record is None else record.append
@@ -251,7 +247,6 @@ class MPU6510(_Py65MPU):
                 self.current_op = op
                 self.pc = (pc + 1) & ADDRESS_MASK
                 self.excycles = 0
-                self.addcycles = extracycles[op]
                 instruct[op](self)
                 self.pc &= ADDRESS_MASK
                 self.processorCycles += cycletime[op] + self.excycles
@@ -297,7 +292,6 @@ class MPU6510(_Py65MPU):
         i_before = self.p & FLAG_I
         self.pc = (pc + 1) & ADDRESS_MASK
         self.excycles = 0
-        self.addcycles = self.extracycles[op]
         self.settled = (0, 0)
         self.instruct[op](self)
         self.pc &= ADDRESS_MASK
@@ -416,8 +410,8 @@ class MPU6510(_Py65MPU):
 
     def _indexed(self, base: int, index: int) -> int:
         address = (base + index) & ADDRESS_MASK
-        if self.addcycles and (base ^ address) & 0xFF00:
-            self.excycles += 1  # the page-crossing penalty of reads
+        if (base ^ address) & 0xFF00 and self.extracycles[self.current_op]:
+            self.excycles += 1  # the page-crossing penalty of reads (stores and RMW have none)
         return address
 
     def AbsoluteXAddr(self):
@@ -784,6 +778,115 @@ def _register_undocumented(cls) -> None:
 
 _register_undocumented(MPU6510)
 MPU6510.cycletime[0xCE] = 6  # DEC abs: py65 1.2.0 charges 3; the datasheet says 6.
+
+
+# ---- the commonest instructions in one frame each --------------------------------------------------
+# py65 runs an instruction as three or four calls (instruction, operation, addressing mode, bus); these,
+# the opcodes that make most of the built-in routines' paths, do the same work with fewer. Same results,
+# cycles and bus accesses (data through ByteAt/WriteByte, opcode and operands from RAM): the CPU test
+# vectors run every opcode.
+
+def _set_nz(self, value: int) -> int:
+    self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+    return value
+
+
+def _fused_handlers() -> dict[int, object]:
+    def sta_zpg(self):
+        self.WriteByte(self.memory[self.pc], self.a)
+        self.pc += 1
+
+    def lda_zpg(self):
+        self.a = value = self.ByteAt(self.memory[self.pc])
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+        self.pc += 1
+
+    def lda_imm(self):
+        self.a = value = self.ByteAt(self.pc)
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+        self.pc += 1
+
+    def lda_abx(self):
+        memory, pc = self.memory, self.pc
+        self.a = value = self.ByteAt(self._indexed(memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8, self.x))
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+        self.pc += 2
+
+    def lda_iny(self):
+        self.a = value = self.ByteAt(self.IndirectYAddr())
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+        self.pc += 1
+
+    def ora_zpg(self):
+        self.a = value = self.a | self.ByteAt(self.memory[self.pc])
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+        self.pc += 1
+
+    def compare_zpg(register: str):
+        def handler(self):
+            diff = getattr(self, register) - self.ByteAt(self.memory[self.pc])
+            self.p = (self.p & _KEEP_ALL_BUT_NZC) | (diff & FLAG_N) | (FLAG_Z if diff == 0 else 0) \
+                | (FLAG_C if diff >= 0 else 0)
+            self.pc += 1
+        return handler
+
+    def adc_zpg(self):
+        self._adc(self.ByteAt(self.memory[self.pc]))
+        self.pc += 1
+
+    def sbc_zpg(self):
+        self._sbc(self.ByteAt(self.memory[self.pc]))
+        self.pc += 1
+
+    def tax(self):
+        self.x = _set_nz(self, self.a)
+
+    def tay(self):
+        self.y = _set_nz(self, self.a)
+
+    def txa(self):
+        self.a = _set_nz(self, self.x)
+
+    def tya(self):
+        self.a = _set_nz(self, self.y)
+
+    def iny(self):
+        self.y = _set_nz(self, (self.y + 1) & 0xFF)
+
+    def clc(self):
+        self.p &= ~FLAG_C
+
+    def sec(self):
+        self.p |= FLAG_C
+
+    def branch(flag: int, when_set: bool):
+        if when_set:
+            def handler(self):
+                if self.p & flag:
+                    self.BranchRelAddr()
+                else:
+                    self.pc += 1
+        else:
+            def handler(self):
+                if self.p & flag:
+                    self.pc += 1
+                else:
+                    self.BranchRelAddr()
+        return handler
+
+    handlers = {0x85: sta_zpg, 0xA5: lda_zpg, 0xA9: lda_imm, 0xBD: lda_abx, 0xB1: lda_iny, 0x05: ora_zpg,
+                0xC5: compare_zpg("a"), 0xC4: compare_zpg("y"), 0xE4: compare_zpg("x"), 0x65: adc_zpg,
+                0xE5: sbc_zpg, 0xAA: tax, 0xA8: tay, 0x8A: txa, 0x98: tya, 0xC8: iny, 0x18: clc, 0x38: sec}
+    for opcode, flag, when_set in ((0x10, FLAG_N, False), (0x30, FLAG_N, True), (0x50, FLAG_V, False),
+                                   (0x70, FLAG_V, True), (0x90, FLAG_C, False), (0xB0, FLAG_C, True),
+                                   (0xD0, FLAG_Z, False), (0xF0, FLAG_Z, True)):
+        handlers[opcode] = branch(flag, when_set)
+    return handlers
+
+
+for _opcode, _handler in _fused_handlers().items():
+    _handler.__name__ = f"inst_0x{_opcode:02x}"
+    MPU6510.instruct[_opcode] = _handler
 
 _py65_brk = MPU6510.instruct[OPCODE_BRK]
 

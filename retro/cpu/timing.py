@@ -217,11 +217,6 @@ def is_conditional_branch(op: OpTiming) -> bool:
     return op.mode in ("rel", "zpr") and op.mnemonic != "BRA"
 
 
-def branch_taken(opcode: int, p: int) -> bool:
-    flag, wanted = BRANCH_CONDITIONS[opcode]
-    return bool(p & flag) == bool(wanted)
-
-
 # ---- the rules as the run loop reads them: per opcode, its base cycles and what it adds ------------
 
 Rule = Callable[[Callable[[int], int], int, int, int, int, "int | None"], int]  # (read, pc, x, y, p, pointer) -> cycles
@@ -236,14 +231,32 @@ def _pointer(read: Callable[[int], int], pc: int, pointer: int | None) -> int:
     return read(zp) | read((zp + 1) & 0xFF) << 8
 
 
-def _branch_rule(is_taken: Callable[[int, int], bool], length: int) -> Rule:
-    """A branch: +1 when taken, +1 more when the target lies in another page than the next instruction;
-    `is_taken(p, read, pc, pointer)` decides (the offset is the instruction's last byte)."""
+def _taken_cycles(read: Callable[[int], int], pc: int, length: int) -> int:
+    """What a taken branch at pc adds: +1, and +1 more when the target lies in another page than the
+    next instruction (the offset is the instruction's last byte; `length` 2, or 3 for BBR/BBS)."""
+    after = (pc + length) & 0xFFFF
+    target = branch_target(pc, read((pc + length - 1) & 0xFFFF), length)
+    return BRANCH_TAKEN_CYCLES + (BRANCH_PAGE_CYCLES if (after ^ target) & PAGE_MASK else 0)
+
+
+def _flag_branch_rule(opcode: int) -> Rule:
+    """Bxx: taken when its flag has the value BRANCH_CONDITIONS says."""
+    flag, wanted = BRANCH_CONDITIONS[opcode]
+    when = flag if wanted else 0
+
     def extra(read, pc, x, y, p, pointer):
-        if not is_taken(p, read, pc, pointer):
-            return 0
-        target = branch_target(pc, read((pc + length - 1) & 0xFFFF), length)
-        return BRANCH_TAKEN_CYCLES + (BRANCH_PAGE_CYCLES if crosses_page((pc + length) & 0xFFFF, target) else 0)
+        return _taken_cycles(read, pc, 2) if (p & flag) == when else 0
+    return extra
+
+
+def _always_taken(read, pc, x, y, p, pointer):  # the 65C02's BRA
+    return _taken_cycles(read, pc, 2)
+
+
+def _bit_branch_rule(bit: int, when_set: bool) -> Rule:
+    """The 65C02's BBR/BBS: taken when the zero-page byte's bit (the pointer's low byte) is as named."""
+    def extra(read, pc, x, y, p, pointer):
+        return _taken_cycles(read, pc, 3) if bool(_pointer(read, pc, pointer) >> bit & 1) == when_set else 0
     return extra
 
 
@@ -252,13 +265,13 @@ def _page_rule(mode: str) -> Rule:
     if mode == "iny":
         def extra(read, pc, x, y, p, pointer):
             base = _pointer(read, pc, pointer)
-            return PAGE_CROSS_CYCLES if crosses_page(base, base + y) else 0
+            return PAGE_CROSS_CYCLES if (base ^ (base + y)) & PAGE_MASK else 0
         return extra
     use_x = mode == "abx"
 
     def extra(read, pc, x, y, p, pointer):
         base = read((pc + 1) & 0xFFFF) | read((pc + 2) & 0xFFFF) << 8
-        return PAGE_CROSS_CYCLES if crosses_page(base, base + (x if use_x else y)) else 0
+        return PAGE_CROSS_CYCLES if (base ^ (base + (x if use_x else y))) & PAGE_MASK else 0
     return extra
 
 
@@ -272,12 +285,11 @@ def _decimal_rule(rule: Rule | None) -> Rule:
 def _rule(opcode: int, op: OpTiming, cpu: str) -> Rule | None:
     rule: Rule | None = None
     if op.mnemonic == "BRA":
-        rule = _branch_rule(lambda p, read, pc, pointer: True, 2)
+        rule = _always_taken
     elif op.mode == "rel":
-        rule = _branch_rule(lambda p, read, pc, pointer: branch_taken(opcode, p), 2)
-    elif op.mode == "zpr":  # BBR/BBS: the zero-page byte they test is the pointer's low byte
-        bit, when_set = int(op.mnemonic[3]), op.mnemonic[2] == "S"
-        rule = _branch_rule(lambda p, read, pc, pointer: bool(_pointer(read, pc, pointer) >> bit & 1) == when_set, 3)
+        rule = _flag_branch_rule(opcode)
+    elif op.mode == "zpr":
+        rule = _bit_branch_rule(int(op.mnemonic[3]), op.mnemonic[2] == "S")
     elif op.page_penalty:
         rule = _page_rule(op.mode)
     if cpu == WDC_65C02 and op.mnemonic in ("ADC", "SBC"):

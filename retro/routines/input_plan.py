@@ -78,17 +78,22 @@ class InputPlan:
 
     def place(self, values: Sequence, table_byte: Callable, write: Callable,
               entry: tuple[dict, object, int] | None = None, scatter: Callable | None = None,
-              select: Callable | None = None) -> tuple[dict[str, object], object]:
+              select: Callable | None = None, write_table: Callable | None = None) -> tuple[dict[str, object], object]:
         """Put `values` (one per input: numbers, or arrays of lanes) in place: `write(address, byte)`
         for every memory byte as it is made (a block's arrays are consumed while in cache), and
         (register values, P) returned; `table_byte(value, k)` is byte k of a table input's value.
         `entry`: (free registers by name, free P bits, the free bits' mask) of an entry-state run
         (retro.routines.entry), replacing the baseline's values of the registers and flags no input
         or `[entry]` sets. Inputs placed by the case go through `scatter(address, byte)` (the
-        address: a number, or one per lane) and `select(condition, a, b)` (a where b otherwise)."""
+        address: a number, or one per lane) and `select(condition, a, b)` (a where b otherwise).
+        `write_table(addresses, value)`: a table input's bytes at once (one case: the value is its bytes),
+        instead of `write` byte by byte."""
         for index, address, shift in self.bytes:
             write(address, (values[index] >> shift) & 0xFF)
         for index, addresses in self.tables:
+            if write_table is not None:
+                write_table(addresses, values[index])
+                continue
             for k, address in enumerate(addresses):
                 write(address, table_byte(values[index], k))
         if self.vias is not None:

@@ -194,7 +194,8 @@ class RoutineRunner:
             touched = self.plan.vias.touched(case)
             writes += [(address, image[address]) for address in self._dirty + touched]
             self._dirty = touched
-        registers, p = self.plan.place(case, case_byte, lambda address, byte: writes.append((address, byte)), entry)
+        registers, p = self.plan.place(case, case_byte, lambda address, byte: writes.append((address, byte)), entry,
+                                       write_table=lambda addresses, value: writes.extend(zip(addresses, value)))
         if self._machine_s:
             registers["s"] = self.machine.entry_s  # the machine's stack top (the entry-state runs vary it)
         return writes, registers, p
