@@ -550,12 +550,7 @@ def test_random_self_modifying_routines_agree_on_all_three_engines(cpu, seed, co
     image = image_with(code)
     push_return_trap(image)
     assert translate(image.__getitem__, CODE, cpu, RETURN_TRAP).live_bytes  # some operands are read at run time
-    registers, memory = random_states(seed + 20, LANES)
-    compiled, left = on_compiled(cpu, code, registers, memory)
-    batch = on_batch(cpu, code, registers, memory)
-    machine = on_machine(cpu, code, registers, memory)
-    problems = _differences("compiled vs batch", compiled, batch) + _differences("batch vs Machine", batch, machine)
-    assert not problems, "\n".join(problems[:10])
+    compiled, left = _three_engines(cpu, code, *random_states(seed + 20, LANES))
     assert left < LANES * 2 // 3  # (a poke with X = 2 onto a patched low byte hits the opcode: about half the calls)
     assert sum(r is not None for r in compiled if r != "fallback") > LANES // 4
 

@@ -7,7 +7,6 @@ engine, the batched core and Machine: registers, flags, cycles and every watched
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from retro.assembler import assemble_file, assemble_text
@@ -15,7 +14,7 @@ from retro.cpu import ifconvert
 from retro.cpu.compiled import numba_problem
 from retro.cpu.machine import RETURN_TRAP, push_return_trap
 from retro.cpu.translate import CONVERTED_NOTE, translate
-from test_compiled import CODE, LANES, _differences, image_with, on_batch, on_compiled, on_machine, random_states
+from test_compiled import CODE, LANES, _three_engines, image_with, random_states
 
 pytestmark = pytest.mark.skipif(numba_problem() is not None, reason=f"{numba_problem()}")
 
@@ -132,12 +131,7 @@ def _converted(code: bytes, cpu: str) -> set[int]:
 
 
 def _agree(cpu: str, code: bytes, seed: int) -> None:
-    registers, memory = random_states(seed, LANES)
-    compiled, left = on_compiled(cpu, code, registers, memory)
-    batch = on_batch(cpu, code, registers, memory)
-    machine = on_machine(cpu, code, registers, memory)
-    problems = _differences("compiled vs batch", compiled, batch) + _differences("batch vs Machine", batch, machine)
-    assert not problems, "\n".join(problems[:10])
+    _, left = _three_engines(cpu, code, *random_states(seed, LANES))
     assert left == 0
 
 
