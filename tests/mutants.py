@@ -754,6 +754,8 @@ MUTANTS = [
     Mutant("compiled-jump-to-itself-unchecked", "retro/cpu/translate.py",
            "    if address <= e.pc:\n        _loop_check(e)", "    if address < e.pc:\n        _loop_check(e)",
            COMPILED_TESTS),
+    Mutant("compiled-whole-memory-restore-skipped", "retro/cpu/translate.py",
+           "                mem[k] = image[k]", "                pass", COMPILED_TESTS),
     Mutant("compiled-output-shift-lost", "retro/routines/batch_runs.py",
            'return self._with("<<", other)', 'return self._with("|", other)', ("tests/routines/test_compiled_check.py",)),
     # ---- if-conversion (retro/cpu/ifconvert.py, translate.py's `_emit_converted`) ----------------------

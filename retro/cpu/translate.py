@@ -49,7 +49,7 @@ from retro.cpu.timing import (
     branch_target,
 )
 
-TRANSLATOR_VERSION = 9  # part of every cache key: a change of the generated code's meaning bumps it
+TRANSLATOR_VERSION = 10  # part of every cache key: a change of the generated code's meaning bumps it
 # A call's status (the compiled function's per-call result): 0 returned, else why it stopped.
 RETURNED = 0
 BUDGET = 4  # the cycle budget was spent (retro.cpu.batch.LaneError.BUDGET)
@@ -1087,8 +1087,9 @@ def {name}(mem, image, log, code_map, addr_block, cols, lane_addr, lane_bytes, b
             status = {budget_status}
 {out_rows}
 {out_copying}
-        if nlog > LOG_MASK + 1:  # more writes than the log holds: the whole memory
-            mem[:] = image
+        if nlog > LOG_MASK + 1:  # more writes than the log holds: the whole memory (a loop: `mem[:] = image`
+            for k in range(mem.shape[0]):  # makes numba compile its shape-mismatch message, 1.6 CPU-s a process)
+                mem[k] = image[k]
         else:
             for k in range(nlog):
                 t = log[k]

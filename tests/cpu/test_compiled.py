@@ -708,3 +708,22 @@ def test_many_known_lane_and_output_addresses_are_looped_over(compiled_cache):
     assert done["status"].tolist() == [0] * n and done["a"].tolist() == lane_bytes[-1].tolist()
     assert done["bytes"][0].tolist() == lane_bytes[-1].tolist() and not done["bytes"][1:].any()
     assert done["cycles"].tolist() == [4 + 4 + 6] * n
+
+
+def test_a_call_writing_more_than_the_log_holds_leaves_memory_as_the_image(compiled_cache):
+    """LDY $0480; LDX #0; loop: STA $0400,X; STA $0401,X; INX; BNE loop; INY; BNE loop; RTS: 256 x 256 x 2 =
+    131,072 writes to computed addresses when $0480 holds 0 (the image's), twice the write log's 65,536,
+    so the call's writes are undone by copying the whole image back. The second call must find $0480 as
+    the image has it, not as the first call left it ($77: 137 outer rounds). By hand: 4 + 2 + 256 x (256 x
+    (5 + 5 + 2 + 3) - 1 + 2 + 3) - 1 + 6 = 984,075 cycles for each call."""
+    code = bytes([0xAC, 0x80, 0x04, 0xA2, 0x00, 0x9D, 0x00, 0x04, 0x9D, 0x01, 0x04, 0xE8, 0xD0, 0xF7,
+                  0xC8, 0xD0, 0xF4, 0x60])
+    image = image_with(code)
+    sp = push_return_trap(image)
+    routine = compile_routine(bytes(image), CODE, "6510", RETURN_TRAP, columns=1, sets=((0, 0, SET_A),))
+    done = routine.run(bytes(image), (np.array([0x77, 0x55], dtype=np.int64),), np.asarray([0, 0, 0, 0x20]), sp,
+                       10_000_000, RETURN_TRAP, CALL_STACK_TOP, np.asarray([0x0480], dtype=np.int64))
+    assert done["status"].tolist() == [0, 0]
+    assert done["bytes"][0].tolist() == [0x77, 0x55]
+    assert done["cycles"].tolist() == [984_075, 984_075]
+    assert bytes(routine.memory_for(bytes(image))[1].astype(np.uint8)) == bytes(image)  # the run left the image
