@@ -58,6 +58,7 @@ FALLBACK_STOP = 101  # an instruction not translated (BRK, RTI, JAM, unstable, S
 FALLBACK_JUMP = 102  # RTS or JMP (ind) to an address no dispatched block starts at
 FALLBACK_WRITE = 103  # a write into the routine's own code bytes
 FALLBACK_DECIMAL = 104  # D set on entry to code translated for binary mode only (`decimal_free`)
+STOPPED = -1  # inside the function only: a loop check stopped the call (the budget, or `bad`: a write into the code)
 NO_BLOCK = -1
 WORD = 0xFFFF
 BYTE = 0xFF
@@ -220,6 +221,7 @@ class _Emitter:
         self.regions: dict[int, ifconvert.Region] = {}  # branches run without a jump (`_emit_converted`)
         self.converted = 0  # regions emitted so far: their variables' numbers
         self.guard: str | None = None  # inside a converted way: the variable that is 1 when it is the way taken
+        self.returns = False  # an RTS was emitted: the dispatch gets the return arm (`_emit_return_arm`)
 
     def put(self, line: str) -> None:
         self.lines.append(self.indent + line)
@@ -452,8 +454,8 @@ def _loop_check(e: _Emitter) -> None:
     a computed jump): the call stops when the budget is spent or a write went into the code. Forward
     jumps go unchecked: their blocks start at ever higher addresses, so code without a backward jump
     ends by itself, and its cycles and writes are looked at once, when it does."""
-    e.put("if cycles >= budget or bad:")
-    e.put(f"    status = {FALLBACK_WRITE} if bad else {BUDGET}")
+    e.put("if (cycles >= budget) | (bad != 0):")
+    e.put(f"    status = {STOPPED}")  # which of the two: once, after the loop (fewer branches to compile)
     e.put("    break")
 
 
@@ -496,6 +498,7 @@ MAX_INDENT = 160  # spaces: nested inlined blocks stop here (Python's tokenizer 
 _Z_BIT = "(((zv - 1) >> 8) & 2)"  # P's Z bit from zv (0..255): 2 when zv == 0, without a branch
 BRANCH_TESTS = {0x80: ("nv >= 128", "nv < 128"), 0x40: ("fv", "fv == 0"), 0x01: ("fc", "fc == 0"),
                 0x02: ("zv == 0", "zv != 0")}
+BRANCH_VALUES = {0x80: "nv >> 7", 0x40: "fv", 0x01: "fc", 0x02: "((zv - 1) >> 8) & 1"}  # the flag as 0 or 1 (nv, zv 0..255)
 
 
 # One function per kind of instruction, each emitting it and returning True when it ends the block
@@ -507,14 +510,20 @@ def _emit_stop(e: _Emitter, pc: int, op: Op | None, blocks: dict[int, int], retu
     return True
 
 
-def _condition(e: _Emitter, pc: int, op: Op) -> str:
-    """When the branch at pc is taken (BBRn / BBSn zp, offset: the 65C02's bit branches)."""
+def _condition(e: _Emitter, pc: int, op: Op, value: bool = False) -> str:
+    """When the branch at pc is taken (BBRn / BBSn zp, offset: the 65C02's bit branches): a test for an
+    `if`, or with `value` an expression that is 1 when taken, else 0, computed without a branch (an
+    if-converted branch's choice: `x = 1 if test else 0` is two more basic blocks for numba to compile)."""
     if op.mnemonic == "BRA":
-        return "True"
+        return "1" if value else "True"
     if op.mode == "zpr":
         test = f"({_read(e.read((pc + 1) & WORD))} >> {int(op.mnemonic[3])}) & 1"
+        if value:
+            return test if op.mnemonic[2] == "S" else f"{test} ^ 1"
         return f"{test} == {1 if op.mnemonic[2] == 'S' else 0}"
     flag, wanted = BRANCH_CONDITIONS[e.read(pc)]
+    if value:
+        return BRANCH_VALUES[flag] if wanted else f"({BRANCH_VALUES[flag]}) ^ 1"
     return BRANCH_TESTS[flag][0 if wanted else 1]
 
 
@@ -606,7 +615,7 @@ def _emit_converted(e: _Emitter, region: ifconvert.Region) -> None:
     op = e.instructions[region.pc]
     length = MODE_LENGTH[op.mode]
     e.put(f"# ${region.pc:04X} {op.mnemonic} {CONVERTED_NOTE}")
-    e.put(f"c{k} = 1 if {_condition(e, region.pc, op)} else 0")
+    e.put(f"c{k} = {_condition(e, region.pc, op, value=True)}")
     _emit_ways(e, region, _taken_cycles(region.pc, length, e.read((region.pc + length - 1) & WORD)))
     if region.then is not None:  # the ways' own branches, one chosen above (e{k}): their two addresses
         e.put(f"# ${region.then.pc:04X} and ${region.exits[1]:04X}: the way taken's branch, {CONVERTED_NOTE}")
@@ -620,7 +629,7 @@ def _exit_branch(e: _Emitter, pc: int, towards: int, into: str) -> None:
     offset = e.read((pc + length - 1) & WORD)
     e.put(f"# ${pc:04X} {op.mnemonic}")
     e.put(f"cycles += {op.cycles}")
-    e.put(f"u = 1 if {_condition(e, pc, op)} else 0")
+    e.put(f"u = {_condition(e, pc, op, value=True)}")
     e.put(f"cycles += {_taken_cycles(pc, length, offset)} * u")
     e.put(f"{into} = u" if branch_target(pc, offset, length) == towards else f"{into} = u ^ 1")
 
@@ -699,15 +708,27 @@ def _emit_jsr(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: i
 
 
 def _emit_rts(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
+    """An RTS: the call's return when `direct`, else the one shared arm that pulls the address
+    (`_emit_return_arm`): a routine's every RTS (aabb_sprite has 27) in four lines, not fifteen."""
+    e.put(f"cycles += {op.cycles}")
     e.put("if direct:  # the caller's own return address, unchanged on the stack: the call has returned")
-    e.put(f"    cycles += {op.cycles}")
     e.put("    break")
+    e.put(f"blk = {len(blocks)}  # the return arm")
+    e.put("continue")
+    e.returns = True
+    return True
+
+
+def _emit_return_arm(e: _Emitter, blocks: dict[int, int]) -> None:
+    """The dispatch's arm after every block's (number len(blocks)): an RTS's return address pulled and
+    gone to (through the stack: a JSR's return, a pushed address, or the caller's when not `direct`)."""
+    e.indent = " " * 12
+    e.put(f"elif blk == {len(blocks)}:  # RTS: the return address from the stack")
+    e.indent = " " * 16
     e.pull("t")
     e.pull("u")
-    e.put(f"cycles += {op.cycles}")
     e.put("t = ((u << 8 | t) + 1) & 65535")
     _jump_to(e, "t", blocks)
-    return True
 
 
 def _store_to(e: _Emitter, pc: int, address: str | int, value: str) -> None:
@@ -1016,6 +1037,8 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
         e.indent = " " * 16
         emit_block(start)
         pending += sorted(e.chained - done - set(pending))
+    if e.returns:
+        _emit_return_arm(e, blocks)
     e.indent = " " * 12
     e.put("else:  # a block number the dispatch does not run (inlined code): never spin, leave the call")
     e.put(f"    status = {FALLBACK_JUMP}")
@@ -1024,7 +1047,7 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
     restore = "\n".join(f"        mem[{address}] = image[{address}]" for address in sorted(e.fixed_writes))
     placing_lanes, copying = _lane_lines(lanes, outputs)
     source = _FUNCTION.format(name=name, entry_block=blocks[entry], body="\n".join(e.lines), budget_status=BUDGET,
-                              bad="fd * 2" if e.binary and e.adds else "0", fallback_decimal=FALLBACK_DECIMAL,
+                              bad="fd * 2" if e.binary and e.adds else "0", fallback_decimal=FALLBACK_DECIMAL, stopped=STOPPED,
                               lane_placing=placing_lanes, out_copying=copying,
                               fallback_write=FALLBACK_WRITE, restore=restore, placing=_placing(places, sets),
                               out_rows=_out_lines(results),
@@ -1081,6 +1104,8 @@ def {name}(mem, image, log, code_map, addr_block, cols, lane_addr, lane_bytes, b
             status = {fallback_decimal} if bad else {budget_status}
         while status == 0:
 {body}
+        if status == {stopped}:
+            status = {fallback_write} if bad else {budget_status}
         if status == 0 and bad:
             status = {fallback_write}
         if status == 0 and cycles > budget:
