@@ -59,6 +59,7 @@ FALLBACK_JUMP = 102  # RTS or JMP (ind) to an address no dispatched block starts
 FALLBACK_WRITE = 103  # a write into the routine's own code bytes
 FALLBACK_DECIMAL = 104  # D set on entry to code translated for binary mode only (`decimal_free`)
 STOPPED = -1  # inside the function only: a loop check stopped the call (the budget, or `bad`: a write into the code)
+JUMPED = -2  # inside the function only: a computed jump stopped the call (`_jump_to`: which way, settled after the loop)
 NO_BLOCK = -1
 WORD = 0xFFFF
 BYTE = 0xFF
@@ -221,7 +222,7 @@ class _Emitter:
         self.regions: dict[int, ifconvert.Region] = {}  # branches run without a jump (`_emit_converted`)
         self.converted = 0  # regions emitted so far: their variables' numbers
         self.guard: str | None = None  # inside a converted way: the variable that is 1 when it is the way taken
-        self.returns = False  # an RTS was emitted: the dispatch gets the return arm (`_emit_return_arm`)
+        self.return_arm: int | None = None  # the block number of the shared return arm, if any (`_emit_return_arm`)
 
     def put(self, line: str) -> None:
         self.lines.append(self.indent + line)
@@ -437,15 +438,16 @@ SHIFTS_ABX_65C02 = {"ASL", "LSR", "ROL", "ROR"}
 TEST_BITS = {"TSB", "TRB", *(f"{kind}MB{bit}" for kind in "RS" for bit in range(8))}
 
 
-def _jump_to(e: _Emitter, target: str, blocks: dict[int, int]) -> None:
-    """Control goes to a computed address: the caller's return, a known block, or the batched core."""
-    e.put(f"if {target} == return_pc and sp == return_sp:")
+def _jump_to(e: _Emitter, blocks: dict[int, int]) -> None:
+    """Control goes to the computed address in `t`: a known block, or the call stops there (the
+    caller's return, an address no dispatched block starts at, the loop check's budget or write into
+    the code), in one test: which of them, and so the status, is settled once after the loop
+    (`_FUNCTION`'s JUMPED, in that order). Four tests at each of aabb_sprite's 27 RTSs were most of
+    its compile time; a shared arm of the dispatch for them made every call slower (mul8: 20%)."""
+    e.put("blk = addr_block[t]")
+    e.put("if (blk < 0) | ((t == return_pc) & (sp == return_sp)) | (cycles >= budget) | (bad != 0):")
+    e.put(f"    status = {JUMPED}")
     e.put("    break")
-    e.put(f"blk = addr_block[{target}]")
-    e.put("if blk < 0:")
-    e.put(f"    status = {FALLBACK_JUMP}")
-    e.put("    break")
-    _loop_check(e)
     e.put("continue")
 
 
@@ -462,7 +464,7 @@ def _loop_check(e: _Emitter) -> None:
 def _go(e: _Emitter, address: int, blocks: dict[int, int], return_pc: int) -> None:
     if address == return_pc:
         e.put(f"t = {address}")
-        _jump_to(e, "t", blocks)
+        _jump_to(e, blocks)
         return
     if address in e.inlined and len(e.indent) < MAX_INDENT:  # its only way in is from here: its code
         e.emit_block(address)  # follows, no trip through the dispatch
@@ -679,7 +681,7 @@ def _emit_jmp(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: i
             _go(e, pointer, blocks, return_pc)
         else:  # a patched target: through the dispatch (a target no block starts at falls back)
             e.put(f"t = {pointer}")
-            _jump_to(e, "t", blocks)
+            _jump_to(e, blocks)
         return True
     if isinstance(pointer, str):
         e.put(f"w = {pointer}")
@@ -694,7 +696,7 @@ def _emit_jmp(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: i
         following = ((pointer & PAGE_MASK) | ((pointer + 1) & BYTE) if isinstance(pointer, int)
                      else f"({pointer} & {PAGE_MASK}) | (({pointer} + 1) & 255)")
         e.put(f"t = {_read(pointer)} | ({_read(following)} << 8)")
-    _jump_to(e, "t", blocks)
+    _jump_to(e, blocks)
     return True
 
 
@@ -708,27 +710,39 @@ def _emit_jsr(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: i
 
 
 def _emit_rts(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: int) -> bool:
-    """An RTS: the call's return when `direct`, else the one shared arm that pulls the address
-    (`_emit_return_arm`): a routine's every RTS (aabb_sprite has 27) in four lines, not fifteen."""
+    """An RTS: the call's return when `direct`, else its return address pulled and gone to, here or,
+    in code of RETURN_ARM_FROM RTSs or more, in the dispatch's one return arm (`_emit_return_arm`)."""
     e.put(f"cycles += {op.cycles}")
     e.put("if direct:  # the caller's own return address, unchanged on the stack: the call has returned")
     e.put("    break")
-    e.put(f"blk = {len(blocks)}  # the return arm")
-    e.put("continue")
-    e.returns = True
+    if e.return_arm is not None:
+        e.put(f"blk = {e.return_arm}  # the return arm")
+        e.put("continue")
+        return True
+    _emit_return(e, blocks)
     return True
 
 
-def _emit_return_arm(e: _Emitter, blocks: dict[int, int]) -> None:
-    """The dispatch's arm after every block's (number len(blocks)): an RTS's return address pulled and
-    gone to (through the stack: a JSR's return, a pushed address, or the caller's when not `direct`)."""
-    e.indent = " " * 12
-    e.put(f"elif blk == {len(blocks)}:  # RTS: the return address from the stack")
-    e.indent = " " * 16
+def _emit_return(e: _Emitter, blocks: dict[int, int]) -> None:
     e.pull("t")
     e.pull("u")
     e.put("t = ((u << 8 | t) + 1) & 65535")
-    _jump_to(e, "t", blocks)
+    _jump_to(e, blocks)
+
+
+RETURN_ARM_FROM = 6  # RTSs from which they share the dispatch's return arm (aabb_sprite has 27)
+
+
+def _emit_return_arm(e: _Emitter, blocks: dict[int, int]) -> None:
+    """The dispatch's arm after every block's: an RTS's return address pulled and gone to. Shared by all
+    of a routine's RTSs when it has many: written out at each of aabb_sprite's 27 it was most of its
+    compile time (9.5 -> 3.7 CPU-s, side by side); an arm of the dispatch costs a call about 1 ns more
+    even when never taken (mul8: 5.2 -> 6.4 ns; aabb_sprite, 14-32 ns a call: within the noise), so
+    code with few RTSs keeps them written out."""
+    e.indent = " " * 12
+    e.put(f"elif blk == {e.return_arm}:  # RTS: the return address from the stack")
+    e.indent = " " * 16
+    _emit_return(e, blocks)
 
 
 def _store_to(e: _Emitter, pc: int, address: str | int, value: str) -> None:
@@ -958,6 +972,37 @@ def _out_lines(results: tuple[tuple[str, str], ...]) -> str:
     return "\n".join(" " * 8 + line for line in lines)
 
 
+_CONSTANT_CYCLES = re.compile(r"^(\s*)cycles \+= (\d+)$")
+_CONTROL = re.compile(r"^\s*(if|elif|else|while|for|break|continue)\b")
+
+
+def merge_cycles(lines: list[str]) -> list[str]:
+    """The generated lines with each straight run's constant `cycles += n` summed into one line at its
+    end: a run is lines of one indentation without control flow, ended by an `if`, `break`, `continue`
+    ..., another indentation, or a line that reads or sets `cycles` any other way (a page penalty, an
+    if-converted way's saved or chosen count). Nothing in between reads the count, so every exit sees
+    the same total; numba compiles a third fewer lines (aabb_sprite: 290 such lines), LLVM folded them
+    anyway."""
+    merged: list[str] = []
+    pending, indent = 0, ""
+    for line in lines:
+        if line.lstrip().startswith("#"):
+            merged.append(line)
+            continue
+        constant = _CONSTANT_CYCLES.match(line)
+        here = line[:len(line) - len(line.lstrip())]
+        if pending and (here != indent or _CONTROL.match(line) or ("cycles" in line and not constant)):
+            merged.append(f"{indent}cycles += {pending}")
+            pending = 0
+        if constant:
+            pending, indent = pending + int(constant.group(2)), here
+        else:
+            merged.append(line)
+    if pending:
+        merged.append(f"{indent}cycles += {pending}")
+    return merged
+
+
 LINES_LIMIT = 64  # known lane or output addresses from which they are looped over, not written one line each
 
 
@@ -1013,6 +1058,8 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
     blocks = {start: number for number, start in enumerate(dispatched + [s for s in starts if s not in dispatched])}
     leaders = set(starts)
     e.inlined = inlined
+    if sum(op is not None and op.mnemonic == "RTS" for op in instructions.values()) >= RETURN_ARM_FROM:
+        e.return_arm = len(blocks)
 
     def emit_block(start: int) -> None:
         pc = start
@@ -1037,7 +1084,7 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
         e.indent = " " * 16
         emit_block(start)
         pending += sorted(e.chained - done - set(pending))
-    if e.returns:
+    if e.return_arm is not None:
         _emit_return_arm(e, blocks)
     e.indent = " " * 12
     e.put("else:  # a block number the dispatch does not run (inlined code): never spin, leave the call")
@@ -1046,8 +1093,8 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
     name = "run_calls"
     restore = "\n".join(f"        mem[{address}] = image[{address}]" for address in sorted(e.fixed_writes))
     placing_lanes, copying = _lane_lines(lanes, outputs)
-    source = _FUNCTION.format(name=name, entry_block=blocks[entry], body="\n".join(e.lines), budget_status=BUDGET,
-                              bad="fd * 2" if e.binary and e.adds else "0", fallback_decimal=FALLBACK_DECIMAL, stopped=STOPPED,
+    source = _FUNCTION.format(name=name, entry_block=blocks[entry], body="\n".join(merge_cycles(e.lines)), budget_status=BUDGET,
+                              bad="fd * 2" if e.binary and e.adds else "0", fallback_decimal=FALLBACK_DECIMAL, stopped=STOPPED, jumped=JUMPED, returned=RETURNED, fallback_jump=FALLBACK_JUMP,
                               lane_placing=placing_lanes, out_copying=copying,
                               fallback_write=FALLBACK_WRITE, restore=restore, placing=_placing(places, sets),
                               out_rows=_out_lines(results),
@@ -1104,6 +1151,13 @@ def {name}(mem, image, log, code_map, addr_block, cols, lane_addr, lane_bytes, b
             status = {fallback_decimal} if bad else {budget_status}
         while status == 0:
 {body}
+        if status == {jumped}:  # the caller's return, else no block there, else the loop check (`_jump_to`)
+            if t == return_pc and sp == return_sp:
+                status = {returned}
+            elif blk < 0:
+                status = {fallback_jump}
+            else:
+                status = {stopped}
         if status == {stopped}:
             status = {fallback_write} if bad else {budget_status}
         if status == 0 and bad:

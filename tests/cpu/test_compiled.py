@@ -727,3 +727,19 @@ def test_a_call_writing_more_than_the_log_holds_leaves_memory_as_the_image(compi
     assert done["bytes"][0].tolist() == [0x77, 0x55]
     assert done["cycles"].tolist() == [984_075, 984_075]
     assert bytes(routine.memory_for(bytes(image))[1].astype(np.uint8)) == bytes(image)  # the run left the image
+
+
+def test_many_returns_share_the_return_arm_and_agree_on_all_three_engines(compiled_cache):
+    """JSR sub; ADC #1; JSR sub; RTS, and sub a ladder of CMP #k; BCS +1; RTS (six exits) ending in LDA #0;
+    RTS: eight RTSs (RETURN_ARM_FROM or more), so every RTS written (some rungs are if-converted
+    together) goes through the dispatch's one return arm (JSR pushes: not `direct`); every call agrees with the batched core and Machine."""
+    ladder = b"".join(bytes([0xC9, k, 0xB0, 0x01, 0x60]) for k in (0x20, 0x40, 0x60, 0x80, 0xA0, 0xC0))
+    sub = CODE + 9
+    code = bytes([0x20, sub & 0xFF, sub >> 8, 0x69, 0x01, 0x20, sub & 0xFF, sub >> 8, 0x60]) + ladder + bytes([0xA9, 0x00, 0x60])
+    image = image_with(code)
+    push_return_trap(image)
+    source = translate(image.__getitem__, CODE, "6510", RETURN_TRAP).source
+    assert source.count("# the return arm") >= 2 and "RTS: the return address from the stack" in source
+    compiled, left = _three_engines("6510", code, *random_states(40, LANES))
+    assert left == 0 and None not in compiled
+    assert len({r[4] for r in compiled}) > 4  # the calls leave the ladder at different rungs
