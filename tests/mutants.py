@@ -822,6 +822,19 @@ MUTANTS = [
            "    fixed = instructions", ("tests/cpu/test_compiled_ifconvert.py",)),
     Mutant("compiled-many-known-lanes-one-line-each", "retro/cpu/translate.py",
            "    if lanes is None or len(lanes) > LINES_LIMIT:", "    if lanes is None:", COMPILED_TESTS),
+    # ---- per-block overhead and start-up (blocks) ------------------------------------------------------
+    Mutant("compiled-entered-image-kept-after-a-new-call-image", "retro/routines/batch_runs.py",
+           "    if held is None or held[0] != s or held[1] != runner.call_image:",
+           "    if held is None or held[0] != s:", ("tests/routines/test_compiled_check.py",)),
+    Mutant("cli-one-command-builds-every-parser", "retro/cli.py",
+           "    parser = build_parser(argv[0] if argv and argv[0] in COMMANDS else None)",
+           "    parser = build_parser(None)", ("tests/test_commands.py",)),
+    Mutant("coverage-merge-skips-a-block-that-ran-code", "retro/analysis/coverage_model.py",
+           "        if other.worst_cycles is None and not any((other.executed,",
+           "        if other.worst_cycles is None and any((other.executed,", ("tests/routines/test_code_coverage.py",)),
+    Mutant("where-constant-term-not-spread", "retro/routines/where.py",
+           "    return truth if truth.shape == (n,) else np.broadcast_to(truth, (n,))",
+           "    return truth", ("tests/routines/test_where.py",)),
 ]
 
 
