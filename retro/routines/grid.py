@@ -127,9 +127,10 @@ class Grid:
         """Each axis's columns of combinations lo..hi-1, by name, in axis order. Axis k's digit of combination
         i is (i // s) % r, s the product of the later axes' lengths (its stride), r its own length: over a
         range of i, runs of s equal digits, the digits counting up modulo r; the column repeats every r * s
-        combinations. A column whose period is short enough (PERIODIC_LIMIT; the later axes' first, within
-        half of KEPT_BYTES for a block length) is a view into its periods laid out once (kept: every block
-        reads its own stretch of them, made by none), another one is made from its runs."""
+        combinations. A column whose period is short enough (PERIODIC_LIMIT) and repeats in the grid (one
+        that fits a block, or REPEATS_LAID_OUT periods in all; the later axes first, within half of
+        KEPT_BYTES for a block length) is a view into its periods laid out once (kept: every block reads its
+        own stretch of them, made by none); another one is made from its runs."""
         n = hi - lo
         if not 0 <= lo <= hi <= self.count:
             raise ValueError(f"Grid: combinations {lo}..{hi - 1} are not within 0..{self.count - 1}")
@@ -143,7 +144,8 @@ class Grid:
             radix = self.lengths[index]
             period = radix * stride
             laid_out = (period + n - 1) * 8 * len(self.axis_columns[index])
-            if period + n - 1 <= PERIODIC_LIMIT and laid_out <= budget:
+            if period + n - 1 <= PERIODIC_LIMIT and (period <= n or REPEATS_LAID_OUT * period <= self.count) \
+                    and laid_out <= budget:
                 budget -= laid_out
                 made.append([(name, self._periodic(index, k, stride, lo % period, n))
                              for k, (name, _) in enumerate(self.axis_columns[index])])
@@ -198,6 +200,8 @@ class _Column:
 KEPT_BYTES = 16 << 20  # a grid's periodic columns kept for the blocks after (several axes and columns)
 PERIODIC_LIMIT = 1 << 18  # combinations of a periodic column laid out (2 MiB): a longer period is made from its
 # runs per block (circle's dy columns, a period of 511 x 256 over blocks of 65,536, are views: no np.repeat a block)
+REPEATS_LAID_OUT = 4  # ... when the grid holds this many of its periods (else laying it out costs more than the runs
+# its few blocks make: tile_box's X, whose one period is the whole grid of two blocks)
 CONSTANTS_KEPT = 16  # constant columns kept (a make's constants, an axis held for a block: the same in the next ones)
 _constants: dict[tuple[int, int], np.ndarray] = {}
 _keeping = threading.Lock()  # the kept columns' dicts (a worker may make blocks on several threads)
