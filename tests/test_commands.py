@@ -7,6 +7,8 @@ in every command."""
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -35,10 +37,43 @@ def test_every_command_is_one_function_in_its_own_module():
     for name in COMMANDS:
         module = __import__(f"retro.commands.{name}", fromlist=[name])
         assert callable(getattr(module, name)), name
-        assert cli.COMMANDS[name] is module  # the command whole in its module: options and main beside it
+        assert cli.command_module(name) is module  # the command whole in its module: options and main beside it
         assert callable(module.add_options) and callable(module.main) and module.HELP, name
         if name != "demo":
             assert callable(module.lines), name
+
+
+def _actions(parser) -> list[tuple]:
+    return [(tuple(a.option_strings), a.dest, a.default, a.nargs, a.choices, a.required, type(a).__name__, a.help)
+            for a in parser._actions]
+
+
+def test_a_command_parses_alike_on_its_own_parser():
+    """A run of one command builds only that command's parser (cli.main): its options are the whole parser's."""
+    whole = subparsers()
+    assert tuple(whole) == cli.COMMANDS  # (the order `retro --help` lists them)
+    for name in cli.COMMANDS:
+        action = next(a for a in cli.build_parser(name)._actions if a.dest == "command")
+        assert list(action.choices) == [name]
+        assert _actions(action.choices[name]) == _actions(whole[name]), name
+
+
+ONE_COMMAND = """
+import json, sys
+from retro import cli
+try:
+    cli.main(["cycles", "--help"])
+except SystemExit as exc:
+    print(json.dumps([exc.code, sorted(m for m in sys.modules if m.startswith("retro.commands."))]))
+"""
+
+
+def test_a_command_imports_only_its_own_module():
+    """`retro cycles ...` loads retro.commands.cycles (and the check it is a view of), not the other commands."""
+    done = subprocess.run([sys.executable, "-c", ONE_COMMAND], capture_output=True, text=True)
+    assert "usage: retro cycles" in done.stdout, done.stderr
+    code, loaded = json.loads(done.stdout.strip().splitlines()[-1])
+    assert code == 0 and loaded == ["retro.commands.check", "retro.commands.cycles", "retro.commands.options"], loaded
 
 
 @pytest.mark.parametrize("option", ["--jobs", "--engine", "--quiet", "--method", "--out", "--json", "--scale"])

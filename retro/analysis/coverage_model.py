@@ -25,7 +25,11 @@ class CodeCoverage:
     worst_cycles: int | None = None
 
     def merge(self, other: "CodeCoverage") -> "CodeCoverage":
-        """Both blocks' counts added, the extremes kept, the worse case's path kept."""
+        """Both blocks' counts added, the extremes kept, the worse case's path kept (`self` itself when
+        `other` holds nothing: a block of the compiled engine, which counts no coverage)."""
+        if other.worst_cycles is None and not any((other.executed, other.taken, other.not_taken, other.cycles_min,
+                                                   other.cycles_max, other.worst_path)):
+            return self
         def added(a: dict[int, int], b: dict[int, int]) -> dict[int, int]:
             return {k: a.get(k, 0) + b.get(k, 0) for k in a.keys() | b.keys()}
 

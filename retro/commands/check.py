@@ -6,24 +6,19 @@ from __future__ import annotations
 import inspect
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from retro.analysis.check import RoutineCheck, inputs_by_name, run_checks
 from retro.analysis.check.coverage import coverage_line, coverage_record, summary
 from retro.analysis.check.entry_runs import VARIANTS
 from retro.analysis.check.results import describe_case, describe_outputs, entry_needs
 from retro.analysis.check.search import CYCLES_PER_CANDIDATE, DEFAULT_SEARCH, STALE_GENERATIONS
-from retro.analysis.junit import junit_xml
 from retro.analysis.raster import format_raster, raster_figures
 from retro.analysis.row_check import rows_lines, rows_record
 from retro.errors import InputError
 from retro.fileio import command_files, output_folder, read_text, write_all_atomic, write_atomic
-from retro.loaders.source_lines import has_line_information, read_source_map
 from retro.numbers import parse_int
 from retro.progress import Progress, quiet
-from retro.reports.annotated import Annotated, RoutineCode, annotate
-from retro.reports.coverage_html import html_pages
-from retro.reports.lcov import lcov_text
-from retro.reports.listing import listing_text
 from retro.routines import cases as case_sets
 from retro.routines.entry import EntryState
 from retro.chips.ppu.constants import DOTS_PER_LINE
@@ -37,6 +32,9 @@ from retro.commands import options
 from retro.progress import progress_printer
 from retro.routines.registry import builtin_names
 from retro.routines.spec import MAX_SEARCH
+
+if TYPE_CHECKING:  # (the reports and JUnit are imported where written: a check without them never loads them)
+    from retro.reports.annotated import Annotated, RoutineCode
 
 MAX_RANDOM = 10 ** 9
 MAX_JOBS = MAX_WORKERS
@@ -502,6 +500,8 @@ def _failure_lines(check: RoutineCheck) -> list[str]:
 def write_junit(checks: list[RoutineCheck], path: str | Path, *, scene: str | Path | None = None) -> Path:
     """`--junit FILE`: the checks as JUnit XML (retro.analysis.junit), written atomically and never
     over one of the check's inputs."""
+    from retro.analysis.junit import junit_xml
+
     return write_atomic(path, junit_xml(checks, format_check), inputs=input_files(checks, scene))
 
 
@@ -527,6 +527,9 @@ def input_files(checks: list[RoutineCheck], scene: str | Path | None = None) -> 
 def routine_code(check: RoutineCheck) -> RoutineCode:
     """What the coverage reports show of a checked routine: its program's bytes and labels, and its
     source lines from `[program] listing`, else from a symbol file that has them (an ld65 debug file)."""
+    from retro.loaders.source_lines import has_line_information, read_source_map
+    from retro.reports.annotated import RoutineCode
+
     routine = check.routine
     program = routine.program
     source_map = routine.source_map
@@ -539,6 +542,8 @@ def routine_code(check: RoutineCheck) -> RoutineCode:
 
 def annotated_checks(checks: list[RoutineCheck]) -> list[Annotated]:
     """Each check's code coverage on its routine's code; a check without it is an error naming it."""
+    from retro.reports.annotated import annotate
+
     missing = [c.routine.name for c in checks if getattr(c, "code_coverage", None) is None]
     if missing:
         raise InputError(f"no code coverage was recorded for {', '.join(missing)} (the compiled engine counts "
@@ -562,6 +567,10 @@ def write_coverage_reports(checks: list[RoutineCheck], *, listing: str | Path | 
     never over an input: the check's files, the listing or debug file, the source files it names."""
     if listing is None and lcov is None and html is None:
         return []
+    from retro.reports.coverage_html import html_pages
+    from retro.reports.lcov import lcov_text
+    from retro.reports.listing import listing_text
+
     routines = annotated_checks(checks)
     inputs = input_files(checks, scene)
     for annotated in routines:

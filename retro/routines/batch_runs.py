@@ -153,10 +153,10 @@ def compiled_routine(runner: RoutineRunner, free: tuple = ()):
     from retro.cpu.compiled import SET_FLAG, SET_REGISTERS, compile_routine
     from retro.cpu.mpu import FLAG_D
 
-    image = bytes(runner.call_image)
     held = runner._compiled if not free else runner._compiled_free.get(free)
-    if held is not None and (held[2] == image or all(image[a] == b for a, b in held[1])):
+    if held is not None and (held[2] == runner.call_image or all(runner.call_image[a] == b for a, b in held[1])):
         return held[0]
+    image = bytes(runner.call_image)
     plan = runner.plan
     inputs_at = [address for _, address, _ in plan.bytes] + [a for _, addresses in plan.tables for a in addresses]
     trapped = bytearray(image)
@@ -257,12 +257,10 @@ def run_compiled(runner: RoutineRunner, columns: list,
     lane_addr, lane_bytes = _lane_bytes(plan, columns, n)
     flat = tuple(np.ascontiguousarray(c if c.ndim == 1 else c[:, 0], dtype=np.int64) for c in [*columns, *extra])
     base = np.asarray([start["a"], start["x"], start["y"], p], dtype=np.int64)
-    image = bytearray(runner.call_image)
     s = runner.fixed_entry_s
-    stack_pointer = push_return_trap(image, s)
+    image = _entered_image(runner, s)
     out_addr = np.asarray(plan.output_addresses, dtype=np.int64)
-    done = compiled.run(bytes(image), flat, base, stack_pointer, runner.limit, RETURN_TRAP, return_s(s), out_addr,
-                        lane_addr, lane_bytes)
+    done = compiled.run(image, flat, base, s, runner.limit, RETURN_TRAP, return_s(s), out_addr, lane_addr, lane_bytes)
     outputs = _outputs(runner.routine.outputs, done, out_addr)
     status = done["status"]
     cycles = done["cycles"]
@@ -271,6 +269,18 @@ def run_compiled(runner: RoutineRunner, columns: list,
     error = np.where(status == LaneError.BUDGET, LaneError.BUDGET, 0).astype(np.int8)
     _rerun_fallbacks(runner, columns, status, outputs, cycles, error, entry)
     return BatchOutcome(outputs, cycles, error)
+
+
+def _entered_image(runner: RoutineRunner, s: int) -> bytes:
+    """The runner's call image with the return trap pushed for entry with S = `s` (push_return_trap), kept
+    while the call image stays the same: a sweep's blocks share one (no copy of the 64 KiB per block, and
+    the compiled routine finds its working memory made for the very same bytes)."""
+    held = runner._entered_image
+    if held is None or held[0] != s or held[1] != runner.call_image:
+        image = bytearray(runner.call_image)
+        push_return_trap(image, s)
+        held = runner._entered_image = (s, bytes(runner.call_image), bytes(image))
+    return held[2]
 
 
 def _outputs(ports, done: dict, out_addr: np.ndarray) -> list:

@@ -728,7 +728,7 @@ def _port_column(port: Port, values, where: str) -> np.ndarray:
         column = np.asarray(values)
     except (TypeError, ValueError):
         column = np.asarray([])
-    if column.dtype == bool or not np.issubdtype(column.dtype, np.integer):
+    if column.dtype != np.int64 and (column.dtype == bool or not np.issubdtype(column.dtype, np.integer)):
         raise InputError(f"{where}: column {port.name} must hold whole numbers, got {column.dtype}")
     shape_ok = column.ndim == 2 and column.shape[1] == len(port.places) if port.table else column.ndim == 1
     if not shape_ok:

@@ -53,7 +53,7 @@ class Grid:
             raise ValueError(f"Grid: column {twice} is on two axes")
         self.make = make
         self.count = int(np.prod(self.lengths, dtype=object))
-        self._kept: dict[tuple[int, int, int, int], _Column] = {}  # periodic columns by (axis, column, phase, length)
+        self._kept: dict[tuple[int, int, int], _Column] = {}  # periodic columns by (axis, column, block length)
         self._kept_bytes = 0
         self._writes_inputs = False  # make writes into its columns: it gets copies
 
@@ -127,8 +127,10 @@ class Grid:
         """Each axis's columns of combinations lo..hi-1, by name, in axis order. Axis k's digit of combination
         i is (i // s) % r, s the product of the later axes' lengths (its stride), r its own length: over a
         range of i, runs of s equal digits, the digits counting up modulo r; the column repeats every r * s
-        combinations. A column whose period fits in the block is made from one period (and kept: the next
-        block with the same phase reuses it), a longer one from its runs."""
+        combinations. A column whose period is short enough (PERIODIC_LIMIT) and repeats in the grid (one
+        that fits a block, or REPEATS_LAID_OUT periods in all; the later axes first, within half of
+        KEPT_BYTES for a block length) is a view into its periods laid out once (kept: every block reads its
+        own stretch of them, made by none); another one is made from its runs."""
         n = hi - lo
         if not 0 <= lo <= hi <= self.count:
             raise ValueError(f"Grid: combinations {lo}..{hi - 1} are not within 0..{self.count - 1}")
@@ -137,10 +139,14 @@ class Grid:
                     for name, _ in columns]
         made = []
         stride = 1
+        budget = KEPT_BYTES // 2  # what this block length's laid-out columns may hold (no churn in the kept ones)
         for index in reversed(range(len(self.axis_columns))):
             radix = self.lengths[index]
             period = radix * stride
-            if period <= n:
+            laid_out = (period + n - 1) * 8 * len(self.axis_columns[index])
+            if period + n - 1 <= PERIODIC_LIMIT and (period <= n or REPEATS_LAID_OUT * period <= self.count) \
+                    and laid_out <= budget:
+                budget -= laid_out
                 made.append([(name, self._periodic(index, k, stride, lo % period, n))
                              for k, (name, _) in enumerate(self.axis_columns[index])])
             else:
@@ -154,19 +160,18 @@ class Grid:
         return [column for columns in made[::-1] for column in columns]
 
     def _periodic(self, index: int, column: int, stride: int, phase: int, n: int) -> _Column:
-        """Axis `index`'s `column` over n combinations from `phase` into its period (one period fits in n)."""
-        key = (index, column, phase, n)
+        """Axis `index`'s `column` over n combinations from `phase` into its period: a view into the period
+        repeated over period + n - 1 combinations (every phase's n fit in it), made once per block length."""
+        key = (index, column, n)
         kept = self._kept.get(key)
         if kept is None:
             values = _at(self.axis_columns[index][column][1], np.arange(self.lengths[index], dtype=np.int64))
             period = np.repeat(values, stride) if stride > 1 else values
-            array = np.empty(n, dtype=np.int64)
-            head = min(n, len(period) - phase)
-            array[:head] = period[phase:phase + head]
-            array[head:min(n, len(period))] = period[:min(n, len(period)) - head]
-            filled = min(n, len(period))
-            while filled < n:  # doubling: whole periods copied from the start
-                more = min(filled, n - filled)
+            array = np.empty(len(period) + n - 1, dtype=np.int64)
+            filled = min(len(array), len(period))
+            array[:filled] = period[:filled]
+            while filled < len(array):  # doubling: whole periods copied from the start
+                more = min(filled, len(array) - filled)
                 array[filled:filled + more] = array[:more]
                 filled += more
             kept = _Column(array, (int(values.min()), int(values.max())) if len(values) else (0, 0))
@@ -176,7 +181,7 @@ class Grid:
                     self._kept_bytes += array.nbytes
                 while self._kept_bytes > KEPT_BYTES and len(self._kept) > 1:
                     self._kept_bytes -= self._kept.pop(next(iter(self._kept))).array.nbytes
-        return kept
+        return _Column(kept.array[phase:phase + n], kept.extremes)
 
 
 def _runs(held: np.ndarray, runs: np.ndarray, n: int) -> _Column:
@@ -192,7 +197,11 @@ class _Column:
     extremes: tuple[int, int]  # its least and greatest value
 
 
-KEPT_BYTES = 16 << 20  # a grid's periodic columns kept for the blocks after (several axes, a few phases each)
+KEPT_BYTES = 16 << 20  # a grid's periodic columns kept for the blocks after (several axes and columns)
+PERIODIC_LIMIT = 1 << 18  # combinations of a periodic column laid out (2 MiB): a longer period is made from its
+# runs per block (circle's dy columns, a period of 511 x 256 over blocks of 65,536, are views: no np.repeat a block)
+REPEATS_LAID_OUT = 4  # ... when the grid holds this many of its periods (else laying it out costs more than the runs
+# its few blocks make: tile_box's X, whose one period is the whole grid of two blocks)
 CONSTANTS_KEPT = 16  # constant columns kept (a make's constants, an axis held for a block: the same in the next ones)
 _constants: dict[tuple[int, int], np.ndarray] = {}
 _keeping = threading.Lock()  # the kept columns' dicts (a worker may make blocks on several threads)

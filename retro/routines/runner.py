@@ -177,6 +177,7 @@ class RoutineRunner:
         self.fallbacks: dict[int, int] = {}  # compiled engine: calls it left to the batched core, by status
         self._compiled = None  # compiled engine: (the routine, its code bytes, its image): batch_runs.compiled_routine
         self._compiled_free: dict = {}  # ... an entry-state run's, by its free registers and P bits
+        self._entered_image = None  # compiled engine: (S, the call image, it with the return trap): batch_runs
         self._machine_s = not self.plan.s_varies and routine.entry_s == ENTRY_S  # S from the machine's stack top
 
     @property

@@ -438,8 +438,8 @@ class _Columns:
                 reach = reach & condition.over(list(columns))
             with np.errstate(all="ignore"):
                 value = self.evaluate(self.term, reach, columns)
-            return np.broadcast_to(_truth(value), (n,)) & reach
-        return np.broadcast_to(_truth(value), (n,))
+            return _spread(_truth(value), n) & reach
+        return _spread(_truth(value), n)
 
     def fail(self, node: ast.AST, message: str, bad: np.ndarray, columns: tuple) -> InputError:
         i = int(np.flatnonzero(bad)[0])
@@ -537,6 +537,11 @@ class _Columns:
     # each kind of node a columnar term may hold -> how it is evaluated
     _RULES = {ast.Name: _name, ast.Constant: _constant, ast.UnaryOp: _unary, ast.BinOp: binary, ast.BoolOp: _boolean,
               ast.Compare: _compare, ast.IfExp: _if, ast.Call: _call}
+
+
+def _spread(truth: np.ndarray, n: int) -> np.ndarray:
+    """A term's truth over the n cases (a term of constants only: one value for all)."""
+    return truth if truth.shape == (n,) else np.broadcast_to(truth, (n,))
 
 
 def _truth(value) -> np.ndarray:

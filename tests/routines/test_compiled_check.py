@@ -190,3 +190,28 @@ def test_stated_facts_leave_the_routine_to_the_batched_core_and_say_why(capsys):
     assert code == 1 and record["engine"] == "batch"
     assert record["engine_reason"] == ("the compiled engine does not take it: the spec states facts ([facts]), "
                                        "which it does not hold against the calls")
+
+
+@needs_numba
+def test_a_compiled_run_starts_from_the_call_image_as_it_is_now():
+    """run_compiled keeps the call image with its return trap pushed from block to block
+    (batch_runs._entered_image); a call image changed since (reset_memory: the entry-state runs) is
+    the one the next block runs from, as on the batched core."""
+    import numpy as np
+
+    from retro.routines import cases as case_sets
+    from retro.routines.registry import get
+    from retro.routines.runner import RoutineRunner
+
+    routine = get("tile")
+    runner = RoutineRunner(routine, routine.seed)
+    cases = [(x & 0xFF, x >> 8, y) for x in range(24, 344, 7) for y in range(50, 250, 9)]
+    columns = case_sets.cases_to_columns(routine, cases)
+    before = runner.run_compiled(columns).outputs[0].copy()
+    props = next(block for block in routine.memory if block.name == "props").address
+    image = bytearray(runner.call_image)
+    image[props:props + 256] = bytes((b + 1) & 0xFF for b in image[props:props + 256])
+    runner.reset_memory(bytes(image))
+    after = runner.run_compiled(columns).outputs[0]
+    assert np.array_equal(after, runner.run_batch(columns).outputs[0])
+    assert np.count_nonzero(after != before) > len(cases) // 2

@@ -44,7 +44,9 @@ GRIDS = [{"a": 3, "b": 5, "c": 7},  # no power of two: every run and period ends
          {"ax": [0, 17], "bx": 256, "aw": 256, "bw": 256},  # aabb8's shape: runs longer than a block
          {"p": 1, "q": 70_001},  # an axis longer than a block, varying fastest
          {"u": 13, "v": 1, "w": 4_099},  # a one-value axis between
-         {"d": {"x1": [0, 0, 5, 9], "x2": [3, 1, 0, 0]}, "r": 256, "k": {"r1": [7], "r2": [8]}}]  # columns together
+         {"d": {"x1": [0, 0, 5, 9], "x2": [3, 1, 0, 0]}, "r": 256, "k": {"r1": [7], "r2": [8]}},  # columns together
+         {"dx": 511, "dy": {"y1": range(511), "y2": range(510, -1, -1)}, "r": 256}]  # circle's: dy's period (130,816)
+# spans blocks and is laid out once (grid.PERIODIC_LIMIT): each block a view into it
 
 
 @pytest.mark.parametrize("axes", GRIDS)

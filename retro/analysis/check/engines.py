@@ -129,7 +129,7 @@ class CallBlock:
 
     outputs: list
     cycles: np.ndarray
-    stolen: np.ndarray
+    stolen: np.ndarray | None  # None: no call lost a cycle (an array engine without a scene)
     modelled: np.ndarray | None  # the timing model's cycles per call; None on the batched core
     returned: int
     stop: str | None = None  # None, "run" or "engine"
@@ -320,8 +320,7 @@ def run_on_batched_core(runner: RoutineRunner, columns: list, confirm_stop: bool
         outcome = runner.run_batch(columns, coverage)
     stopped = np.flatnonzero(outcome.error)
     n = len(outcome.cycles)
-    stolen = outcome.stolen if outcome.stolen is not None else np.zeros(n, dtype=np.int64)
-    block = CallBlock(outcome.outputs, outcome.cycles, stolen, None,
+    block = CallBlock(outcome.outputs, outcome.cycles, outcome.stolen, None,
                       int(stopped[0]) if len(stopped) else n, lane_errors=outcome.error,
                       coverage=from_lanes(outcome.coverage) if coverage else None, mock_calls=outcome.mock_calls,
                       fallbacks=fallbacks)

@@ -113,23 +113,22 @@ def _answers_on_arrays(routine: Routine, columns: list, memory: dict,
     where = f"{routine.spec_path}: reference {routine.reference_name} (arrays = true)"
     values = _call_on_arrays(routine, columns, memory, where)
     answerable = np.ones(n, dtype=bool)
-    out, fitting = [], []
+    out, fitting = [], []  # per output, which answers fit it (None: flags, which fit every output)
     for port, item in zip(routine.outputs, values):
         array = _output_array(port, item, n, where)
+        out.append(array)
         if _is_flags(item):  # 0 and 1 fit every output: no pass over the block
-            out.append(array)
-            fitting.append(np.ones(array.shape[:1], dtype=bool))
+            fitting.append(None)
             continue
         fits = (array >= 0) & (array < (1 << port.bits))
         if port.table:
             fits = fits.all(axis=1)
         answerable &= fits
         fitting.append(fits)
-        out.append(array)
-    bad = np.flatnonzero(~answerable & inside)
+    bad = np.flatnonzero(~answerable & inside) if any(fits is not None for fits in fitting) else ()
     if len(bad):
         i = int(bad[0])
-        k = next(k for k, fits in enumerate(fitting) if not fits[i])
+        k = next(k for k, fits in enumerate(fitting) if fits is not None and not fits[i])
         port = routine.outputs[k]
         raise InputError(f"{where} returned {out[k][i].tolist()} for {port.name}: outside 0..{(1 << port.bits) - 1} "
                          f"(inputs {describe_case(routine, case_sets.case_of(columns, i))})")
@@ -173,7 +172,7 @@ def _output_array(port, item, n: int, where: str) -> np.ndarray:
     shape = (n, len(port.places)) if port.table else (n,)
     if array.shape != shape and array.ndim == 0:
         array = np.broadcast_to(array, shape)
-    if array.shape != shape or not np.issubdtype(array.dtype, np.integer):
+    if array.shape != shape or (array.dtype != np.int64 and not np.issubdtype(array.dtype, np.integer)):
         raise InputError(f"{where} returned {array.dtype} of shape {array.shape} for {port.name}: expected "
                          f"whole numbers of shape {shape}")
     return array.astype(np.int64, copy=not array.flags.writeable)  # (a broadcast scalar becomes an array)

@@ -84,11 +84,13 @@ def batch_chunk(spec: str, seed: int, columns: list, first: int = 0, every: int 
 
 
 def array_block(spec: str, seed: int, columns: list, first: int, every: int, engine: str,
-                start: SceneStart | None, outside_wanted: int = EXAMPLES_KEPT) -> tuple[Tally, EntryBaseline | None]:
+                start: SceneStart | None, outside_wanted: int = EXAMPLES_KEPT,
+                runner: RoutineRunner | None = None) -> tuple[Tally, EntryBaseline | None]:
     """A column block on an array engine, tallied, and its entry-state rerun cases held for
     `held_entry_tally` (None: `every` is 0), so that a task's blocks rerun theirs together;
-    `outside_wanted` as for count_block."""
-    runner = runner_for(spec, seed, start)
+    `outside_wanted` as for count_block. `runner`: the spec's runner_for, when the caller holds it (a
+    sweep task asks once for all its blocks: the files it was built from are looked at once a task)."""
+    runner = runner or runner_for(spec, seed, start)
     block = run_on_batched_core(runner, columns, engine=engine)
     tally, inside = count_array_block(runner.routine, block, columns, runner.memory_values, outside_wanted)
     if not every:
@@ -205,12 +207,13 @@ def sweep_task(sweep: Sweep, first: int, count: int) -> Tally:
     totals = Tally()
     held: list = []
     blocks = _blocks_from(sweep, first)
+    runner = runner_for(sweep.spec, sweep.seed, sweep.start) if sweep.engine != "scalar" else None
     position = first
     while position < first + count:
         block = next(blocks, None)
         if block is None:
             break
-        tally, baseline = _block_tally(sweep, block, position, EXAMPLES_KEPT - len(totals.outside_examples))
+        tally, baseline = _block_tally(sweep, block, position, EXAMPLES_KEPT - len(totals.outside_examples), runner)
         totals.merge(tally)
         if baseline is not None:
             held.append(baseline)
@@ -236,12 +239,14 @@ def _blocks_from(sweep: Sweep, first: int) -> Iterator:
     return blocks
 
 
-def _block_tally(sweep: Sweep, block: list, first: int, outside_wanted: int) -> tuple[Tally, EntryBaseline | None]:
+def _block_tally(sweep: Sweep, block: list, first: int, outside_wanted: int,
+                 runner: RoutineRunner | None) -> tuple[Tally, EntryBaseline | None]:
     """A block tallied, and on an array engine its entry-state rerun cases held (None: none)."""
     if sweep.engine == "scalar":
         return machine_chunk(sweep.spec, sweep.seed, case_sets.columns_to_cases(block), sweep.start, first,
                              sweep.every), None
-    return array_block(sweep.spec, sweep.seed, block, first, sweep.every, sweep.engine, sweep.start, outside_wanted)
+    return array_block(sweep.spec, sweep.seed, block, first, sweep.every, sweep.engine, sweep.start, outside_wanted,
+                       runner)
 
 
 def _tasks(sweep: Sweep, known: int, unknown: bool, ended: Callable[[], bool]) -> Iterator[tuple]:

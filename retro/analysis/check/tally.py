@@ -169,7 +169,8 @@ def _count(routine: Routine, block: CallBlock, columns: list, cases: list[tuple]
     if block.coverage is not None:
         out.code_coverage = block.coverage
     out.fallbacks = dict(block.fallbacks or {})
-    stalled = bool(block.stolen[:n].any())  # the timing model and the static bounds know no stalls
+    # the timing model and the static bounds know no stalls (an array engine without a scene has none: None)
+    stalled = block.stolen is not None and bool(block.stolen[:n].any())
     cpu = block.cycles[:n] - block.stolen[:n] if stalled else block.cycles[:n]
     cycle_wrong = (np.flatnonzero(block.modelled[:n] != cpu) if block.modelled is not None
                    else np.zeros(0, dtype=np.int64))
@@ -224,7 +225,8 @@ def _calls(routine: Routine, block: CallBlock, columns: list, cases: list[tuple]
     """The block's returned calls with their domain and answers, in as few passes over the block as it
     allows (most blocks: every case inside, every answer right)."""
     n = block.returned
-    columns = [c[:n] for c in columns]
+    if columns and len(columns[0]) != n:  # (most blocks: every call returned)
+        columns = [c[:n] for c in columns]
     if cases is not None:
         cases = cases[:n]
     if row_keys is not None:  # rows: what they state is compared elsewhere; no reference, no domain
