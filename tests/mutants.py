@@ -60,6 +60,7 @@ IFCONV_TESTS = ("tests/cpu/test_compiled_ifconvert.py",)
 WORKER_TESTS = ("tests/test_workers.py",)
 STREAM_TESTS = ("tests/routines/test_case_stream.py",)
 GRID_TESTS = ("tests/routines/test_grid_columns.py", "tests/routines/test_case_stream.py")
+TABLE_ROW_TESTS = ("tests/routines/test_table_rows.py",)
 FLOW_TESTS = ("tests/cpu/test_flow_values.py", "tests/routines/test_static_smc.py")
 TALLY_TESTS = ("tests/routines/test_tally_blocks.py",)
 COMMAND_TESTS = ("tests/test_commands.py", "tests/test_cli_foundation.py", "tests/routines/test_routines_cli.py")
@@ -822,6 +823,19 @@ MUTANTS = [
            "    fixed = instructions", ("tests/cpu/test_compiled_ifconvert.py",)),
     Mutant("compiled-many-known-lanes-one-line-each", "retro/cpu/translate.py",
            "    if lanes is None or len(lanes) > LINES_LIMIT:", "    if lanes is None:", COMPILED_TESTS),
+    # table columns that are one row repeated (grid.repeated_row) and their readers' one-row paths
+    Mutant("one-row-without-the-zero-stride", "retro/routines/grid.py",
+           "if column.ndim != 2 or not len(column) or column.strides[0] != 0:",
+           "if column.ndim != 2 or not len(column):", TABLE_ROW_TESTS),
+    Mutant("pixel-one-pair-from-the-block-s-ends", "retro/routines/builtin_cases.py",
+           "if len(pair) and pair.min() == pair.max():", "if len(pair) and pair[0] == pair[-1]:", TABLE_ROW_TESTS),
+    Mutant("pixel-one-pair-when-either-column-is-one-row", "retro/routines/builtin_cases.py",
+           "if row_a is not None and row_b is not None:", "if row_a is not None or row_b is not None:",
+           TABLE_ROW_TESTS),
+    Mutant("lane-bytes-of-one-row-from-its-first-byte", "retro/routines/batch_runs.py",
+           "= same.astype(np.uint8)[:, None]", "= same[:1].astype(np.uint8)[:, None]", TABLE_ROW_TESTS),
+    Mutant("one-row-column-checked-at-its-first-value", "retro/routines/cases.py",
+           "        column = row\n", "        column = row[:1]\n", TABLE_ROW_TESTS),
 ]
 
 

@@ -22,6 +22,7 @@ from retro.cpu.machine import (
 )
 from retro.cpu.mpu import FLAG_B, FLAG_U
 from retro.cpu.variants import VARIANTS
+from retro.routines.grid import one_row
 from retro.routines.input_plan import column_byte
 from retro.routines.outputs import port_values
 from retro.routines.world import WORLD_PLACES
@@ -230,7 +231,12 @@ def _lane_bytes(plan, columns: list, n: int) -> tuple[np.ndarray, np.ndarray]:
     lane_bytes = np.empty((len(lane_addr), n), dtype=np.uint8)
     row = 0
     for index, addresses in plan.tables:
-        lane_bytes[row:row + len(addresses)] = columns[index][:n, :len(addresses)].astype(np.uint8).T
+        column = columns[index][:n, :len(addresses)]
+        same = one_row(column)
+        if same is not None:  # one row repeated: each address's one byte over every lane (wrapped as astype)
+            lane_bytes[row:row + len(addresses)] = same.astype(np.uint8)[:, None]
+        else:
+            lane_bytes[row:row + len(addresses)] = column.astype(np.uint8).T
         row += len(addresses)
     return lane_addr, lane_bytes
 
