@@ -97,8 +97,17 @@ def test_the_compiled_engine_s_table_bytes_of_a_repeated_row_are_those_of_its_co
     repeated = [dx, dy, repeated_row(masks[2][0], n), repeated_row(masks[2][1], n)]
     addresses, lanes = _lane_bytes(runner.plan, repeated, n)
     copied_addresses, copied = _lane_bytes(runner.plan, [c.copy() for c in repeated], n)
-    assert np.array_equal(addresses, copied_addresses) and np.array_equal(lanes, copied)
-    assert lanes.shape == (126, n) and lanes[:, 0].tolist() == [*masks[2][0], *masks[2][1]]
+    assert np.array_equal(addresses, copied_addresses) and np.array_equal(lanes[:, :n], copied[:, :n])
+    assert lanes.shape[0] == 126 and lanes[:, 0].tolist() == [*masks[2][0], *masks[2][1]]
+    assert (lanes[:, :n] == lanes[:, :1]).all()
+
+
+def test_lane_byte_rows_are_an_odd_number_of_cache_lines_wide():
+    from retro.routines.batch_runs import CACHE_LINE, lane_row_width
+
+    for n in (*range(0, 300), 4_000, 4_096, 8_000, 8_192, 65_536):
+        width = lane_row_width(n)
+        assert n <= width < n + 2 * CACHE_LINE and width % CACHE_LINE == 0 and (width // CACHE_LINE) % 2 == 1, n
 
 
 @pytest.mark.parametrize("engine", ["batch", "compiled"])
