@@ -344,13 +344,14 @@ def _overlap_table(mask_a: bytes, mask_b: bytes) -> np.ndarray:
     return np.array([[reference.pixel(dx, dy, a, b) for dx in span] for dy in span], dtype=bool)
 
 
-ROW_HASH = np.random.default_rng(0x6502).integers(1, 2 ** 63, size=2 * MASK_BYTES, dtype=np.uint64) | np.uint64(1)
+PAIR_WORDS = -(-2 * MASK_BYTES // 8)  # a mask pair's 126 bytes as 64-bit words (the last one padded with 0)
+ROW_HASH = np.random.default_rng(0x6502).integers(1, 2 ** 63, size=PAIR_WORDS, dtype=np.uint64) | np.uint64(1)
 
 
 def _distinct_rows(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(distinct rows, each row's index among them): by a 64-bit hash of each row, checked row by row
-    (a collision falls back to sorting the rows themselves)."""
-    keys = rows.astype(np.uint64) @ ROW_HASH  # wraps modulo 2^64
+    """(distinct rows, each row's index among them) of (n, PAIR_WORDS) uint64 rows: by a 64-bit hash of
+    each row, checked row by row (a collision falls back to sorting the rows themselves)."""
+    keys = rows @ ROW_HASH  # wraps modulo 2^64
     _, first, which = np.unique(keys, return_index=True, return_inverse=True)
     distinct = rows[first]
     if (distinct[which.ravel()] == rows).all():
@@ -362,14 +363,15 @@ def _distinct_rows(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _mask_pairs(mask_a: np.ndarray, mask_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(distinct mask pairs as rows of 126 bytes, each case's index among them): a block whose two
     columns are each one row repeated (grid.one_row: pixel's sweep) is one pair without a look at its
-    cases; any other is hashed row by row (`_distinct_rows`)."""
+    cases; any other is hashed row by row as 64-bit words (`_distinct_rows`)."""
     row_a, row_b = one_row(mask_a), one_row(mask_b)
     if row_a is not None and row_b is not None:
         return np.concatenate([row_a, row_b])[None].astype(np.uint8), np.zeros(len(mask_a), dtype=np.intp)
-    masks = np.empty((len(mask_a), 2 * MASK_BYTES), dtype=np.uint8)
+    masks = np.zeros((len(mask_a), 8 * PAIR_WORDS), dtype=np.uint8)
     masks[:, :MASK_BYTES] = mask_a  # (wrapped to bytes, as astype(np.uint8) would)
-    masks[:, MASK_BYTES:] = mask_b
-    return _distinct_rows(masks)
+    masks[:, MASK_BYTES:2 * MASK_BYTES] = mask_b
+    distinct, which = _distinct_rows(masks.view(np.uint64))
+    return np.ascontiguousarray(distinct).view(np.uint8)[:, :2 * MASK_BYTES], which
 
 
 def pixel_reference(dx, dy, mask_a, mask_b):

@@ -136,3 +136,18 @@ def test_a_repeated_row_block_is_passed_on_whole_and_its_values_checked(tmp_path
            "mask_a": repeated_row([*range(62), 256], 10), "mask_b": repeated_row(row, 10)}
     with pytest.raises(InputError, match="column mask_a holds 256"):
         case_sets._block_columns(routine, bad, "here")
+
+
+def test_pixel_reference_on_mask_pairs_whose_hashes_collide_sorts_the_rows_themselves(monkeypatch):
+    """Every row hashed alike (the hash's weights all 0): the check of each row against its pair's finds it,
+    and the pairs come from the rows themselves."""
+    monkeypatch.setattr(builtin_cases, "ROW_HASH", np.zeros_like(builtin_cases.ROW_HASH))
+    masks = builtin_cases.pixel_masks(0)
+    rng = np.random.default_rng(11)
+    n = 1_000
+    dx, dy = _offsets(rng, n)
+    mask_a, mask_b = builtin_cases._mask_columns(0, rng.integers(0, len(masks), size=n))
+    pairs, which = builtin_cases._mask_pairs(mask_a, mask_b)
+    assert len(pairs) == len({(tuple(a), tuple(b)) for a, b in zip(mask_a.tolist(), mask_b.tolist())})
+    assert np.array_equal(pairs[which], np.concatenate([mask_a, mask_b], axis=1))
+    assert builtin_cases.pixel_reference(dx, dy, mask_a, mask_b).tolist() == _pixel_by_case(dx, dy, mask_a, mask_b)
