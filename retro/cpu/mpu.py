@@ -225,6 +225,10 @@ class MPU6510(_Py65MPU):
         modelled = 0
         self.modelled = 0
         cycles = self.processorCycles  # (kept here too: no handler sets it without chips on the lines)
+        devices = self.page_devices
+        ram_only = devices.count(None) == len(devices)
+        if ram_only:  # no device on the bus: data reads and writes go straight to RAM (ByteAt and WriteByte's
+            self.ByteAt, self.WriteByte = memory.__getitem__, memory.__setitem__  # own path), for this run
         try:
             while True:
                 pc = self.pc & ADDRESS_MASK  # (masked here rather than after each instruction)
@@ -253,6 +257,8 @@ class MPU6510(_Py65MPU):
         finally:
             self.executed = count
             self.modelled = modelled
+            if ram_only:
+                del self.ByteAt, self.WriteByte
 
     def recent_addresses(self, count: int) -> list[int]:
         """The addresses of the last min(count, RECENT_SIZE) instructions, oldest first."""
