@@ -326,6 +326,8 @@ MUTANTS = [
            CPU_TESTS),
     Mutant("fused-cpx-immediate-read-as-zero-page", "retro/cpu/mpu.py",
            '0xE0: compare("x", False)', '0xE0: compare("x", True)', CPU_TESTS),
+    Mutant("fused-lda-indexed-by-the-other-register", "retro/cpu/mpu.py",
+           "self.x if by_x else self.y", "self.y if by_x else self.x", CPU_TESTS),
     Mutant("recorded-run-ram-only-with-devices", "retro/cpu/mpu.py",
            "ram_only = devices.count(None) == len(devices)", "ram_only = True", ("tests/cpu/test_machine.py",)),
     Mutant("recorded-run-keeps-ram-accessors", "retro/cpu/mpu.py",

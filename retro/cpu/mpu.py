@@ -812,11 +812,14 @@ def _fused_handlers() -> dict[int, object]:
         self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
         self.pc += 1
 
-    def lda_abx(self):
-        memory, pc = self.memory, self.pc
-        self.a = value = self.ByteAt(self._indexed(memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8, self.x))
-        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
-        self.pc += 2
+    def lda_indexed(by_x: bool):  # LDA abs,X and abs,Y
+        def handler(self):
+            memory, pc = self.memory, self.pc
+            base = memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8
+            self.a = value = self.ByteAt(self._indexed(base, self.x if by_x else self.y))
+            self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+            self.pc = pc + 2
+        return handler
 
     def lda_iny(self):
         self.a = value = self.ByteAt(self.IndirectYAddr())
@@ -900,12 +903,6 @@ def _fused_handlers() -> dict[int, object]:
         self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
         self.pc += 2
 
-    def lda_aby(self):
-        memory, pc = self.memory, self.pc
-        self.a = value = self.ByteAt(self._indexed(memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8, self.y))
-        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
-        self.pc += 2
-
     def load(register: str, zero_page: bool):  # LDX, LDY: immediate or zero page
         def handler(self):
             pc = self.pc
@@ -982,10 +979,10 @@ def _fused_handlers() -> dict[int, object]:
     def dey(self):
         self.y = _set_nz(self, (self.y - 1) & 0xFF)
 
-    handlers = {0x85: sta_zpg, 0xA5: lda_zpg, 0xA9: lda_imm, 0xBD: lda_abx, 0xB1: lda_iny, 0x05: ora_zpg,
+    handlers = {0x85: sta_zpg, 0xA5: lda_zpg, 0xA9: lda_imm, 0xBD: lda_indexed(True), 0xB1: lda_iny, 0x05: ora_zpg,
                 0xC5: compare("a", True), 0xC4: compare("y", True), 0xE4: compare("x", True), 0x65: adc_zpg,
                 0xE5: sbc_zpg, 0xAA: tax, 0xA8: tay, 0x8A: txa, 0x98: tya, 0xC8: iny, 0x18: clc, 0x38: sec,
-                0x8D: sta_abs, 0x86: stx_zpg, 0x84: sty_zpg, 0xAD: lda_abs, 0xB9: lda_aby,
+                0x8D: sta_abs, 0x86: stx_zpg, 0x84: sty_zpg, 0xAD: lda_abs, 0xB9: lda_indexed(False),
                 0xA2: load("x", False), 0xA0: load("y", False),
                 0xA6: load("x", True), 0xA4: load("y", True),
                 0x29: and_imm, 0x09: ora_imm, 0x49: eor_imm, 0x31: and_iny,
