@@ -60,6 +60,7 @@ IFCONV_TESTS = ("tests/cpu/test_compiled_ifconvert.py",)
 WORKER_TESTS = ("tests/test_workers.py",)
 STREAM_TESTS = ("tests/routines/test_case_stream.py",)
 GRID_TESTS = ("tests/routines/test_grid_columns.py", "tests/routines/test_case_stream.py")
+TABLE_ROW_TESTS = ("tests/routines/test_table_rows.py",)
 FLOW_TESTS = ("tests/cpu/test_flow_values.py", "tests/routines/test_static_smc.py")
 TALLY_TESTS = ("tests/routines/test_tally_blocks.py",)
 COMMAND_TESTS = ("tests/test_commands.py", "tests/test_cli_foundation.py", "tests/routines/test_routines_cli.py")
@@ -314,8 +315,24 @@ MUTANTS = [
     Mutant("fused-bne-taken-on-zero", "retro/cpu/mpu.py",
            "(0xD0, FLAG_Z, False)", "(0xD0, FLAG_Z, True)", CPU_TESTS),
     Mutant("fused-compare-without-carry", "retro/cpu/mpu.py",
-           "                | (FLAG_C if diff >= 0 else 0)\n            self.pc += 1",
-           "                | 0\n            self.pc += 1", CPU_TESTS),
+           "                | (FLAG_C if diff >= 0 else 0)\n            self.pc = pc + 1",
+           "                | 0\n            self.pc = pc + 1", CPU_TESTS),
+    Mutant("fused-lsr-a-carry-from-the-top-bit", "retro/cpu/mpu.py",
+           "(a & FLAG_C) | (0 if value else FLAG_Z)", "(a >> 7) | (0 if value else FLAG_Z)", CPU_TESTS),
+    Mutant("fused-dec-zpg-increments", "retro/cpu/mpu.py", "0xC6: step_zpg(-1)", "0xC6: step_zpg(1)", CPU_TESTS),
+    Mutant("fused-sbc-aby-indexed-by-x", "retro/cpu/mpu.py",
+           "self._sbc(self.ByteAt(self._indexed(memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8, self.y)))",
+           "self._sbc(self.ByteAt(self._indexed(memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8, self.x)))",
+           CPU_TESTS),
+    Mutant("fused-cpx-immediate-read-as-zero-page", "retro/cpu/mpu.py",
+           '0xE0: compare("x", False)', '0xE0: compare("x", True)', CPU_TESTS),
+    Mutant("fused-lda-indexed-by-the-other-register", "retro/cpu/mpu.py",
+           "self.x if by_x else self.y", "self.y if by_x else self.x", CPU_TESTS),
+    Mutant("recorded-run-ram-only-with-devices", "retro/cpu/mpu.py",
+           "ram_only = devices.count(None) == len(devices)", "ram_only = True", ("tests/cpu/test_machine.py",)),
+    Mutant("recorded-run-keeps-ram-accessors", "retro/cpu/mpu.py",
+           "            if ram_only:\n                del self.ByteAt, self.WriteByte\n", "",
+           ("tests/cpu/test_machine.py",)),
     Mutant("machine-table-inputs-shifted", "retro/routines/runner.py",
            "writes.extend(zip(addresses, value))", "writes.extend(zip(addresses[1:], value))",
            ("tests/routines/test_batch_check.py", "tests/test_check_golden.py")),
@@ -853,6 +870,23 @@ MUTANTS = [
     Mutant("where-constant-term-not-spread", "retro/routines/where.py",
            "    return truth if truth.shape == (n,) else np.broadcast_to(truth, (n,))",
            "    return truth", ("tests/routines/test_where.py",)),
+    # table columns that are one row repeated (grid.repeated_row) and their readers' one-row paths
+    Mutant("one-row-without-the-zero-stride", "retro/routines/grid.py",
+           "if column.ndim != 2 or not len(column) or column.strides[0] != 0:",
+           "if column.ndim != 2 or not len(column):", TABLE_ROW_TESTS),
+    Mutant("pixel-one-pair-from-the-block-s-ends", "retro/routines/builtin_cases.py",
+           "if len(pair) and pair.min() == pair.max():", "if len(pair) and pair[0] == pair[-1]:", TABLE_ROW_TESTS),
+    Mutant("pixel-one-pair-when-either-column-is-one-row", "retro/routines/builtin_cases.py",
+           "if row_a is not None and row_b is not None:", "if row_a is not None or row_b is not None:",
+           TABLE_ROW_TESTS),
+    Mutant("lane-bytes-of-one-row-from-its-first-byte", "retro/routines/batch_runs.py",
+           "= same.astype(np.uint8)[:, None]", "= same[:1].astype(np.uint8)[:, None]", TABLE_ROW_TESTS),
+    Mutant("lane-byte-rows-a-power-of-two-apart", "retro/routines/batch_runs.py",
+           "return CACHE_LINE * (lines + 1 - lines % 2)", "return CACHE_LINE * lines", TABLE_ROW_TESTS),
+    Mutant("pixel-distinct-rows-trust-the-hash", "retro/routines/builtin_cases.py",
+           "if (distinct[which.ravel()] == rows).all():", "if True:", TABLE_ROW_TESTS),
+    Mutant("one-row-column-checked-at-its-first-value", "retro/routines/cases.py",
+           "        column = row\n", "        column = row[:1]\n", TABLE_ROW_TESTS),
 ]
 
 

@@ -224,12 +224,16 @@ class MPU6510(_Py65MPU):
         count = 0
         modelled = 0
         self.modelled = 0
+        cycles = self.processorCycles  # (kept here too: no handler sets it without chips on the lines)
+        devices = self.page_devices
+        ram_only = devices.count(None) == len(devices)
+        if ram_only:  # no device on the bus: data reads and writes go straight to RAM (ByteAt and WriteByte's
+            self.ByteAt, self.WriteByte = memory.__getitem__, memory.__setitem__  # own path), for this run
         try:
             while True:
-                pc = self.pc
-                if pc == stop_pc and (stop_sp < 0 or self.sp == stop_sp):
-                    return count
-                if self.processorCycles >= limit:
+                pc = self.pc & ADDRESS_MASK  # (masked here rather than after each instruction)
+                if (pc == stop_pc and (stop_sp < 0 or self.sp == stop_sp)) or cycles >= limit:
+                    self.pc = pc
                     return count
                 recent[count & RECENT_MASK] = pc
                 count += 1
@@ -248,11 +252,13 @@ class MPU6510(_Py65MPU):
                 self.pc = (pc + 1) & ADDRESS_MASK
                 self.excycles = 0
                 instruct[op](self)
-                self.pc &= ADDRESS_MASK
-                self.processorCycles += cycletime[op] + self.excycles
+                cycles += cycletime[op] + self.excycles
+                self.processorCycles = cycles
         finally:
             self.executed = count
             self.modelled = modelled
+            if ram_only:
+                del self.ByteAt, self.WriteByte
 
     def recent_addresses(self, count: int) -> list[int]:
         """The addresses of the last min(count, RECENT_SIZE) instructions, oldest first."""
@@ -806,11 +812,14 @@ def _fused_handlers() -> dict[int, object]:
         self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
         self.pc += 1
 
-    def lda_abx(self):
-        memory, pc = self.memory, self.pc
-        self.a = value = self.ByteAt(self._indexed(memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8, self.x))
-        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
-        self.pc += 2
+    def lda_indexed(by_x: bool):  # LDA abs,X and abs,Y
+        def handler(self):
+            memory, pc = self.memory, self.pc
+            base = memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8
+            self.a = value = self.ByteAt(self._indexed(base, self.x if by_x else self.y))
+            self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+            self.pc = pc + 2
+        return handler
 
     def lda_iny(self):
         self.a = value = self.ByteAt(self.IndirectYAddr())
@@ -822,12 +831,13 @@ def _fused_handlers() -> dict[int, object]:
         self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
         self.pc += 1
 
-    def compare_zpg(register: str):
+    def compare(register: str, zero_page: bool):  # CMP, CPX, CPY: immediate or zero page
         def handler(self):
-            diff = getattr(self, register) - self.ByteAt(self.memory[self.pc])
+            pc = self.pc
+            diff = getattr(self, register) - self.ByteAt(self.memory[pc] if zero_page else pc)
             self.p = (self.p & _KEEP_ALL_BUT_NZC) | (diff & FLAG_N) | (FLAG_Z if diff == 0 else 0) \
                 | (FLAG_C if diff >= 0 else 0)
-            self.pc += 1
+            self.pc = pc + 1
         return handler
 
     def adc_zpg(self):
@@ -874,9 +884,111 @@ def _fused_handlers() -> dict[int, object]:
                     self.BranchRelAddr()
         return handler
 
-    handlers = {0x85: sta_zpg, 0xA5: lda_zpg, 0xA9: lda_imm, 0xBD: lda_abx, 0xB1: lda_iny, 0x05: ora_zpg,
-                0xC5: compare_zpg("a"), 0xC4: compare_zpg("y"), 0xE4: compare_zpg("x"), 0x65: adc_zpg,
-                0xE5: sbc_zpg, 0xAA: tax, 0xA8: tay, 0x8A: txa, 0x98: tya, 0xC8: iny, 0x18: clc, 0x38: sec}
+    def sta_abs(self):
+        memory, pc = self.memory, self.pc
+        self.WriteByte(memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8, self.a)
+        self.pc += 2
+
+    def stx_zpg(self):
+        self.WriteByte(self.memory[self.pc], self.x)
+        self.pc += 1
+
+    def sty_zpg(self):
+        self.WriteByte(self.memory[self.pc], self.y)
+        self.pc += 1
+
+    def lda_abs(self):
+        memory, pc = self.memory, self.pc
+        self.a = value = self.ByteAt(memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8)
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+        self.pc += 2
+
+    def load(register: str, zero_page: bool):  # LDX, LDY: immediate or zero page
+        def handler(self):
+            pc = self.pc
+            value = self.ByteAt(self.memory[pc] if zero_page else pc)
+            setattr(self, register, value)
+            self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+            self.pc = pc + 1
+        return handler
+
+    def and_imm(self):
+        self.a = value = self.a & self.ByteAt(self.pc)
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+        self.pc += 1
+
+    def ora_imm(self):
+        self.a = value = self.a | self.ByteAt(self.pc)
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+        self.pc += 1
+
+    def eor_imm(self):
+        self.a = value = self.a ^ self.ByteAt(self.pc)
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+        self.pc += 1
+
+    def and_iny(self):
+        self.a = value = self.a & self.ByteAt(self.IndirectYAddr())
+        self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+        self.pc += 1
+
+    def adc_imm(self):
+        self._adc(self.ByteAt(self.pc))
+        self.pc += 1
+
+    def sbc_imm(self):
+        self._sbc(self.ByteAt(self.pc))
+        self.pc += 1
+
+    def sbc_aby(self):
+        memory, pc = self.memory, self.pc
+        self._sbc(self.ByteAt(self._indexed(memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8, self.y)))
+        self.pc += 2
+
+    def adc_aby(self):
+        memory, pc = self.memory, self.pc
+        self._adc(self.ByteAt(self._indexed(memory[pc] | memory[(pc + 1) & ADDRESS_MASK] << 8, self.y)))
+        self.pc += 2
+
+    def lsr_acc(self):
+        a = self.a
+        self.a = value = a >> 1
+        self.p = (self.p & _KEEP_ALL_BUT_NZC) | (a & FLAG_C) | (0 if value else FLAG_Z)  # (N: bit 7 is 0)
+
+    def asl_acc(self):
+        a = self.a
+        self.a = value = (a << 1) & 0xFF
+        self.p = (self.p & _KEEP_ALL_BUT_NZC) | (a >> 7) | (value & FLAG_N if value else FLAG_Z)
+
+    def step_zpg(delta: int):  # INC zpg, DEC zpg: read, flags, then the RMW double write
+        def handler(self):
+            address = self.memory[self.pc]
+            old = self.ByteAt(address)
+            value = (old + delta) & 0xFF
+            self.p = (self.p & _KEEP_ALL_BUT_NZ) | (value & FLAG_N if value else FLAG_Z)
+            self._write_back(address, old, value)
+            self.pc += 1
+        return handler
+
+    def inx(self):
+        self.x = _set_nz(self, (self.x + 1) & 0xFF)
+
+    def dex(self):
+        self.x = _set_nz(self, (self.x - 1) & 0xFF)
+
+    def dey(self):
+        self.y = _set_nz(self, (self.y - 1) & 0xFF)
+
+    handlers = {0x85: sta_zpg, 0xA5: lda_zpg, 0xA9: lda_imm, 0xBD: lda_indexed(True), 0xB1: lda_iny, 0x05: ora_zpg,
+                0xC5: compare("a", True), 0xC4: compare("y", True), 0xE4: compare("x", True), 0x65: adc_zpg,
+                0xE5: sbc_zpg, 0xAA: tax, 0xA8: tay, 0x8A: txa, 0x98: tya, 0xC8: iny, 0x18: clc, 0x38: sec,
+                0x8D: sta_abs, 0x86: stx_zpg, 0x84: sty_zpg, 0xAD: lda_abs, 0xB9: lda_indexed(False),
+                0xA2: load("x", False), 0xA0: load("y", False),
+                0xA6: load("x", True), 0xA4: load("y", True),
+                0x29: and_imm, 0x09: ora_imm, 0x49: eor_imm, 0x31: and_iny,
+                0xC9: compare("a", False), 0xE0: compare("x", False), 0xC0: compare("y", False),
+                0x69: adc_imm, 0xE9: sbc_imm, 0xF9: sbc_aby, 0x79: adc_aby, 0x4A: lsr_acc, 0x0A: asl_acc,
+                0xE6: step_zpg(1), 0xC6: step_zpg(-1), 0xE8: inx, 0xCA: dex, 0x88: dey}
     for opcode, flag, when_set in ((0x10, FLAG_N, False), (0x30, FLAG_N, True), (0x50, FLAG_V, False),
                                    (0x70, FLAG_V, True), (0x90, FLAG_C, False), (0xB0, FLAG_C, True),
                                    (0xD0, FLAG_Z, False), (0xF0, FLAG_Z, True)):

@@ -22,6 +22,7 @@ from retro.cpu.machine import (
 )
 from retro.cpu.mpu import FLAG_B, FLAG_U
 from retro.cpu.variants import VARIANTS
+from retro.routines.grid import one_row
 from retro.routines.input_plan import column_byte
 from retro.routines.outputs import port_values
 from retro.routines.world import WORLD_PLACES
@@ -222,15 +223,36 @@ def _results(ports) -> tuple[tuple[str, str], ...]:
             + tuple((name, name) for name in "axyp" if any(not _in_function(port) for port in ports)))
 
 
+CACHE_LINE = 64  # bytes
+
+
+def lane_row_width(n: int) -> int:
+    """The width of a lane-bytes row for n lanes: n rounded up to an odd number of cache lines. The kernel
+    reads one byte of every row per call; rows a power of two apart (8,192 lanes) all fall in the same
+    cache set and evict each other on every call (pixel's 126 rows: 3.5 ms a block of 8,192 calls, 1.1 ms
+    with rows 8,256 bytes apart, measured)."""
+    lines = -(-n // CACHE_LINE)
+    return CACHE_LINE * (lines + 1 - lines % 2)
+
+
 def _lane_bytes(plan, columns: list, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """The table inputs as (addresses, one row of bytes per address): each table cast to bytes in one
-    contiguous pass, then turned (a strided cast of int64 column by column cost pixel's 126 bytes 0.5
-    us a call, this 0.14); the kernel reads registers, flags and single bytes from the columns itself."""
+    """The table inputs as (addresses, one row of bytes per address): lane i's bytes in column i of each
+    row, rows `lane_row_width(n)` wide (the columns past n are never read: the kernel runs the calls of
+    the case columns, n). Each table cast to bytes in one contiguous pass, then turned (a strided cast of
+    int64 column by column cost pixel's 126 bytes 0.5 us a call, this 0.14); a table that is one row
+    repeated (grid.one_row) set a byte per row. The kernel reads registers, flags and single bytes from
+    the case columns itself."""
     lane_addr = np.asarray([address for _, addresses in plan.tables for address in addresses], dtype=np.int64)
-    lane_bytes = np.empty((len(lane_addr), n), dtype=np.uint8)
+    lane_bytes = np.empty((len(lane_addr), lane_row_width(n)), dtype=np.uint8)
     row = 0
     for index, addresses in plan.tables:
-        lane_bytes[row:row + len(addresses)] = columns[index][:n, :len(addresses)].astype(np.uint8).T
+        column = columns[index][:n, :len(addresses)]
+        same = one_row(column)
+        rows = lane_bytes[row:row + len(addresses), :n]
+        if same is not None:  # one row repeated: each address's one byte over every lane (wrapped as astype)
+            rows[:] = same.astype(np.uint8)[:, None]
+        else:
+            rows[:] = column.astype(np.uint8).T
         row += len(addresses)
     return lane_addr, lane_bytes
 

@@ -24,7 +24,7 @@ import numpy as np
 from retro.chips.vic.constants import SPRITE_HEIGHT, SPRITE_WIDTH
 from retro.chips.vic.constants import SPRITE_X_POSITIONS as X_POSITIONS  # 9-bit X
 from retro.routines import reference
-from retro.routines.grid import Grid
+from retro.routines.grid import Grid, one_row, repeated_row
 from retro.chips.vic.screen import SPRITE_ROW_BYTES
 
 BYTE = 256
@@ -344,19 +344,34 @@ def _overlap_table(mask_a: bytes, mask_b: bytes) -> np.ndarray:
     return np.array([[reference.pixel(dx, dy, a, b) for dx in span] for dy in span], dtype=bool)
 
 
-ROW_HASH = np.random.default_rng(0x6502).integers(1, 2 ** 63, size=2 * MASK_BYTES, dtype=np.uint64) | np.uint64(1)
+PAIR_WORDS = -(-2 * MASK_BYTES // 8)  # a mask pair's 126 bytes as 64-bit words (the last one padded with 0)
+ROW_HASH = np.random.default_rng(0x6502).integers(1, 2 ** 63, size=PAIR_WORDS, dtype=np.uint64) | np.uint64(1)
 
 
 def _distinct_rows(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(distinct rows, each row's index among them): by a 64-bit hash of each row, checked row by row
-    (a collision falls back to sorting the rows themselves)."""
-    keys = rows.astype(np.uint64) @ ROW_HASH  # wraps modulo 2^64
+    """(distinct rows, each row's index among them) of (n, PAIR_WORDS) uint64 rows: by a 64-bit hash of
+    each row, checked row by row (a collision falls back to sorting the rows themselves)."""
+    keys = rows @ ROW_HASH  # wraps modulo 2^64
     _, first, which = np.unique(keys, return_index=True, return_inverse=True)
     distinct = rows[first]
     if (distinct[which.ravel()] == rows).all():
         return distinct, which.ravel()
     distinct, which = np.unique(rows, axis=0, return_inverse=True)
     return distinct, which.ravel()
+
+
+def _mask_pairs(mask_a: np.ndarray, mask_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(distinct mask pairs as rows of 126 bytes, each case's index among them): a block whose two
+    columns are each one row repeated (grid.one_row: pixel's sweep) is one pair without a look at its
+    cases; any other is hashed row by row as 64-bit words (`_distinct_rows`)."""
+    row_a, row_b = one_row(mask_a), one_row(mask_b)
+    if row_a is not None and row_b is not None:
+        return np.concatenate([row_a, row_b])[None].astype(np.uint8), np.zeros(len(mask_a), dtype=np.intp)
+    masks = np.zeros((len(mask_a), 8 * PAIR_WORDS), dtype=np.uint8)
+    masks[:, :MASK_BYTES] = mask_a  # (wrapped to bytes, as astype(np.uint8) would)
+    masks[:, MASK_BYTES:2 * MASK_BYTES] = mask_b
+    distinct, which = _distinct_rows(masks.view(np.uint64))
+    return np.ascontiguousarray(distinct).view(np.uint8)[:, :2 * MASK_BYTES], which
 
 
 def pixel_reference(dx, dy, mask_a, mask_b):
@@ -366,8 +381,7 @@ def pixel_reference(dx, dy, mask_a, mask_b):
     every offset come from reference.pixel once, then every case is a lookup."""
     scalar = np.ndim(dx) == 0
     dx, dy = np.atleast_1d(dx).astype(np.int64), np.atleast_1d(dy).astype(np.int64)
-    masks = np.concatenate([np.atleast_2d(mask_a), np.atleast_2d(mask_b)], axis=1).astype(np.uint8)
-    pairs, which = _distinct_rows(masks)
+    pairs, which = _mask_pairs(np.atleast_2d(mask_a), np.atleast_2d(mask_b))
     signed_dx, signed_dy = dx - ((dx & 0x80) << 1), dy - ((dy & 0x80) << 1)
     near = (np.abs(signed_dx) <= OFFSET_SPAN) & (np.abs(signed_dy) <= OFFSET_SPAN)
     hit = np.zeros(len(dx), dtype=bool)
@@ -385,9 +399,21 @@ def pixel_boundary(seed: int = 0) -> list[tuple]:
             for dy in offsets if abs(dy) <= 25 or dx == 0]
 
 
-def _mask_columns(masks, pair: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    table = np.asarray(masks, dtype=np.int64)  # (pairs, 2, 63)
-    return table[pair, 0], table[pair, 1]
+@lru_cache(maxsize=8)
+def _mask_tables(seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """pixel_masks(seed) as two (pairs, 63) byte tables: the first masks, the second masks."""
+    table = np.asarray(pixel_masks(seed), dtype=np.uint8)  # (pairs, 2, 63)
+    return np.ascontiguousarray(table[:, 0]), np.ascontiguousarray(table[:, 1])
+
+
+def _mask_columns(seed: int, pair: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each case's two masks (`pair`: its index among pixel_masks(seed)) as (n, 63) int64 columns. A block
+    of one pair gets that pair's rows repeated (grid.repeated_row: no copy, and its readers see one pair);
+    any other, the rows picked as bytes, then widened (several times faster than picking int64 rows)."""
+    tables = _mask_tables(seed)
+    if len(pair) and pair.min() == pair.max():
+        return tuple(repeated_row(table[int(pair[0])], len(pair)) for table in tables)
+    return tuple(np.take(table, pair, axis=0).astype(np.int64) for table in tables)
 
 
 def pixel_random(rng: np.random.Generator, n: int, seed: int = 0) -> dict:
@@ -395,16 +421,17 @@ def pixel_random(rng: np.random.Generator, n: int, seed: int = 0) -> dict:
     dx = rng.integers(-26, 27, size=n)
     dy = rng.integers(-23, 24, size=n)
     pair = rng.integers(0, len(masks), size=n)
-    mask_a, mask_b = _mask_columns(masks, pair)
+    mask_a, mask_b = _mask_columns(seed, pair)
     return {"dx": dx & 0xFF, "dy": dy & 0xFF, "mask_a": mask_a, "mask_b": mask_b}
 
 
 def pixel_sweep(seed: int = 0) -> Grid:
-    """Every pair of offset bytes for every mask pair of the corpus."""
+    """Every pair of offset bytes for every mask pair of the corpus (a block of cases holds one pair: its
+    mask columns are that pair's rows repeated, `_mask_columns`)."""
     masks = pixel_masks(seed)
 
     def with_masks(pair, dx, dy):
-        mask_a, mask_b = _mask_columns(masks, pair)
+        mask_a, mask_b = _mask_columns(seed, pair)
         return {"dx": dx, "dy": dy, "mask_a": mask_a, "mask_b": mask_b}
     return Grid({"pair": len(masks), "dx": BYTE, "dy": BYTE}, with_masks)
 

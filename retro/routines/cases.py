@@ -25,7 +25,7 @@ from itertools import chain, islice
 import numpy as np
 
 from retro.errors import InputError
-from retro.routines.grid import GRID_BLOCK, Grid
+from retro.routines.grid import GRID_BLOCK, Grid, one_row
 from retro.routines.sandbox import guarded, shown
 from retro.routines.places import Values
 from retro.routines.spec import Port, Routine, call_with
@@ -233,8 +233,9 @@ def _cases_from(parts: list[Part], first: int, counted: Callable[[int, int], Non
 
 
 def rechunked(blocks: Iterable[Columns], size: int) -> Iterator[Columns]:
-    """Column blocks cut and joined into blocks of `size` cases (the last one shorter): a contiguous block
-    of `size` cases passed on as it is, the others copied."""
+    """Column blocks cut and joined into blocks of `size` cases (the last one shorter): a block of `size`
+    cases whose columns are contiguous (or one table row repeated: grid.one_row) passed on as it is, the
+    others copied."""
     pending: deque[Columns] = deque()
     offset = count = 0  # where the first pending block's unused cases start; cases pending in all
     for block in blocks:
@@ -252,7 +253,8 @@ def _take(pending: deque, offset: int, size: int) -> tuple[Columns, int]:
     """`size` cases from the front of `pending` (the first block from `offset`; a whole contiguous block as it
     is, else copied); the new offset."""
     block = pending[0]
-    if not offset and len(block[0]) == size and all(column.flags.c_contiguous for column in block):  # passed on
+    if not offset and len(block[0]) == size and all(column.flags.c_contiguous or one_row(column) is not None
+                                                    for column in block):  # passed on (one row repeated too)
         pending.popleft()
         return block, 0
     pieces = []
@@ -742,6 +744,9 @@ def _check_column_fits(port: Port, column: np.ndarray, where: str, extremes: tup
     limit = 1 << (8 if port.table else port.bits)
     if not column.size:
         return
+    row = one_row(column)
+    if row is not None:  # one row repeated: its values are the column's
+        column = row
     if extremes is None:
         if column.dtype == np.int64 and column.view(np.uint64).max() < limit:  # one pass: a negative is huge there
             return

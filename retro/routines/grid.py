@@ -232,6 +232,22 @@ def _constant_column(value: int, n: int) -> np.ndarray:
     return column
 
 
+def repeated_row(row, n: int) -> np.ndarray:
+    """n copies of one row as an (n, len(row)) int64 table column without copying it (a read-only view
+    of the row with a zero stride): a block whose cases all hold the same table (pixel's sweep, one
+    mask pair a block). `one_row` finds the row again, so the column's readers do its work once."""
+    row = np.asarray(row, dtype=np.int64)
+    return np.broadcast_to(row, (n, len(row)))
+
+
+def one_row(column: np.ndarray) -> np.ndarray | None:
+    """The row every row of a table column is, when the column is one row repeated by a zero stride
+    (`repeated_row`, or a slice of it); else None, whatever its rows hold (not looked at)."""
+    if column.ndim != 2 or not len(column) or column.strides[0] != 0:
+        return None
+    return column[0]
+
+
 def _read_only(array: np.ndarray) -> np.ndarray:
     """A read-only view of `array`."""
     view = array.view()

@@ -164,21 +164,53 @@ def test_the_clock_keeps_running_across_calls_and_devices_see_the_bus_cycle():
         0x60,              # C00C RTS        6
     ]})
     device = machine.attach(Recorder(), 0xD000, 0xD3FF)
+
+    def accesses(start: int) -> list[tuple]:
+        return [("read", 0xD012, start + 3), ("read", 0xD012, start + 4 + 3), ("write", 0xD020, 0x80, start + 8 + 3),
+                ("read", 0xD020, start + 12 + 3), ("write", 0xD020, 0x80, start + 12 + 4),
+                ("write", 0xD020, 0x81, start + 12 + 5)]
     machine.call(ORIGIN, trace=True)  # the clock moves on; the second call starts later
     device.events.clear()
     start = machine.cycle
     result = machine.call(ORIGIN)
     assert result.cycles == 4 + 4 + 4 + 6 + 6
     assert machine.cycle == start + result.cycles
-    assert device.events == [
-        ("read", 0xD012, start + 3),
-        ("read", 0xD012, start + 4 + 3),
-        ("write", 0xD020, 0x80, start + 8 + 3),
-        ("read", 0xD020, start + 12 + 3),
-        ("write", 0xD020, 0x80, start + 12 + 4),
-        ("write", 0xD020, 0x81, start + 12 + 5),
-    ]
+    assert device.events == accesses(start)
     assert machine.peek(0xD012) == [0x80]
+    device.events.clear()  # the recording loop (the engine agreement's) puts the same accesses on the bus
+    start = machine.cycle
+    cycles, *_ = machine.call_fast(ORIGIN, timed=True)
+    assert cycles == machine.last_modelled == result.cycles
+    assert device.events == accesses(start)
+
+
+def test_the_recording_loop_reads_ram_directly_only_for_its_run():
+    """Without a device on the bus run_recorded puts RAM's own accessors in place of ByteAt and WriteByte
+    for the run; after it (returned or halted) the bus's are back, and a device attached later is seen."""
+    machine = machine_with({ORIGIN: [0xAD, 0x12, 0xD0, 0x8D, 0x20, 0xD0, 0x60],  # LDA $D012, STA $D020, RTS
+                            0xC100: [0x02]})  # JAM
+    machine.poke(0xD012, 7)
+    assert machine.call_fast(ORIGIN, timed=True)[1] == 7 and machine.peek(0xD020) == [7]
+    assert "ByteAt" not in vars(machine.mpu) and "WriteByte" not in vars(machine.mpu)
+    with pytest.raises(RunError):
+        machine.call_fast(0xC100, timed=True)
+    assert "ByteAt" not in vars(machine.mpu) and "WriteByte" not in vars(machine.mpu)
+
+    class Register:
+        def __init__(self):
+            self.written = []
+
+        def read(self, address, cycle):
+            return 0x42
+
+        def write(self, address, value, cycle):
+            self.written.append((address, value))
+
+        def peek(self, address):
+            return 0x42
+
+    device = machine.attach(Register(), 0xD000, 0xD3FF)
+    assert machine.call_fast(ORIGIN, timed=True)[1] == 0x42 and device.written == [(0xD020, 0x42)]
 
 
 def test_a_device_on_part_of_a_page_leaves_the_rest_to_ram_and_can_stall_the_cpu():
