@@ -21,15 +21,15 @@ from __future__ import annotations
 
 import json
 import os
-import resource
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
+from compiled_speed import ISSUE_SET, _child_cpu  # (the issue's set, and the children's CPU, defined there)
+
 ROOT = Path(__file__).resolve().parents[1]
 ROUTINES = ["circle", "circle_r", "tile_box", "aabb_sprite"]
-ISSUE_SET = ["aabb_edges", "aabb_sprite", "circle", "circle_r", "mul8", "pixel", "sprite_edges", "tile", "tile_box"]
 ROUNDS = 3
 BASE = "43b5b3b"  # main where this work began
 
@@ -81,13 +81,17 @@ print(json.dumps({"check": min(checks), "engine_used": engine, "blocks": count,
 """
 
 
-def _child_cpu() -> float:
-    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return usage.ru_utime + usage.ru_stime
+BYTECODE = Path(tempfile.gettempdir()) / "retro-blocks-bytecode"  # PYTHONPYCACHEPREFIX of both trees' runs
 
 
 def _environment(tree: Path) -> dict:
-    return {**os.environ, "PYTHONPATH": str(tree)}
+    """The tree's modules first, and one bytecode cache for both trees' runs, written (under BYTECODE), never
+    a tree's own __pycache__: a working tree keeps the .pyc files of earlier runs and an archived one has
+    none, so with PYTHONDONTWRITEBYTECODE set (this machine) one tree's start would pay for compiling its
+    sources and the other's not. Each figure is a best of ROUNDS: the first run of each tree fills it."""
+    environment = {**os.environ, "PYTHONPATH": str(tree), "PYTHONPYCACHEPREFIX": str(BYTECODE)}
+    environment.pop("PYTHONDONTWRITEBYTECODE", None)
+    return environment
 
 
 def _in_tree(tree: Path, name: str) -> dict:

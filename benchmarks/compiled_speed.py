@@ -6,9 +6,10 @@ and the compiled engine (`run_compiled`, the same 65,536 cases, calls it leaves 
 included), on the routine's own random cases (its spec's generator: half of them near the answer's
 edge: the branches go either way at random, the compiled engine's worst case); then the batched core
 and the compiled engine on the first SWEEP_BLOCKS blocks of the routine's `--exhaustive` cases (its
-exhaustive product, else its sweep: what a proof runs, the issue's measure); the ratios; and apart, the compiled engine's compile time (CPU seconds of a fresh process's first
-compile into an empty cache, numba's import and start included: a cold compile, whatever routines
-the run measured before) and its load time from the cache, and from how many calls the compile pays for itself against the
+exhaustive product, else its sweep: what a proof runs, the issue's measure); the ratios; and apart,
+the compiled engine's compile time (CPU seconds of a fresh process's first compile into an empty
+cache, numba's import and start included: a cold compile, whatever routines the run measured before)
+and its load time from the cache, and from how many calls the compile pays for itself against the
 batched core.
 
 With `--checks`: whole checks instead, `retro check NAME --exhaustive --no-search --jobs 1 --json` in a

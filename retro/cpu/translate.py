@@ -438,12 +438,13 @@ SHIFTS_ABX_65C02 = {"ASL", "LSR", "ROL", "ROR"}
 TEST_BITS = {"TSB", "TRB", *(f"{kind}MB{bit}" for kind in "RS" for bit in range(8))}
 
 
-def _jump_to(e: _Emitter, blocks: dict[int, int]) -> None:
+def _jump_to(e: _Emitter) -> None:
     """Control goes to the computed address in `t`: a known block, or the call stops there (the
     caller's return, an address no dispatched block starts at, the loop check's budget or write into
     the code), in one test: which of them, and so the status, is settled once after the loop
     (`_FUNCTION`'s JUMPED, in that order). Four tests at each of aabb_sprite's 27 RTSs were most of
-    its compile time; a shared arm of the dispatch for them made every call slower (mul8: 20%)."""
+    its compile time. (A shared arm of the dispatch serves the RTSs only in code of RETURN_ARM_FROM or
+    more, `_emit_rts`: an arm made every call of mul8 20% slower.)"""
     e.put("blk = addr_block[t]")
     e.put("if (blk < 0) | ((t == return_pc) & (sp == return_sp)) | (cycles >= budget) | (bad != 0):")
     e.put(f"    status = {JUMPED}")
@@ -464,7 +465,7 @@ def _loop_check(e: _Emitter) -> None:
 def _go(e: _Emitter, address: int, blocks: dict[int, int], return_pc: int) -> None:
     if address == return_pc:
         e.put(f"t = {address}")
-        _jump_to(e, blocks)
+        _jump_to(e)
         return
     if address in e.inlined and len(e.indent) < MAX_INDENT:  # its only way in is from here: its code
         e.emit_block(address)  # follows, no trip through the dispatch
@@ -681,7 +682,7 @@ def _emit_jmp(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: i
             _go(e, pointer, blocks, return_pc)
         else:  # a patched target: through the dispatch (a target no block starts at falls back)
             e.put(f"t = {pointer}")
-            _jump_to(e, blocks)
+            _jump_to(e)
         return True
     if isinstance(pointer, str):
         e.put(f"w = {pointer}")
@@ -696,7 +697,7 @@ def _emit_jmp(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: i
         following = ((pointer & PAGE_MASK) | ((pointer + 1) & BYTE) if isinstance(pointer, int)
                      else f"({pointer} & {PAGE_MASK}) | (({pointer} + 1) & 255)")
         e.put(f"t = {_read(pointer)} | ({_read(following)} << 8)")
-    _jump_to(e, blocks)
+    _jump_to(e)
     return True
 
 
@@ -719,21 +720,21 @@ def _emit_rts(e: _Emitter, pc: int, op: Op, blocks: dict[int, int], return_pc: i
         e.put(f"blk = {e.return_arm}  # the return arm")
         e.put("continue")
         return True
-    _emit_return(e, blocks)
+    _emit_return(e)
     return True
 
 
-def _emit_return(e: _Emitter, blocks: dict[int, int]) -> None:
+def _emit_return(e: _Emitter) -> None:
     e.pull("t")
     e.pull("u")
     e.put("t = ((u << 8 | t) + 1) & 65535")
-    _jump_to(e, blocks)
+    _jump_to(e)
 
 
 RETURN_ARM_FROM = 6  # RTSs from which they share the dispatch's return arm (aabb_sprite has 27)
 
 
-def _emit_return_arm(e: _Emitter, blocks: dict[int, int]) -> None:
+def _emit_return_arm(e: _Emitter) -> None:
     """The dispatch's arm after every block's: an RTS's return address pulled and gone to. Shared by all
     of a routine's RTSs when it has many: written out at each of aabb_sprite's 27 it was most of its
     compile time (9.5 -> 3.7 CPU-s, side by side); an arm of the dispatch costs a call about 1 ns more
@@ -742,7 +743,7 @@ def _emit_return_arm(e: _Emitter, blocks: dict[int, int]) -> None:
     e.indent = " " * 12
     e.put(f"elif blk == {e.return_arm}:  # RTS: the return address from the stack")
     e.indent = " " * 16
-    _emit_return(e, blocks)
+    _emit_return(e)
 
 
 def _store_to(e: _Emitter, pc: int, address: str | int, value: str) -> None:
@@ -1085,7 +1086,7 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
         emit_block(start)
         pending += sorted(e.chained - done - set(pending))
     if e.return_arm is not None:
-        _emit_return_arm(e, blocks)
+        _emit_return_arm(e)
     e.indent = " " * 12
     e.put("else:  # a block number the dispatch does not run (inlined code): never spin, leave the call")
     e.put(f"    status = {FALLBACK_JUMP}")
@@ -1093,8 +1094,10 @@ def translate(read: Callable[[int], int], entry: int, cpu: str, return_pc: int,
     name = "run_calls"
     restore = "\n".join(f"        mem[{address}] = image[{address}]" for address in sorted(e.fixed_writes))
     placing_lanes, copying = _lane_lines(lanes, outputs)
-    source = _FUNCTION.format(name=name, entry_block=blocks[entry], body="\n".join(merge_cycles(e.lines)), budget_status=BUDGET,
-                              bad="fd * 2" if e.binary and e.adds else "0", fallback_decimal=FALLBACK_DECIMAL, stopped=STOPPED, jumped=JUMPED, returned=RETURNED, fallback_jump=FALLBACK_JUMP,
+    source = _FUNCTION.format(name=name, entry_block=blocks[entry], body="\n".join(merge_cycles(e.lines)),
+                              budget_status=BUDGET, bad="fd * 2" if e.binary and e.adds else "0",
+                              fallback_decimal=FALLBACK_DECIMAL, stopped=STOPPED, jumped=JUMPED, returned=RETURNED,
+                              fallback_jump=FALLBACK_JUMP,
                               lane_placing=placing_lanes, out_copying=copying,
                               fallback_write=FALLBACK_WRITE, restore=restore, placing=_placing(places, sets),
                               out_rows=_out_lines(results),
